@@ -1,0 +1,262 @@
+#include "bench/protocol.h"
+
+#include <ATen/Parallel.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "prior/motion/errors.h"
+#include "tasks/jobs.h"
+
+namespace mf::bench {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double elapsed_ms(Clock::time_point since) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
+}
+
+void check_prediction(const Motion& pred, const Motion& truth, const std::string& method) {
+  if (pred.num_frames() != truth.num_frames() || pred.num_joints() != truth.num_joints()) {
+    std::ostringstream msg;
+    msg << "method " << method << " returned " << pred.num_frames() << " frames of " << pred.num_joints()
+        << " joints, expected " << truth.num_frames() << " frames of " << truth.num_joints();
+    throw InputError(msg.str());
+  }
+}
+
+TaskResult start_result(Task task, const std::string& method) {
+  TaskResult result;
+  result.task = task;
+  result.method = method;
+  result.threads = at::get_num_threads();
+  return result;
+}
+
+std::string fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+}  // namespace
+
+const char* task_name(Task task) {
+  switch (task) {
+    case Task::Gap: return "gap";
+    case Task::Sparse: return "sparse";
+    case Task::Resample: return "resample";
+  }
+  return "?";
+}
+
+Task task_from_name(const std::string& name) {
+  for (Task t : all_tasks()) {
+    if (name == task_name(t)) return t;
+  }
+  throw InputError("unknown task '" + name + "' (expected gap, sparse or resample)");
+}
+
+std::vector<Task> all_tasks() { return {Task::Gap, Task::Sparse, Task::Resample}; }
+
+std::vector<Window> protocol_windows(const std::vector<Clip>& clips, int length, int stride) {
+  if (length < 1 || stride < 1) throw InputError("protocol windows need length >= 1 and stride >= 1");
+  std::vector<Window> windows;
+  for (size_t c = 0; c < clips.size(); ++c) {
+    const int frames = clips[c].motion.num_frames();
+    for (int start = 0; start + length <= frames; start += stride) {
+      windows.push_back({static_cast<int>(c), start, length});
+    }
+  }
+  return windows;
+}
+
+std::vector<Window> cap_windows(const std::vector<Window>& windows, int max_windows) {
+  const size_t n = windows.size();
+  if (max_windows <= 0 || n <= static_cast<size_t>(max_windows)) return windows;
+  std::vector<Window> out;
+  out.reserve(max_windows);
+  for (size_t i = 0; i < static_cast<size_t>(max_windows); ++i) out.push_back(windows[i * n / max_windows]);
+  return out;
+}
+
+std::vector<int> sparse_keyframes(int frames, int spacing) {
+  if (spacing < 1 || frames < 2) throw InputError("sparse keyframes need spacing >= 1 and at least 2 frames");
+  std::vector<int> keys;
+  for (int f = 0; f < frames - 1; f += spacing) keys.push_back(f);
+  keys.push_back(frames - 1);
+  return keys;
+}
+
+Motion hide_unknown_frames(const Motion& motion, const std::vector<int>& known) {
+  if (known.empty()) throw InputError("hide_unknown_frames: no known frame");
+  Motion out = motion;
+  std::vector<char> is_known(motion.num_frames(), 0);
+  for (int f : known) {
+    if (f < 0 || f >= motion.num_frames()) throw InputError("hide_unknown_frames: known frame out of range");
+    is_known[f] = 1;
+  }
+  Eigen::Vector3d last_root = motion.root_positions[known.front()];
+  for (int f = 0; f < motion.num_frames(); ++f) {
+    if (is_known[f]) {
+      last_root = motion.root_positions[f];
+      continue;
+    }
+    out.root_positions[f] = last_root;
+    for (int j = 0; j < motion.num_joints(); ++j) out.rotation(f, j) = Eigen::Quaterniond::Identity();
+  }
+  return out;
+}
+
+TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
+                           const ProtocolOptions& options) {
+  if (options.context < 1) throw InputError("gap filling needs at least one context frame");
+  TaskResult result = start_result(Task::Gap, method);
+  for (int T : options.gap_lengths) {
+    if (T < 1) throw InputError("gap lengths must be positive");
+    const int length = options.context + T + 1;
+    const int a = options.context, b = options.context + T;
+    const std::vector<Window> windows = cap_windows(protocol_windows(clips, length, options.stride), options.max_windows);
+    std::vector<int> evaluated, known;
+    for (int f = 0; f < length; ++f) (f >= a && f < b ? evaluated : known).push_back(f);
+    MetricAccumulator acc(stats);
+    double ms = 0.0;
+    for (const Window& w : windows) {
+      const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), options.context - 1,
+                                        options.root_forward);
+      const Motion input = hide_unknown_frames(truth, known);
+      const auto t0 = Clock::now();
+      const Motion pred = run_fill(input, a, b, method);
+      ms += elapsed_ms(t0);
+      check_prediction(pred, truth, method);
+      acc.add(truth, pred, evaluated, known);
+    }
+    RowResult row;
+    row.parameter = T;
+    row.metrics = acc.summary();
+    row.ms_per_window = windows.empty() ? 0.0 : ms / windows.size();
+    result.rows.push_back(row);
+  }
+  return result;
+}
+
+TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
+                                const ProtocolOptions& options) {
+  TaskResult result = start_result(Task::Sparse, method);
+  const int length = options.sparse_window;
+  const std::vector<Window> windows = cap_windows(protocol_windows(clips, length, options.stride), options.max_windows);
+  for (int k : options.keyframe_spacings) {
+    const std::vector<int> keys = sparse_keyframes(length, k);
+    std::vector<int> evaluated;
+    for (int f = 0, i = 0; f < length; ++f) {
+      if (i < static_cast<int>(keys.size()) && keys[i] == f) {
+        ++i;
+      } else {
+        evaluated.push_back(f);
+      }
+    }
+    MetricAccumulator acc(stats);
+    double ms = 0.0;
+    int used = 0;
+    for (const Window& w : windows) {
+      if (evaluated.empty()) break;  // spacing 1: nothing to evaluate
+      const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, options.root_forward);
+      const Motion input = hide_unknown_frames(truth, keys);
+      const auto t0 = Clock::now();
+      const Motion pred = run_inbetween(input, keys, method);
+      ms += elapsed_ms(t0);
+      check_prediction(pred, truth, method);
+      acc.add(truth, pred, evaluated, keys);
+      ++used;
+    }
+    RowResult row;
+    row.parameter = k;
+    row.metrics = acc.summary();
+    row.ms_per_window = used == 0 ? 0.0 : ms / used;
+    result.rows.push_back(row);
+  }
+  return result;
+}
+
+TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
+                          const ProtocolOptions& options) {
+  const int length = options.resample_window;
+  if (length < 3 || length % 2 == 0) throw InputError("the resampling window must be odd and at least 3 frames");
+  TaskResult result = start_result(Task::Resample, method);
+  const std::vector<Window> windows = cap_windows(protocol_windows(clips, length, options.stride), options.max_windows);
+  std::vector<int> evaluated, known;
+  for (int f = 0; f < length; ++f) (f % 2 ? evaluated : known).push_back(f);
+  MetricAccumulator acc(stats);
+  double ms = 0.0;
+  double fps = clips.empty() ? 0.0 : clips.front().motion.fps;
+  for (const Window& w : windows) {
+    const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, options.root_forward);
+    fps = truth.fps;
+    Motion input = Motion::identity(truth.skeleton, static_cast<int>(known.size()), truth.fps / 2.0);
+    for (size_t i = 0; i < known.size(); ++i) {
+      input.root_positions[i] = truth.root_positions[known[i]];
+      for (int j = 0; j < truth.num_joints(); ++j) input.rotation(static_cast<int>(i), j) = truth.rotation(known[i], j);
+    }
+    const auto t0 = Clock::now();
+    const Motion pred = run_resample(input, truth.fps, method, nullptr);
+    ms += elapsed_ms(t0);
+    check_prediction(pred, truth, method);
+    acc.add(truth, pred, evaluated, known);
+  }
+  RowResult row;
+  row.parameter = static_cast<int>(std::lround(fps));
+  row.metrics = acc.summary();
+  row.ms_per_window = windows.empty() ? 0.0 : ms / windows.size();
+  result.rows.push_back(row);
+  return result;
+}
+
+TaskResult run_task(Task task, const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
+                    const ProtocolOptions& options) {
+  switch (task) {
+    case Task::Gap: return run_gap_filling(clips, stats, method, options);
+    case Task::Sparse: return run_sparse_keyframes(clips, stats, method, options);
+    case Task::Resample: return run_resampling(clips, stats, method, options);
+  }
+  throw InputError("unknown task");
+}
+
+std::string format_table(const TaskResult& result) {
+  std::ostringstream out;
+  const char* title = "";
+  const char* param = "";
+  switch (result.task) {
+    case Task::Gap:
+      title = "Gap filling (10 context frames + T + 1 target)";
+      param = "T";
+      break;
+    case Task::Sparse:
+      title = "Sparse keyframes (128-frame windows, keyframe every k frames)";
+      param = "k";
+      break;
+    case Task::Resample:
+      title = "Resampling (every other frame -> full rate)";
+      param = "fps out";
+      break;
+  }
+  out << "### " << title << "\n\n";
+  out << "method: `" << result.method << "`, torch threads: " << result.threads << "\n\n";
+  out << "| " << param
+      << " | windows | L2P | L2Q | NPSS | MPJPE (cm) | skating (cm) | skating GT (cm) "
+         "| known pos max / mean (cm) | known rot max / mean (deg) | ms / window |\n";
+  out << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const RowResult& row : result.rows) {
+    const MetricSummary& m = row.metrics;
+    out << "| " << row.parameter << " | " << m.windows << " | " << fixed(m.l2p, 3) << " | " << fixed(m.l2q, 3)
+        << " | " << fixed(m.npss, 4) << " | " << fixed(m.mpjpe_cm, 2) << " | " << fixed(m.skating_cm, 3) << " | "
+        << fixed(m.truth_skating_cm, 3) << " | " << fixed(m.known.position_max_cm, 3) << " / "
+        << fixed(m.known.position_mean_cm(), 3) << " | " << fixed(m.known.rotation_max_deg, 3) << " / "
+        << fixed(m.known.rotation_mean_deg(), 3) << " | " << fixed(row.ms_per_window, 3) << " |\n";
+  }
+  return out.str();
+}
+
+}  // namespace mf::bench

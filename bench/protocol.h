@@ -1,0 +1,105 @@
+// The benchmark protocol of motionfield-bench (docs/BENCHMARKS.md): LaFAN1-style
+// windows cut from held-out clips, each task run through the task entry points
+// of tasks/jobs.h with a named method, and the metrics of bench/metrics.h
+// summarised in one markdown table per (task, method).
+//
+// Tasks (defaults of ProtocolOptions):
+// * Gap filling ("gap"): windows of context (10) + T + 1 frames for T in
+//   {5, 15, 30, 45, 90}, starting every 40 frames in each clip (only windows
+//   that fit), canonicalised at frame context - 1 (9). The method sees the
+//   window with frames [context, context + T) unknown (mf::run_fill); metrics
+//   over those T frames, known-frame error over the others.
+// * Sparse keyframes ("sparse"): windows of 128 frames every 40 frames,
+//   keyframes 0, k, 2k, ... and the last frame for k in {5, 10, 15, 20, 30}
+//   (mf::run_inbetween), canonicalised at frame 0; metrics over the other
+//   frames, known-frame error over the keyframes.
+// * Resampling 15 -> 30 fps ("resample"): windows of 65 frames every 40 frames;
+//   the input is the even frames at half the frame rate (33 frames), resampled
+//   with mf::run_resample back to the clip's rate (65 frames); canonicalised at
+//   frame 0; metrics over the odd frames, known-frame error over the even ones.
+//
+// Every window is canonicalised (bench/metrics.h) before the method sees it, so
+// truth and prediction share the frame; frames the method must not know are
+// overwritten (identity rotations, the previous known root position) before
+// the call, so no method can read the answer. Wall time per window counts the
+// method call only.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "bench/metrics.h"
+#include "prior/data/dataset.h"
+
+namespace mf::bench {
+
+enum class Task { Gap, Sparse, Resample };
+
+/// "gap", "sparse", "resample".
+const char* task_name(Task task);
+/// Inverse of task_name; throws mf::InputError on an unknown name.
+Task task_from_name(const std::string& name);
+/// Every task in the order of the tables.
+std::vector<Task> all_tasks();
+
+struct ProtocolOptions {
+  std::vector<int> gap_lengths{5, 15, 30, 45, 90};
+  std::vector<int> keyframe_spacings{5, 10, 15, 20, 30};
+  int context = 10;            ///< gap filling: known frames before the gap
+  int stride = 40;             ///< window start every `stride` frames
+  int sparse_window = 128;
+  int resample_window = 65;    ///< odd, so that both ends are input frames
+  int max_windows = 0;         ///< cap per table row (spread evenly over the windows); 0 = all
+  Eigen::Vector3d root_forward = Eigen::Vector3d::UnitZ();
+};
+
+/// Windows of `length` frames starting at 0, stride, 2 stride, ... in each
+/// clip, only those that fit (start + length <= frames), clip by clip in order.
+/// Throws mf::InputError unless length >= 1 and stride >= 1.
+std::vector<Window> protocol_windows(const std::vector<Clip>& clips, int length, int stride);
+
+/// At most `max_windows` of `windows`, spread evenly (indices floor(i * n / max));
+/// all of them when max_windows <= 0 or there are not more.
+std::vector<Window> cap_windows(const std::vector<Window>& windows, int max_windows);
+
+/// Keyframes 0, spacing, 2 spacing, ... below `frames`, plus frames - 1.
+/// Throws mf::InputError unless spacing >= 1 and frames >= 2.
+std::vector<int> sparse_keyframes(int frames, int spacing);
+
+/// A copy of `motion` whose frames outside `known` (sorted, non-empty) hold
+/// identity rotations and the root position of the last known frame before
+/// them (the first known frame for frames before it).
+Motion hide_unknown_frames(const Motion& motion, const std::vector<int>& known);
+
+/// One table row: one gap length / keyframe spacing.
+struct RowResult {
+  int parameter = 0;           ///< T, k, or the output frame rate for resampling
+  MetricSummary metrics;
+  double ms_per_window = 0.0;  ///< wall time of the method call per window
+};
+
+struct TaskResult {
+  Task task = Task::Gap;
+  std::string method;
+  int threads = 1;             ///< torch intra-op threads during the run
+  std::vector<RowResult> rows;
+};
+
+/// The three tasks on `clips` (the validation split) with `method` (a name of
+/// mf::available_methods()). Rows without any window are kept with zero
+/// windows. Errors of the method propagate.
+TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
+                           const ProtocolOptions& options = {});
+TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
+                                const ProtocolOptions& options = {});
+TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
+                          const ProtocolOptions& options = {});
+TaskResult run_task(Task task, const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
+                    const ProtocolOptions& options = {});
+
+/// The markdown table of a result, with a heading line naming the task, the
+/// method and the torch thread count.
+std::string format_table(const TaskResult& result);
+
+}  // namespace mf::bench

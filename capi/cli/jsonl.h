@@ -1,0 +1,110 @@
+// JSON Lines for `motionfield batch`: a small, strict JSON parser (RFC 8259)
+// and the translation of one parsed line into a batch job.
+//
+// The parser accepts exactly one JSON value surrounded by optional whitespace
+// (space, tab, CR, LF): objects, arrays, strings (every escape of RFC 8259,
+// including \uXXXX and surrogate pairs, decoded to UTF-8), numbers in JSON's
+// grammar (no leading zeros, no leading '+', no NaN/Infinity, no hex), true,
+// false and null. It rejects what lenient parsers let through: trailing commas,
+// comments, single quotes, unescaped control characters in strings, invalid
+// UTF-8, lone surrogates, duplicate object keys, numbers that overflow a double,
+// nesting deeper than kJsonMaxDepth and anything after the value. Errors are
+// JsonError, whose message starts with "column N: " (1-based, counted in
+// characters of the UTF-8 input).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace mf::cli {
+
+constexpr int kJsonMaxDepth = 64;
+
+class JsonError : public std::runtime_error {
+ public:
+  JsonError(int column, const std::string& message);
+  /// 1-based character column of the offending input.
+  int column() const { return column_; }
+
+ private:
+  int column_;
+};
+
+/// One JSON value. Objects keep their members in input order.
+class JsonValue {
+ public:
+  enum class Type { Null, Bool, Number, String, Array, Object };
+
+  JsonValue() = default;  ///< null
+  static JsonValue boolean(bool b);
+  static JsonValue number(double d);
+  static JsonValue string(std::string s);
+  static JsonValue array(std::vector<JsonValue> items);
+  /// `keys` and `values` have the same length; keys must be unique.
+  static JsonValue object(std::vector<std::string> keys, std::vector<JsonValue> values);
+
+  Type type() const { return type_; }
+  bool is_null() const { return type_ == Type::Null; }
+  bool is_bool() const { return type_ == Type::Bool; }
+  bool is_number() const { return type_ == Type::Number; }
+  bool is_string() const { return type_ == Type::String; }
+  bool is_array() const { return type_ == Type::Array; }
+  bool is_object() const { return type_ == Type::Object; }
+
+  /// Accessors; each throws std::logic_error if the value has another type.
+  bool as_bool() const;
+  double as_number() const;
+  const std::string& as_string() const;
+  const std::vector<JsonValue>& as_array() const;
+  const std::vector<std::string>& keys() const;     ///< object member names, in order
+  const std::vector<JsonValue>& values() const;     ///< object member values, in order
+
+  /// Member `key` of an object, or nullptr if absent (or if this is not an object).
+  const JsonValue* find(const std::string& key) const;
+
+  /// Compact JSON text of the value (strings escaped, numbers with up to 17
+  /// significant digits): for messages.
+  std::string dump() const;
+
+ private:
+  Type type_ = Type::Null;
+  bool bool_ = false;
+  double number_ = 0.0;
+  std::string string_;
+  std::vector<JsonValue> items_;  // array items, or object values
+  std::vector<std::string> keys_;
+};
+
+/// Parses one JSON text. Throws JsonError.
+JsonValue parse_json(const std::string& text);
+
+/// Name of a JSON type for messages: "null", "a boolean", "a number", ...
+const char* json_type_name(JsonValue::Type type);
+
+/// One job of `motionfield batch`: {"task": "inbetween" | "fill" | "resample",
+/// "in": path, "out": path, "keyframes": [int...], "gap": [A, B], "fps": F,
+/// "method": name}. Only the keys the task needs are read and type-checked; any
+/// other key ("id", a frame count, the input's fps, ...) is ignored, so callers
+/// can annotate jobs.
+struct BatchJob {
+  std::string task;    ///< "inbetween", "fill" or "resample"
+  std::string in, out; ///< paths as given (relative to the current directory)
+  std::string method;  ///< empty: the default method
+  std::string id;      ///< the job's "id" for messages (JSON text; strings unquoted), empty if none
+  bool has_keyframes = false;
+  std::vector<int> keyframes;  ///< inbetween: required; fill: optional and then authoritative
+  bool has_gap = false;
+  int gap_begin = 0, gap_end = 0;  ///< fill: frames gap_begin..gap_end-1 are unknown
+  double fps = 0.0;                ///< resample: the target fps
+};
+
+/// Reads a job from one parsed line. Throws mf::InputError with a message naming
+/// the key when the value is not an object, "task" is missing or unknown, or a
+/// key the task needs is missing or has the wrong type ("in" and "out" non-empty
+/// strings; "keyframes" an array of integers; "gap" an array of two integers;
+/// "fps" a number; "method" a string). Range checks (keyframes within the clip,
+/// fps positive, ...) happen later, in tasks/jobs.h, once the input is read.
+BatchJob batch_job_from_json(const JsonValue& line);
+
+}  // namespace mf::cli

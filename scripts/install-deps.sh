@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Installs motionfield's build and test dependencies from Debian's packages.
+# Idempotent: it installs only what is missing and runs `apt-get update` only then.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ccache pkg-config xz-utils tar
+  libtorch-dev          # libtorch 1.13, CPU
+  libceres-dev          # Ceres solver (L-BFGS driver for the latent solvers)
+  libeigen3-dev
+  libgtest-dev
+  libopenblas0-pthread  # BLAS for libtorch and Eigen: ~3x faster than ATLAS here (docs/BLAS.md)
+  python3 python3-numpy # the Python binding's tests
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all dependencies present"
+else
+  echo "install-deps: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# libtorch and Eigen call the libblas.so.3 alternative; make sure it is OpenBLAS
+# (measured in docs/BLAS.md) and not the generic ATLAS/reference build.
+openblas=/usr/lib/x86_64-linux-gnu/openblas-pthread/libblas.so.3
+current=$(readlink -f /etc/alternatives/libblas.so.3-x86_64-linux-gnu 2>/dev/null || true)
+if [ -e "$openblas" ] && [ "$current" != "$(readlink -f $openblas)" ]; then
+  echo "install-deps: selecting OpenBLAS as the libblas.so.3 alternative"
+  SUDO=""; if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  $SUDO update-alternatives --set libblas.so.3-x86_64-linux-gnu "$openblas"
+  lapack=/usr/lib/x86_64-linux-gnu/openblas-pthread/liblapack.so.3
+  if [ -e "$lapack" ]; then $SUDO update-alternatives --set liblapack.so.3-x86_64-linux-gnu "$lapack" || true; fi
+fi

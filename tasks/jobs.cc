@@ -1,0 +1,125 @@
+#include "tasks/jobs.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "prior/motion/errors.h"
+#include "tasks/baselines.h"
+
+namespace mf {
+namespace {
+
+constexpr double kMaxResampledFrames = 10'000'000;
+
+std::string method_list() {
+  std::string s;
+  for (const std::string& m : available_methods()) s += (s.empty() ? "" : ", ") + m;
+  return s;
+}
+
+// Empty -> the default; anything not registered -> InputError naming the choices.
+std::string resolve_method(const std::string& method) {
+  const std::string m = method.empty() ? default_method() : method;
+  for (const std::string& a : available_methods())
+    if (a == m) return m;
+  throw InputError("unknown method '" + method + "' (available: " + method_list() + ")");
+}
+
+void check_motion(const Motion& input) {
+  if (input.num_frames() < 1) throw InputError("the input motion has no frames");
+  if (input.rotations.size() != static_cast<size_t>(input.num_frames()) * input.num_joints())
+    throw InputError("the input motion's rotation count does not match its frames and joints");
+  if (!(std::isfinite(input.fps) && input.fps > 0)) throw InputError("the input motion's fps must be finite and positive");
+}
+
+Motion run_known(const Motion& input, const std::vector<int>& known, const std::string& method) {
+  if (method == "zerovel") return zero_velocity_motion(input, known);
+  return interpolate_motion(input, known);
+}
+
+}  // namespace
+
+std::vector<std::string> available_methods() { return {"interp", "zerovel"}; }
+
+std::string default_method() { return "interp"; }
+
+void validate_keyframes(const std::vector<int>& keyframes, int frames) {
+  if (keyframes.size() < 2)
+    throw InputError("at least two keyframes are required (got " + std::to_string(keyframes.size()) + ")");
+  for (size_t i = 0; i < keyframes.size(); ++i) {
+    const int k = keyframes[i];
+    if (k < 0 || k >= frames)
+      throw InputError("keyframe " + std::to_string(k) + " is out of range: the input has " + std::to_string(frames) +
+                       " frames (0.." + std::to_string(frames - 1) + ")");
+    if (i > 0 && k == keyframes[i - 1]) throw InputError("keyframe " + std::to_string(k) + " is given twice");
+    if (i > 0 && k < keyframes[i - 1])
+      throw InputError("keyframes must be in increasing order (" + std::to_string(keyframes[i - 1]) + " is followed by " +
+                       std::to_string(k) + ")");
+  }
+}
+
+std::vector<int> known_frames_outside_gap(int frames, int a, int b) {
+  const std::string gap = std::to_string(a) + ":" + std::to_string(b);
+  if (b <= a) throw InputError("gap " + gap + " is empty: it must be A:B with A < B (frames A..B-1 are filled)");
+  if (a < 1) throw InputError("gap " + gap + " touches the first frame: frame 0 must stay known (A >= 1)");
+  if (b > frames - 1)
+    throw InputError("gap " + gap + " touches or passes the last frame: the input has " + std::to_string(frames) +
+                     " frames, so B must be at most " + std::to_string(frames - 1));
+  std::vector<int> known;
+  known.reserve(static_cast<size_t>(frames - (b - a)));
+  for (int f = 0; f < a; ++f) known.push_back(f);
+  for (int f = b; f < frames; ++f) known.push_back(f);
+  return known;
+}
+
+int resampled_frame_count(int frames, double fps_in, double fps_out, bool* rounded) {
+  if (!(std::isfinite(fps_in) && fps_in > 0)) throw InputError("the input fps must be finite and positive");
+  if (!(std::isfinite(fps_out) && fps_out > 0)) throw InputError("the target fps must be finite and positive");
+  if (frames < 1) throw InputError("cannot resample a motion without frames");
+  const double exact = static_cast<double>(frames - 1) * (fps_out / fps_in) + 1.0;
+  const double nearest = std::round(exact);
+  // BVH frame times carry about 6 significant digits (0.0333333 s), so a ratio
+  // within 1e-5 relative of an integer count is taken as that integer.
+  const bool integral = std::abs(exact - nearest) <= 1e-5 * std::max(1.0, exact);
+  const double count = integral ? nearest : std::floor(exact);
+  if (count > kMaxResampledFrames) {
+    std::ostringstream msg;
+    msg << "resampling " << frames << " frames from " << fps_in << " to " << fps_out << " fps would give more than "
+        << static_cast<long long>(kMaxResampledFrames) << " frames";
+    throw InputError(msg.str());
+  }
+  if (rounded) *rounded = !integral;
+  return static_cast<int>(count);
+}
+
+Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method) {
+  const std::string m = resolve_method(method);
+  check_motion(input);
+  validate_keyframes(keyframes, input.num_frames());
+  return run_known(input, keyframes, m);
+}
+
+Motion run_fill(const Motion& input, int a, int b, const std::string& method) {
+  const std::string m = resolve_method(method);
+  check_motion(input);
+  return run_known(input, known_frames_outside_gap(input.num_frames(), a, b), m);
+}
+
+Motion run_resample(const Motion& input, double fps, const std::string& method, std::vector<std::string>* warnings) {
+  const std::string m = resolve_method(method);
+  check_motion(input);
+  bool rounded = false;
+  const int frames = resampled_frame_count(input.num_frames(), input.fps, fps, &rounded);
+  if (rounded && warnings) {
+    std::ostringstream msg;
+    msg << "resampling " << input.num_frames() << " frames from " << input.fps << " to " << fps
+        << " fps gives a non-integer frame count " << (input.num_frames() - 1) * (fps / input.fps) + 1.0
+        << "; rounded down to " << frames << " frames (the last " << fps << " fps frame ends before the input's last frame)";
+    warnings->push_back(msg.str());
+  }
+  if (m == "zerovel") return resample_zero_velocity(input, fps, frames);
+  return resample_interpolate(input, fps, frames);
+}
+
+}  // namespace mf

@@ -1,0 +1,59 @@
+// The task entry points behind the CLI, the batch mode and the benchmark: input
+// validation (bad input throws mf::InputError with a message for the user) and
+// dispatch to a method by name. Later issues register the prior's solvers and
+// the transformers here; the default method is the best measured one.
+//
+// Methods today:
+//   "interp"   root LERP + rotation SLERP between known frames (the default),
+//   "zerovel"  hold the last known frame (zero velocity).
+// An empty method name means default_method(); any other unregistered name
+// throws InputError listing the available ones.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "prior/motion/motion.h"
+
+namespace mf {
+
+/// Names accepted by --method, e.g. {"interp", "zerovel"}.
+std::vector<std::string> available_methods();
+/// What runs when no method is given.
+std::string default_method();
+
+/// Throws InputError unless: at least two keyframes, strictly increasing (so
+/// sorted and unique), every one in [0, frames). The message names the
+/// offending keyframe (out of range, given twice, or out of order).
+void validate_keyframes(const std::vector<int>& keyframes, int frames);
+
+/// Known frames of a gap fill: every frame outside [a, b), in increasing order.
+/// Throws InputError unless 1 <= a < b <= frames - 1 (the gap is non-empty and
+/// has a known frame on each side).
+std::vector<int> known_frames_outside_gap(int frames, int a, int b);
+
+/// Output frame count of resampling `frames` frames from fps_in to fps_out,
+/// keeping the time span: (frames - 1) * fps_out / fps_in + 1. A value within
+/// 1e-5 relative of an integer counts as that integer (BVH frame times carry
+/// about six significant digits: 0.0333333 s must still mean 30 fps); otherwise
+/// it is rounded down and *rounded (if non-null) is set to true, else to false.
+/// Throws InputError when an fps is not finite and positive, frames < 1, or the
+/// result would exceed 10 million frames.
+int resampled_frame_count(int frames, double fps_in, double fps_out, bool* rounded);
+
+/// Sparse-keyframe in-betweening: the output has the input's length and fps;
+/// known frames are `keyframes` (validated with validate_keyframes()), the
+/// others are never read. Known frames are copied exactly.
+Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method);
+
+/// Gap filling: frames a..b-1 unknown, all others known (as run_inbetween with
+/// known_frames_outside_gap()).
+Motion run_fill(const Motion& input, int a, int b, const std::string& method);
+
+/// Resampling to `fps`, keeping the time span; the output's fps is `fps` and
+/// its length resampled_frame_count(). If the frame count had to be rounded
+/// down, a sentence saying so is appended to *warnings (if non-null).
+Motion run_resample(const Motion& input, double fps, const std::string& method,
+                    std::vector<std::string>* warnings);
+
+}  // namespace mf

@@ -1,0 +1,53 @@
+#include "tests/test_util.h"
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+namespace mf::test {
+
+Skeleton small_skeleton() {
+  Skeleton s;
+  s.names = {"Hips", "Spine", "Head", "UpperLeg_L", "Foot_L", "UpperLeg_R", "Foot_R"};
+  s.parents = {-1, 0, 1, 0, 3, 0, 5};
+  s.offsets = {{0, 0, 0},    {0, 0.2, 0},   {0, 0.4, 0}, {0.1, -0.05, 0},
+               {0, -0.8, 0}, {-0.1, -0.05, 0}, {0, -0.8, 0}};
+  return s;
+}
+
+Motion random_motion(const Skeleton& skeleton, int frames, double fps, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Motion m = Motion::identity(skeleton, frames, fps);
+  const int J = skeleton.num_joints();
+  // Each channel is a sum of two sinusoids with random frequency and phase.
+  for (int j = 0; j < J; ++j) {
+    Eigen::Vector3d a1(u(rng), u(rng), u(rng)), a2(u(rng), u(rng), u(rng));
+    Eigen::Vector3d w1 = Eigen::Vector3d(u(rng), u(rng), u(rng)).cwiseAbs() * 3.0;
+    Eigen::Vector3d w2 = Eigen::Vector3d(u(rng), u(rng), u(rng)).cwiseAbs() * 7.0;
+    for (int f = 0; f < frames; ++f) {
+      double t = f / fps;
+      Eigen::Vector3d aa;
+      for (int k = 0; k < 3; ++k) aa[k] = 0.8 * a1[k] * std::sin(w1[k] * t + k) + 0.3 * a2[k] * std::cos(w2[k] * t);
+      double angle = aa.norm();
+      m.rotation(f, j) = angle < 1e-12 ? Eigen::Quaterniond::Identity()
+                                       : Eigen::Quaterniond(Eigen::AngleAxisd(angle, aa / angle));
+    }
+  }
+  double vx = u(rng), vz = u(rng);
+  for (int f = 0; f < frames; ++f) {
+    double t = f / fps;
+    m.root_positions[f] = Eigen::Vector3d(vx * t, 0.9 + 0.05 * std::sin(6.0 * t), vz * t + 0.2 * std::sin(2.0 * t));
+  }
+  return m;
+}
+
+std::string scratch_dir(const std::string& name) {
+  namespace fs = std::filesystem;
+  fs::path p = fs::path(MF_BINARY_DIR) / "test-scratch" / name;
+  fs::remove_all(p);
+  fs::create_directories(p);
+  return p.string();
+}
+
+}  // namespace mf::test
