@@ -8,7 +8,9 @@
 #include <Eigen/Core>
 #include <chrono>
 #include <cstdio>
+#include <algorithm>
 #include <cstdlib>
+#include <vector>
 #include <string>
 
 namespace {

@@ -175,7 +175,13 @@ std::vector<double> continuous_quaternions(const GlobalPose& pose, const GlobalP
     for (int f = 0; f < pose.frames; ++f) {
       Eigen::Vector4d q = wxyz(pose.rotation(f, j));
       if (f == 0) {
-        const double side = reference ? q.dot(wxyz(reference->rotation(0, j))) : q[0];
+        double side = q[0];
+        if (reference) {
+          // The hemisphere continuous_quaternions(*reference) gives its frame 0.
+          Eigen::Vector4d r = wxyz(reference->rotation(0, j));
+          if (r[0] < 0.0) r = -r;
+          side = q.dot(r);
+        }
         if (side < 0.0) q = -q;
       } else if (q.dot(prev) < 0.0) {
         q = -q;
@@ -187,7 +193,8 @@ std::vector<double> continuous_quaternions(const GlobalPose& pose, const GlobalP
   return out;
 }
 
-double l2p(const GlobalPose& truth, const GlobalPose& pred, const std::vector<int>& frames, const EvalStats& stats) {
+double l2p(const GlobalPose& truth, const GlobalPose& pred, const std::vector<int>& frames, const EvalStats& stats,
+           L2PAxes axes) {
   check_same_size(truth, pred, "L2P");
   check_frames(frames, truth.frames, "L2P");
   if (static_cast<int>(stats.position_std.size()) != 3 * truth.joints) {
@@ -200,6 +207,7 @@ double l2p(const GlobalPose& truth, const GlobalPose& pred, const std::vector<in
     for (int j = 0; j < truth.joints; ++j) {
       const Eigen::Vector3d d = pred.position(f, j) - truth.position(f, j);
       for (int a = 0; a < 3; ++a) {
+        if ((axes == L2PAxes::Horizontal && a == 1) || (axes == L2PAxes::Vertical && a != 1)) continue;
         const double z = d[a] / stats.position_std[3 * j + a];  // the means cancel
         sq += z * z;
       }
@@ -358,6 +366,8 @@ void MetricAccumulator::add(const Motion& truth, const Motion& pred, const std::
   const long n = static_cast<long>(evaluated.size());
 
   l2p_sum_ += l2p(tp, pp, evaluated, stats_) * n;
+  l2p_h_sum_ += l2p(tp, pp, evaluated, stats_, L2PAxes::Horizontal) * n;
+  l2p_v_sum_ += l2p(tp, pp, evaluated, stats_, L2PAxes::Vertical) * n;
   mpjpe_sum_ += mpjpe_cm(tp, pp, evaluated) * n;
 
   const std::vector<double> tq = continuous_quaternions(tp);
@@ -393,6 +403,8 @@ MetricSummary MetricAccumulator::summary() const {
   s.windows = windows_;
   if (frames_ > 0) {
     s.l2p = l2p_sum_ / frames_;
+    s.l2p_horizontal = l2p_h_sum_ / frames_;
+    s.l2p_vertical = l2p_v_sum_ / frames_;
     s.l2q = l2q_sum_ / frames_;
     s.mpjpe_cm = mpjpe_sum_ / frames_;
   }

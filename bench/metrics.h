@@ -150,7 +150,8 @@ double quantile(std::vector<double> values, double q);
 /// Global quaternions of every frame as (w, x, y, z) channels, frame-major:
 /// out[(f * J + j) * 4 + c]. Signs are continuous over time; when `reference`
 /// is given (same joint count, at least one frame), frame 0 of each joint takes
-/// the hemisphere of reference's frame 0, otherwise the hemisphere with w >= 0.
+/// the hemisphere that continuous_quaternions(*reference) gives reference's
+/// frame 0 (so truth and prediction agree), otherwise the hemisphere w >= 0.
 std::vector<double> continuous_quaternions(const GlobalPose& pose, const GlobalPose* reference = nullptr);
 
 // ---------------------------------------------------------------------------
@@ -158,8 +159,14 @@ std::vector<double> continuous_quaternions(const GlobalPose& pose, const GlobalP
 // truth and prediction must have the same frame and joint counts (else
 // mf::InputError). Positions in metres as produced by forward_kinematics.
 
+/// Which coordinates L2P sums: all (the metric), or only the horizontal (x, z)
+/// or vertical (y) ones (a diagnostic: on upright data the vertical standard
+/// deviations are small and the vertical part can dominate).
+enum class L2PAxes { All, Horizontal, Vertical };
+
 /// Mean over `frames` of the L2 norm of the z-scored position difference.
-double l2p(const GlobalPose& truth, const GlobalPose& pred, const std::vector<int>& frames, const EvalStats& stats);
+double l2p(const GlobalPose& truth, const GlobalPose& pred, const std::vector<int>& frames, const EvalStats& stats,
+           L2PAxes axes = L2PAxes::All);
 
 /// Mean over `frames` of the L2 norm of the difference of the global quaternion
 /// channels; both given as continuous_quaternions() output for `joints` joints.
@@ -218,6 +225,8 @@ KnownFrameError known_frame_error(const Motion& truth, const GlobalPose& truth_p
 struct MetricSummary {
   int windows = 0;
   double l2p = 0.0;
+  double l2p_horizontal = 0.0;  ///< L2P over x and z only (diagnostic)
+  double l2p_vertical = 0.0;    ///< L2P over y only (diagnostic)
   double l2q = 0.0;
   double npss = 0.0;
   double mpjpe_cm = 0.0;
@@ -246,7 +255,7 @@ class MetricAccumulator {
  private:
   const EvalStats& stats_;
   int windows_ = 0;
-  double l2p_sum_ = 0.0, l2q_sum_ = 0.0, mpjpe_sum_ = 0.0;
+  double l2p_sum_ = 0.0, l2p_h_sum_ = 0.0, l2p_v_sum_ = 0.0, l2q_sum_ = 0.0, mpjpe_sum_ = 0.0;
   long frames_ = 0;
   NpssTerms npss_;
   SkatingTerms skate_pred_, skate_truth_;

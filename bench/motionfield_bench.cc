@@ -1,1 +1,198 @@
-int main(){return 0;}
+// motionfield-bench: the LaFAN1-style benchmark of docs/BENCHMARKS.md. Loads the
+// data set, computes the evaluation statistics on the training split, runs every
+// (task, method) pair on the validation split and prints markdown tables.
+#include <ATen/Parallel.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "bench/metrics.h"
+#include "bench/protocol.h"
+#include "prior/data/dataset.h"
+#include "prior/motion/errors.h"
+#include "tasks/jobs.h"
+
+namespace {
+
+const char* kUsage =
+    "usage: motionfield-bench [options]\n"
+    "  --methods a,b     methods to run (default: every available method)\n"
+    "  --tasks a,b       gap, sparse, resample (default: all)\n"
+    "  --threads N       torch intra-op threads (default 2)\n"
+    "  --source PATH     BVH folder or archive (default: the shared training archive)\n"
+    "  --cache-dir DIR   extraction and parse cache (default: <project>/.cache)\n"
+    "  --max-windows N   at most N windows per table row, spread evenly (default: all)\n"
+    "  --out FILE        also write the markdown to FILE\n"
+    "  --l2p-axes        add columns splitting L2P into horizontal (x, z) and vertical (y) parts\n"
+    "  --print-stats     add the table of training statistics (position mean / std, standing heights)\n"
+    "  --help            this text\n";
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    if (!item.empty()) out.push_back(item);
+  }
+  if (out.empty()) throw mf::InputError("empty list '" + s + "'");
+  return out;
+}
+
+int parse_int(const std::string& flag, const std::string& value, int min_value) {
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(value.c_str(), &end, 10);
+  if (value.empty() || *end != '\0' || errno != 0 || v < min_value || v > 1000000) {
+    throw mf::InputError(flag + " expects an integer >= " + std::to_string(min_value) + ", got '" + value + "'");
+  }
+  return static_cast<int>(v);
+}
+
+struct Args {
+  std::vector<std::string> methods;
+  std::vector<mf::bench::Task> tasks;
+  int threads = 2;
+  std::string source;
+  std::string cache_dir;
+  int max_windows = 0;
+  std::string out;
+  bool l2p_axes = false;
+  bool print_stats = false;
+};
+
+Args parse_args(int argc, char** argv) {
+  Args args;
+  for (int i = 1; i < argc; ++i) {
+    const std::string flag = argv[i];
+    if (flag == "--help" || flag == "-h") {
+      std::cout << kUsage;
+      std::exit(0);
+    }
+    if (flag == "--l2p-axes") {
+      args.l2p_axes = true;
+      continue;
+    }
+    if (flag == "--print-stats") {
+      args.print_stats = true;
+      continue;
+    }
+    if (i + 1 >= argc) throw mf::InputError("unknown flag or missing value: " + flag + "\n" + kUsage);
+    const std::string value = argv[++i];
+    if (flag == "--methods") {
+      args.methods = split_list(value);
+    } else if (flag == "--tasks") {
+      args.tasks.clear();
+      for (const std::string& t : split_list(value)) args.tasks.push_back(mf::bench::task_from_name(t));
+    } else if (flag == "--threads") {
+      args.threads = parse_int(flag, value, 1);
+    } else if (flag == "--source") {
+      args.source = value;
+    } else if (flag == "--cache-dir") {
+      args.cache_dir = value;
+    } else if (flag == "--max-windows") {
+      args.max_windows = parse_int(flag, value, 0);
+    } else if (flag == "--out") {
+      args.out = value;
+    } else {
+      throw mf::InputError("unknown flag " + flag + "\n" + kUsage);
+    }
+  }
+  const std::vector<std::string> available = mf::available_methods();
+  if (args.methods.empty()) args.methods = available;
+  for (const std::string& m : args.methods) {
+    bool found = false;
+    for (const std::string& a : available) found = found || a == m;
+    if (!found) {
+      std::string list;
+      for (const std::string& a : available) list += (list.empty() ? "" : ", ") + a;
+      throw mf::InputError("unknown method '" + m + "' (available: " + list + ")");
+    }
+  }
+  if (args.tasks.empty()) args.tasks = mf::bench::all_tasks();
+  if (args.source.empty()) args.source = mf::default_train_archive();
+  if (args.cache_dir.empty()) args.cache_dir = mf::default_cache_dir();
+  return args;
+}
+
+std::string fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+int run(int argc, char** argv) {
+  const Args args = parse_args(argc, argv);
+  at::set_num_threads(args.threads);
+
+  mf::DatasetOptions data_options;
+  data_options.source = args.source;
+  data_options.cache_dir = args.cache_dir;
+  data_options.verbose = true;
+  std::cerr << "loading " << args.source << "\n";
+  const auto t0 = std::chrono::steady_clock::now();
+  const mf::Dataset data = mf::load_dataset(data_options);
+  std::cerr << "loaded " << data.train.size() << " training and " << data.validation.size()
+            << " validation clips in "
+            << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() << " s\n";
+  if (data.validation.empty()) throw mf::InputError("the validation split of " + args.source + " is empty");
+
+  const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);
+  long validation_frames = 0;
+  for (const mf::Clip& c : data.validation) validation_frames += c.motion.num_frames();
+
+  std::ostringstream md;
+  md << "## motionfield-bench\n\n";
+  md << "- validation clips: " << data.validation.size() << " (" << validation_frames << " frames)"
+     << ", training clips: " << data.train.size() << "\n";
+  md << "- L2P statistics: " << stats.windows << " training windows of 50 frames every 20, canonicalised at frame 9\n";
+  md << "- standing heights (median of per-clip 5th percentiles, training split):";
+  for (size_t i = 0; i < stats.feet.size(); ++i) {
+    md << (i ? ", " : " ") << data.skeleton.names[stats.feet[i].joint] << " " << fixed(100.0 * stats.standing_height[i], 2)
+       << " cm (threshold " << fixed(stats.feet[i].threshold_cm, 0) << " cm)";
+  }
+  md << "\n- torch threads: " << at::get_num_threads();
+  if (args.max_windows > 0) md << ", at most " << args.max_windows << " windows per row";
+  md << "\n\n";
+  if (args.print_stats) md << "### Training statistics\n\n" << mf::bench::format_eval_stats(stats) << "\n";
+  std::cout << md.str() << std::flush;
+
+  mf::bench::ProtocolOptions options;
+  options.max_windows = args.max_windows;
+  for (mf::bench::Task task : args.tasks) {
+    for (const std::string& method : args.methods) {
+      std::cerr << "running " << mf::bench::task_name(task) << " / " << method << "\n";
+      const mf::bench::TaskResult result = mf::bench::run_task(task, data.validation, stats, method, options);
+      const std::string table = mf::bench::format_table(result, args.l2p_axes) + "\n";
+      std::cout << table << std::flush;
+      md << table;
+    }
+  }
+
+  if (!args.out.empty()) {
+    std::ofstream f(args.out);
+    f << md.str();
+    if (!f) throw std::runtime_error("cannot write " + args.out);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    return run(argc, argv);
+  } catch (const mf::InputError& e) {
+    std::cerr << "motionfield-bench: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "motionfield-bench: error: " << e.what() << "\n";
+    return 1;
+  }
+}

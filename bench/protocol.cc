@@ -224,7 +224,7 @@ TaskResult run_task(Task task, const std::vector<Clip>& clips, const EvalStats& 
   throw InputError("unknown task");
 }
 
-std::string format_table(const TaskResult& result) {
+std::string format_table(const TaskResult& result, bool l2p_axes) {
   std::ostringstream out;
   const char* title = "";
   const char* param = "";
@@ -244,18 +244,40 @@ std::string format_table(const TaskResult& result) {
   }
   out << "### " << title << "\n\n";
   out << "method: `" << result.method << "`, torch threads: " << result.threads << "\n\n";
-  out << "| " << param
-      << " | windows | L2P | L2Q | NPSS | MPJPE (cm) | skating (cm) | skating GT (cm) "
+  out << "| " << param << " | windows | L2P" << (l2p_axes ? " | L2P xz | L2P y" : "")
+      << " | L2Q | NPSS | MPJPE (cm) | skating (cm) | skating GT (cm) "
          "| known pos max / mean (cm) | known rot max / mean (deg) | ms / window |\n";
-  out << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  out << "|---:|---:|---:|" << (l2p_axes ? "---:|---:|" : "") << "---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const RowResult& row : result.rows) {
     const MetricSummary& m = row.metrics;
-    out << "| " << row.parameter << " | " << m.windows << " | " << fixed(m.l2p, 3) << " | " << fixed(m.l2q, 3)
+    out << "| " << row.parameter << " | " << m.windows << " | " << fixed(m.l2p, 3);
+    if (l2p_axes) out << " | " << fixed(m.l2p_horizontal, 3) << " | " << fixed(m.l2p_vertical, 3);
+    out << " | " << fixed(m.l2q, 3)
         << " | " << fixed(m.npss, 4) << " | " << fixed(m.mpjpe_cm, 2) << " | " << fixed(m.skating_cm, 3) << " | "
         << fixed(m.truth_skating_cm, 3) << " | " << fixed(m.known.position_max_cm, 3) << " / "
         << fixed(m.known.position_mean_cm(), 3) << " | " << fixed(m.known.rotation_max_deg, 3) << " / "
         << fixed(m.known.rotation_mean_deg(), 3) << " | " << fixed(row.ms_per_window, 3) << " |\n";
   }
+  return out.str();
+}
+
+std::string format_eval_stats(const EvalStats& stats) {
+  std::ostringstream out;
+  out << "| joint | mean x | mean y | mean z | std x | std y | std z | standing height | contact threshold |\n";
+  out << "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (size_t j = 0; j < stats.joint_names.size() && 3 * j + 2 < stats.position_std.size(); ++j) {
+    out << "| " << stats.joint_names[j];
+    for (int a = 0; a < 3; ++a) out << " | " << fixed(100.0 * stats.position_mean[3 * j + a], 1);
+    for (int a = 0; a < 3; ++a) out << " | " << fixed(100.0 * stats.position_std[3 * j + a], 1);
+    std::string standing = " | | |";
+    for (size_t i = 0; i < stats.feet.size(); ++i) {
+      if (stats.feet[i].joint == static_cast<int>(j)) {
+        standing = " | " + fixed(100.0 * stats.standing_height[i], 2) + " | " + fixed(stats.feet[i].threshold_cm, 0) + " |";
+      }
+    }
+    out << standing << "\n";
+  }
+  out << "\nAll values in cm; positions canonicalised (see bench/metrics.h).\n";
   return out.str();
 }
 

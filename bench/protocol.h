@@ -99,7 +99,13 @@ TaskResult run_task(Task task, const std::vector<Clip>& clips, const EvalStats& 
                     const ProtocolOptions& options = {});
 
 /// The markdown table of a result, with a heading line naming the task, the
-/// method and the torch thread count.
-std::string format_table(const TaskResult& result);
+/// method and the torch thread count. With `l2p_axes`, two more columns split
+/// L2P into its horizontal (x, z) and vertical (y) parts.
+std::string format_table(const TaskResult& result, bool l2p_axes = false);
+
+/// A markdown table of the evaluation statistics: per joint, the mean and
+/// standard deviation (cm) of each canonical position coordinate, and the
+/// standing height and contact threshold of the foot joints.
+std::string format_eval_stats(const EvalStats& stats);
 
 }  // namespace mf::bench

@@ -1,5 +1,6 @@
 #include "tasks/baselines.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -49,12 +50,13 @@ void blend_frames(const Motion& from, int a, int b, double t, Motion& to, int f_
 }
 
 // Input frame position (in input frames, possibly fractional) of output frame i.
-// Positions within 1e-6 of an integer snap to it, so that output frames that
-// coincide with input frames copy them exactly despite rounding in the fps.
+// Positions within 1e-5 relative of an integer snap to it, so that output
+// frames that coincide with input frames copy them exactly although BVH frame
+// times carry only about six digits (0.0333333 s is 30.00003 fps).
 double source_position(int i, double fps_in, double fps_out, int frames_in) {
   double s = static_cast<double>(i) * fps_in / fps_out;
   const double r = std::round(s);
-  if (std::abs(s - r) < 1e-6) s = r;
+  if (std::abs(s - r) <= 1e-5 * std::max(1.0, r)) s = r;
   if (s > frames_in - 1) s = frames_in - 1;
   return s;
 }

@@ -32,7 +32,8 @@ Motion zero_velocity_motion(const Motion& input, const std::vector<int>& known);
 /// Resampling by interpolation at continuous times: output frame i sits at time
 /// i / new_fps, i.e. at input frame position s = i * input.fps / new_fps; root
 /// LERP and rotation SLERP between input frames floor(s) and floor(s) + 1.
-/// Positions within 1e-6 frames of an integer copy that input frame exactly;
+/// Positions within 1e-5 relative of an integer copy that input frame exactly
+/// (BVH frame times carry about six digits: 0.0333333 s must still mean 30 fps);
 /// positions past the last input frame hold it. `frames` is the output frame
 /// count (see resampled_frame_count() in tasks/jobs.h); the output's fps is
 /// `new_fps`.

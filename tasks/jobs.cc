@@ -113,9 +113,11 @@ Motion run_resample(const Motion& input, double fps, const std::string& method, 
   const int frames = resampled_frame_count(input.num_frames(), input.fps, fps, &rounded);
   if (rounded && warnings) {
     std::ostringstream msg;
+    const double span_in = (input.num_frames() - 1) / input.fps, span_out = (frames - 1) / fps;
     msg << "resampling " << input.num_frames() << " frames from " << input.fps << " to " << fps
-        << " fps gives a non-integer frame count " << (input.num_frames() - 1) * (fps / input.fps) + 1.0
-        << "; rounded down to " << frames << " frames (the last " << fps << " fps frame ends before the input's last frame)";
+        << " fps does not give a whole number of frames (" << (input.num_frames() - 1) * (fps / input.fps) + 1.0
+        << "); rounded down to " << frames << " frames, so the output ends " << (span_in - span_out)
+        << " s before the input's last frame";
     warnings->push_back(msg.str());
   }
   if (m == "zerovel") return resample_zero_velocity(input, fps, frames);

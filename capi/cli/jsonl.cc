@@ -230,6 +230,7 @@ class Parser {
     }
     while (true) {
       skip_ws();
+      if (!at_end() && s_[pos_] == '}' && !keys.empty()) fail(pos_, "expected a string key, found '}' (trailing comma?)");
       if (at_end() || s_[pos_] != '"') fail(pos_, "expected a string key, found " + describe(pos_));
       const size_t key_pos = pos_;
       std::string key = parse_string();

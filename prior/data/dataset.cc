@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <spawn.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -17,9 +18,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <sstream>
+#include <string_view>
 #include <system_error>
 #include <thread>
 
@@ -59,6 +63,25 @@ std::string hex64(uint64_t v) {
 
 std::string temp_suffix() {
   return ".tmp-" + std::to_string(static_cast<long long>(::getpid())) + "-" + std::to_string(g_temp_counter++);
+}
+
+// Removes `<dir>/<prefix>.tmp-<pid>-<n>` entries left by a process that died
+// (killed during an extraction or a cache write). An entry is removed only when
+// its process no longer exists and it is more than an hour old, so a live
+// writer in another PID namespace sharing the folder is not disturbed.
+void remove_stale_temps(const fs::path& dir, const std::string& prefix) {
+  const std::string start = prefix + ".tmp-";
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string n = it->path().filename().string();
+    if (n.compare(0, start.size(), start) != 0) continue;
+    const long long pid = std::atoll(n.c_str() + start.size());
+    if (pid <= 0 || (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH)) continue;
+    std::error_code e2;
+    const auto age = fs::file_time_type::clock::now() - fs::last_write_time(it->path(), e2);
+    if (e2 || age < std::chrono::hours(1)) continue;
+    fs::remove_all(it->path(), e2);
+  }
 }
 
 using Clock = std::chrono::steady_clock;
@@ -230,9 +253,13 @@ std::vector<Clip> read_clips_file(const std::string& path, std::vector<std::stri
   const std::streamoff file_size = in.tellg();
   in.seekg(0);
   if (file_size < 0) throw InputError(path + ": cannot read clips file");
-  std::string data(static_cast<size_t>(file_size), '\0');
-  in.read(data.data(), file_size);
+  // Not a std::string: zero-filling a few hundred megabytes first costs time.
+  const size_t data_size = static_cast<size_t>(file_size);
+  std::unique_ptr<char[]> buffer(new (std::nothrow) char[std::max<size_t>(data_size, 1)]);
+  if (!buffer) throw InputError(path + ": clips file too large to load (" + std::to_string(data_size) + " bytes)");
+  in.read(buffer.get(), file_size);
   if (in.gcount() != file_size) throw InputError(path + ": cannot read clips file");
+  const std::string_view data(buffer.get(), data_size);
 
   if (data.size() < 8 || std::memcmp(data.data(), kClipsMagic, 8) != 0)
     throw InputError(path + ": not a motionfield clips file");
@@ -430,6 +457,7 @@ fs::path ensure_extracted(const fs::path& archive, ArchiveKind kind, const fs::p
     if (verbose) std::fprintf(stderr, "mf dataset: using extracted %s\n", final_dir.c_str());
     return final_dir;
   }
+  remove_stale_temps(cache_dir, "extract-" + hex64(key));
   const fs::path tmp = cache_dir / ("extract-" + hex64(key) + temp_suffix());
   const fs::path log = tmp.string() + ".log";
   auto cleanup = [&] {
@@ -512,7 +540,11 @@ void parse_clips(const std::vector<SourceFile>& files, const DatasetOptions& opt
       try {
         motions[i] = read_motion(files[i].path.string(), nullptr, options.units);
       } catch (const std::exception& e) {
+        // Messages start with the file's path; the path relative to the source
+        // keeps them independent of where an archive was extracted.
         errors[i] = e.what();
+        const std::string full = files[i].path.string();
+        if (errors[i].compare(0, full.size(), full) == 0) errors[i].replace(0, full.size(), files[i].rel);
         if (errors[i].empty()) errors[i] = "unknown error";
       } catch (...) {
         errors[i] = "unknown error";
@@ -524,10 +556,10 @@ void parse_clips(const std::vector<SourceFile>& files, const DatasetOptions& opt
       }
     }
   };
-  int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
-  threads = static_cast<int>(std::max<size_t>(1, std::min<size_t>(static_cast<size_t>(std::max(threads, 1)), n)));
+  size_t threads = options.threads > 0 ? static_cast<size_t>(options.threads) : std::thread::hardware_concurrency();
+  threads = std::clamp<size_t>(threads, 1, std::max<size_t>(n, 1));
   std::vector<std::thread> pool;
-  for (int t = 1; t < threads; ++t) {
+  for (size_t t = 1; t < threads; ++t) {
     try {
       pool.emplace_back(worker);
     } catch (const std::system_error&) {
@@ -660,6 +692,7 @@ Dataset load_dataset(const DatasetOptions& options) {
     parse_clips(files, options, &clips, &ds.skipped);
     if (use_cache && !clips.empty()) {
       try {
+        remove_stale_temps(cache_dir, cache_file.filename().string());
         write_clips_file(cache_file.string(), clips, ds.skipped);
         if (options.verbose) std::fprintf(stderr, "mf dataset: wrote cache %s\n", cache_file.c_str());
       } catch (const std::exception& e) {

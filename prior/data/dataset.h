@@ -28,7 +28,9 @@
 // time, cache format version); for a folder it covers the folder's absolute path
 // and the relative path, size and modification time of every clip. The clips
 // key also covers the length units. Touching or replacing the source therefore
-// misses the old cache; stale files are never deleted automatically.
+// misses the old cache; old extractions and clips files are never deleted
+// automatically (temporaries left by a killed process are, once they are more
+// than an hour old). Several processes may load the same source at once.
 #pragma once
 
 #include <cstdint>

@@ -7,7 +7,7 @@
 // locale. Every malformed input throws mf::BvhError whose message starts with
 // "<source>:<line>: " (truncated files, wrong channel counts, bad or non-finite
 // numbers, missing MOTION, zero frames, a frame count that disagrees with the
-// data, unknown keywords, nesting deeper than kMaxDepth, counts beyond the limits
+// data, unknown keywords, nesting deeper than kBvhMaxDepth, counts beyond the limits
 // below). It never crashes and never allocates more than the input justifies.
 #pragma once
 

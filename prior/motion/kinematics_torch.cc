@@ -6,6 +6,7 @@
 #include <string>
 
 #include "prior/motion/errors.h"
+#include "prior/motion/rotations_torch.h"
 #include "prior/motion/skeleton.h"
 
 namespace mf {
@@ -68,8 +69,8 @@ FkTensors forward_kinematics(const std::vector<int>& parents, const at::Tensor& 
   positions[0] = root;
   for (int64_t j = 1; j < J; ++j) {
     const at::Tensor& parent_rot = rotations[static_cast<size_t>(parents[j])];
-    rotations[j] = at::matmul(parent_rot, local.select(-3, j));
-    positions[j] = positions[static_cast<size_t>(parents[j])] + at::matmul(parent_rot, offs[j]);
+    rotations[j] = torch_rot::matmul3(parent_rot, local.select(-3, j));
+    positions[j] = positions[static_cast<size_t>(parents[j])] + torch_rot::matvec3(parent_rot, offs[j]);
   }
   return {at::stack(positions, -2), at::stack(rotations, -3)};
 }

@@ -17,6 +17,9 @@ struct FkTensors {
 
 /// local_rotations: [..., J, 3, 3]; root_positions: [..., 3]; offsets: [J, 3]
 /// (row 0, the root's, is unused). parents[j] < j, parents[0] = -1.
+/// The leading dimensions of local_rotations and root_positions broadcast (e.g.
+/// [B, T, J, 3, 3] with [B, T, 3], or with one shared [T, 3] path). The result
+/// has the promoted dtype of the inputs. Shape or parent errors throw mf::InputError.
 FkTensors forward_kinematics(const std::vector<int>& parents, const at::Tensor& offsets,
                              const at::Tensor& local_rotations, const at::Tensor& root_positions);
 

@@ -36,9 +36,7 @@ double wrap_pi(double a) {
 }
 
 // The 2*pi wrap of `a` nearest to `target`.
-double wrap_near(double a, double target) {
-  return a + 2.0 * kPi * std::round((target - a) / (2.0 * kPi));
-}
+double wrap_near(double a, double target) { return a + 2.0 * kPi * std::round((target - a) / (2.0 * kPi)); }
 
 Eigen::Vector3d wrap_near(const Eigen::Vector3d& a, const Eigen::Vector3d& target) {
   return {wrap_near(a[0], target[0]), wrap_near(a[1], target[1]), wrap_near(a[2], target[2])};
@@ -54,12 +52,9 @@ EulerOrder euler_order_from_string(const std::string& s) {
   if (s.size() != 3) throw InputError("Euler order '" + s + "' must be three axis letters, e.g. ZXY");
   EulerOrder order{};
   for (int n = 0; n < 3; ++n) {
-    switch (std::toupper(static_cast<unsigned char>(s[n]))) {
-      case 'X': order[n] = Axis::X; break;
-      case 'Y': order[n] = Axis::Y; break;
-      case 'Z': order[n] = Axis::Z; break;
-      default: throw InputError("Euler order '" + s + "' has an axis other than X, Y or Z");
-    }
+    const int letter = std::toupper(static_cast<unsigned char>(s[n]));
+    if (letter < 'X' || letter > 'Z') throw InputError("Euler order '" + s + "' has an axis other than X, Y or Z");
+    order[n] = static_cast<Axis>(letter - 'X');
   }
   if (order[0] == order[1] || order[1] == order[2] || order[0] == order[2])
     throw InputError("Euler order '" + s + "' must name three distinct axes");

@@ -28,14 +28,19 @@ std::string to_string(const EulerOrder& order);
 Eigen::Quaterniond quat_from_euler(const Eigen::Vector3d& angles, const EulerOrder& order);
 
 /// Inverse of quat_from_euler. The middle angle lies in [-pi/2, pi/2]; at the
-/// gimbal-lock singularity (middle angle +-pi/2) the third angle is set to zero
-/// and the first carries the remaining rotation. Result angles in (-pi, pi].
-/// quat_from_euler(euler_from_quat(q, o), o) equals q up to sign for every q.
+/// gimbal-lock singularity (middle angle +-pi/2, detected as cos(middle) < 1e-10)
+/// the third angle is set to zero and the first carries the remaining rotation.
+/// First and third angles in (-pi, pi]. quat_from_euler(euler_from_quat(q, o), o)
+/// equals q up to sign for every q (to about 1e-15 rad, also near the lock).
+/// `q` need not be normalised.
 Eigen::Vector3d euler_from_quat(const Eigen::Quaterniond& q, const EulerOrder& order);
 
-/// Like euler_from_quat, but of the two equivalent Euler triples (and the 2*pi
-/// wraps of each angle) returns the one closest to `previous`, so that curves
-/// written frame by frame stay continuous.
+/// Like euler_from_quat, but of the two equivalent Euler triples (a0, a1, a2) and
+/// (a0 + pi, pi - a1, a2 + pi), each angle shifted by the multiple of 2*pi nearest
+/// `previous`, returns the one closest to `previous` (Euclidean distance), so that
+/// curves written frame by frame stay continuous (angles may leave (-pi, pi]).
+/// In gimbal lock, where only a0 +- a2 is determined, the third angle is kept at
+/// previous[2] and the first takes the rest.
 Eigen::Vector3d euler_from_quat_near(const Eigen::Quaterniond& q, const EulerOrder& order,
                                      const Eigen::Vector3d& previous);
 

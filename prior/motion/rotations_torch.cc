@@ -175,7 +175,7 @@ at::Tensor geodesic_angle(const at::Tensor& m0, const at::Tensor& m1) {
   require_matrix(m1, "geodesic_angle", "m1");
   // angle = 2 atan2(|xyz|, |w|) of the relative rotation: accurate near 0 (unlike
   // acos of the trace) and with finite gradients at 0 and at pi.
-  at::Tensor q = matrix_to_quat(at::matmul(m0.transpose(-1, -2), m1));
+  at::Tensor q = matrix_to_quat(matmul3(m0.transpose(-1, -2), m1));
   at::Tensor xyz = q.narrow(-1, 1, 3);
   at::Tensor s = sqrt_positive((xyz * xyz).sum(-1));
   return 2 * at::atan2(s, comp(q, 0).abs());
@@ -199,5 +199,9 @@ at::Tensor quat_make_continuous(const at::Tensor& q, int64_t dim) {
   at::Tensor signs = at::cat({at::ones(first_shape, step.options()), step}, dim).cumprod(dim);
   return q * signs;
 }
+
+at::Tensor matmul3(const at::Tensor& a, const at::Tensor& b) { return (a.unsqueeze(-1) * b.unsqueeze(-3)).sum(-2); }
+
+at::Tensor matvec3(const at::Tensor& m, const at::Tensor& v) { return (m * v.unsqueeze(-2)).sum(-1); }
 
 }  // namespace mf::torch_rot

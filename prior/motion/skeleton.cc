@@ -1,5 +1,6 @@
 #include "prior/motion/skeleton.h"
 
+#include <cmath>
 #include <unordered_set>
 
 #include "prior/motion/errors.h"
@@ -33,14 +34,16 @@ void Skeleton::validate() const {
 bool Skeleton::same_as(const Skeleton& other, double tolerance) const {
   if (names != other.names || parents != other.parents || offsets.size() != other.offsets.size()) return false;
   for (size_t j = 0; j < offsets.size(); ++j)
-    if (!((offsets[j] - other.offsets[j]).cwiseAbs().maxCoeff() <= tolerance)) return false;
+    for (int k = 0; k < 3; ++k)  // written so that NaN compares unequal
+      if (!(std::abs(offsets[j][k] - other.offsets[j][k]) <= tolerance)) return false;
   return true;
 }
 
 std::vector<std::vector<int>> Skeleton::children() const {
   std::vector<std::vector<int>> result(names.size());
   for (size_t j = 0; j < parents.size() && j < names.size(); ++j)
-    if (parents[j] >= 0 && parents[j] < static_cast<int>(names.size())) result[parents[j]].push_back(static_cast<int>(j));
+    if (parents[j] >= 0 && parents[j] < static_cast<int>(names.size()))
+      result[parents[j]].push_back(static_cast<int>(j));
   return result;
 }
 

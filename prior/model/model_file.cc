@@ -1,0 +1,220 @@
+#include "prior/model/model_file.h"
+
+#include <ATen/ATen.h>
+
+#include <cmath>
+#include <cstring>
+#include <cstdlib>
+#include <filesystem>
+
+#include "prior/motion/errors.h"
+#include "prior/util/binary_io.h"
+
+namespace mf {
+
+namespace {
+
+constexpr char kMagic[8] = {'M', 'F', 'M', 'O', 'D', 'E', 'L', '\0'};
+
+void write_tensor(ByteWriter& w, const std::string& name, const at::Tensor& t) {
+  at::Tensor c = t.detach().to(at::kFloat).contiguous();
+  w.str(name);
+  w.u32(static_cast<uint32_t>(c.dim()));
+  for (int64_t d : c.sizes()) w.pod<int64_t>(d);
+  w.bytes(c.data_ptr<float>(), static_cast<size_t>(c.numel()) * sizeof(float));
+}
+
+std::vector<std::pair<std::string, at::Tensor>> stats_tensors(const NemfStats& s) {
+  return {{"stats.feature_mean", s.feature_mean}, {"stats.feature_std", s.feature_std},
+          {"stats.root_mean", s.root_mean},       {"stats.root_std", s.root_std},
+          {"stats.gmp_in_mean", s.gmp_in_mean},   {"stats.gmp_in_std", s.gmp_in_std},
+          {"stats.gmp_out_mean", s.gmp_out_mean}, {"stats.gmp_out_std", s.gmp_out_std}};
+}
+
+std::string shape_string(at::IntArrayRef s) {
+  std::string out = "[";
+  for (size_t i = 0; i < s.size(); ++i) out += (i ? ", " : "") + std::to_string(s[i]);
+  return out + "]";
+}
+
+}  // namespace
+
+std::vector<uint8_t> serialize_nemf(const NemfModel& model) {
+  ByteWriter p;
+  auto config = model.config().to_map();
+  p.u32(static_cast<uint32_t>(config.size()));
+  for (const auto& [k, v] : config) {
+    p.str(k);
+    p.f64(v);
+  }
+  const RigInfo& rig = model.rig();
+  const Skeleton& sk = rig.skeleton;
+  p.u32(static_cast<uint32_t>(sk.num_joints()));
+  for (int j = 0; j < sk.num_joints(); ++j) {
+    p.str(sk.names[j]);
+    p.i32(sk.parents[j]);
+    for (int a = 0; a < 3; ++a) p.f64(sk.offsets[j][a]);
+  }
+  for (int a = 0; a < 3; ++a) p.f64(rig.root_forward[a]);
+  p.u32(static_cast<uint32_t>(rig.num_feet()));
+  for (int k = 0; k < rig.num_feet(); ++k) {
+    p.i32(rig.foot_joints[k]);
+    p.f64(rig.foot_heights[k]);
+    p.f64(rig.foot_thresholds[k]);
+  }
+  p.f64(rig.contact_speed);
+  auto stats = stats_tensors(model.stats());
+  auto weights = model.named_parameters();
+  p.u32(static_cast<uint32_t>(stats.size() + weights.size()));
+  for (const auto& [name, t] : stats) write_tensor(p, name, t);
+  for (const auto& [name, t] : weights) write_tensor(p, name, t);
+
+  ByteWriter out;
+  out.bytes(kMagic, sizeof(kMagic));
+  out.u32(kModelFormatVersion);
+  out.str(kNemfKind);
+  out.u64(p.buffer().size());
+  out.bytes(p.buffer().data(), p.buffer().size());
+  out.u64(fnv1a64_bytes(p.buffer().data(), p.buffer().size()));
+  return std::move(out.buffer());
+}
+
+NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& source) {
+  ByteReader head(data, size, source);
+  char magic[8];
+  if (size < sizeof(magic) || std::memcmp(data, kMagic, sizeof(magic)) != 0) {
+    throw InputError(source + ": not a motionfield model file (bad magic)");
+  }
+  head.bytes(magic, sizeof(magic));
+  uint32_t version = head.u32();
+  if (version != kModelFormatVersion) {
+    throw InputError(source + ": unsupported model format version " + std::to_string(version) +
+                     " (this build reads version " + std::to_string(kModelFormatVersion) + ")");
+  }
+  std::string kind = head.str(64);
+  if (kind != kNemfKind) {
+    throw InputError(source + ": wrong kind of model: the file holds a '" + kind + "' model, expected '" + kNemfKind +
+                     "'");
+  }
+  uint64_t payload_size = head.u64();
+  if (payload_size > head.remaining() || head.remaining() - payload_size < sizeof(uint64_t)) {
+    throw InputError(source + ": truncated model file (payload of " + std::to_string(payload_size) +
+                     " bytes announced, " + std::to_string(head.remaining()) + " bytes left)");
+  }
+  const uint8_t* payload = data + head.position();
+  uint64_t stored;
+  std::memcpy(&stored, payload + payload_size, sizeof(stored));
+  if (stored != fnv1a64_bytes(payload, payload_size)) {
+    throw InputError(source + ": corrupted model file (checksum mismatch)");
+  }
+
+  ByteReader p(payload, payload_size, source);
+  std::map<std::string, double> values;
+  uint32_t n = p.u32();
+  if (n > 1000) p.fail("too many hyperparameters");
+  for (uint32_t i = 0; i < n; ++i) {
+    std::string k = p.str(256);
+    values[k] = p.f64();
+  }
+  NemfConfig config = NemfConfig::from_map(values);
+  std::string problem = config.validate();
+  if (!problem.empty()) throw InputError(source + ": invalid hyperparameters: " + problem);
+
+  RigInfo rig;
+  uint32_t J = p.u32();
+  if (J == 0 || J > 1024) p.fail("bad joint count " + std::to_string(J));
+  for (uint32_t j = 0; j < J; ++j) {
+    rig.skeleton.names.push_back(p.str(1024));
+    rig.skeleton.parents.push_back(p.i32());
+    Eigen::Vector3d o;
+    for (int a = 0; a < 3; ++a) o[a] = p.f64();
+    rig.skeleton.offsets.push_back(o);
+  }
+  try {
+    rig.skeleton.validate();
+  } catch (const InputError& e) {
+    throw InputError(source + ": invalid skeleton: " + e.what());
+  }
+  for (int a = 0; a < 3; ++a) rig.root_forward[a] = p.f64();
+  uint32_t F = p.u32();
+  if (F > J) p.fail("more feet than joints");
+  for (uint32_t k = 0; k < F; ++k) {
+    int joint = p.i32();
+    if (joint < 0 || joint >= static_cast<int>(J)) p.fail("foot joint out of range");
+    rig.foot_joints.push_back(joint);
+    rig.foot_heights.push_back(p.f64());
+    rig.foot_thresholds.push_back(p.f64());
+  }
+  rig.contact_speed = p.f64();
+
+  NemfModel model(config, rig);
+  std::map<std::string, at::Tensor> tensors;
+  uint32_t count = p.u32();
+  if (count > 100000) p.fail("too many tensors");
+  for (uint32_t i = 0; i < count; ++i) {
+    std::string name = p.str(1024);
+    uint32_t rank = p.u32();
+    if (rank > 8) p.fail("tensor '" + name + "' has rank " + std::to_string(rank));
+    std::vector<int64_t> dims(rank);
+    uint64_t numel = 1;
+    for (auto& d : dims) {
+      d = p.pod<int64_t>();
+      if (d < 0 || d > (int64_t(1) << 32)) p.fail("tensor '" + name + "' has a bad dimension");
+      numel *= static_cast<uint64_t>(d);
+    }
+    p.need_items(numel, sizeof(float));
+    at::Tensor t = at::empty(dims, at::kFloat);
+    p.bytes(t.data_ptr<float>(), numel * sizeof(float));
+    if (!at::isfinite(t).all().item<bool>()) p.fail("tensor '" + name + "' holds non-finite values");
+    tensors[name] = t;
+  }
+  if (p.remaining() != 0) p.fail("unexpected trailing data");
+
+  auto take = [&](const std::string& name, at::Tensor& target) {
+    auto it = tensors.find(name);
+    if (it == tensors.end()) throw InputError(source + ": model file lacks tensor '" + name + "'");
+    if (target.defined() && !target.sizes().equals(it->second.sizes())) {
+      throw InputError(source + ": tensor '" + name + "' has shape " + shape_string(it->second.sizes()) +
+                       ", expected " + shape_string(target.sizes()));
+    }
+    at::NoGradGuard guard;
+    target.copy_(it->second);
+    tensors.erase(it);
+  };
+  NemfStats& s = model.stats();
+  take("stats.feature_mean", s.feature_mean);
+  take("stats.feature_std", s.feature_std);
+  take("stats.root_mean", s.root_mean);
+  take("stats.root_std", s.root_std);
+  take("stats.gmp_in_mean", s.gmp_in_mean);
+  take("stats.gmp_in_std", s.gmp_in_std);
+  take("stats.gmp_out_mean", s.gmp_out_mean);
+  take("stats.gmp_out_std", s.gmp_out_std);
+  for (auto& [name, param] : model.named_parameters()) take(name, param);
+  if (!tensors.empty()) {
+    throw InputError(source + ": model file has unexpected tensor '" + tensors.begin()->first +
+                     "' (trained with another architecture?)");
+  }
+  return model;
+}
+
+void save_nemf(const NemfModel& model, const std::string& path) { write_file_atomically(path, serialize_nemf(model)); }
+
+NemfModel load_nemf(const std::string& path) {
+  std::vector<uint8_t> bytes = read_file_bytes(path);
+  return deserialize_nemf(bytes.data(), bytes.size(), path);
+}
+
+std::string default_model_path() {
+  namespace fs = std::filesystem;
+  if (const char* env = std::getenv("MF_MODEL"); env && *env) return env;
+#ifdef MF_INSTALLED_MODEL
+  if (fs::exists(MF_INSTALLED_MODEL)) return MF_INSTALLED_MODEL;
+#endif
+#ifdef MF_SOURCE_MODEL
+  if (fs::exists(MF_SOURCE_MODEL)) return MF_SOURCE_MODEL;
+#endif
+  return "";
+}
+
+}  // namespace mf

@@ -1,0 +1,43 @@
+// The model file: one self-describing binary file per trained model.
+//
+// Layout (little-endian):
+//   "MFMODEL\0"                 8-byte magic
+//   u32 format version          kModelFormatVersion
+//   str kind                    "nemf" (the transformer issue adds its kinds)
+//   u64 payload size
+//   payload:
+//     hyperparameters           u32 n, then n x (str name, f64 value)
+//     rig                       skeleton (names, parents, offsets in metres),
+//                               root forward axis, feet (joint, standing height,
+//                               threshold), contact speed
+//     tensors                   u32 n, then n x (str name, u32 rank, i64 dims...,
+//                               float32 data): normalisation stats ("stats.*")
+//                               and weights
+//   u64 checksum                FNV-1a 64 of the payload
+// Strings are u32 length + bytes. Loading validates every part and throws
+// mf::InputError saying precisely what is wrong (not a model file, truncated,
+// corrupted, wrong version, wrong kind, missing or misshapen weights).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "prior/model/nemf.h"
+
+namespace mf {
+
+constexpr uint32_t kModelFormatVersion = 1;
+constexpr char kNemfKind[] = "nemf";
+
+std::vector<uint8_t> serialize_nemf(const NemfModel& model);
+NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& source);
+
+void save_nemf(const NemfModel& model, const std::string& path);
+NemfModel load_nemf(const std::string& path);
+
+/// The default model shipped in models/: MF_MODEL if set, else the installed or
+/// source-tree models/motionfield-prior.mfm, else "" when none exists.
+std::string default_model_path();
+
+}  // namespace mf

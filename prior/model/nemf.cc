@@ -1,0 +1,385 @@
+#include "prior/model/nemf.h"
+
+#include <torch/nn/module.h>
+#include <torch/nn/modules/conv.h>
+#include <torch/nn/modules/linear.h>
+#include <torch/nn/modules/normalization.h>
+#include <torch/nn/init.h>
+#include <ATen/ATen.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "prior/motion/errors.h"
+#include "prior/motion/rotations_torch.h"
+
+namespace mf {
+
+namespace {
+
+constexpr int kFeaturesPerJoint = 15;
+
+at::Tensor lrelu(const at::Tensor& x) { return at::leaky_relu(x, 0.2); }
+
+// Temporal convolution whose weights connect each joint only to itself, its
+// parent and its children (a skeleton-aware convolution with distance 1).
+struct SkeletonConvImpl : torch::nn::Module {
+  SkeletonConvImpl(const std::vector<int>& parents, int cin, int cout, int kernel, int stride, int padding)
+      : stride_(stride), padding_(padding) {
+    const int J = static_cast<int>(parents.size());
+    at::Tensor adjacency = at::eye(J, at::kFloat);
+    for (int j = 1; j < J; ++j) {
+      adjacency[j][parents[j]] = 1.0f;
+      adjacency[parents[j]][j] = 1.0f;
+    }
+    // [J * cout, J * cin, 1]: joint blocks of the adjacency.
+    at::Tensor mask = adjacency.repeat_interleave(cout, 0).repeat_interleave(cin, 1).unsqueeze(-1);
+    mask_ = register_buffer("mask", mask);
+    at::Tensor degree = adjacency.sum(1).repeat_interleave(cout, 0).view({-1, 1, 1});
+    at::Tensor bound = at::rsqrt(degree * (cin * kernel));
+    weight_ = register_parameter("weight", (at::rand({J * cout, J * cin, kernel}) * 2 - 1) * bound * mask);
+    bias_ = register_parameter("bias", at::zeros({J * cout}));
+  }
+  at::Tensor forward(const at::Tensor& x) {
+    return at::conv1d(x, weight_ * mask_, bias_, {stride_}, {padding_});
+  }
+  int stride_, padding_;
+  at::Tensor weight_, bias_, mask_;
+};
+TORCH_MODULE(SkeletonConv);
+
+struct LocalEncoderImpl : torch::nn::Module {
+  LocalEncoderImpl(const NemfConfig& c, const std::vector<int>& parents) : joints_(static_cast<int>(parents.size())) {
+    int cin = kFeaturesPerJoint + 1;  // + mask channel
+    int ch = c.encoder_channels;
+    for (int i = 0; i < 4; ++i) {
+      int cout = ch * std::min(1 << i, 2);
+      convs_.push_back(register_module("conv" + std::to_string(i), SkeletonConv(parents, cin, cout, 4, 2, 1)));
+      norms_.push_back(register_module("norm" + std::to_string(i),
+                                       torch::nn::GroupNorm(torch::nn::GroupNormOptions(joints_, joints_ * cout))));
+      cin = cout;
+    }
+    mix_ = register_module("mix", torch::nn::Conv1d(torch::nn::Conv1dOptions(joints_ * cin, 256, 1)));
+    head_ = register_module("head", torch::nn::Linear(256 * (c.window / 16), 2 * c.zl));
+  }
+  at::Tensor forward(at::Tensor x) {  // [B, J * 16, window] -> [B, 2 * zl]
+    for (size_t i = 0; i < convs_.size(); ++i) x = lrelu(norms_[i]->forward(convs_[i]->forward(x)));
+    x = lrelu(mix_->forward(x));
+    return head_->forward(x.flatten(1));
+  }
+  int joints_;
+  std::vector<SkeletonConv> convs_;
+  std::vector<torch::nn::GroupNorm> norms_;
+  torch::nn::Conv1d mix_{nullptr};
+  torch::nn::Linear head_{nullptr};
+};
+TORCH_MODULE(LocalEncoder);
+
+struct GlobalEncoderImpl : torch::nn::Module {
+  explicit GlobalEncoderImpl(const NemfConfig& c) {
+    const int channels[5] = {7, 64, 128, 128, 128};
+    for (int i = 0; i < 4; ++i) {
+      convs_.push_back(register_module(
+          "conv" + std::to_string(i),
+          torch::nn::Conv1d(torch::nn::Conv1dOptions(channels[i], channels[i + 1], 4).stride(2).padding(1))));
+    }
+    head_ = register_module("head", torch::nn::Linear(128 * (c.window / 16), 2 * c.zg));
+  }
+  at::Tensor forward(at::Tensor x) {  // [B, 7, window] -> [B, 2 * zg]
+    for (auto& conv : convs_) x = lrelu(conv->forward(x));
+    return head_->forward(x.flatten(1));
+  }
+  std::vector<torch::nn::Conv1d> convs_;
+  torch::nn::Linear head_{nullptr};
+};
+TORCH_MODULE(GlobalEncoder);
+
+// The MLP f(t; z_l, z_g). Each layer's Linear over [h, PE(t), z_l, (z_g)] is
+// split by input so the latent parts are computed once per window, not per frame.
+struct DecoderImpl : torch::nn::Module {
+  DecoderImpl(const NemfConfig& c, int joints) : config_(c), joints_(joints) {
+    const int W = c.decoder_width;
+    for (int l = 0; l < c.decoder_layers; ++l) {
+      std::string s = std::to_string(l);
+      pe_.push_back(register_module("pe" + s, torch::nn::Linear(2 * c.pe_frequencies, W)));
+      zl_.push_back(register_module("zl" + s, torch::nn::Linear(torch::nn::LinearOptions(c.zl, W).bias(false))));
+      hidden_.push_back(l == 0 ? nullptr
+                               : register_module("h" + s, torch::nn::Linear(torch::nn::LinearOptions(W, W).bias(false))));
+      zg_.push_back(l < c.decoder_layers - c.zg_layers
+                        ? nullptr
+                        : register_module("zg" + s, torch::nn::Linear(torch::nn::LinearOptions(c.zg, W).bias(false))));
+      norms_.push_back(register_module("norm" + s, torch::nn::LayerNorm(torch::nn::LayerNormOptions({W}))));
+    }
+    head_ = register_module("head", torch::nn::Linear(W, joints * 6));
+    torch::NoGradGuard no_grad;
+    head_->weight.mul_(0.1);
+    head_->bias.zero_();
+  }
+  // pe [B or 1, S, 2F], z_l [B, zl], z_g [B, zg] -> 6D [B, S, J, 6]
+  at::Tensor forward(const at::Tensor& pe, const at::Tensor& z_l, const at::Tensor& z_g) {
+    at::Tensor h;
+    for (int l = 0; l < config_.decoder_layers; ++l) {
+      at::Tensor a = pe_[l]->forward(pe) + zl_[l]->forward(z_l).unsqueeze(1);
+      if (hidden_[l]) a = a + hidden_[l]->forward(h);
+      if (zg_[l]) a = a + zg_[l]->forward(z_g).unsqueeze(1);
+      h = at::relu(norms_[l]->forward(a));
+    }
+    at::Tensor out = head_->forward(h);
+    out = out.unflatten(-1, {joints_, 6});
+    // Centred on the identity rotation so the initial output is well conditioned.
+    at::Tensor identity = at::tensor({1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f}, out.options());
+    return out + identity;
+  }
+  NemfConfig config_;
+  int joints_;
+  std::vector<torch::nn::Linear> pe_, zl_, hidden_, zg_;
+  std::vector<torch::nn::LayerNorm> norms_;
+  torch::nn::Linear head_{nullptr};
+};
+TORCH_MODULE(Decoder);
+
+struct GlobalPredictorImpl : torch::nn::Module {
+  GlobalPredictorImpl(const NemfConfig& c, int joints, int feet) : pad_(c.gmp_kernel / 2) {
+    const int W = c.gmp_width;
+    input_ = register_module("input", torch::nn::Conv1d(torch::nn::Conv1dOptions(joints * 3 + 6, W, c.gmp_kernel)));
+    for (int i = 0; i < c.gmp_blocks; ++i) {
+      blocks_.push_back(register_module("block" + std::to_string(i),
+                                        torch::nn::Conv1d(torch::nn::Conv1dOptions(W, W, c.gmp_kernel))));
+    }
+    output_ = register_module("output", torch::nn::Conv1d(torch::nn::Conv1dOptions(W, 4 + feet, 1)));
+  }
+  at::Tensor pad(const at::Tensor& x) const { return at::replication_pad1d(x, {pad_, pad_}); }
+  at::Tensor forward(const at::Tensor& x) {  // [B, C, T] -> [B, 4 + F, T]
+    at::Tensor h = lrelu(input_->forward(pad(x)));
+    for (auto& b : blocks_) h = h + lrelu(b->forward(pad(h)));
+    return output_->forward(h);
+  }
+  int pad_;
+  torch::nn::Conv1d input_{nullptr}, output_{nullptr};
+  std::vector<torch::nn::Conv1d> blocks_;
+};
+TORCH_MODULE(GlobalPredictor);
+
+struct NemfNetImpl : torch::nn::Module {
+  NemfNetImpl(const NemfConfig& c, const RigInfo& rig) {
+    local = register_module("local_encoder", LocalEncoder(c, rig.skeleton.parents));
+    global = register_module("global_encoder", GlobalEncoder(c));
+    decoder = register_module("decoder", Decoder(c, rig.num_joints()));
+    gmp = register_module("gmp", GlobalPredictor(c, rig.num_joints(), rig.num_feet()));
+  }
+  LocalEncoder local{nullptr};
+  GlobalEncoder global{nullptr};
+  Decoder decoder{nullptr};
+  GlobalPredictor gmp{nullptr};
+};
+TORCH_MODULE(NemfNet);
+
+at::Tensor ones_like_stats(int64_t n) { return at::ones({n}); }
+
+}  // namespace
+
+std::string NemfConfig::validate() const {
+  std::ostringstream e;
+  if (window < 16 || window % 16 != 0) e << "window must be a positive multiple of 16; ";
+  if (!(fps > 0) || !std::isfinite(fps)) e << "fps must be positive; ";
+  if (pe_frequencies < 1 || pe_frequencies > 16) e << "pe_frequencies must be in [1, 16]; ";
+  if (decoder_width < 8 || decoder_width > 4096) e << "decoder_width must be in [8, 4096]; ";
+  if (decoder_layers < 1 || decoder_layers > 32) e << "decoder_layers must be in [1, 32]; ";
+  if (zl < 1 || zl > 4096 || zg < 1 || zg > 4096) e << "latent sizes must be in [1, 4096]; ";
+  if (zg_layers < 1 || zg_layers > decoder_layers) e << "zg_layers must be in [1, decoder_layers]; ";
+  if (encoder_channels < 1 || encoder_channels > 256) e << "encoder_channels must be in [1, 256]; ";
+  if (gmp_width < 4 || gmp_kernel < 1 || gmp_kernel % 2 == 0 || gmp_blocks < 0) e << "bad GMP sizes; ";
+  return e.str();
+}
+
+std::string NemfConfig::describe() const {
+  std::ostringstream s;
+  s << "decoder " << decoder_layers << "x" << decoder_width << ", z_l " << zl << ", z_g " << zg << " (last "
+    << zg_layers << " layers), PE " << pe_frequencies << " octaves, encoder channels " << encoder_channels
+    << ", GMP " << gmp_blocks << " blocks x " << gmp_width << " (kernel " << gmp_kernel << "), window " << window
+    << " frames at " << fps << " fps";
+  return s.str();
+}
+
+std::map<std::string, double> NemfConfig::to_map() const {
+  return {{"window", window},
+          {"fps", fps},
+          {"pe_frequencies", pe_frequencies},
+          {"decoder_width", decoder_width},
+          {"decoder_layers", decoder_layers},
+          {"zl", zl},
+          {"zg", zg},
+          {"zg_layers", zg_layers},
+          {"encoder_channels", encoder_channels},
+          {"gmp_width", gmp_width},
+          {"gmp_kernel", gmp_kernel},
+          {"gmp_blocks", gmp_blocks}};
+}
+
+NemfConfig NemfConfig::from_map(const std::map<std::string, double>& v) {
+  NemfConfig c;
+  auto get = [&](const char* k, auto& field) {
+    auto it = v.find(k);
+    if (it == v.end()) throw InputError(std::string("model hyperparameter '") + k + "' is missing");
+    field = static_cast<std::remove_reference_t<decltype(field)>>(it->second);
+  };
+  get("window", c.window);
+  get("fps", c.fps);
+  get("pe_frequencies", c.pe_frequencies);
+  get("decoder_width", c.decoder_width);
+  get("decoder_layers", c.decoder_layers);
+  get("zl", c.zl);
+  get("zg", c.zg);
+  get("zg_layers", c.zg_layers);
+  get("encoder_channels", c.encoder_channels);
+  get("gmp_width", c.gmp_width);
+  get("gmp_kernel", c.gmp_kernel);
+  get("gmp_blocks", c.gmp_blocks);
+  return c;
+}
+
+at::Tensor time_encoding(const at::Tensor& frames, int window, int frequencies) {
+  at::Tensor t = frames.to(at::kFloat) / static_cast<double>(window) * 2.0 - 1.0;
+  at::Tensor freq = at::pow(2.0, at::arange(frequencies, at::kFloat));
+  at::Tensor a = t.unsqueeze(-1) * freq;
+  return at::cat({at::sin(a), at::cos(a)}, -1);
+}
+
+struct NemfModel::Impl {
+  Impl(const NemfConfig& c, const RigInfo& r) : config(c), rig(r), net(c, r) {
+    const int J = r.num_joints();
+    stats.feature_mean = at::zeros({J * kFeaturesPerJoint});
+    stats.feature_std = ones_like_stats(J * kFeaturesPerJoint);
+    stats.root_mean = at::zeros({6});
+    stats.root_std = ones_like_stats(6);
+    stats.gmp_in_mean = at::zeros({J * 3 + 6});
+    stats.gmp_in_std = ones_like_stats(J * 3 + 6);
+    stats.gmp_out_mean = at::zeros({4});
+    stats.gmp_out_std = ones_like_stats(4);
+  }
+  NemfConfig config;
+  RigInfo rig;
+  NemfStats stats;
+  NemfNet net;
+};
+
+NemfModel::NemfModel(const NemfConfig& config, const RigInfo& rig) {
+  std::string problem = config.validate();
+  if (!problem.empty()) throw InputError("invalid prior configuration: " + problem);
+  rig.skeleton.validate();
+  impl_ = std::make_unique<Impl>(config, rig);
+}
+NemfModel::~NemfModel() = default;
+NemfModel::NemfModel(NemfModel&&) noexcept = default;
+NemfModel& NemfModel::operator=(NemfModel&&) noexcept = default;
+
+const NemfConfig& NemfModel::config() const { return impl_->config; }
+const RigInfo& NemfModel::rig() const { return impl_->rig; }
+NemfStats& NemfModel::stats() { return impl_->stats; }
+const NemfStats& NemfModel::stats() const { return impl_->stats; }
+
+NemfLatent NemfModel::encode(const at::Tensor& local_rotations, const at::Tensor& mask) const {
+  const int64_t T = local_rotations.size(1), J = impl_->rig.num_joints();
+  if (local_rotations.dim() != 5 || T < 2 || T > impl_->config.window || local_rotations.size(2) != J) {
+    throw InputError("encode: expected [B, T, " + std::to_string(J) + ", 3, 3] with 2 <= T <= " +
+                     std::to_string(impl_->config.window));
+  }
+  at::Tensor root6d;
+  at::Tensor features = local_features(local_rotations, impl_->rig, impl_->config.fps, &root6d);
+  return encode_features(features.flatten(2), root6d, mask);
+}
+
+NemfLatent NemfModel::encode_features(const at::Tensor& features, const at::Tensor& root6d,
+                                      const at::Tensor& mask) const {
+  const NemfConfig& c = impl_->config;
+  const int64_t B = features.size(0), T = features.size(1), J = impl_->rig.num_joints();
+  if (T < 1 || T > c.window || features.size(2) != J * kFeaturesPerJoint) {
+    throw InputError("encode: expected features [B, T, " + std::to_string(J * kFeaturesPerJoint) + "] with T <= " +
+                     std::to_string(c.window));
+  }
+  const NemfStats& s = impl_->stats;
+  at::Tensor m = mask.to(features.options()).unsqueeze(-1);  // [B, T, 1]
+  at::Tensor f = (features - s.feature_mean) / s.feature_std * m;
+  at::Tensor r = (root6d - s.root_mean) / s.root_std * m;
+  if (T < c.window) {
+    f = at::cat({f, at::zeros({B, c.window - T, f.size(2)}, f.options())}, 1);
+    r = at::cat({r, at::zeros({B, c.window - T, 6}, r.options())}, 1);
+    m = at::cat({m, at::zeros({B, c.window - T, 1}, m.options())}, 1);
+  }
+  // Per joint: its 15 features then the mask, channels-first for the convolutions.
+  at::Tensor local_in = at::cat({f.unflatten(2, {J, kFeaturesPerJoint}), m.unsqueeze(2).expand({B, c.window, J, 1})}, -1)
+                            .flatten(2)
+                            .transpose(1, 2);
+  at::Tensor global_in = at::cat({r, m}, -1).transpose(1, 2);
+  at::Tensor l = impl_->net->local->forward(local_in);
+  at::Tensor g = impl_->net->global->forward(global_in);
+  NemfLatent z;
+  z.mu_l = l.narrow(1, 0, c.zl);
+  z.logvar_l = l.narrow(1, c.zl, c.zl);
+  z.mu_g = g.narrow(1, 0, c.zg);
+  z.logvar_g = g.narrow(1, c.zg, c.zg);
+  return z;
+}
+
+at::Tensor NemfModel::decode(const at::Tensor& frames, const at::Tensor& z_l, const at::Tensor& z_g) const {
+  const NemfConfig& c = impl_->config;
+  at::Tensor pe = time_encoding(frames, c.window, c.pe_frequencies).to(z_l.options());
+  if (pe.dim() == 2) pe = pe.unsqueeze(0);
+  at::Tensor d6 = impl_->net->decoder->forward(pe, z_l, z_g);
+  return torch_rot::sixd_to_matrix(d6);
+}
+
+GmpOutput NemfModel::predict_global(const at::Tensor& local_rotations) const {
+  return predict_global_from_inputs(gmp_inputs(local_rotations, impl_->rig));
+}
+
+GmpOutput NemfModel::predict_global_from_inputs(const at::Tensor& inputs) const {
+  const RigInfo& rig = impl_->rig;
+  const NemfStats& s = impl_->stats;
+  at::Tensor x = (inputs - s.gmp_in_mean) / s.gmp_in_std;
+  at::Tensor y = impl_->net->gmp->forward(x.transpose(1, 2)).transpose(1, 2);  // [B, T, 4 + F]
+  at::Tensor out = y.narrow(-1, 0, 4) * s.gmp_out_std + s.gmp_out_mean;
+  GmpOutput g;
+  g.velocity = out.narrow(-1, 0, 3);
+  g.height = out.narrow(-1, 3, 1);
+  g.contact_logits = y.narrow(-1, 4, rig.num_feet());
+  return g;
+}
+
+at::Tensor NemfModel::root_positions(const at::Tensor& local_rotations, const GmpOutput& gmp,
+                                     const at::Tensor& start_xz) const {
+  at::Tensor h = heading_rotation(local_rotations.select(-3, 0), impl_->rig.root_forward);
+  return integrate_root(gmp.velocity, gmp.height, h, impl_->config.fps, start_xz);
+}
+
+std::vector<std::pair<std::string, at::Tensor>> NemfModel::named_parameters() const {
+  std::vector<std::pair<std::string, at::Tensor>> out;
+  for (const auto& item : impl_->net->named_parameters(true)) out.emplace_back(item.key(), item.value());
+  return out;
+}
+
+std::vector<at::Tensor> NemfModel::parameters() const { return impl_->net->parameters(true); }
+
+std::vector<at::Tensor> NemfModel::vae_parameters() const {
+  std::vector<at::Tensor> out;
+  for (const auto& item : impl_->net->named_parameters(true)) {
+    if (item.key().rfind("gmp.", 0) != 0) out.push_back(item.value());
+  }
+  return out;
+}
+
+std::vector<at::Tensor> NemfModel::gmp_parameters() const { return impl_->net->gmp->parameters(true); }
+
+int64_t NemfModel::num_parameters() const {
+  int64_t n = 0;
+  for (auto& p : parameters()) n += p.numel();
+  return n;
+}
+
+void NemfModel::train(bool on) { impl_->net->train(on); }
+
+void NemfModel::set_requires_grad(bool on) {
+  for (auto& p : parameters()) p.set_requires_grad(on);
+}
+
+}  // namespace mf

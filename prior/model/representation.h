@@ -1,0 +1,114 @@
+// The prior's view of motion: canonical windows as batched float tensors, the
+// local-motion features its encoder reads, and the quantities its global
+// motion predictor (GMP) is trained on. Everything here is differentiable where
+// the solvers need it, and shared by training, the tasks and the benchmark.
+//
+// Canonical frame of a window: translated so that the root's ground position at
+// the anchor frame (frame 0 unless said otherwise) is the origin, and turned
+// about +Y so that the root's heading at the anchor frame is +Z.
+//
+// Heading: the root's forward axis (a unit vector in the root's local frame,
+// RigInfo::root_forward) mapped to the world, projected on the ground; H(t) is
+// the rotation about +Y by yaw(t) = atan2(f.x, f.z), so H(t) * (0, 0, 1) is the
+// heading direction.
+//
+// Tensor layout used throughout (B windows, T frames, J joints, float32):
+//   local_rotations [B, T, J, 3, 3]  parent-relative; joint 0's is the root's
+//                                    global rotation in the canonical frame
+//   root_positions  [B, T, 3]        metres, canonical frame
+#pragma once
+
+#include <ATen/core/Tensor.h>
+#include <string>
+#include <vector>
+
+#include "prior/motion/motion.h"
+
+namespace mf {
+
+/// What the prior needs to know about a rig beyond its skeleton; measured from
+/// the training data and stored in the model file.
+struct RigInfo {
+  Skeleton skeleton;
+  Eigen::Vector3d root_forward{0, 0, 1};  ///< root-local axis that points forward
+  std::vector<int> foot_joints;           ///< joints whose contacts the GMP predicts
+  std::vector<double> foot_heights;       ///< standing height of each foot joint, metres
+  std::vector<double> foot_thresholds;    ///< contact height threshold above standing height, metres
+  double contact_speed = 0.25;            ///< max horizontal speed in contact, m/s
+
+  int num_joints() const { return skeleton.num_joints(); }
+  int num_feet() const { return static_cast<int>(foot_joints.size()); }
+};
+
+/// Foot joints of a skeleton by name (ankle: "foot"/"ankle", toe: "toe",
+/// case-insensitive), ankles first; `toe_flags` (optional) tells which are toes.
+std::vector<int> find_foot_joints(const Skeleton& skeleton, std::vector<bool>* toe_flags = nullptr);
+
+/// Rig facts measured from clips: the root's forward axis (the root-local
+/// principal axis best aligned with the horizontal velocity while moving), the
+/// feet and their standing heights (median over clips of each clip's
+/// 5th-percentile height), contact thresholds (ankle 8 cm, toe 4 cm above
+/// standing height, as NeMF's, measured relative to this rig's standing height).
+RigInfo measure_rig(const Skeleton& skeleton, const std::vector<const Motion*>& clips);
+
+/// Motion frames [begin, begin + length) as tensors [1, length, ...] in the
+/// canonical frame of frame `begin + anchor`.
+struct WindowTensors {
+  at::Tensor local_rotations;  ///< [1, T, J, 3, 3]
+  at::Tensor root_positions;   ///< [1, T, 3]
+};
+WindowTensors window_tensors(const Motion& motion, int begin, int length, const RigInfo& rig, int anchor = 0);
+
+/// The rigid ground transform that made a window canonical: world = R_y(yaw) * canonical + (x, 0, z).
+struct GroundTransform {
+  double yaw = 0.0;
+  double x = 0.0;
+  double z = 0.0;
+};
+GroundTransform canonical_transform(const Motion& motion, int anchor_frame, const RigInfo& rig);
+
+/// Writes canonical tensors (one window, [T, ...] or [1, T, ...]) back into
+/// `motion` frames [begin, begin + T), undoing `transform`.
+void write_window(const at::Tensor& local_rotations, const at::Tensor& root_positions,
+                  const GroundTransform& transform, Motion* motion, int begin);
+
+/// The ground-plane coordinates (x, z) of points [..., 3] -> [..., 2].
+at::Tensor ground_xz(const at::Tensor& points);
+
+/// Heading rotations H(t) [..., 3, 3] from root rotations [..., 3, 3].
+at::Tensor heading_rotation(const at::Tensor& root_rotations, const Eigen::Vector3d& root_forward);
+
+/// Per-frame local-motion features of the encoder, [B, T, J, 15]: root-relative
+/// joint positions in the heading frame (3), their velocities (3, central
+/// differences, one-sided at the ends, per second), the 6D of each joint's
+/// global rotation with the heading removed (6) and its angular velocity (3,
+/// rad/s). Root orientation (6D, canonical frame) is returned in `root6d`
+/// [B, T, 6] for the global encoder.
+at::Tensor local_features(const at::Tensor& local_rotations, const RigInfo& rig, double fps, at::Tensor* root6d);
+
+/// Root-relative joint positions with the heading removed, [B, T, J, 3]; the
+/// GMP's main input.
+at::Tensor heading_relative_positions(const at::Tensor& local_rotations, const RigInfo& rig);
+
+/// The GMP's per-frame input, [B, T, J * 3 + 6]: heading-relative joint
+/// positions and the 6D of the root rotation with the heading removed.
+at::Tensor gmp_inputs(const at::Tensor& local_rotations, const RigInfo& rig);
+
+/// GMP targets from ground truth: root velocity in the heading frame (m/s,
+/// forward differences, the last frame repeats) [B, T, 3], root height [B, T, 1]
+/// and foot contacts in {0, 1} [B, T, F].
+struct GmpTargets {
+  at::Tensor velocity;
+  at::Tensor height;
+  at::Tensor contacts;
+};
+GmpTargets gmp_targets(const at::Tensor& local_rotations, const at::Tensor& root_positions, const RigInfo& rig,
+                       double fps);
+
+/// Root translation from heading-frame velocities: forward-Euler integration
+/// of the horizontal velocity from `start_xz` [B, 2] (the canonical origin when
+/// undefined), height set directly. [B, T, 3].
+at::Tensor integrate_root(const at::Tensor& velocity, const at::Tensor& height, const at::Tensor& headings,
+                          double fps, const at::Tensor& start_xz = {});
+
+}  // namespace mf

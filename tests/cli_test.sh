@@ -1,0 +1,208 @@
+#!/usr/bin/env bash
+# End-to-end tests of the motionfield CLI on the bundled sample.
+#   usage: bash tests/cli_test.sh <path-to-motionfield> <source-dir>
+# Checks frame counts and frame times of every subcommand's output, that known
+# frames come back unchanged (with the hidden `motionfield diff` helper), the
+# exit code 2 of every kind of bad input, and batch mode.
+set -u
+
+MF=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
+SRC=$(cd "$2" && pwd)
+SAMPLE="$SRC/samples/walk_keyframes.bvh"
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/mf-cli-test.XXXXXX")
+trap 'rm -rf "$TMP"' EXIT
+
+failures=0
+checks=0
+pass() { checks=$((checks + 1)); }
+fail() { checks=$((checks + 1)); failures=$((failures + 1)); echo "FAIL: $*"; }
+
+frames_of() { awk '/^Frames:/ { print $2; exit }' "$1"; }
+frame_time_of() { awk '/^Frame Time:/ { print $3; exit }' "$1"; }
+
+# expect_rc CODE DESCRIPTION -- COMMAND...: runs the command, stderr to $TMP/err.
+expect_rc() {
+  local want=$1 what=$2
+  shift 3
+  "$@" >"$TMP/out" 2>"$TMP/err"
+  local rc=$?
+  if [ "$rc" -eq "$want" ]; then pass; else fail "$what: exit code $rc, expected $want"; sed 's/^/  stderr: /' "$TMP/err"; fi
+}
+
+expect_frames() {  # FILE COUNT
+  local n
+  n=$(frames_of "$1")
+  if [ "$n" = "$2" ]; then pass; else fail "$1: $n frames, expected $2"; fi
+}
+
+expect_frame_time() {  # FILE SECONDS (within 1e-6 relative)
+  local t
+  t=$(frame_time_of "$1")
+  if awk -v a="$t" -v b="$2" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= 1e-6 * b) }'; then
+    pass
+  else
+    fail "$1: frame time $t, expected $2"
+  fi
+}
+
+expect_stderr() {  # PATTERN DESCRIPTION
+  if grep -q -- "$1" "$TMP/err"; then pass; else fail "$2: stderr lacks '$1'"; sed 's/^/  stderr: /' "$TMP/err"; fi
+}
+
+expect_absent() {  # FILE
+  if [ -e "$1" ]; then fail "$1 was written although the command failed"; else pass; fi
+}
+
+[ -x "$MF" ] || { echo "not executable: $MF"; exit 1; }
+[ -f "$SAMPLE" ] || { echo "missing sample: $SAMPLE"; exit 1; }
+N=$(frames_of "$SAMPLE")
+FT=$(frame_time_of "$SAMPLE")
+[ "$N" = 61 ] || fail "sample has $N frames, expected 61"
+
+# ------------------------------------------------------------ help, version
+expect_rc 0 "--version" -- "$MF" --version
+grep -q "^motionfield [0-9]" "$TMP/out" && pass || fail "--version prints 'motionfield <version>'"
+expect_rc 0 "--help" -- "$MF" --help
+for cmd in inbetween fill resample batch; do
+  expect_rc 0 "$cmd --help" -- "$MF" "$cmd" --help
+  grep -q "usage: motionfield $cmd" "$TMP/out" && pass || fail "$cmd --help prints its usage"
+done
+
+# ------------------------------------------------------------ inbetween
+ALL=$(seq -s, 0 $((N - 1)))
+expect_rc 0 "inbetween, every frame a keyframe" -- "$MF" inbetween --in "$SAMPLE" --keyframes "$ALL" --out "$TMP/all.bvh"
+expect_frames "$TMP/all.bvh" "$N"
+expect_frame_time "$TMP/all.bvh" "$FT"
+expect_rc 0 "keeping every frame reproduces the input" -- "$MF" diff "$SAMPLE" "$TMP/all.bvh"
+
+KEYS=0,10,20,30,40,50,60
+for method in interp zerovel; do
+  expect_rc 0 "inbetween --method $method" -- \
+    "$MF" inbetween --in "$SAMPLE" --keyframes "$KEYS" --out "$TMP/kf-$method.bvh" --method "$method"
+  expect_frames "$TMP/kf-$method.bvh" "$N"
+  expect_frame_time "$TMP/kf-$method.bvh" "$FT"
+  expect_rc 0 "inbetween $method keeps the keyframes" -- "$MF" diff "$SAMPLE" "$TMP/kf-$method.bvh" --frames "$KEYS"
+  # ...and really changes the others (so the comparison above can fail).
+  expect_rc 3 "inbetween $method changes unknown frames" -- "$MF" diff "$SAMPLE" "$TMP/kf-$method.bvh"
+done
+# --flag=value form, --threads anywhere, and the default method (interp).
+expect_rc 0 "inbetween --in=..." -- "$MF" --threads 1 inbetween --in="$SAMPLE" --keyframes="$KEYS" --out="$TMP/default.bvh"
+expect_frames "$TMP/default.bvh" "$N"
+expect_rc 0 "the default method is interp" -- "$MF" diff "$TMP/default.bvh" "$TMP/kf-interp.bvh"
+expect_rc 3 "...and not zerovel" -- "$MF" diff "$TMP/default.bvh" "$TMP/kf-zerovel.bvh"
+
+# ------------------------------------------------------------ fill
+for method in interp zerovel; do
+  expect_rc 0 "fill --method $method" -- "$MF" fill --in "$SAMPLE" --gap 10:40 --out "$TMP/fill-$method.bvh" --method "$method"
+  expect_frames "$TMP/fill-$method.bvh" "$N"
+  expect_frame_time "$TMP/fill-$method.bvh" "$FT"
+  expect_rc 0 "fill $method keeps frames outside the gap" -- \
+    "$MF" diff "$SAMPLE" "$TMP/fill-$method.bvh" --frames "$(seq -s, 0 9),$(seq -s, 40 60)"
+done
+expect_rc 0 "fill with the widest gap" -- "$MF" fill --in "$SAMPLE" --gap 1:60 --out "$TMP/fill-wide.bvh"
+expect_frames "$TMP/fill-wide.bvh" "$N"
+
+# ------------------------------------------------------------ resample
+for method in interp zerovel; do
+  expect_rc 0 "resample to 60 fps ($method)" -- "$MF" resample --in "$SAMPLE" --fps 60 --out "$TMP/r60-$method.bvh" --method "$method"
+  expect_frames "$TMP/r60-$method.bvh" $(((N - 1) * 2 + 1))
+  expect_frame_time "$TMP/r60-$method.bvh" 0.0166666667
+  expect_rc 0 "resample to 60 fps keeps the input frames at even output frames" -- \
+    "$MF" diff "$SAMPLE" "$TMP/r60-$method.bvh" --step 2
+  [ -s "$TMP/err" ] && fail "resample to 60 fps printed to stderr" || pass
+done
+expect_rc 0 "resample to 15 fps" -- "$MF" resample --in "$SAMPLE" --fps 15 --out "$TMP/r15.bvh"
+expect_frames "$TMP/r15.bvh" 31
+expect_frame_time "$TMP/r15.bvh" 0.0666666667
+expect_rc 0 "resample to 15 fps keeps even input frames" -- "$MF" diff "$TMP/r15.bvh" "$SAMPLE" --step 2
+expect_rc 0 "resample to 24 fps" -- "$MF" resample --in "$SAMPLE" --fps 24 --out "$TMP/r24.bvh"
+expect_frames "$TMP/r24.bvh" 49
+expect_frame_time "$TMP/r24.bvh" 0.0416666667
+# 60 * 23.3 / 30 + 1 = 47.6 frames: rounded down with a warning.
+expect_rc 0 "resample to 23.3 fps" -- "$MF" resample --in "$SAMPLE" --fps 23.3 --out "$TMP/r23.bvh"
+expect_frames "$TMP/r23.bvh" 47
+expect_frame_time "$TMP/r23.bvh" 0.0429184549
+expect_stderr "rounded down to 47 frames" "non-integer resample ratio warns"
+
+# ------------------------------------------------------------ bad input: exit 2, nothing written
+bad() {  # DESCRIPTION ARGS... (the output path is $TMP/bad.bvh)
+  local what=$1
+  shift
+  expect_rc 2 "$what" -- "$MF" "$@"
+  [ -s "$TMP/err" ] && pass || fail "$what: no message on stderr"
+  expect_absent "$TMP/bad.bvh"
+}
+bad "keyframe out of range" inbetween --in "$SAMPLE" --keyframes 0,30,61 --out "$TMP/bad.bvh"
+expect_stderr "keyframe 61 is out of range" "out-of-range message"
+bad "negative keyframe" inbetween --in "$SAMPLE" --keyframes -1,30 --out "$TMP/bad.bvh"
+bad "unsorted keyframes" inbetween --in "$SAMPLE" --keyframes 0,30,20 --out "$TMP/bad.bvh"
+bad "duplicate keyframes" inbetween --in "$SAMPLE" --keyframes 0,30,30,60 --out "$TMP/bad.bvh"
+bad "one keyframe" inbetween --in "$SAMPLE" --keyframes 30 --out "$TMP/bad.bvh"
+bad "keyframes not numbers" inbetween --in "$SAMPLE" --keyframes 0,x --out "$TMP/bad.bvh"
+bad "empty keyframe" inbetween --in "$SAMPLE" --keyframes 0,,60 --out "$TMP/bad.bvh"
+bad "gap touching the start" fill --in "$SAMPLE" --gap 0:10 --out "$TMP/bad.bvh"
+bad "gap touching the end" fill --in "$SAMPLE" --gap 10:61 --out "$TMP/bad.bvh"
+bad "empty gap" fill --in "$SAMPLE" --gap 10:10 --out "$TMP/bad.bvh"
+bad "reversed gap" fill --in "$SAMPLE" --gap 20:10 --out "$TMP/bad.bvh"
+bad "malformed gap" fill --in "$SAMPLE" --gap 10-20 --out "$TMP/bad.bvh"
+bad "fps zero" resample --in "$SAMPLE" --fps 0 --out "$TMP/bad.bvh"
+bad "fps not a number" resample --in "$SAMPLE" --fps sixty --out "$TMP/bad.bvh"
+bad "missing input file" inbetween --in "$TMP/does-not-exist.bvh" --keyframes 0,10 --out "$TMP/bad.bvh"
+head -c 2000 "$SAMPLE" >"$TMP/truncated.bvh"
+bad "truncated BVH" inbetween --in "$TMP/truncated.bvh" --keyframes 0,10 --out "$TMP/bad.bvh"
+expect_stderr "truncated.bvh:" "BVH errors name the file"
+printf 'HIERARCHY\nROOT a\n{\n OFFSET 0 0 zero\n}\n' >"$TMP/garbage.bvh"
+bad "malformed BVH" fill --in "$TMP/garbage.bvh" --gap 1:2 --out "$TMP/bad.bvh"
+bad "unknown flag" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh" --frobnicate 1
+bad "unknown method" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh" --method magic
+expect_stderr "unknown method 'magic'" "unknown method message"
+bad "missing --keyframes" inbetween --in "$SAMPLE" --out "$TMP/bad.bvh"
+bad "flag without value" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh" --method
+bad "flag given twice" inbetween --in "$SAMPLE" --keyframes 0,10 --keyframes 0,20 --out "$TMP/bad.bvh"
+bad "stray argument" fill --in "$SAMPLE" --gap 1:2 --out "$TMP/bad.bvh" extra
+bad "output directory missing" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/no/such/dir/bad.bvh"
+bad "unknown command" dance --in "$SAMPLE"
+bad "bad --threads" --threads 0 inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh"
+bad "no command"
+
+# ------------------------------------------------------------ batch
+mkdir -p "$TMP/batch"
+cp "$SAMPLE" "$TMP/batch/walk.bvh"
+cat >"$TMP/batch/jobs.jsonl" <<'EOF'
+{"id": "kf", "task": "inbetween", "in": "walk.bvh", "out": "b1.bvh", "keyframes": [0, 20, 40, 60], "frames": 61, "fps_in": 30}
+
+{"id": "bad-gap", "task": "fill", "in": "walk.bvh", "out": "b2.bvh", "gap": [0, 10]}
+{"task": "resample", "in": "walk.bvh", "out": "b3.bvh", "fps": 60, "method": "zerovel", "note": {"any": ["thing"]}}
+{"task": "fill", "in": "walk.bvh", "out": "b4.bvh", "gap": [5, 8], "keyframes": [0, 30, 60]}
+EOF
+(cd "$TMP/batch" && expect_rc 2 "batch with one bad job" -- "$MF" batch jobs.jsonl)
+expect_frames "$TMP/batch/b1.bvh" 61
+expect_frames "$TMP/batch/b3.bvh" 121
+expect_frames "$TMP/batch/b4.bvh" 61
+expect_absent "$TMP/batch/b2.bvh"
+expect_stderr "line 3" "batch names the failed job's line"
+expect_stderr "bad-gap" "batch names the failed job's id"
+expect_stderr "touches the first frame" "batch gives the reason"
+if grep -q "line [145]" "$TMP/err"; then fail "batch reported a good job"; else pass; fi
+(cd "$TMP/batch" && expect_rc 0 "fill keyframes are authoritative" -- "$MF" diff walk.bvh b4.bvh --frames 0,30,60)
+(cd "$TMP/batch" && expect_rc 3 "fill keyframes are authoritative (frames 1..29 filled)" -- "$MF" diff walk.bvh b4.bvh --frames 15)
+(cd "$TMP/batch" && expect_rc 0 "batch job keeps its keyframes" -- "$MF" diff walk.bvh b1.bvh --frames 0,20,40,60)
+
+printf '%s\n' '{"task": "inbetween", "in": "walk.bvh", "out": "g1.bvh", "keyframes": [0, 60]}' \
+  '{"task": "resample", "in": "walk.bvh", "out": "g2.bvh", "fps": 23.3}' >"$TMP/batch/good.jsonl"
+(cd "$TMP/batch" && expect_rc 0 "batch, all good" -- "$MF" batch good.jsonl)
+expect_frames "$TMP/batch/g1.bvh" 61
+expect_frames "$TMP/batch/g2.bvh" 47
+expect_stderr "line 2: warning: .*rounded down" "batch passes warnings on with the line"
+
+printf '%s\n' '{"task": "inbetween", "in": "walk.bvh", "out": "x.bvh", "keyframes": [0, 60],}' \
+  '["not", "an", "object"]' '{"task": "inbetween", "in": "missing.bvh", "out": "y.bvh", "keyframes": [0, 1]}' \
+  >"$TMP/batch/allbad.jsonl"
+(cd "$TMP/batch" && expect_rc 2 "batch, all bad" -- "$MF" batch allbad.jsonl)
+expect_stderr "line 1: error: invalid JSON: column" "batch names the JSON error's column"
+expect_stderr "line 2: error:" "batch rejects non-objects"
+expect_stderr "line 3: error:" "batch reports a missing input"
+expect_rc 2 "batch file missing" -- "$MF" batch "$TMP/batch/none.jsonl"
+
+echo "cli_test: $((checks - failures)) of $checks checks passed"
+[ "$failures" -eq 0 ]

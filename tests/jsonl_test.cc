@@ -1,0 +1,221 @@
+#include "capi/cli/jsonl.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "prior/motion/errors.h"
+
+namespace mf::cli {
+namespace {
+
+// Parses `text`, expects a JsonError and returns its column (0 if none was thrown).
+int error_column(const std::string& text, std::string* message = nullptr) {
+  try {
+    parse_json(text);
+  } catch (const JsonError& e) {
+    if (message) *message = e.what();
+    return e.column();
+  }
+  ADD_FAILURE() << "no error for: " << text;
+  return 0;
+}
+
+TEST(JsonlTest, Scalars) {
+  EXPECT_TRUE(parse_json("null").is_null());
+  EXPECT_TRUE(parse_json("true").as_bool());
+  EXPECT_FALSE(parse_json(" false ").as_bool());
+  EXPECT_EQ(parse_json("\"abc\"").as_string(), "abc");
+  EXPECT_EQ(parse_json("\"\"").as_string(), "");
+}
+
+TEST(JsonlTest, Numbers) {
+  EXPECT_EQ(parse_json("0").as_number(), 0.0);
+  EXPECT_EQ(parse_json("-0").as_number(), 0.0);
+  EXPECT_EQ(parse_json("42").as_number(), 42.0);
+  EXPECT_EQ(parse_json("-12").as_number(), -12.0);
+  EXPECT_EQ(parse_json("0.25").as_number(), 0.25);
+  EXPECT_EQ(parse_json("1.5e3").as_number(), 1500.0);
+  EXPECT_EQ(parse_json("2E-2").as_number(), 0.02);
+  EXPECT_EQ(parse_json("1e+2").as_number(), 100.0);
+  EXPECT_EQ(parse_json("23.3").as_number(), 23.3);
+  EXPECT_EQ(parse_json("1e-400").as_number(), 0.0);  // underflow is harmless
+  EXPECT_EQ(parse_json("-9007199254740993").as_number(), -9007199254740992.0);
+}
+
+TEST(JsonlTest, StringEscapes) {
+  EXPECT_EQ(parse_json(R"("a\"b\\c\/d")").as_string(), "a\"b\\c/d");
+  EXPECT_EQ(parse_json(R"("\b\f\n\r\t")").as_string(), "\b\f\n\r\t");
+  EXPECT_EQ(parse_json(R"("\u0041\u00e9\u20AC")").as_string(), "A\xC3\xA9\xE2\x82\xAC");   // A, e acute, euro
+  EXPECT_EQ(parse_json(R"("\ud83d\ude00")").as_string(), "\xF0\x9F\x98\x80");              // surrogate pair
+  EXPECT_EQ(parse_json(R"("\u0000")").as_string(), std::string(1, '\0'));
+  EXPECT_EQ(parse_json("\"caf\xC3\xA9 \xF0\x9F\x98\x80\"").as_string(), "caf\xC3\xA9 \xF0\x9F\x98\x80");  // raw UTF-8
+}
+
+TEST(JsonlTest, ArraysAndObjects) {
+  const JsonValue v = parse_json(R"( {"a": [1, 2, {"b": null}], "c": {}, "d": [], "e": "x"} )");
+  ASSERT_TRUE(v.is_object());
+  EXPECT_EQ(v.keys(), (std::vector<std::string>{"a", "c", "d", "e"}));  // input order
+  const JsonValue* a = v.find("a");
+  ASSERT_NE(a, nullptr);
+  ASSERT_EQ(a->as_array().size(), 3u);
+  EXPECT_EQ(a->as_array()[1].as_number(), 2.0);
+  EXPECT_TRUE(a->as_array()[2].find("b")->is_null());
+  EXPECT_TRUE(v.find("c")->is_object());
+  EXPECT_TRUE(v.find("d")->as_array().empty());
+  EXPECT_EQ(v.find("missing"), nullptr);
+  EXPECT_EQ(a->find("b"), nullptr);  // not an object
+  EXPECT_EQ(v.dump(), R"({"a":[1,2,{"b":null}],"c":{},"d":[],"e":"x"})");
+}
+
+TEST(JsonlTest, DumpEscapesAndRoundTrips) {
+  const std::string text = R"(["q\"\\\n\u0001",true,false,null,-0.5,1e+300])";
+  const JsonValue v = parse_json(text);
+  EXPECT_EQ(v.dump(), R"(["q\"\\\n\u0001",true,false,null,-0.5,1e+300])");
+  EXPECT_EQ(parse_json(v.dump()).dump(), v.dump());
+}
+
+TEST(JsonlTest, WrongTypeAccessThrowsLogicError) {
+  EXPECT_THROW(parse_json("1").as_string(), std::logic_error);
+  EXPECT_THROW(parse_json("[]").keys(), std::logic_error);
+}
+
+TEST(JsonlTest, ErrorsNameTheColumn) {
+  std::string m;
+  EXPECT_EQ(error_column(R"({"a": 1,})", &m), 9);  // trailing comma in an object
+  EXPECT_NE(m.find("column 9: "), std::string::npos) << m;
+  EXPECT_NE(m.find("trailing comma"), std::string::npos) << m;
+  EXPECT_EQ(error_column("[1, 2,]", &m), 7);
+  EXPECT_NE(m.find("trailing comma"), std::string::npos) << m;
+  EXPECT_EQ(error_column("{} x"), 4);           // garbage after the value
+  EXPECT_EQ(error_column("[1 2]"), 4);          // missing comma
+  EXPECT_EQ(error_column(R"({"a" 1})"), 6);     // missing colon
+  EXPECT_EQ(error_column("{a: 1}"), 2);         // unquoted key
+  EXPECT_EQ(error_column("['a']"), 2);          // single quotes
+  EXPECT_EQ(error_column(""), 1);               // empty input
+  EXPECT_EQ(error_column("   "), 4);
+  EXPECT_EQ(error_column("[1, // c\n 2]"), 5);  // comments
+  // Columns count characters, not bytes: the two-byte e acute is one column.
+  EXPECT_EQ(error_column("[\"\xC3\xA9\",]"), 6);
+}
+
+TEST(JsonlTest, RejectsBadNumbers) {
+  EXPECT_EQ(error_column("01"), 2);
+  EXPECT_EQ(error_column("-"), 2);
+  EXPECT_EQ(error_column("+1"), 1);
+  EXPECT_EQ(error_column("1."), 3);
+  EXPECT_EQ(error_column(".5"), 1);
+  EXPECT_EQ(error_column("1e"), 3);
+  EXPECT_EQ(error_column("1e+"), 4);
+  EXPECT_EQ(error_column("0x10"), 2);
+  EXPECT_EQ(error_column("NaN"), 1);
+  EXPECT_EQ(error_column("-Infinity"), 2);
+  std::string m;
+  EXPECT_EQ(error_column("[1e400]", &m), 2);
+  EXPECT_NE(m.find("out of range"), std::string::npos) << m;
+  EXPECT_EQ(error_column("-1234567890123456789012345678901234567890e300"), 1);
+}
+
+TEST(JsonlTest, RejectsBadLiteralsAndStrings) {
+  EXPECT_EQ(error_column("tru"), 1);
+  EXPECT_EQ(error_column("nulll"), 5);
+  EXPECT_EQ(error_column("True"), 1);
+  EXPECT_EQ(error_column("\"abc"), 1);              // unterminated
+  EXPECT_EQ(error_column("\"a\tb\""), 3);           // raw control character
+  EXPECT_EQ(error_column(R"("a\xb")"), 3);          // unknown escape
+  EXPECT_EQ(error_column(R"("\u12G4")"), 6);        // bad hex digit
+  EXPECT_EQ(error_column(R"("\u12")"), 2);          // truncated
+  EXPECT_EQ(error_column(R"("\ude00")"), 2);        // lone low surrogate
+  EXPECT_EQ(error_column(R"("\ud83dx")"), 2);       // high surrogate alone
+  EXPECT_EQ(error_column(R"("\ud83d\u0041")"), 8);  // high surrogate + non-low
+  EXPECT_EQ(error_column("\"\xFF\""), 2);           // invalid UTF-8
+  EXPECT_EQ(error_column("\"\xC3\""), 2);           // truncated UTF-8
+  EXPECT_EQ(error_column("\"\xC0\xAF\""), 2);       // overlong encoding
+  EXPECT_EQ(error_column("\"\xED\xA0\x80\""), 2);   // UTF-8-encoded surrogate
+}
+
+TEST(JsonlTest, RejectsDuplicateKeysAndDeepNesting) {
+  std::string m;
+  EXPECT_EQ(error_column(R"({"a": 1, "a": 2})", &m), 10);
+  EXPECT_NE(m.find("duplicate key \"a\""), std::string::npos) << m;
+  const std::string ok = std::string(kJsonMaxDepth, '[') + std::string(kJsonMaxDepth, ']');
+  EXPECT_NO_THROW(parse_json(ok));
+  const std::string deep = std::string(kJsonMaxDepth + 1, '[') + std::string(kJsonMaxDepth + 1, ']');
+  EXPECT_EQ(error_column(deep, &m), kJsonMaxDepth + 1);
+  EXPECT_NE(m.find("nesting"), std::string::npos) << m;
+  EXPECT_THROW(parse_json(std::string(100000, '[')), JsonError);  // no stack overflow
+}
+
+// ------------------------------------------------------------ batch jobs
+
+BatchJob job(const std::string& line) { return batch_job_from_json(parse_json(line)); }
+
+std::string job_error(const std::string& line) {
+  try {
+    job(line);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error for: " << line;
+  return "";
+}
+
+TEST(JsonlTest, InbetweenJobIgnoresKeysItDoesNotNeed) {
+  const BatchJob j = job(R"({"id": "walk-3", "task": "inbetween", "in": "a.bvh", "out": "b/c.bvh",)"
+                         R"( "keyframes": [0, 15, 30], "frames": 31, "fps": "thirty", "gap": "n/a", "note": {"x": [1]}})");
+  EXPECT_EQ(j.task, "inbetween");
+  EXPECT_EQ(j.in, "a.bvh");
+  EXPECT_EQ(j.out, "b/c.bvh");
+  EXPECT_EQ(j.id, "walk-3");
+  EXPECT_TRUE(j.method.empty());
+  EXPECT_TRUE(j.has_keyframes);
+  EXPECT_EQ(j.keyframes, (std::vector<int>{0, 15, 30}));
+  EXPECT_FALSE(j.has_gap);
+}
+
+TEST(JsonlTest, FillJobUsesGapUnlessKeyframesAreGiven) {
+  BatchJob j = job(R"({"task": "fill", "in": "a.bvh", "out": "b.bvh", "gap": [10, 20], "method": "zerovel", "id": 7})");
+  EXPECT_TRUE(j.has_gap);
+  EXPECT_FALSE(j.has_keyframes);
+  EXPECT_EQ(j.gap_begin, 10);
+  EXPECT_EQ(j.gap_end, 20);
+  EXPECT_EQ(j.method, "zerovel");
+  EXPECT_EQ(j.id, "7");
+  // keyframes is authoritative: the gap is then not even read.
+  j = job(R"({"task": "fill", "in": "a.bvh", "out": "b.bvh", "gap": "whatever", "keyframes": [0, 5, 9]})");
+  EXPECT_TRUE(j.has_keyframes);
+  EXPECT_FALSE(j.has_gap);
+  EXPECT_EQ(j.keyframes, (std::vector<int>{0, 5, 9}));
+}
+
+TEST(JsonlTest, ResampleJob) {
+  const BatchJob j = job(R"({"task": "resample", "in": "a.bvh", "out": "b.bvh", "fps": 23.5, "keyframes": "x"})");
+  EXPECT_EQ(j.fps, 23.5);
+  EXPECT_FALSE(j.has_keyframes);
+}
+
+TEST(JsonlTest, BadJobsNameTheProblem) {
+  auto has = [](const std::string& m, const std::string& part) { return m.find(part) != std::string::npos; };
+  EXPECT_TRUE(has(job_error("[1, 2]"), "JSON object"));
+  EXPECT_TRUE(has(job_error(R"({"in": "a", "out": "b"})"), "missing key \"task\""));
+  EXPECT_TRUE(has(job_error(R"({"task": "dance", "in": "a", "out": "b"})"), "unknown task \"dance\""));
+  EXPECT_TRUE(has(job_error(R"({"task": 3, "in": "a", "out": "b"})"), "\"task\" must be a string"));
+  EXPECT_TRUE(has(job_error(R"({"task": "fill", "out": "b", "gap": [1, 2]})"), "missing key \"in\""));
+  EXPECT_TRUE(has(job_error(R"({"task": "fill", "in": "", "out": "b", "gap": [1, 2]})"), "\"in\" must not be empty"));
+  EXPECT_TRUE(has(job_error(R"({"task": "fill", "in": "a", "out": 5, "gap": [1, 2]})"), "\"out\" must be a string"));
+  EXPECT_TRUE(has(job_error(R"({"task": "inbetween", "in": "a", "out": "b"})"), "missing key \"keyframes\""));
+  EXPECT_TRUE(has(job_error(R"({"task": "inbetween", "in": "a", "out": "b", "keyframes": "0,5"})"), "array of integers"));
+  EXPECT_TRUE(has(job_error(R"({"task": "inbetween", "in": "a", "out": "b", "keyframes": [0, 1.5]})"),
+                  "\"keyframes\" item 1 must be an integer, not 1.5"));
+  EXPECT_TRUE(has(job_error(R"({"task": "inbetween", "in": "a", "out": "b", "keyframes": [0, 1e10]})"), "integer"));
+  EXPECT_TRUE(has(job_error(R"({"task": "fill", "in": "a", "out": "b"})"), "missing key \"gap\""));
+  EXPECT_TRUE(has(job_error(R"({"task": "fill", "in": "a", "out": "b", "gap": [1, 2, 3]})"), "two integers"));
+  EXPECT_TRUE(has(job_error(R"({"task": "fill", "in": "a", "out": "b", "gap": [1, "2"]})"), "\"gap\" item 1"));
+  EXPECT_TRUE(has(job_error(R"({"task": "resample", "in": "a", "out": "b"})"), "missing key \"fps\""));
+  EXPECT_TRUE(has(job_error(R"({"task": "resample", "in": "a", "out": "b", "fps": "60"})"), "\"fps\" must be a number"));
+  EXPECT_TRUE(has(job_error(R"({"task": "resample", "in": "a", "out": "b", "fps": 60, "method": 1})"),
+                  "\"method\" must be a string"));
+}
+
+}  // namespace
+}  // namespace mf::cli

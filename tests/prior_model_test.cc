@@ -1,0 +1,204 @@
+// The prior's model: shapes, short windows, continuous time, gradients to the
+// latents through a frozen network, the model file and its error messages, and
+// a few steps of the training program.
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "prior/model/model_file.h"
+#include "prior/model/nemf.h"
+#include "prior/model/representation.h"
+#include "prior/motion/errors.h"
+#include "prior/motion/motion_bvh.h"
+#include "tests/test_util.h"
+#include "training/prior_trainer.h"
+
+namespace mf {
+namespace {
+
+NemfConfig tiny_config() {
+  NemfConfig c;
+  c.window = 32;
+  c.decoder_width = 32;
+  c.decoder_layers = 3;
+  c.zl = 8;
+  c.zg = 4;
+  c.zg_layers = 2;
+  c.encoder_channels = 4;
+  c.gmp_width = 8;
+  c.gmp_blocks = 1;
+  return c;
+}
+
+RigInfo tiny_rig() {
+  Skeleton s = test::small_skeleton();
+  Motion m = test::random_motion(s, 60, 30.0, 3);
+  return measure_rig(s, {&m});
+}
+
+TEST(PriorModel, RigFindsFeetAndForward) {
+  RigInfo rig = tiny_rig();
+  ASSERT_EQ(rig.num_feet(), 2);  // Foot_L, Foot_R (no toes in the small skeleton)
+  EXPECT_EQ(rig.skeleton.names[rig.foot_joints[0]], "Foot_L");
+  EXPECT_EQ(rig.foot_thresholds[0], 0.08);
+  EXPECT_NEAR(rig.root_forward.norm(), 1.0, 1e-12);
+}
+
+TEST(PriorModel, CanonicalWindowRoundTrip) {
+  RigInfo rig = tiny_rig();
+  Motion m = test::random_motion(rig.skeleton, 40, 30.0, 5);
+  WindowTensors w = window_tensors(m, 10, 20, rig, 0);
+  // Frame 0 of the window: root on the ground origin, heading along +Z.
+  EXPECT_NEAR(w.root_positions[0][0][0].item<float>(), 0.0f, 1e-5);
+  EXPECT_NEAR(w.root_positions[0][0][2].item<float>(), 0.0f, 1e-5);
+  at::Tensor h = heading_rotation(w.local_rotations.select(-3, 0), rig.root_forward);
+  EXPECT_NEAR(h[0][0][0][0].item<float>(), 1.0f, 1e-5);
+  Motion back = m;
+  for (auto& q : back.rotations) q = Eigen::Quaterniond(0.5, 0.5, 0.5, 0.5);
+  write_window(w.local_rotations, w.root_positions, canonical_transform(m, 10, rig), &back, 10);
+  for (int f = 10; f < 30; ++f) {
+    EXPECT_LT((back.root_positions[f] - m.root_positions[f]).norm(), 1e-5);
+    for (int j = 0; j < m.num_joints(); ++j) {
+      EXPECT_LT(back.rotation(f, j).angularDistance(m.rotation(f, j)), 1e-5);
+    }
+  }
+}
+
+TEST(PriorModel, GmpTargetsIntegrateBackToTheRootPath) {
+  RigInfo rig = tiny_rig();
+  Motion m = test::random_motion(rig.skeleton, 30, 30.0, 9);
+  WindowTensors w = window_tensors(m, 0, 30, rig, 0);
+  GmpTargets t = gmp_targets(w.local_rotations, w.root_positions, rig, 30.0);
+  at::Tensor h = heading_rotation(w.local_rotations.select(-3, 0), rig.root_forward);
+  at::Tensor start = ground_xz(w.root_positions.select(1, 0));
+  at::Tensor p = integrate_root(t.velocity, t.height, h, 30.0, start);
+  EXPECT_LT((p - w.root_positions).abs().max().item<float>(), 1e-4);
+}
+
+TEST(PriorModel, EncodeDecodeShapesShortWindowsAndContinuousTime) {
+  at::manual_seed(0);
+  RigInfo rig = tiny_rig();
+  NemfModel model(tiny_config(), rig);
+  Motion m = test::random_motion(rig.skeleton, 20, 30.0, 1);
+  WindowTensors w = window_tensors(m, 0, 20, rig, 0);  // shorter than the 32-frame window
+  NemfLatent z = model.encode(w.local_rotations, at::ones({1, 20}));
+  EXPECT_EQ(z.mu_l.sizes(), (at::IntArrayRef{1, 8}));
+  EXPECT_EQ(z.mu_g.sizes(), (at::IntArrayRef{1, 4}));
+  at::Tensor frames = at::arange(0.0, 19.0, 0.25);  // 120 fps decode
+  at::Tensor rot = model.decode(frames, z.mu_l, z.mu_g);
+  ASSERT_EQ(rot.sizes(), (at::IntArrayRef{1, frames.size(0), rig.num_joints(), 3, 3}));
+  // Orthonormal rotations.
+  at::Tensor eye = at::matmul(rot, rot.transpose(-1, -2));
+  EXPECT_LT((eye - at::eye(3)).abs().max().item<float>(), 1e-4);
+  EXPECT_THROW(model.encode(w.local_rotations.narrow(1, 0, 1), at::ones({1, 1})), InputError);
+}
+
+TEST(PriorModel, GradientsReachTheLatentThroughAFrozenNetwork) {
+  at::manual_seed(0);
+  RigInfo rig = tiny_rig();
+  NemfModel model(tiny_config(), rig);
+  model.set_requires_grad(false);
+  at::Tensor zl = at::zeros({1, 8}).set_requires_grad(true);
+  at::Tensor zg = at::zeros({1, 4}).set_requires_grad(true);
+  at::Tensor rot = model.decode(at::arange(0, 32, at::kFloat), zl, zg);
+  GmpOutput g = model.predict_global(rot);
+  at::Tensor loss = rot.sum() + model.root_positions(rot, g).sum();
+  loss.backward();
+  ASSERT_TRUE(zl.grad().defined());
+  EXPECT_GT(zl.grad().abs().sum().item<float>(), 0.0f);
+  EXPECT_GT(zg.grad().abs().sum().item<float>(), 0.0f);
+  for (auto& p : model.parameters()) EXPECT_FALSE(p.grad().defined());
+}
+
+class ModelFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    at::manual_seed(0);
+    dir_ = test::scratch_dir("model_file");
+    path_ = dir_ + "/m.mfm";
+    NemfModel model(tiny_config(), tiny_rig());
+    save_nemf(model, path_);
+    bytes_ = serialize_nemf(model);
+  }
+  std::string error_of(const std::vector<uint8_t>& b) {
+    try {
+      deserialize_nemf(b.data(), b.size(), "x.mfm");
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  }
+  std::string dir_, path_;
+  std::vector<uint8_t> bytes_;
+};
+
+TEST_F(ModelFile, RoundTripGivesTheSameOutputs) {
+  at::manual_seed(0);
+  NemfModel a(tiny_config(), tiny_rig());
+  a.stats().feature_mean.fill_(0.25);
+  save_nemf(a, path_);
+  NemfModel b = load_nemf(path_);
+  EXPECT_EQ(b.config().to_map(), a.config().to_map());
+  EXPECT_TRUE(b.rig().skeleton.same_as(a.rig().skeleton));
+  EXPECT_EQ(b.rig().foot_joints, a.rig().foot_joints);
+  EXPECT_TRUE(at::equal(b.stats().feature_mean, a.stats().feature_mean));
+  at::Tensor z = at::randn({1, 8}), g = at::randn({1, 4}), t = at::arange(0, 32, at::kFloat);
+  EXPECT_TRUE(at::allclose(a.decode(t, z, g), b.decode(t, z, g)));
+}
+
+TEST_F(ModelFile, ErrorsSayWhatIsWrong) {
+  std::vector<uint8_t> b = bytes_;
+  b[0] = 'X';
+  EXPECT_NE(error_of(b).find("not a motionfield model file"), std::string::npos);
+  b = bytes_;
+  b[8] = 99;  // format version
+  EXPECT_NE(error_of(b).find("unsupported model format version 99"), std::string::npos);
+  b = bytes_;
+  b[16] = 'x';  // kind "nemf" -> "xemf" (after the u32 length at 12..15)
+  EXPECT_NE(error_of(b).find("wrong kind of model"), std::string::npos);
+  b = bytes_;
+  b.resize(b.size() / 2);
+  EXPECT_NE(error_of(b).find("truncated"), std::string::npos);
+  b = bytes_;
+  b[b.size() / 2] ^= 0x5a;
+  EXPECT_NE(error_of(b).find("checksum"), std::string::npos);
+  EXPECT_NE(error_of({}).find("not a motionfield model file"), std::string::npos);
+  EXPECT_THROW(load_nemf(dir_ + "/missing.mfm"), InputError);
+}
+
+TEST(PriorTraining, AFewStepsRunCheckpointAndResume) {
+  namespace fs = std::filesystem;
+  std::string dir = test::scratch_dir("prior_training");
+  Skeleton s = test::small_skeleton();
+  for (int i = 0; i < 12; ++i) {
+    Motion m = test::random_motion(s, 20 + 7 * i, 30.0, 100 + i);
+    write_motion(dir + "/clip" + std::to_string(i) + ".bvh", m, default_bvh_layout(s));
+  }
+  PriorTrainingOptions o;
+  o.data = dir;
+  o.cache_dir = dir + "/cache";
+  o.out_dir = dir + "/run";
+  o.config = tiny_config();
+  o.batch = 4;
+  o.stride = 16;
+  o.max_epochs = 2;
+  o.verbose = false;
+  PriorTrainingResult r = train_prior(o);
+  EXPECT_EQ(r.epochs, 2);
+  EXPECT_GT(r.steps, 0);
+  EXPECT_TRUE(fs::exists(o.out_dir + "/best.mfm"));
+  EXPECT_TRUE(fs::exists(o.out_dir + "/log.csv"));
+  o.resume = true;
+  o.max_epochs = 3;
+  PriorTrainingResult r2 = train_prior(o);
+  EXPECT_EQ(r2.epochs, 3);
+  EXPECT_GT(r2.steps, r.steps);
+  NemfModel m = load_nemf(r2.best_path);
+  EXPECT_EQ(m.config().zl, 8);
+}
+
+}  // namespace
+}  // namespace mf

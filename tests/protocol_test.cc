@@ -1,0 +1,202 @@
+// The benchmark protocol (bench/protocol.h) on tiny synthetic data sets.
+#include "bench/protocol.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "prior/motion/errors.h"
+#include "tests/test_util.h"
+
+namespace mf::bench {
+namespace {
+
+Clip make_clip(const std::string& name, Motion motion) {
+  Clip c;
+  c.name = name;
+  c.motion = std::move(motion);
+  return c;
+}
+
+// A fixed random pose (frame 0 of a random motion) held still while the root
+// moves along a straight line at constant speed: interpolation is exact on it.
+Motion linear_root_motion(int frames, uint32_t seed) {
+  const Motion r = test::random_motion(test::small_skeleton(), frames, 30.0, seed);
+  Motion m = r;
+  for (int f = 0; f < frames; ++f) {
+    for (int j = 0; j < m.num_joints(); ++j) m.rotation(f, j) = r.rotation(0, j);
+    m.root_positions[f] = Eigen::Vector3d(0.3 + 0.02 * f, 0.9, -1.0 + 0.035 * f);
+  }
+  return m;
+}
+
+EvalStats small_stats() {
+  std::vector<Clip> train;
+  train.push_back(make_clip("t1.bvh", test::random_motion(test::small_skeleton(), 120, 30.0, 11)));
+  train.push_back(make_clip("t2.bvh", test::random_motion(test::small_skeleton(), 90, 30.0, 12)));
+  return compute_eval_stats(train);
+}
+
+TEST(ProtocolTest, WindowsStartEveryStrideAndFit) {
+  const Skeleton s = test::small_skeleton();
+  std::vector<Clip> clips = {make_clip("a", Motion::identity(s, 100, 30)), make_clip("b", Motion::identity(s, 16, 30)),
+                             make_clip("c", Motion::identity(s, 15, 30))};
+  const std::vector<Window> w = protocol_windows(clips, 16, 40);
+  ASSERT_EQ(w.size(), 4u);  // a: 0, 40, 80 (80 + 16 <= 100); b: 0; c: none
+  EXPECT_EQ(w[2].clip, 0);
+  EXPECT_EQ(w[2].start, 80);
+  EXPECT_EQ(w[3].clip, 1);
+  EXPECT_EQ(w[3].start, 0);
+  EXPECT_EQ(w[3].length, 16);
+  EXPECT_TRUE(protocol_windows(clips, 101, 40).empty());
+  EXPECT_THROW(protocol_windows(clips, 10, 0), InputError);
+
+  std::vector<Window> ten;
+  for (int i = 0; i < 10; ++i) ten.push_back({i, 0, 5});
+  const std::vector<Window> capped = cap_windows(ten, 3);
+  ASSERT_EQ(capped.size(), 3u);
+  EXPECT_EQ(capped[0].clip, 0);
+  EXPECT_EQ(capped[1].clip, 3);
+  EXPECT_EQ(capped[2].clip, 6);
+  EXPECT_EQ(cap_windows(ten, 0).size(), 10u);
+  EXPECT_EQ(cap_windows(ten, 20).size(), 10u);
+}
+
+TEST(ProtocolTest, SparseKeyframesIncludeTheLastFrame) {
+  EXPECT_EQ(sparse_keyframes(128, 30), (std::vector<int>{0, 30, 60, 90, 120, 127}));
+  EXPECT_EQ(sparse_keyframes(11, 5), (std::vector<int>{0, 5, 10}));
+  EXPECT_EQ(sparse_keyframes(2, 5), (std::vector<int>{0, 1}));
+  EXPECT_THROW(sparse_keyframes(1, 5), InputError);
+  EXPECT_THROW(sparse_keyframes(10, 0), InputError);
+}
+
+TEST(ProtocolTest, HiddenFramesCarryNoTruth) {
+  const Motion m = test::random_motion(test::small_skeleton(), 6, 30.0, 5);
+  const Motion h = hide_unknown_frames(m, {1, 4});
+  EXPECT_TRUE(h.root_positions[0].isApprox(m.root_positions[1]));
+  EXPECT_TRUE(h.root_positions[2].isApprox(m.root_positions[1]));
+  EXPECT_TRUE(h.root_positions[5].isApprox(m.root_positions[4]));
+  EXPECT_TRUE(h.rotation(3, 2).isApprox(Eigen::Quaterniond::Identity()));
+  EXPECT_TRUE(h.rotation(4, 2).isApprox(m.rotation(4, 2)));
+  EXPECT_TRUE(h.rotation(1, 0).isApprox(m.rotation(1, 0)));
+}
+
+TEST(ProtocolTest, GapFillingCountsWindowsAndInterpIsExactOnLinearRoot) {
+  const EvalStats stats = small_stats();
+  std::vector<Clip> val = {make_clip("v1", linear_root_motion(100, 21)), make_clip("v2", linear_root_motion(60, 22))};
+  ProtocolOptions options;
+  options.gap_lengths = {5, 30, 90};
+  const TaskResult r = run_gap_filling(val, stats, "interp", options);
+  EXPECT_EQ(r.method, "interp");
+  EXPECT_GE(r.threads, 1);
+  ASSERT_EQ(r.rows.size(), 3u);
+  // T = 5: 16 frames: v1 at 0, 40, 80; v2 at 0, 40. T = 30: 41 frames: v1 at 0,
+  // 40 (40 + 41 <= 100); v2 at 0. T = 90: 101 frames: none.
+  EXPECT_EQ(r.rows[0].parameter, 5);
+  EXPECT_EQ(r.rows[0].metrics.windows, 5);
+  EXPECT_EQ(r.rows[1].metrics.windows, 3);
+  EXPECT_EQ(r.rows[2].metrics.windows, 0);
+  for (int i = 0; i < 2; ++i) {
+    const MetricSummary& m = r.rows[i].metrics;
+    EXPECT_NEAR(m.mpjpe_cm, 0.0, 1e-6) << i;
+    EXPECT_NEAR(m.l2p, 0.0, 1e-6) << i;
+    EXPECT_NEAR(m.l2q, 0.0, 1e-6) << i;
+    EXPECT_NEAR(m.npss, 0.0, 1e-6) << i;
+    EXPECT_NEAR(m.known.position_max_cm, 0.0, 1e-6) << i;
+    EXPECT_NEAR(m.skating_cm, m.truth_skating_cm, 1e-6) << i;
+  }
+
+  options.max_windows = 2;
+  const TaskResult capped = run_gap_filling(val, stats, "interp", options);
+  EXPECT_EQ(capped.rows[0].metrics.windows, 2);
+  EXPECT_EQ(capped.rows[1].metrics.windows, 2);
+}
+
+TEST(ProtocolTest, BaselinesKeepKnownFramesAndInterpBeatsZeroVelocity) {
+  const EvalStats stats = small_stats();
+  std::vector<Clip> val;
+  for (uint32_t seed = 30; seed < 33; ++seed) {
+    val.push_back(make_clip("v" + std::to_string(seed), test::random_motion(test::small_skeleton(), 140, 30.0, seed)));
+  }
+  ProtocolOptions options;
+  options.gap_lengths = {5, 15, 30};
+  options.keyframe_spacings = {5, 20};
+  for (Task task : all_tasks()) {
+    const TaskResult interp = run_task(task, val, stats, "interp", options);
+    const TaskResult zerovel = run_task(task, val, stats, "zerovel", options);
+    ASSERT_EQ(interp.rows.size(), zerovel.rows.size());
+    for (size_t i = 0; i < interp.rows.size(); ++i) {
+      const MetricSummary& a = interp.rows[i].metrics;
+      const MetricSummary& b = zerovel.rows[i].metrics;
+      ASSERT_GT(a.windows, 0) << task_name(task) << " row " << i;
+      EXPECT_EQ(a.windows, b.windows);
+      EXPECT_LT(a.known.position_max_cm, 1e-4) << task_name(task);
+      EXPECT_LT(a.known.rotation_max_deg, 1e-3) << task_name(task);
+      EXPECT_LT(b.known.position_max_cm, 1e-4) << task_name(task);
+      EXPECT_LT(b.known.rotation_max_deg, 1e-3) << task_name(task);
+      EXPECT_GT(a.l2p, 0.0);
+      EXPECT_LT(a.l2p, b.l2p) << task_name(task) << " row " << i;
+      EXPECT_LT(a.mpjpe_cm, b.mpjpe_cm) << task_name(task) << " row " << i;
+      EXPECT_NEAR(a.truth_skating_cm, b.truth_skating_cm, 1e-12);
+    }
+  }
+  // Window counts: sparse 128-frame windows at 0 only (40 + 128 > 140), resample
+  // 65-frame windows at 0 and 40 (80 + 65 > 140).
+  EXPECT_EQ(run_sparse_keyframes(val, stats, "interp", options).rows[0].metrics.windows, 3);
+  const TaskResult res = run_resampling(val, stats, "interp", options);
+  ASSERT_EQ(res.rows.size(), 1u);
+  EXPECT_EQ(res.rows[0].parameter, 30);
+  EXPECT_EQ(res.rows[0].metrics.windows, 6);
+}
+
+TEST(ProtocolTest, ResamplingOfLinearRootIsExact) {
+  const EvalStats stats = small_stats();
+  std::vector<Clip> val = {make_clip("v", linear_root_motion(70, 40))};
+  const TaskResult r = run_resampling(val, stats, "interp");
+  ASSERT_EQ(r.rows.size(), 1u);
+  EXPECT_EQ(r.rows[0].metrics.windows, 1);
+  EXPECT_NEAR(r.rows[0].metrics.mpjpe_cm, 0.0, 1e-6);
+  EXPECT_NEAR(r.rows[0].metrics.known.position_max_cm, 0.0, 1e-6);
+}
+
+TEST(ProtocolTest, TableNamesMethodThreadsAndRows) {
+  TaskResult r;
+  r.task = Task::Sparse;
+  r.method = "zerovel";
+  r.threads = 2;
+  RowResult row;
+  row.parameter = 15;
+  row.metrics.windows = 7;
+  row.metrics.l2p = 1.23456;
+  row.metrics.npss = 0.01234;
+  row.ms_per_window = 0.5;
+  r.rows.push_back(row);
+  const std::string t = format_table(r);
+  EXPECT_NE(t.find("`zerovel`"), std::string::npos);
+  EXPECT_NE(t.find("torch threads: 2"), std::string::npos);
+  EXPECT_NE(t.find("| 15 | 7 | 1.235 |"), std::string::npos) << t;
+  EXPECT_NE(t.find("0.0123"), std::string::npos);
+  EXPECT_EQ(t.find("L2P xz"), std::string::npos);
+  r.rows[0].metrics.l2p_horizontal = 0.5;
+  r.rows[0].metrics.l2p_vertical = 1.125;
+  const std::string wide = format_table(r, true);
+  EXPECT_NE(wide.find("| L2P | L2P xz | L2P y | L2Q |"), std::string::npos) << wide;
+  EXPECT_NE(wide.find("| 15 | 7 | 1.235 | 0.500 | 1.125 |"), std::string::npos) << wide;
+  EXPECT_EQ(task_from_name("resample"), Task::Resample);
+  EXPECT_THROW(task_from_name("nope"), InputError);
+}
+
+TEST(ProtocolTest, StatsTableListsJointsAndFeet) {
+  EvalStats stats;
+  stats.joint_names = {"Hips", "Foot_L"};
+  stats.position_mean = {0, 0.9, 0, 0.1, 0.12, 0};
+  stats.position_std = {0.5, 0.025, 0.1, 0.5, 0.05, 0.1};
+  stats.feet = {{1, 8.0}};
+  stats.standing_height = {0.1174};
+  const std::string t = format_eval_stats(stats);
+  EXPECT_NE(t.find("| Hips | 0.0 | 90.0 | 0.0 | 50.0 | 2.5 | 10.0 | | |"), std::string::npos) << t;
+  EXPECT_NE(t.find("| Foot_L | 10.0 | 12.0 | 0.0 | 50.0 | 5.0 | 10.0 | 11.74 | 8 |"), std::string::npos) << t;
+}
+
+}  // namespace
+}  // namespace mf::bench

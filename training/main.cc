@@ -1,0 +1,144 @@
+// motionfield-train: trains motionfield's models from a folder or archive of BVH files.
+//
+//   motionfield-train prior --out DIR [--data PATH] [--config FILE] [--width N] [--layers N]
+//                           [--zl N] [--zg N] [--max-minutes M] [--seed S] [--threads N] [--resume] ...
+//
+// Exit codes: 0 ok, 2 bad input, 1 internal error.
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <stdexcept>
+#include <string>
+
+#include "prior/data/dataset.h"
+#include "prior/model/model_file.h"
+#include "prior/motion/errors.h"
+#include "training/prior_trainer.h"
+
+namespace {
+
+const char* kUsage =
+    "usage: motionfield-train prior --out DIR [options]\n"
+    "  --data PATH          folder or .tar/.tar.xz/.tar.gz of BVH files (default: the shared training archive)\n"
+    "  --cache-dir DIR      extraction and parse cache (default: <project>/.cache)\n"
+    "  --config FILE        key = value lines, same keys as the flags below without '--'\n"
+    "  --width N --layers N --zl N --zg N --zg-layers N --encoder-channels N --pe N\n"
+    "  --gmp-width N --gmp-kernel N --gmp-blocks N --window N\n"
+    "  --max-minutes M      wall-time budget, counting earlier runs when resuming (default 60)\n"
+    "  --max-epochs N --batch N --stride N --frames-per-window N --lr X --lr-final X\n"
+    "  --kl-weight X --kl-warmup X --seed N --threads N (default 2) --max-train-clips N --max-steps N\n"
+    "  --resume             continue from DIR/last.* if present\n"
+    "  --export PATH        copy the best checkpoint to PATH at the end\n"
+    "  --quiet\n";
+
+double number(const std::string& key, const std::string& value) {
+  size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(value, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != value.size()) throw mf::InputError("--" + key + ": not a number: '" + value + "'");
+  return v;
+}
+
+void apply(mf::PriorTrainingOptions& o, std::string& export_path, const std::string& key, const std::string& value) {
+  auto i = [&] { return static_cast<int>(number(key, value)); };
+  auto d = [&] { return number(key, value); };
+  if (key == "data") o.data = value;
+  else if (key == "cache-dir") o.cache_dir = value;
+  else if (key == "out") o.out_dir = value;
+  else if (key == "width") o.config.decoder_width = i();
+  else if (key == "layers") o.config.decoder_layers = i();
+  else if (key == "zl") o.config.zl = i();
+  else if (key == "zg") o.config.zg = i();
+  else if (key == "zg-layers") o.config.zg_layers = i();
+  else if (key == "encoder-channels") o.config.encoder_channels = i();
+  else if (key == "pe") o.config.pe_frequencies = i();
+  else if (key == "gmp-width") o.config.gmp_width = i();
+  else if (key == "gmp-kernel") o.config.gmp_kernel = i();
+  else if (key == "gmp-blocks") o.config.gmp_blocks = i();
+  else if (key == "window") o.config.window = i();
+  else if (key == "max-minutes") o.max_minutes = d();
+  else if (key == "max-epochs") o.max_epochs = i();
+  else if (key == "batch") o.batch = i();
+  else if (key == "stride") o.stride = i();
+  else if (key == "frames-per-window") o.frames_per_window = i();
+  else if (key == "lr") o.lr = d();
+  else if (key == "lr-final") o.lr_final = d();
+  else if (key == "kl-weight") o.kl_weight = d();
+  else if (key == "kl-warmup") o.kl_warmup = d();
+  else if (key == "seed") o.seed = static_cast<uint64_t>(d());
+  else if (key == "threads") o.threads = i();
+  else if (key == "max-train-clips") o.max_train_clips = i();
+  else if (key == "max-steps") o.max_steps = i();
+  else if (key == "export") export_path = value;
+  else throw mf::InputError("unknown option --" + key);
+}
+
+void read_config(mf::PriorTrainingOptions& o, std::string& export_path, const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw mf::InputError(path + ": cannot open the config file");
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    size_t hash = line.find('#');
+    if (hash != std::string::npos) line.resize(hash);
+    size_t eq = line.find('=');
+    auto trim = [](std::string s) {
+      size_t a = s.find_first_not_of(" \t\r"), b = s.find_last_not_of(" \t\r");
+      return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
+    };
+    if (trim(line).empty()) continue;
+    if (eq == std::string::npos) throw mf::InputError(path + ":" + std::to_string(n) + ": expected key = value");
+    apply(o, export_path, trim(line.substr(0, eq)), trim(line.substr(eq + 1)));
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
+      std::fputs(kUsage, argc < 2 ? stderr : stdout);
+      return argc < 2 ? 2 : 0;
+    }
+    if (std::string(argv[1]) != "prior") throw mf::InputError(std::string("unknown model kind '") + argv[1] + "'");
+    mf::PriorTrainingOptions o;
+    o.data = mf::default_train_archive();
+    o.cache_dir = mf::default_cache_dir();
+    std::string export_path;
+    for (int i = 2; i < argc; ++i) {
+      std::string a = argv[i];
+      if (a == "--resume") o.resume = true;
+      else if (a == "--quiet") o.verbose = false;
+      else if (a == "--help") {
+        std::fputs(kUsage, stdout);
+        return 0;
+      } else if (a.rfind("--", 0) == 0 && i + 1 < argc) {
+        std::string key = a.substr(2), value = argv[++i];
+        if (key == "config") read_config(o, export_path, value);
+        else apply(o, export_path, key, value);
+      } else {
+        throw mf::InputError("unexpected argument '" + a + "' (options take a value)");
+      }
+    }
+    mf::PriorTrainingResult r = mf::train_prior(o);
+    std::printf("trained %d epochs, %lld steps in %.1f min; best validation score %.4f: %s\n", r.epochs,
+                static_cast<long long>(r.steps), r.minutes, r.best_validation, r.best_path.c_str());
+    if (!export_path.empty()) {
+      mf::save_nemf(mf::load_nemf(r.best_path), export_path);
+      std::printf("exported %s\n", export_path.c_str());
+    }
+    return 0;
+  } catch (const mf::InputError& e) {
+    std::fprintf(stderr, "motionfield-train: %s\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "motionfield-train: internal error: %s\n", e.what());
+    return 1;
+  }
+}

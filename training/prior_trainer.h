@@ -1,0 +1,60 @@
+// Training of the NeMF-style prior (prior/model/nemf.h) on a folder or archive
+// of BVH clips, with a time budget, checkpoints, resume and CSV logs.
+//
+// Data: every training clip is cut into windows of `config.window` frames at a
+// stride of `stride` frames with a random phase per epoch; clips shorter than a
+// window give one window of their own length (padded and masked, see nemf.h).
+// Each window is made canonical at its first frame.
+//
+// Losses (NeMF's): geodesic(local rotations) + geodesic(root orientation)
+// + 10 * L1(FK positions relative to the root) + beta * KL, beta warmed up
+// linearly from 0 to `kl_weight` over the first `kl_warmup` fraction of the
+// budget; the decoder is trained on `frames_per_window` random frames of each
+// window (it is a field over time). The GMP is trained on ground-truth local
+// motion: L1(velocity) + L1(height) + L1(translation) + 0.5 * BCE(contacts).
+// Validation (encode the mean, decode every frame) after each epoch chooses
+// the best checkpoint.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "prior/model/nemf.h"
+
+namespace mf {
+
+struct PriorTrainingOptions {
+  std::string data;                 ///< archive or folder of BVH files
+  std::string cache_dir;            ///< extraction / parse cache
+  std::string out_dir;              ///< checkpoints, log.csv; created if missing
+  NemfConfig config;
+  uint64_t seed = 1;
+  int threads = 2;
+  double max_minutes = 60.0;        ///< wall-time budget of this run, including previous runs when resuming
+  int max_epochs = 1000000;
+  int batch = 32;
+  int stride = 32;
+  int frames_per_window = 32;
+  double lr = 1e-3;
+  double lr_final = 1e-5;           ///< cosine decay over the budget down to this
+  double kl_weight = 1e-5;
+  double kl_warmup = 0.2;
+  bool resume = false;              ///< continue from out_dir/last.* when present
+  int max_train_clips = 0;          ///< 0 = all (small values for smoke tests)
+  int max_steps = 0;                ///< 0 = unlimited (for tests)
+  bool verbose = true;
+};
+
+struct PriorTrainingResult {
+  int epochs = 0;
+  int64_t steps = 0;
+  double minutes = 0.0;
+  double best_validation = 0.0;     ///< rotation + position validation loss of the best checkpoint
+  std::string best_path;            ///< out_dir/best.mfm
+};
+
+/// Trains and writes out_dir/{best.mfm,last.mfm,last.state,last.optim,log.csv}.
+/// Throws InputError for bad options or data.
+PriorTrainingResult train_prior(const PriorTrainingOptions& options);
+
+}  // namespace mf
