@@ -6,6 +6,7 @@
 
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "tasks/method.h"
 
 namespace mf {
 namespace {
@@ -123,6 +124,32 @@ Motion resample_zero_velocity(const Motion& input, double new_fps, int frames) {
     copy_frame(input, static_cast<int>(std::floor(source_position(i, input.fps, new_fps, N))), out, i);
   }
   return out;
+}
+
+}  // namespace mf
+
+namespace mf {
+
+std::vector<Method> baseline_methods() {
+  Method interp;
+  interp.name = "interp";
+  interp.description = "root LERP and rotation SLERP between known frames";
+  interp.complete = [](const Motion& in, const std::vector<int>& known, const TaskContext&) {
+    return interpolate_motion(in, known);
+  };
+  interp.resample = [](const Motion& in, double fps, int frames, const TaskContext&) {
+    return resample_interpolate(in, fps, frames);
+  };
+  Method zerovel;
+  zerovel.name = "zerovel";
+  zerovel.description = "hold the last known frame (zero velocity)";
+  zerovel.complete = [](const Motion& in, const std::vector<int>& known, const TaskContext&) {
+    return zero_velocity_motion(in, known);
+  };
+  zerovel.resample = [](const Motion& in, double fps, int frames, const TaskContext&) {
+    return resample_zero_velocity(in, fps, frames);
+  };
+  return {interp, zerovel};
 }
 
 }  // namespace mf

@@ -5,7 +5,6 @@
 #include <sstream>
 
 #include "prior/motion/errors.h"
-#include "tasks/baselines.h"
 
 namespace mf {
 namespace {
@@ -19,10 +18,15 @@ std::string method_list() {
 }
 
 // Empty -> the default; anything not registered -> InputError naming the choices.
-std::string resolve_method(const std::string& method) {
-  const std::string m = method.empty() ? default_method() : method;
-  for (const std::string& a : available_methods())
-    if (a == m) return m;
+const Method& resolve_method(const std::string& method, const TaskContext& ctx) {
+  const std::string m = method.empty() ? default_method(ctx) : method;
+  for (const Method& a : registered_methods()) {
+    if (a.name != m) continue;
+    if (a.needs_model && !ctx.model) {
+      throw InputError("method '" + m + "' needs the prior, and no model is loaded (name one with --model)");
+    }
+    return a;
+  }
   throw InputError("unknown method '" + method + "' (available: " + method_list() + ")");
 }
 
@@ -33,16 +37,26 @@ void check_motion(const Motion& input) {
   if (!(std::isfinite(input.fps) && input.fps > 0)) throw InputError("the input motion's fps must be finite and positive");
 }
 
-Motion run_known(const Motion& input, const std::vector<int>& known, const std::string& method) {
-  if (method == "zerovel") return zero_velocity_motion(input, known);
-  return interpolate_motion(input, known);
-}
-
 }  // namespace
 
-std::vector<std::string> available_methods() { return {"interp", "zerovel"}; }
+const std::vector<Method>& registered_methods() {
+  static const std::vector<Method> methods = [] {
+    std::vector<Method> all = baseline_methods();
+    for (auto family : {prior_methods, solver_methods}) {
+      for (Method& m : family()) all.push_back(std::move(m));
+    }
+    return all;
+  }();
+  return methods;
+}
 
-std::string default_method() { return "interp"; }
+std::vector<std::string> available_methods() {
+  std::vector<std::string> names;
+  for (const Method& m : registered_methods()) names.push_back(m.name);
+  return names;
+}
+
+std::string default_method(const TaskContext& ctx) { return "interp"; }
 
 void validate_keyframes(const std::vector<int>& keyframes, int frames) {
   if (keyframes.size() < 2)
@@ -93,21 +107,30 @@ int resampled_frame_count(int frames, double fps_in, double fps_out, bool* round
   return static_cast<int>(count);
 }
 
-Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method) {
-  const std::string m = resolve_method(method);
+Motion run_known_frames(const Motion& input, const std::vector<int>& known, const std::string& method,
+                        const TaskContext& ctx) {
+  const Method& m = resolve_method(method, ctx);
   check_motion(input);
-  validate_keyframes(keyframes, input.num_frames());
-  return run_known(input, keyframes, m);
+  validate_keyframes(known, input.num_frames());
+  if (!m.complete) throw InputError("method '" + m.name + "' does not do in-betweening or gap filling");
+  return m.complete(input, known, ctx);
 }
 
-Motion run_fill(const Motion& input, int a, int b, const std::string& method) {
-  const std::string m = resolve_method(method);
-  check_motion(input);
-  return run_known(input, known_frames_outside_gap(input.num_frames(), a, b), m);
+Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method,
+                     const TaskContext& ctx) {
+  return run_known_frames(input, keyframes, method, ctx);
 }
 
-Motion run_resample(const Motion& input, double fps, const std::string& method, std::vector<std::string>* warnings) {
-  const std::string m = resolve_method(method);
+Motion run_fill(const Motion& input, int a, int b, const std::string& method, const TaskContext& ctx) {
+  resolve_method(method, ctx);
+  check_motion(input);
+  return run_known_frames(input, known_frames_outside_gap(input.num_frames(), a, b), method, ctx);
+}
+
+Motion run_resample(const Motion& input, double fps, const std::string& method, std::vector<std::string>* warnings,
+                    const TaskContext& ctx) {
+  const Method& m = resolve_method(method, ctx);
+  if (!m.resample) throw InputError("method '" + m.name + "' does not do resampling");
   check_motion(input);
   bool rounded = false;
   const int frames = resampled_frame_count(input.num_frames(), input.fps, fps, &rounded);
@@ -120,8 +143,7 @@ Motion run_resample(const Motion& input, double fps, const std::string& method, 
         << " s before the input's last frame";
     warnings->push_back(msg.str());
   }
-  if (m == "zerovel") return resample_zero_velocity(input, fps, frames);
-  return resample_interpolate(input, fps, frames);
+  return m.resample(input, fps, frames, ctx);
 }
 
 }  // namespace mf

@@ -3,24 +3,28 @@
 // dispatch to a method by name. Later issues register the prior's solvers and
 // the transformers here; the default method is the best measured one.
 //
-// Methods today:
-//   "interp"   root LERP + rotation SLERP between known frames (the default),
-//   "zerovel"  hold the last known frame (zero velocity).
-// An empty method name means default_method(); any other unregistered name
-// throws InputError listing the available ones.
+// Methods are registered in tasks/method.h. An empty method name means
+// default_method(ctx); an unregistered name throws InputError listing the
+// available ones; a method that needs the prior throws InputError when the
+// context has no model; a method that does not support the task throws
+// InputError saying so.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "prior/motion/motion.h"
+#include "tasks/method.h"
 
 namespace mf {
 
-/// Names accepted by --method, e.g. {"interp", "zerovel"}.
+/// Every registered method (baselines, the prior's, the solvers'), in a fixed order.
+const std::vector<Method>& registered_methods();
+/// Names accepted by --method, e.g. {"interp", "zerovel", ...}.
 std::vector<std::string> available_methods();
-/// What runs when no method is given.
-std::string default_method();
+/// What runs when no method is given: the best measured method that can run
+/// in this context (methods that need a model fall back to "interp" without one).
+std::string default_method(const TaskContext& ctx = {});
 
 /// Throws InputError unless: at least two keyframes, strictly increasing (so
 /// sorted and unique), every one in [0, frames). The message names the
@@ -44,16 +48,22 @@ int resampled_frame_count(int frames, double fps_in, double fps_out, bool* round
 /// Sparse-keyframe in-betweening: the output has the input's length and fps;
 /// known frames are `keyframes` (validated with validate_keyframes()), the
 /// others are never read. Known frames are copied exactly.
-Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method);
+Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method,
+                     const TaskContext& ctx = {});
 
 /// Gap filling: frames a..b-1 unknown, all others known (as run_inbetween with
 /// known_frames_outside_gap()).
-Motion run_fill(const Motion& input, int a, int b, const std::string& method);
+Motion run_fill(const Motion& input, int a, int b, const std::string& method, const TaskContext& ctx = {});
 
 /// Resampling to `fps`, keeping the time span; the output's fps is `fps` and
 /// its length resampled_frame_count(). If the frame count had to be rounded
 /// down, a sentence saying so is appended to *warnings (if non-null).
 Motion run_resample(const Motion& input, double fps, const std::string& method,
-                    std::vector<std::string>* warnings);
+                    std::vector<std::string>* warnings, const TaskContext& ctx = {});
+
+/// Runs `complete` of a method on explicit known frames (validated like
+/// keyframes): the common path of run_inbetween and run_fill.
+Motion run_known_frames(const Motion& input, const std::vector<int>& known, const std::string& method,
+                        const TaskContext& ctx = {});
 
 }  // namespace mf

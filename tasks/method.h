@@ -1,0 +1,68 @@
+// Methods: the named algorithms behind every task ("interp", "zerovel", the
+// prior's methods, the solvers, the transformers), and the context they run in.
+// tasks/jobs.h validates input and dispatches to them by name.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "prior/motion/motion.h"
+
+namespace mf {
+
+class NemfModel;
+
+/// Progress of a long-running method (a solver's iterations).
+struct TaskProgress {
+  int iteration = 0;
+  int max_iterations = 0;
+  double energy = 0.0;
+};
+
+/// Thrown when a progress callback or the cancel flag stops a method.
+class CancelledError : public std::runtime_error {
+ public:
+  CancelledError() : std::runtime_error("cancelled") {}
+};
+
+/// What a method may use besides its input. Cheap to copy.
+struct TaskContext {
+  /// The prior; required by methods with needs_model, unused by the baselines.
+  /// Immutable and shared between threads.
+  std::shared_ptr<const NemfModel> model;
+  uint64_t seed = 0;
+  /// Called now and then by long methods; returning false cancels.
+  std::function<bool(const TaskProgress&)> progress;
+  /// Non-zero cancels (thread-safe; set from any thread).
+  const std::atomic<int>* cancel = nullptr;
+
+  /// Calls `progress` and checks `cancel`; throws CancelledError when asked to stop.
+  void report(const TaskProgress& p) const {
+    if ((cancel && cancel->load() != 0) || (progress && !progress(p))) throw CancelledError();
+  }
+};
+
+struct Method {
+  std::string name;
+  std::string description;
+  bool needs_model = false;
+  /// Completes a motion from its known frames (sorted, unique, at least two,
+  /// in range): every other frame is produced, known frames come out as given.
+  /// Unknown input frames must never be read. Null when unsupported.
+  std::function<Motion(const Motion& input, const std::vector<int>& known, const TaskContext& ctx)> complete;
+  /// Resamples to `fps` with exactly `frames` output frames at times i / fps.
+  /// Null when unsupported.
+  std::function<Motion(const Motion& input, double fps, int frames, const TaskContext& ctx)> resample;
+};
+
+/// The method families, each defined beside its implementation.
+std::vector<Method> baseline_methods();  // tasks/baselines.cc
+std::vector<Method> prior_methods();     // tasks/prior_methods.cc
+std::vector<Method> solver_methods();    // tasks/solver_methods.cc
+
+}  // namespace mf

@@ -1,0 +1,7 @@
+#include "tasks/method.h"
+
+namespace mf {
+
+std::vector<Method> prior_methods() { return {}; }
+
+}  // namespace mf
