@@ -1,5 +1,7 @@
 #include "bench/metrics.h"
 
+#include "prior/model/representation.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -75,16 +77,12 @@ Motion canonicalise(const Motion& motion, int anchor_frame, const Eigen::Vector3
   return transform_motion(motion, canonical_transform(motion, anchor_frame, root_forward));
 }
 
-std::vector<FootJoint> find_foot_joints(const Skeleton& skeleton) {
+std::vector<FootJoint> metric_foot_joints(const Skeleton& skeleton) {
+  std::vector<bool> is_toe;
+  const std::vector<int> joints = find_foot_joints(skeleton, &is_toe);
   std::vector<FootJoint> feet;
-  for (int j = 0; j < skeleton.num_joints(); ++j) {
-    const std::string name = lower(skeleton.names[j]);
-    if (name.find("toe") != std::string::npos) {
-      feet.push_back({j, 4.0});
-    } else if (name.find("foot") != std::string::npos || name.find("ankle") != std::string::npos) {
-      feet.push_back({j, 8.0});
-    }
-  }
+  for (size_t k = 0; k < joints.size(); ++k) feet.push_back({joints[k], is_toe[k] ? 4.0 : 8.0});
+  std::sort(feet.begin(), feet.end(), [](const FootJoint& a, const FootJoint& b) { return a.joint < b.joint; });
   return feet;
 }
 
@@ -108,7 +106,7 @@ EvalStats compute_eval_stats(const std::vector<Clip>& train, const EvalStatsOpti
   const int J = skeleton.num_joints();
   EvalStats stats;
   stats.joint_names = skeleton.names;
-  stats.feet = find_foot_joints(skeleton);
+  stats.feet = metric_foot_joints(skeleton);
 
   const int D = 3 * J;
   std::vector<double> sum(D, 0.0), sum_sq(D, 0.0);

@@ -108,8 +108,9 @@ struct FootJoint {
   double threshold_cm = 8.0;  ///< 8 for ankles, 4 for toes
 };
 
-/// The foot joints of a skeleton by name (see the file comment), in index order.
-std::vector<FootJoint> find_foot_joints(const Skeleton& skeleton);
+/// The foot joints of a skeleton by name (mf::find_foot_joints, see the file
+/// comment) with their contact thresholds, in index order.
+std::vector<FootJoint> metric_foot_joints(const Skeleton& skeleton);
 
 /// Statistics of the training split the metrics need.
 struct EvalStats {

@@ -1,6 +1,8 @@
 // motionfield-bench: the LaFAN1-style benchmark of docs/BENCHMARKS.md. Loads the
-// data set, computes the evaluation statistics on the training split, runs every
-// (task, method) pair on the validation split and prints markdown tables.
+// data set, computes the evaluation statistics on the training split, loads the
+// prior once (shared by every method that needs it), runs every (task, method)
+// pair on the validation split and the prior's own evaluation (recon, fps,
+// seams, sample), and prints markdown tables.
 #include <ATen/Parallel.h>
 
 #include <cerrno>
@@ -9,13 +11,17 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/prior_eval.h"
 #include "bench/protocol.h"
 #include "prior/data/dataset.h"
+#include "prior/model/model_file.h"
+#include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "tasks/jobs.h"
 
@@ -24,7 +30,12 @@ namespace {
 const char* kUsage =
     "usage: motionfield-bench [options]\n"
     "  --methods a,b     methods to run (default: every available method)\n"
-    "  --tasks a,b       gap, sparse, resample (default: all)\n"
+    "  --tasks a,b       gap, sparse, resample, and with a model recon, fps, seams, sample\n"
+    "                    (default: gap, sparse, resample, plus the prior's four when a model is loaded)\n"
+    "  --model PATH      the prior (default: the default model, see mf::default_model_path())\n"
+    "  --no-model        run without a prior (methods that need one are skipped)\n"
+    "  --samples N       windows drawn for the sample task (default 256)\n"
+    "  --seed N          seed of the sample task (default 1)\n"
     "  --threads N       torch intra-op threads (default 2)\n"
     "  --source PATH     BVH folder or archive (default: the shared training archive)\n"
     "  --cache-dir DIR   extraction and parse cache (default: <project>/.cache)\n"
@@ -55,9 +66,25 @@ int parse_int(const std::string& flag, const std::string& value, int min_value) 
   return static_cast<int>(v);
 }
 
+const std::vector<std::string> kPriorTasks = {"recon", "fps", "seams", "sample"};
+
+bool is_prior_task(const std::string& name) {
+  for (const std::string& t : kPriorTasks) {
+    if (t == name) return true;
+  }
+  return false;
+}
+
 struct Args {
   std::vector<std::string> methods;
+  bool methods_given = false;
   std::vector<mf::bench::Task> tasks;
+  std::vector<std::string> prior_tasks;
+  bool tasks_given = false;
+  std::string model;
+  bool no_model = false;
+  int samples = 256;
+  int seed = 1;
   int threads = 2;
   std::string source;
   std::string cache_dir;
@@ -83,13 +110,32 @@ Args parse_args(int argc, char** argv) {
       args.print_stats = true;
       continue;
     }
+    if (flag == "--no-model") {
+      args.no_model = true;
+      continue;
+    }
     if (i + 1 >= argc) throw mf::InputError("unknown flag or missing value: " + flag + "\n" + kUsage);
     const std::string value = argv[++i];
     if (flag == "--methods") {
       args.methods = split_list(value);
+      args.methods_given = true;
     } else if (flag == "--tasks") {
       args.tasks.clear();
-      for (const std::string& t : split_list(value)) args.tasks.push_back(mf::bench::task_from_name(t));
+      args.prior_tasks.clear();
+      args.tasks_given = true;
+      for (const std::string& t : split_list(value)) {
+        if (is_prior_task(t)) {
+          args.prior_tasks.push_back(t);
+        } else {
+          args.tasks.push_back(mf::bench::task_from_name(t));
+        }
+      }
+    } else if (flag == "--model") {
+      args.model = value;
+    } else if (flag == "--samples") {
+      args.samples = parse_int(flag, value, 1);
+    } else if (flag == "--seed") {
+      args.seed = parse_int(flag, value, 0);
     } else if (flag == "--threads") {
       args.threads = parse_int(flag, value, 1);
     } else if (flag == "--source") {
@@ -115,7 +161,13 @@ Args parse_args(int argc, char** argv) {
       throw mf::InputError("unknown method '" + m + "' (available: " + list + ")");
     }
   }
-  if (args.tasks.empty()) args.tasks = mf::bench::all_tasks();
+  if (!args.tasks_given) args.tasks = mf::bench::all_tasks();
+  if (args.no_model && !args.model.empty()) throw mf::InputError("--model and --no-model exclude each other");
+  if (!args.no_model && args.model.empty()) args.model = mf::default_model_path();
+  if (!args.tasks_given && !args.model.empty()) args.prior_tasks = kPriorTasks;
+  if (!args.prior_tasks.empty() && args.model.empty()) {
+    throw mf::InputError("the tasks recon, fps, seams and sample need a model (--model PATH)");
+  }
   if (args.source.empty()) args.source = mf::default_train_archive();
   if (args.cache_dir.empty()) args.cache_dir = mf::default_cache_dir();
   return args;
@@ -127,9 +179,26 @@ std::string fixed(double v, int decimals) {
   return buf;
 }
 
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 int run(int argc, char** argv) {
   const Args args = parse_args(argc, argv);
   at::set_num_threads(args.threads);
+  const auto run_start = std::chrono::steady_clock::now();
+  std::string command = "motionfield-bench";
+  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+
+  // The prior, loaded once, frozen, shared by every method and task.
+  mf::TaskContext ctx;
+  std::shared_ptr<mf::NemfModel> model;
+  if (!args.model.empty()) {
+    std::cerr << "loading model " << args.model << "\n";
+    model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));
+    model->set_requires_grad(false);
+    ctx.model = model;
+  }
 
   mf::DatasetOptions data_options;
   data_options.source = args.source;
@@ -149,6 +218,8 @@ int run(int argc, char** argv) {
 
   std::ostringstream md;
   md << "## motionfield-bench\n\n";
+  md << "- command: `" << command << "`\n";
+  md << "- model: " << (model ? args.model + " (" + model->config().describe() + ")" : std::string("none")) << "\n";
   md << "- validation clips: " << data.validation.size() << " (" << validation_frames << " frames)"
      << ", training clips: " << data.train.size() << "\n";
   md << "- L2P statistics: " << stats.windows << " training windows of 50 frames every 20, canonicalised at frame 9\n";
@@ -163,17 +234,56 @@ int run(int argc, char** argv) {
   if (args.print_stats) md << "### Training statistics\n\n" << mf::bench::format_eval_stats(stats) << "\n";
   std::cout << md.str() << std::flush;
 
+  auto emit = [&](const std::string& text) {
+    std::cout << text << std::flush;
+    md << text;
+  };
   mf::bench::ProtocolOptions options;
   options.max_windows = args.max_windows;
   for (mf::bench::Task task : args.tasks) {
     for (const std::string& method : args.methods) {
+      if (!mf::bench::method_supports(method, task)) {
+        // Only worth a note when the method was asked for by name.
+        if (args.methods_given) {
+          emit("Method `" + method + "` does not support the " + mf::bench::task_name(task) + " task: skipped.\n\n");
+        }
+        continue;
+      }
+      bool needs_model = false;
+      for (const mf::Method& m : mf::registered_methods()) needs_model = needs_model || (m.name == method && m.needs_model);
+      if (needs_model && !ctx.model) {
+        emit("Method `" + method + "` needs a model and none was given (--model PATH): skipped on the " +
+             mf::bench::task_name(task) + " task.\n\n");
+        continue;
+      }
       std::cerr << "running " << mf::bench::task_name(task) << " / " << method << "\n";
-      const mf::bench::TaskResult result = mf::bench::run_task(task, data.validation, stats, method, options);
-      const std::string table = mf::bench::format_table(result, args.l2p_axes) + "\n";
-      std::cout << table << std::flush;
-      md << table;
+      const mf::bench::TaskResult result = mf::bench::run_task(task, data.validation, stats, method, options, ctx);
+      emit(mf::bench::format_table(result, args.l2p_axes) + "\n");
     }
   }
+
+  mf::bench::PriorEvalOptions prior_options;
+  prior_options.max_windows = args.max_windows;
+  prior_options.samples = args.samples;
+  prior_options.seed = static_cast<uint64_t>(args.seed);
+  for (const std::string& task : args.prior_tasks) {
+    std::cerr << "running " << task << " / prior\n";
+    const auto t0 = std::chrono::steady_clock::now();
+    std::string table;
+    if (task == "recon") {
+      table = mf::bench::format_recon(mf::bench::run_recon(*model, data.validation, stats, prior_options));
+    } else if (task == "fps") {
+      table = mf::bench::format_fps(mf::bench::run_fps(*model, data.validation, prior_options));
+    } else if (task == "seams") {
+      table = mf::bench::format_seams(mf::bench::run_seams(*model, data.validation, prior_options),
+                                      prior_options.seam_radius);
+    } else {
+      table = mf::bench::format_sample(
+          mf::bench::run_sample(*model, data.validation, data.train, stats, prior_options));
+    }
+    emit(table + "\nTask wall time: " + fixed(seconds_since(t0), 1) + " s.\n\n");
+  }
+  emit("Total wall time: " + fixed(seconds_since(run_start), 1) + " s.\n");
 
   if (!args.out.empty()) {
     std::ofstream f(args.out);

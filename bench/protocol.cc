@@ -112,7 +112,7 @@ Motion hide_unknown_frames(const Motion& motion, const std::vector<int>& known) 
 }
 
 TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
-                           const ProtocolOptions& options) {
+                           const ProtocolOptions& options, const TaskContext& ctx) {
   if (options.context < 1) throw InputError("gap filling needs at least one context frame");
   TaskResult result = start_result(Task::Gap, method);
   for (int T : options.gap_lengths) {
@@ -129,7 +129,7 @@ TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stat
                                         options.root_forward);
       const Motion input = hide_unknown_frames(truth, known);
       const auto t0 = Clock::now();
-      const Motion pred = run_fill(input, a, b, method);
+      const Motion pred = run_fill(input, a, b, method, ctx);
       ms += elapsed_ms(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, known);
@@ -144,7 +144,7 @@ TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stat
 }
 
 TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
-                                const ProtocolOptions& options) {
+                                const ProtocolOptions& options, const TaskContext& ctx) {
   TaskResult result = start_result(Task::Sparse, method);
   const int length = options.sparse_window;
   const std::vector<Window> windows = cap_windows(protocol_windows(clips, length, options.stride), options.max_windows);
@@ -166,7 +166,7 @@ TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats&
       const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, options.root_forward);
       const Motion input = hide_unknown_frames(truth, keys);
       const auto t0 = Clock::now();
-      const Motion pred = run_inbetween(input, keys, method);
+      const Motion pred = run_inbetween(input, keys, method, ctx);
       ms += elapsed_ms(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, keys);
@@ -182,7 +182,7 @@ TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats&
 }
 
 TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
-                          const ProtocolOptions& options) {
+                          const ProtocolOptions& options, const TaskContext& ctx) {
   const int length = options.resample_window;
   if (length < 3 || length % 2 == 0) throw InputError("the resampling window must be odd and at least 3 frames");
   TaskResult result = start_result(Task::Resample, method);
@@ -201,7 +201,7 @@ TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats
       for (int j = 0; j < truth.num_joints(); ++j) input.rotation(static_cast<int>(i), j) = truth.rotation(known[i], j);
     }
     const auto t0 = Clock::now();
-    const Motion pred = run_resample(input, truth.fps, method, nullptr);
+    const Motion pred = run_resample(input, truth.fps, method, nullptr, ctx);
     ms += elapsed_ms(t0);
     check_prediction(pred, truth, method);
     acc.add(truth, pred, evaluated, known);
@@ -215,13 +215,21 @@ TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats
 }
 
 TaskResult run_task(Task task, const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
-                    const ProtocolOptions& options) {
+                    const ProtocolOptions& options, const TaskContext& ctx) {
   switch (task) {
-    case Task::Gap: return run_gap_filling(clips, stats, method, options);
-    case Task::Sparse: return run_sparse_keyframes(clips, stats, method, options);
-    case Task::Resample: return run_resampling(clips, stats, method, options);
+    case Task::Gap: return run_gap_filling(clips, stats, method, options, ctx);
+    case Task::Sparse: return run_sparse_keyframes(clips, stats, method, options, ctx);
+    case Task::Resample: return run_resampling(clips, stats, method, options, ctx);
   }
   throw InputError("unknown task");
+}
+
+bool method_supports(const std::string& method, Task task) {
+  for (const Method& m : registered_methods()) {
+    if (m.name != method) continue;
+    return task == Task::Resample ? static_cast<bool>(m.resample) : static_cast<bool>(m.complete);
+  }
+  return false;
 }
 
 std::string format_table(const TaskResult& result, bool l2p_axes) {

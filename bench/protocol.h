@@ -18,6 +18,10 @@
 //   with mf::run_resample back to the clip's rate (65 frames); canonicalised at
 //   frame 0; metrics over the odd frames, known-frame error over the even ones.
 //
+// Methods get an mf::TaskContext (the prior, loaded once by the caller, for the
+// methods that need it). The prior's own evaluation (reconstruction, frame
+// rates, seams, samples) is in bench/prior_eval.h.
+//
 // Every window is canonicalised (bench/metrics.h) before the method sees it, so
 // truth and prediction share the frame; frames the method must not know are
 // overwritten (identity rotations, the previous known root position) before
@@ -31,6 +35,7 @@
 
 #include "bench/metrics.h"
 #include "prior/data/dataset.h"
+#include "tasks/method.h"
 
 namespace mf::bench {
 
@@ -87,16 +92,22 @@ struct TaskResult {
 };
 
 /// The three tasks on `clips` (the validation split) with `method` (a name of
-/// mf::available_methods()). Rows without any window are kept with zero
-/// windows. Errors of the method propagate.
+/// mf::available_methods()). `ctx` is handed to every method call (the prior
+/// for methods with needs_model; a method that needs one throws mf::InputError
+/// without it). Rows without any window are kept with zero windows. Errors of
+/// the method propagate.
 TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
-                           const ProtocolOptions& options = {});
+                           const ProtocolOptions& options = {}, const TaskContext& ctx = {});
 TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
-                                const ProtocolOptions& options = {});
+                                const ProtocolOptions& options = {}, const TaskContext& ctx = {});
 TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
-                          const ProtocolOptions& options = {});
+                          const ProtocolOptions& options = {}, const TaskContext& ctx = {});
 TaskResult run_task(Task task, const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
-                    const ProtocolOptions& options = {});
+                    const ProtocolOptions& options = {}, const TaskContext& ctx = {});
+
+/// Whether `method` (a registered name) supports `task` (complete for gap and
+/// sparse, resample for resample); false for unknown names.
+bool method_supports(const std::string& method, Task task);
 
 /// The markdown table of a result, with a heading line naming the task, the
 /// method and the torch thread count. With `l2p_axes`, two more columns split

@@ -165,6 +165,24 @@ bad "unknown command" dance --in "$SAMPLE"
 bad "bad --threads" --threads 0 inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh"
 bad "no command"
 
+# ------------------------------------------------------------ the model (--model)
+bad "--model that does not exist" --model "$TMP/none.mfm" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh"
+expect_stderr "cannot open model file" "missing model message"
+bad "--model that is not a model" --model "$SAMPLE" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh"
+expect_stderr "not a motionfield model file" "not-a-model message"
+bad "--model given twice" --model "$SAMPLE" --model "$SAMPLE" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh"
+expect_rc 0 "resample --help lists the methods" -- "$MF" resample --help
+grep -q "^methods:" "$TMP/out" && grep -q "^    interp" "$TMP/out" && pass || fail "resample --help lists the methods"
+# A method that needs the prior, with no model to load ($MF_MODEL names a missing file).
+prior_method=$(awk '/^methods:/ { on = 1; next } on && /needs the model/ { print $1; exit }' "$TMP/out")
+if [ -n "$prior_method" ]; then
+  MF_MODEL="$TMP/none.mfm" bad "method $prior_method without a model" \
+    resample --in "$SAMPLE" --fps 60 --out "$TMP/bad.bvh" --method "$prior_method"
+fi
+# Baselines need no model: a broken default model does not stop them.
+MF_MODEL="$TMP/none.mfm" expect_rc 0 "baselines ignore the default model" -- \
+  "$MF" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/nomodel.bvh" --method interp
+
 # ------------------------------------------------------------ batch
 mkdir -p "$TMP/batch"
 cp "$SAMPLE" "$TMP/batch/walk.bvh"

@@ -85,7 +85,7 @@ TEST(MetricsTest, FindsFootJointsByName) {
   s.names = {"Hips", "Foot_L", "Toes_L", "LeftAnkle", "LeftToeBase", "LowerLeg_L", "FOOT_R"};
   s.parents = {-1, 0, 1, 0, 3, 0, 0};
   s.offsets.assign(7, Eigen::Vector3d(0, -0.1, 0));
-  const std::vector<FootJoint> feet = find_foot_joints(s);
+  const std::vector<FootJoint> feet = metric_foot_joints(s);
   ASSERT_EQ(feet.size(), 5u);
   EXPECT_EQ(feet[0].joint, 1);
   EXPECT_EQ(feet[0].threshold_cm, 8.0);

@@ -19,25 +19,8 @@
 namespace mf {
 namespace {
 
-NemfConfig tiny_config() {
-  NemfConfig c;
-  c.window = 32;
-  c.decoder_width = 32;
-  c.decoder_layers = 3;
-  c.zl = 8;
-  c.zg = 4;
-  c.zg_layers = 2;
-  c.encoder_channels = 4;
-  c.gmp_width = 8;
-  c.gmp_blocks = 1;
-  return c;
-}
-
-RigInfo tiny_rig() {
-  Skeleton s = test::small_skeleton();
-  Motion m = test::random_motion(s, 60, 30.0, 3);
-  return measure_rig(s, {&m});
-}
+NemfConfig tiny_config() { return test::tiny_nemf_config(); }
+RigInfo tiny_rig() { return test::tiny_rig(); }
 
 TEST(PriorModel, RigFindsFeetAndForward) {
   RigInfo rig = tiny_rig();

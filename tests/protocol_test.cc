@@ -1,10 +1,14 @@
 // The benchmark protocol (bench/protocol.h) on tiny synthetic data sets.
 #include "bench/protocol.h"
 
+#include <ATen/ATen.h>
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <string>
 
+#include "prior/model/nemf.h"
+#include "prior/model/representation.h"
 #include "prior/motion/errors.h"
 #include "tests/test_util.h"
 
@@ -196,6 +200,46 @@ TEST(ProtocolTest, StatsTableListsJointsAndFeet) {
   const std::string t = format_eval_stats(stats);
   EXPECT_NE(t.find("| Hips | 0.0 | 90.0 | 0.0 | 50.0 | 2.5 | 10.0 | | |"), std::string::npos) << t;
   EXPECT_NE(t.find("| Foot_L | 10.0 | 12.0 | 0.0 | 50.0 | 5.0 | 10.0 | 11.74 | 8 |"), std::string::npos) << t;
+}
+
+// A tiny untrained prior on the small test skeleton, frozen like the benchmark's.
+std::shared_ptr<const NemfModel> tiny_prior() {
+  at::manual_seed(0);
+  NemfConfig c;
+  c.window = 32;
+  c.decoder_width = 16;
+  c.decoder_layers = 2;
+  c.zl = 8;
+  c.zg = 4;
+  c.zg_layers = 1;
+  c.encoder_channels = 4;
+  c.gmp_width = 8;
+  c.gmp_blocks = 1;
+  const Skeleton s = test::small_skeleton();
+  const Motion m = test::random_motion(s, 60, 30.0, 3);
+  auto model = std::make_shared<NemfModel>(c, measure_rig(s, {&m}));
+  model->set_requires_grad(false);
+  return model;
+}
+
+TEST(ProtocolTest, TheContextReachesMethodsThatNeedTheModel) {
+  const EvalStats stats = small_stats();
+  std::vector<Clip> val = {make_clip("v", test::random_motion(test::small_skeleton(), 110, 30.0, 50))};
+  EXPECT_TRUE(method_supports("prior", Task::Resample));
+  EXPECT_FALSE(method_supports("prior", Task::Gap));
+  EXPECT_TRUE(method_supports("interp", Task::Sparse));
+  EXPECT_FALSE(method_supports("no-such-method", Task::Resample));
+  // Without a model in the context the prior's method refuses to run.
+  EXPECT_THROW(run_resampling(val, stats, "prior"), InputError);
+  TaskContext ctx;
+  ctx.model = tiny_prior();
+  const TaskResult r = run_task(Task::Resample, val, stats, "prior", ProtocolOptions{}, ctx);
+  ASSERT_EQ(r.rows.size(), 1u);
+  EXPECT_EQ(r.rows[0].metrics.windows, 2);  // 65-frame windows at 0 and 40
+  // The prior's resampling keeps the input frames exactly.
+  EXPECT_LT(r.rows[0].metrics.known.position_max_cm, 1e-6);
+  EXPECT_LT(r.rows[0].metrics.known.rotation_max_deg, 1e-6);
+  EXPECT_GT(r.rows[0].metrics.mpjpe_cm, 0.0);
 }
 
 }  // namespace

@@ -42,6 +42,26 @@ Motion random_motion(const Skeleton& skeleton, int frames, double fps, uint32_t 
   return m;
 }
 
+NemfConfig tiny_nemf_config() {
+  NemfConfig c;
+  c.window = 32;
+  c.decoder_width = 32;
+  c.decoder_layers = 3;
+  c.zl = 8;
+  c.zg = 4;
+  c.zg_layers = 2;
+  c.encoder_channels = 4;
+  c.gmp_width = 8;
+  c.gmp_blocks = 1;
+  return c;
+}
+
+RigInfo tiny_rig() {
+  Skeleton s = small_skeleton();
+  Motion m = random_motion(s, 60, 30.0, 3);
+  return measure_rig(s, {&m});
+}
+
 std::string scratch_dir(const std::string& name) {
   namespace fs = std::filesystem;
   fs::path p = fs::path(MF_BINARY_DIR) / "test-scratch" / name;

@@ -1,10 +1,12 @@
 // motionfield: the command-line front end (in-betweening, gap filling,
-// resampling, batch runs). Exit codes: 0 ok, 2 bad input, 1 internal error;
-// every message goes to stderr, prefixed with "motionfield: ".
-#include <ATen/Parallel.h>
+// resampling, batch runs). It is a client of the C API (motionfield.h) and
+// calls nothing else of motionfield; the JSON Lines parser (jsonl.h) is its own.
+// Exit codes: 0 ok, 2 bad input, 1 internal error; every message goes to
+// stderr, prefixed with "motionfield: ".
 #include <unistd.h>
 
 #include <charconv>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -13,21 +15,15 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "capi/cli/jsonl.h"
-#include "prior/motion/bvh.h"
-#include "prior/motion/errors.h"
-#include "prior/motion/motion_bvh.h"
-#include "prior/motion/rotations.h"
-#include "tasks/jobs.h"
-
-#ifndef MF_VERSION
-#define MF_VERSION "unknown"
-#endif
+#include "motionfield.h"
+#include "prior/motion/errors.h"  // mf::InputError (header only): the CLI's "bad input"
 
 namespace {
 
@@ -38,12 +34,206 @@ constexpr int kExitDiffer = 3;  // only `motionfield diff`
 
 using mf::InputError;
 
+// ---------------------------------------------------------------- the C API, C++ side
+
+// Throws for a failed C call: bad input (invalid argument, I/O, model, unsupported)
+// as InputError (exit 2), anything else as std::runtime_error (exit 1).
+void check(int status) {
+  if (status == MF_OK) return;
+  const std::string message = mf_last_error_message();
+  switch (status) {
+    case MF_ERROR_INVALID_ARGUMENT:
+    case MF_ERROR_IO:
+    case MF_ERROR_MODEL:
+    case MF_ERROR_UNSUPPORTED:
+      throw InputError(message);
+    default:
+      throw std::runtime_error(std::string(mf_status_name(status)) + ": " + message);
+  }
+}
+
+struct MotionDeleter {
+  void operator()(mf_motion* m) const { mf_motion_destroy(m); }
+};
+struct ModelDeleter {
+  void operator()(mf_model* m) const { mf_model_destroy(m); }
+};
+using MotionPtr = std::unique_ptr<mf_motion, MotionDeleter>;
+using ModelPtr = std::unique_ptr<mf_model, ModelDeleter>;
+
+MotionPtr load_motion(const std::string& path) {
+  mf_motion* m = nullptr;
+  check(mf_motion_load_bvh(path.c_str(), nullptr, &m));
+  return MotionPtr(m);
+}
+
+int32_t frame_count(const mf_motion* m) {
+  int32_t n = 0;
+  check(mf_motion_get_frame_count(m, &n));
+  return n;
+}
+
+int32_t joint_count(const mf_motion* m) {
+  int32_t n = 0;
+  check(mf_motion_get_joint_count(m, &n));
+  return n;
+}
+
+double fps_of(const mf_motion* m) {
+  double fps = 0;
+  check(mf_motion_get_fps(m, &fps));
+  return fps;
+}
+
+double frame_time_of(const mf_motion* m) {
+  double t = 0;
+  check(mf_motion_get_frame_time(m, &t));
+  return t;
+}
+
+std::vector<float> rotations_of(const mf_motion* m) {
+  size_t n = 0;
+  check(mf_motion_get_rotations(m, nullptr, 0, &n));
+  std::vector<float> out(n);
+  check(mf_motion_get_rotations(m, out.data(), out.size(), &n));
+  return out;
+}
+
+std::vector<float> root_positions_of(const mf_motion* m) {
+  size_t n = 0;
+  check(mf_motion_get_root_positions(m, nullptr, 0, &n));
+  std::vector<float> out(n);
+  check(mf_motion_get_root_positions(m, out.data(), out.size(), &n));
+  return out;
+}
+
+std::vector<std::string> joint_names_of(const mf_motion* m) {
+  std::vector<std::string> names;
+  for (int32_t j = 0, J = joint_count(m); j < J; ++j) {
+    size_t n = 0;
+    check(mf_motion_get_joint_name(m, j, nullptr, 0, &n));
+    std::string name(n, '\0');
+    check(mf_motion_get_joint_name(m, j, name.data(), name.size(), &n));
+    name.resize(n - 1);
+    names.push_back(name);
+  }
+  return names;
+}
+
+struct MethodInfo {
+  std::string name, description;
+  uint32_t flags = 0;
+};
+
+std::vector<MethodInfo> methods() {
+  int32_t n = 0;
+  check(mf_method_count(&n));
+  std::vector<MethodInfo> out;
+  for (int32_t i = 0; i < n; ++i) {
+    const char* name = nullptr;
+    const char* description = nullptr;
+    uint32_t flags = 0;
+    check(mf_method_get(i, &name, &description, &flags));
+    out.push_back({name, description, flags});
+  }
+  return out;
+}
+
+// Flags of a registered method; InputError "unknown method ..." otherwise.
+uint32_t method_flags(const std::string& name) {
+  int32_t index = 0;
+  check(mf_method_find(name.c_str(), &index));
+  uint32_t flags = 0;
+  check(mf_method_get(index, nullptr, nullptr, &flags));
+  return flags;
+}
+
+std::string default_method_name(const mf_model* model) {
+  const char* name = nullptr;
+  check(mf_default_method(model, &name));
+  return name;
+}
+
+// "  interp     description" lines of the methods that have `flag`, for help texts.
+std::string method_list(uint32_t flag) {
+  std::string out;
+  try {
+    for (const MethodInfo& m : methods()) {
+      if (!(m.flags & flag)) continue;
+      std::string line = "    " + m.name;
+      line.resize(std::max<size_t>(line.size() + 1, 14), ' ');
+      out += line + m.description + ((m.flags & MF_METHOD_NEEDS_MODEL) ? " [needs the model]" : "") + "\n";
+    }
+  } catch (const std::exception&) {
+  }
+  return out;
+}
+
+// The model the jobs run with: --model PATH (loaded once, up front), else the
+// default model (loaded on first need, when a job names no method, since the
+// default method depends on it, or names one that needs the model).
+class Models {
+ public:
+  explicit Models(std::string explicit_path) : explicit_path_(std::move(explicit_path)) {}
+
+  void load_explicit() {
+    if (explicit_path_.empty() || model_) return;
+    mf_model* m = nullptr;
+    check(mf_model_load(explicit_path_.c_str(), &m));
+    model_.reset(m);
+    path_ = explicit_path_;
+  }
+
+  // The model for a job with `method` ("" = the default method): may be null.
+  const mf_model* for_method(const std::string& method) {
+    if (!explicit_path_.empty()) {
+      load_explicit();
+      return model_.get();
+    }
+    const bool needs = !method.empty() && (method_flags(method) & MF_METHOD_NEEDS_MODEL);
+    if (!method.empty() && !needs) return nullptr;
+    load_default();
+    if (needs && !model_)
+      throw InputError("method '" + method + "' needs the prior, and no model is loaded (name one with --model)");
+    return model_.get();
+  }
+
+  const std::string& path() const { return path_; }
+
+ private:
+  void load_default() {
+    if (tried_default_) {
+      if (!default_error_.empty()) throw InputError(default_error_);
+      return;
+    }
+    tried_default_ = true;
+    size_t n = 0;
+    check(mf_model_default_path(nullptr, 0, &n));
+    std::string path(n, '\0');
+    check(mf_model_default_path(path.data(), path.size(), &n));
+    path.resize(n - 1);
+    if (path.empty()) return;
+    mf_model* m = nullptr;
+    const int status = mf_model_load(path.c_str(), &m);
+    if (status != MF_OK) {
+      default_error_ = std::string("cannot load the default model: ") + mf_last_error_message();
+      throw InputError(default_error_);
+    }
+    model_.reset(m);
+    path_ = path;
+  }
+
+  std::string explicit_path_, path_, default_error_;
+  bool tried_default_ = false;
+  ModelPtr model_;
+};
+
 // ---------------------------------------------------------------- help texts
 
 const char* kMainHelp =
-    "motionfield " MF_VERSION ": motion in-betweening, gap filling and resampling of BVH clips\n"
+    "motionfield " MF_VERSION_STRING ": motion in-betweening, gap filling and resampling of BVH clips\n"
     "\n"
-    "usage: motionfield [--threads N] [--verbose] <command> [options]\n"
+    "usage: motionfield [--threads N] [--model PATH] [--verbose] <command> [options]\n"
     "\n"
     "commands:\n"
     "  inbetween  fill the frames between sparse keyframes\n"
@@ -53,6 +243,9 @@ const char* kMainHelp =
     "\n"
     "global options:\n"
     "  --threads N    intra-op threads for the solvers (default 2)\n"
+    "  --model PATH   the prior's model file (default: the installed model, $MF_MODEL\n"
+    "                 or models/motionfield-prior.mfm, if any); needed only by\n"
+    "                 methods that use the prior\n"
     "  --verbose, -v  print what runs and how long it takes (stderr)\n"
     "  --help, -h     this help; `motionfield <command> --help` for a command\n"
     "  --version      print the version\n"
@@ -70,7 +263,7 @@ const char* kInbetweenHelp =
     "  --in PATH         input BVH\n"
     "  --keyframes LIST  comma-separated frame indices, e.g. 0,10,20,29\n"
     "  --out PATH        output BVH (written atomically)\n"
-    "  --method M        interp (default: LERP root, SLERP rotations) or zerovel\n";
+    "  --method M        one of the methods below (default: the best available)\n";
 
 const char* kFillHelp =
     "usage: motionfield fill --in IN.bvh --gap A:B --out OUT.bvh [--method M]\n"
@@ -81,7 +274,7 @@ const char* kFillHelp =
     "  --in PATH   input BVH\n"
     "  --gap A:B   the unknown frames, A inclusive, B exclusive\n"
     "  --out PATH  output BVH (written atomically)\n"
-    "  --method M  interp (default) or zerovel\n";
+    "  --method M  one of the methods below (default: the best available)\n";
 
 const char* kResampleHelp =
     "usage: motionfield resample --in IN.bvh --fps F --out OUT.bvh [--method M]\n"
@@ -93,7 +286,7 @@ const char* kResampleHelp =
     "  --in PATH   input BVH\n"
     "  --fps F     target frame rate, e.g. 60\n"
     "  --out PATH  output BVH (written atomically)\n"
-    "  --method M  interp (default) or zerovel\n";
+    "  --method M  one of the methods below (default: the best available)\n";
 
 const char* kBatchHelp =
     "usage: motionfield batch JOBS.jsonl\n"
@@ -104,7 +297,8 @@ const char* kBatchHelp =
     "  {\"task\": \"resample\", \"in\": \"a.bvh\", \"out\": \"d.bvh\", \"fps\": 60, \"method\": \"interp\"}\n"
     "For fill, a \"keyframes\" list, if given, is authoritative over \"gap\". Keys a\n"
     "job does not need (\"id\", frame counts, ...) are ignored; blank lines are\n"
-    "skipped; relative paths are relative to the current directory.\n"
+    "skipped; relative paths are relative to the current directory. The model\n"
+    "(--model) is loaded once for all jobs.\n"
     "A failed job is reported on stderr (line number, id, reason) and the others\n"
     "still run. Exit code: 0 if every job succeeded, 1 if any job hit an internal\n"
     "error, otherwise 2 if any job had bad input. Progress is shown on stderr when\n"
@@ -225,20 +419,8 @@ CommandArgs parse_command_args(const std::string& command, const std::vector<std
 struct Settings {
   int threads = 2;
   bool verbose = false;
+  std::string model;
 };
-
-bool is_known_method(const std::string& m) {
-  for (const std::string& a : mf::available_methods())
-    if (a == m) return true;
-  return false;
-}
-
-void check_method(const std::string& m) {
-  if (m.empty() || is_known_method(m)) return;
-  std::string list;
-  for (const std::string& a : mf::available_methods()) list += (list.empty() ? "" : ", ") + a;
-  throw InputError("unknown method '" + m + "' (available: " + list + ")");
-}
 
 void check_output_path(const std::string& out) {
   namespace fs = std::filesystem;
@@ -250,56 +432,68 @@ void check_output_path(const std::string& out) {
     throw InputError("cannot write " + out + ": directory " + dir.string() + " does not exist");
 }
 
+// The warning of a resampling whose frame count had to be rounded down.
+std::string rounding_warning(int frames, double fps_in, double fps_out, int out_frames) {
+  std::ostringstream msg;
+  const double span_in = (frames - 1) / fps_in, span_out = (out_frames - 1) / fps_out;
+  msg << "resampling " << frames << " frames from " << fps_in << " to " << fps_out
+      << " fps does not give a whole number of frames (" << (frames - 1) * (fps_out / fps_in) + 1.0
+      << "); rounded down to " << out_frames << " frames, so the output ends " << (span_in - span_out)
+      << " s before the input's last frame";
+  return msg.str();
+}
+
 // Runs one job (from the command line or a batch line) end to end: read, solve,
 // write. Warnings are appended to *warnings.
-void run_job(const mf::cli::BatchJob& job, const Settings& settings, std::vector<std::string>* warnings) {
+void run_job(const mf::cli::BatchJob& job, const Settings& settings, Models& models,
+             std::vector<std::string>* warnings) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  check_method(job.method);
+  if (!job.method.empty()) method_flags(job.method);  // unknown methods fail before any reading
   check_output_path(job.out);
+  const mf_model* model = models.for_method(job.method);
 
-  mf::BvhDocument layout;
-  const mf::Motion input = mf::read_motion(job.in, &layout);
+  const MotionPtr input = load_motion(job.in);
+  const int frames_in = frame_count(input.get());
   const auto t1 = Clock::now();
 
-  mf::Motion result;
-  int expected_frames = input.num_frames();
+  mf_task_options options;
+  check(mf_task_options_init(&options));
+  options.method = job.method.empty() ? nullptr : job.method.c_str();
+  mf_motion* raw = nullptr;
+  int32_t expected_frames = frames_in;
   if (job.task == "inbetween" || (job.task == "fill" && job.has_keyframes)) {
-    result = mf::run_inbetween(input, job.keyframes, job.method);
+    const std::vector<int32_t> keys(job.keyframes.begin(), job.keyframes.end());
+    check(mf_inbetween(model, input.get(), keys.data(), keys.size(), &options, &raw));
   } else if (job.task == "fill") {
-    result = mf::run_fill(input, job.gap_begin, job.gap_end, job.method);
+    check(mf_fill(model, input.get(), job.gap_begin, job.gap_end, &options, &raw));
   } else if (job.task == "resample") {
-    result = mf::run_resample(input, job.fps, job.method, warnings);
-    expected_frames = mf::resampled_frame_count(input.num_frames(), input.fps, job.fps, nullptr);
+    const double fps_in = fps_of(input.get());
+    int32_t rounded = 0;
+    check(mf_resample_frame_count(frames_in, fps_in, job.fps, &expected_frames, &rounded));
+    if (rounded && warnings) warnings->push_back(rounding_warning(frames_in, fps_in, job.fps, expected_frames));
+    check(mf_resample(model, input.get(), job.fps, &options, &raw));
   } else {
     throw InputError("unknown task '" + job.task + "'");
   }
+  const MotionPtr result(raw);
   const auto t2 = Clock::now();
 
-  mf::BvhDocument doc = mf::motion_to_bvh(result, layout);
-  // Same-rate tasks keep the input's frame time as written (0.0333333 stays
-  // 0.0333333, not 1 / (1 / 0.0333333)).
-  if (job.task != "resample") doc.frame_time = layout.frame_time;
-  if (doc.num_frames != expected_frames)
-    throw std::logic_error("the result has " + std::to_string(doc.num_frames) + " frames, expected " +
+  const int32_t frames_out = frame_count(result.get());
+  if (frames_out != expected_frames)
+    throw std::logic_error("the result has " + std::to_string(frames_out) + " frames, expected " +
                            std::to_string(expected_frames));
-  try {
-    mf::write_bvh_file(job.out, doc);
-  } catch (const InputError&) {
-    throw;
-  } catch (const std::exception& e) {
-    throw InputError("cannot write " + job.out + ": " + e.what());
-  }
+  check(mf_motion_save_bvh(result.get(), job.out.c_str(), nullptr));
   const auto t3 = Clock::now();
 
   if (settings.verbose) {
     auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
+    const std::string method = job.method.empty() ? default_method_name(model) : job.method;
     std::fprintf(stderr,
-                 "motionfield: %s %s -> %s: %d -> %d frames, method %s, %d threads; read %.1f ms, solve %.1f ms, "
-                 "write %.1f ms\n",
-                 job.task.c_str(), job.in.c_str(), job.out.c_str(), input.num_frames(), doc.num_frames,
-                 (job.method.empty() ? mf::default_method() : job.method).c_str(), settings.threads, ms(t1 - t0),
-                 ms(t2 - t1), ms(t3 - t2));
+                 "motionfield: %s %s -> %s: %d -> %d frames, method %s, model %s, %d threads; read %.1f ms, "
+                 "solve %.1f ms, write %.1f ms\n",
+                 job.task.c_str(), job.in.c_str(), job.out.c_str(), frames_in, frames_out, method.c_str(),
+                 model ? models.path().c_str() : "none", settings.threads, ms(t1 - t0), ms(t2 - t1), ms(t3 - t2));
   }
 }
 
@@ -312,6 +506,8 @@ int command_single(const std::string& command, const std::vector<std::string>& a
   const CommandArgs a = parse_command_args(command, args, {"in", "out", "method", task_flag});
   if (a.help) {
     std::fputs(command == "inbetween" ? kInbetweenHelp : command == "fill" ? kFillHelp : kResampleHelp, stdout);
+    std::printf("\nmethods:\n%s",
+                method_list(command == "resample" ? MF_METHOD_RESAMPLES : MF_METHOD_COMPLETES).c_str());
     return kExitOk;
   }
   if (!a.positional.empty())
@@ -337,8 +533,10 @@ int command_single(const std::string& command, const std::vector<std::string>& a
   } else {
     job.fps = parse_double(task_value, "--fps");
   }
+  Models models(settings.model);
+  models.load_explicit();
   std::vector<std::string> warnings;
-  run_job(job, settings, &warnings);
+  run_job(job, settings, models, &warnings);
   print_warnings(warnings, "");
   return kExitOk;
 }
@@ -365,6 +563,8 @@ int command_batch(const std::vector<std::string>& args, const Settings& settings
   if (file.bad()) throw InputError("cannot read " + path);
   if (!lines.empty() && lines[0].compare(0, 3, "\xEF\xBB\xBF") == 0) lines[0].erase(0, 3);  // UTF-8 BOM
 
+  Models models(settings.model);
+  models.load_explicit();
   int total = 0;
   for (const std::string& l : lines) total += blank(l) ? 0 : 1;
   const bool progress = isatty(STDERR_FILENO) == 1;
@@ -390,7 +590,7 @@ int command_batch(const std::vector<std::string>& args, const Settings& settings
       if (const mf::cli::JsonValue* id = value.find("id"))
         label += " (id " + (id->is_string() ? id->as_string() : id->dump()) + ")";
       const mf::cli::BatchJob job = mf::cli::batch_job_from_json(value);
-      run_job(job, settings, &warnings);
+      run_job(job, settings, models, &warnings);
       clear_progress();
       print_warnings(warnings, label + ": ");
     } catch (const InputError& e) {
@@ -415,6 +615,25 @@ int command_batch(const std::vector<std::string>& args, const Settings& settings
   return kExitOk;
 }
 
+// Angle in degrees between two rotations given as (w, x, y, z) floats: the
+// angle of q_a^-1 q_b, computed from its vector part (accurate near zero).
+double rotation_difference_degrees(const float* a, const float* b) {
+  double qa[4], qb[4], na = 0, nb = 0;
+  for (int k = 0; k < 4; ++k) {
+    qa[k] = a[k], qb[k] = b[k];
+    na += qa[k] * qa[k], nb += qb[k] * qb[k];
+  }
+  na = std::sqrt(na), nb = std::sqrt(nb);
+  for (int k = 0; k < 4; ++k) qa[k] /= na, qb[k] /= nb;
+  // r = conj(qa) * qb
+  const double w = qa[0] * qb[0] + qa[1] * qb[1] + qa[2] * qb[2] + qa[3] * qb[3];
+  const double x = qa[0] * qb[1] - qa[1] * qb[0] - qa[2] * qb[3] + qa[3] * qb[2];
+  const double y = qa[0] * qb[2] + qa[1] * qb[3] - qa[2] * qb[0] - qa[3] * qb[1];
+  const double z = qa[0] * qb[3] - qa[1] * qb[2] + qa[2] * qb[1] - qa[3] * qb[0];
+  const double angle = 2.0 * std::atan2(std::sqrt(x * x + y * y + z * z), std::abs(w));
+  return angle * (180.0 / 3.14159265358979323846);
+}
+
 int command_diff(const std::vector<std::string>& args) {
   const CommandArgs a = parse_command_args("diff", args, {"tol", "frames", "step"});
   if (a.help) {
@@ -425,44 +644,52 @@ int command_diff(const std::vector<std::string>& args) {
   const double tol = a.has("tol") ? parse_double(a.get("tol"), "--tol") : 1e-4;
   const int step = a.has("step") ? parse_int(a.get("step"), "--step") : 1;
   if (step < 1) throw InputError("diff: --step must be at least 1");
-  mf::BvhDocument doc_a, doc_b;
-  const mf::BvhUnits units;
-  const mf::Motion ma = mf::read_motion(a.positional[0], &doc_a, units);
-  const mf::Motion mb = mf::read_motion(a.positional[1], &doc_b, units);
+  constexpr double kFileUnitsPerMetre = 100.0;  // BVH files are read as centimetres
+  const MotionPtr ma = load_motion(a.positional[0]);
+  const MotionPtr mb = load_motion(a.positional[1]);
+  const int frames_a = frame_count(ma.get()), frames_b = frame_count(mb.get());
 
   std::vector<std::string> problems;
-  if (ma.skeleton.names != mb.skeleton.names) problems.push_back("joint names differ");
+  if (joint_names_of(ma.get()) != joint_names_of(mb.get())) problems.push_back("joint names differ");
   std::vector<int> frames;
   if (a.has("frames")) {
     frames = parse_int_list(a.get("frames"), "--frames");
   } else {
-    for (int f = 0; f < ma.num_frames(); ++f) frames.push_back(f);
+    for (int f = 0; f < frames_a; ++f) frames.push_back(f);
   }
   if (!a.has("frames") && !a.has("step")) {
-    if (ma.num_frames() != mb.num_frames())
-      problems.push_back("frame counts differ: " + std::to_string(ma.num_frames()) + " vs " +
-                         std::to_string(mb.num_frames()));
-    if (std::abs(doc_a.frame_time - doc_b.frame_time) > 1e-6 * doc_a.frame_time) {
+    if (frames_a != frames_b)
+      problems.push_back("frame counts differ: " + std::to_string(frames_a) + " vs " + std::to_string(frames_b));
+    const double ta = frame_time_of(ma.get()), tb = frame_time_of(mb.get());
+    if (std::abs(ta - tb) > 1e-6 * ta) {
       std::ostringstream s;
       s.precision(9);
-      s << "frame times differ: " << doc_a.frame_time << " vs " << doc_b.frame_time;
+      s << "frame times differ: " << ta << " vs " << tb;
       problems.push_back(s.str());
     }
   }
   double max_pos = 0, max_rot = 0;
   int worst_pos = -1, worst_rot = -1;
   if (problems.empty()) {
-    const int J = ma.num_joints();
+    const int J = joint_count(ma.get());
+    const std::vector<float> rot_a = rotations_of(ma.get()), rot_b = rotations_of(mb.get());
+    const std::vector<float> pos_a = root_positions_of(ma.get()), pos_b = root_positions_of(mb.get());
     for (int f : frames) {
       const long long g = static_cast<long long>(f) * step;
-      if (f < 0 || f >= ma.num_frames() || g >= mb.num_frames()) {
+      if (f < 0 || f >= frames_a || g >= frames_b) {
         problems.push_back("frame " + std::to_string(f) + " is out of range");
         break;
       }
-      const double d = (ma.root_positions[f] - mb.root_positions[g]).norm() / units.length_scale;
+      double d2 = 0;
+      for (int k = 0; k < 3; ++k) {
+        const double d = static_cast<double>(pos_a[3 * f + k]) - pos_b[3 * g + k];
+        d2 += d * d;
+      }
+      const double d = std::sqrt(d2) * kFileUnitsPerMetre;
       if (d > max_pos) max_pos = d, worst_pos = f;
       for (int j = 0; j < J; ++j) {
-        const double r = mf::geodesic_angle(ma.rotation(f, j), mb.rotation(static_cast<int>(g), j)) * (180.0 / 3.14159265358979323846);
+        const double r = rotation_difference_degrees(&rot_a[4 * (static_cast<size_t>(f) * J + j)],
+                                                     &rot_b[4 * (static_cast<size_t>(g) * J + j)]);
         if (r > max_rot) max_rot = r, worst_rot = f;
       }
     }
@@ -480,24 +707,39 @@ int command_diff(const std::vector<std::string>& args) {
   return problems.empty() ? kExitOk : kExitDiffer;
 }
 
+// Value of a global option given as "--name VALUE" or "--name=VALUE" at argv[*i].
+bool global_option(int argc, char** argv, int* i, const std::string& name, std::string* value) {
+  const std::string a = argv[*i];
+  const std::string flag = "--" + name;
+  if (a == flag) {
+    if (*i + 1 >= argc) throw InputError(flag + " needs a value");
+    *value = argv[++*i];
+    return true;
+  }
+  if (a.rfind(flag + "=", 0) == 0) {
+    *value = a.substr(flag.size() + 1);
+    return true;
+  }
+  return false;
+}
+
 int run(int argc, char** argv) {
   Settings settings;
   std::vector<std::string> rest;
-  bool want_help = false, want_version = false;
+  bool want_help = false, want_version = false, have_model = false;
   // Global options may appear anywhere; everything else belongs to the command.
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--threads" || a.rfind("--threads=", 0) == 0) {
-      std::string value;
-      if (a == "--threads") {
-        if (i + 1 >= argc) throw InputError("--threads needs a value");
-        value = argv[++i];
-      } else {
-        value = a.substr(10);
-      }
+    std::string value;
+    if (global_option(argc, argv, &i, "threads", &value)) {
       settings.threads = parse_int(value, "--threads");
       if (settings.threads < 1 || settings.threads > 1024)
         throw InputError("--threads must be between 1 and 1024, not " + value);
+    } else if (global_option(argc, argv, &i, "model", &value)) {
+      if (have_model) throw InputError("--model is given more than once");
+      if (value.empty()) throw InputError("--model needs a value");
+      settings.model = value;
+      have_model = true;
     } else if (a == "--verbose" || a == "-v") {
       settings.verbose = true;
     } else if (a == "--version") {
@@ -509,7 +751,7 @@ int run(int argc, char** argv) {
     }
   }
   if (want_version) {
-    std::printf("motionfield %s\n", MF_VERSION);
+    std::printf("motionfield %s\n", mf_version_string());
     return kExitOk;
   }
   if (want_help) {
@@ -520,7 +762,7 @@ int run(int argc, char** argv) {
     std::fputs(kMainHelp, stderr);
     throw InputError("no command given");
   }
-  at::set_num_threads(settings.threads);
+  check(mf_set_num_threads(settings.threads));
   if (settings.verbose) std::fprintf(stderr, "motionfield: %d intra-op threads\n", settings.threads);
 
   const std::string command = rest.front();

@@ -1,0 +1,424 @@
+/*
+ * motionfield.h: the stable C interface of motionfield, a learned human-motion
+ * prior (a NeMF-style implicit motion field) with task solvers for keyframe
+ * in-betweening, gap filling and resampling.
+ *
+ * This is the only public header and libmotionfield.so the only public library.
+ * It is plain C89 and compiles as C++; every exported name starts with "mf_"
+ * (macros with "MF_").
+ *
+ * ---------------------------------------------------------------- conventions
+ *
+ * Units and axes. Lengths are metres, times seconds, angles radians. Y is up and
+ * the ground is the XZ plane at y = 0. Rotations are unit quaternions stored
+ * (w, x, y, z) (Hamilton convention, rotating column vectors: v' = q v q^-1). A
+ * joint's local rotation maps its own frame into its parent's frame; the global
+ * transform of joint j is G_j = G_parent(j) * T(offset_j) * R_j, and the root
+ * (joint 0) uses its per-frame root position instead of its offset.
+ *
+ * Arrays. Bulk data is exchanged through caller-owned, row-major float buffers:
+ *   rotations        [frames][joints][4]  (w, x, y, z)
+ *   root positions   [frames][3]          (x, y, z), metres, world frame
+ *   joint offsets    [joints][3]          metres, in the parent's frame
+ *   global positions [frames][joints][3]  metres, world frame
+ * Getters take the buffer, its capacity in elements and an optional `needed`
+ * out-param that receives the number of elements the result has:
+ *   - out == NULL and capacity == 0: a size query; *needed is set, MF_OK.
+ *   - capacity < needed: MF_ERROR_BUFFER_TOO_SMALL, *needed is set and the
+ *     buffer is not touched.
+ *   - otherwise the first `needed` elements are written, MF_OK.
+ * String getters work the same way with capacities in bytes; `needed` counts
+ * the terminating NUL. The library never hands out memory the caller must
+ * free: the strings it returns as `const char *` are static and live as long
+ * as the library is loaded.
+ *
+ * Status codes. Every fallible function returns an int status: MF_OK (0) or
+ * one of the MF_ERROR_* codes below. On failure a message for the user is
+ * available from mf_last_error_message() on the same thread, and out-params
+ * and caller buffers are left untouched (the one exception: `needed` is set on
+ * MF_ERROR_BUFFER_TOO_SMALL). No C++ exception ever crosses this interface.
+ *
+ * Handles. Objects are opaque handles created through an out-param and freed
+ * by a *_destroy() function that accepts NULL. There is no global
+ * initialisation call. A loaded model and a motion are immutable: one handle
+ * may be used from any number of threads at once. Functions that take handles
+ * never keep references to the caller's buffers after they return.
+ *
+ * Options. Options structs start with `uint32_t struct_size` and have an
+ * mf_*_options_init() function that sets struct_size to sizeof the struct as
+ * this header declares it and every other field to its default, which is
+ * always zero (or NULL). Passing NULL instead of an options struct means all
+ * defaults. The library reads only the first struct_size bytes, so callers
+ * compiled against an older header keep working; a struct from a newer header
+ * (struct_size larger than the library knows) is accepted when the fields this
+ * library does not know are zero, and rejected with MF_ERROR_UNSUPPORTED
+ * otherwise.
+ *
+ * Threads. The library's numeric work runs on an intra-op thread pool whose
+ * size mf_set_num_threads() sets for the whole process. Tasks may be run from
+ * several threads at once on one shared model; each gives the same result as
+ * when run alone with the same thread count. Progress callbacks run on the
+ * thread that called the task.
+ *
+ * Versioning. Functions are only ever appended; MF_ABI_VERSION changes (with
+ * the SONAME, libmotionfield.so.<MF_ABI_VERSION>) only when an existing
+ * function or struct would have to change.
+ */
+#ifndef MOTIONFIELD_H
+#define MOTIONFIELD_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(_WIN32)
+#  if defined(MF_BUILDING_LIBRARY)
+#    define MF_API __declspec(dllexport)
+#  else
+#    define MF_API __declspec(dllimport)
+#  endif
+#elif defined(__GNUC__) && __GNUC__ >= 4
+#  define MF_API __attribute__((visibility("default")))
+#else
+#  define MF_API
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ================================================================ handles */
+
+/** A loaded model (the prior). Immutable; share it between threads. */
+typedef struct mf_model mf_model;
+/** A skeleton with per-frame local rotations and root positions. Immutable. */
+typedef struct mf_motion mf_motion;
+/** A flag that stops a running task from any thread. */
+typedef struct mf_cancel_token mf_cancel_token;
+/** A motion encoded by a model as a sequence of window latents. Immutable. */
+typedef struct mf_encoding mf_encoding;
+
+/* ================================================================ version */
+
+#define MF_VERSION_MAJOR 0
+#define MF_VERSION_MINOR 1
+#define MF_VERSION_PATCH 0
+/** MAJOR * 10000 + MINOR * 100 + PATCH */
+#define MF_VERSION_NUMBER (MF_VERSION_MAJOR * 10000 + MF_VERSION_MINOR * 100 + MF_VERSION_PATCH)
+#define MF_VERSION_STRING "0.1.0"
+/** The ABI major: the N of libmotionfield.so.N. */
+#define MF_ABI_VERSION 0
+
+/** MF_ABI_VERSION of the loaded library (compare with the header's). */
+MF_API uint32_t mf_abi_version(void);
+/** MF_VERSION_NUMBER of the loaded library. */
+MF_API uint32_t mf_version_number(void);
+/** MF_VERSION_STRING of the loaded library, e.g. "0.1.0". Never NULL. */
+MF_API const char *mf_version_string(void);
+
+/* ================================================================ status */
+
+#define MF_OK 0
+/** A NULL pointer, a value out of range, malformed input (a BVH file that does
+ *  not parse, keyframes out of order, a non-finite number, joint counts that do
+ *  not match, an unknown method name, ...). */
+#define MF_ERROR_INVALID_ARGUMENT 1
+/** A caller buffer is smaller than the result; `needed` tells the size. */
+#define MF_ERROR_BUFFER_TOO_SMALL 2
+/** A file could not be opened, read or written (or no default model exists). */
+#define MF_ERROR_IO 3
+/** A model file is not a valid motionfield model (bad magic, truncated,
+ *  corrupted, wrong version or kind), or a method needs a model and none was
+ *  given. */
+#define MF_ERROR_MODEL 4
+/** A progress callback returned non-zero or the cancel token was cancelled. */
+#define MF_ERROR_CANCELLED 5
+/** A bug in motionfield; the message says what happened. */
+#define MF_ERROR_INTERNAL 6
+/** The request needs something this library does not have (an options field
+ *  from a newer header set to a non-default value, ...). */
+#define MF_ERROR_UNSUPPORTED 7
+/** Memory could not be allocated. */
+#define MF_ERROR_OUT_OF_MEMORY 8
+
+/** The message of the most recent failed call on this thread ("" if none has
+ *  failed yet). Never NULL; valid until the next failing call on this thread.
+ *  Successful calls leave it unchanged. */
+MF_API const char *mf_last_error_message(void);
+/** The name of a status code ("MF_OK", "MF_ERROR_IO", ...; "MF_ERROR_UNKNOWN"
+ *  for a code this library does not define). Never NULL. */
+MF_API const char *mf_status_name(int status);
+
+/* ================================================================ threads */
+
+/** Sets the number of intra-op threads of the numeric work in this process
+ *  (1..1024). Until it is called, the library uses libtorch's default. Results
+ *  may differ in the last bits between thread counts. */
+MF_API int mf_set_num_threads(int32_t num_threads);
+/** The current number of intra-op threads. */
+MF_API int mf_get_num_threads(int32_t *out);
+
+/* ================================================================ cancel, progress */
+
+MF_API int mf_cancel_token_create(mf_cancel_token **out);
+/** Asks every task that uses the token to stop (thread-safe; the task returns
+ *  MF_ERROR_CANCELLED at its next check). The token stays cancelled until reset. */
+MF_API int mf_cancel_token_cancel(mf_cancel_token *token);
+/** Clears the flag so that the token can be used again. */
+MF_API int mf_cancel_token_reset(mf_cancel_token *token);
+/** *out = 1 if cancelled, else 0. */
+MF_API int mf_cancel_token_is_cancelled(const mf_cancel_token *token, int32_t *out);
+/** Destroys the token (NULL is fine). No task may still be using it. */
+MF_API void mf_cancel_token_destroy(mf_cancel_token *token);
+
+/** What a progress callback is told. Filled by the library; struct_size is the
+ *  size the library filled, so read only fields that fit in it. */
+typedef struct mf_progress {
+  uint32_t struct_size;
+  /** Iterations done so far (0 before the work starts). */
+  int32_t iteration;
+  /** Total iterations if known, else 0. */
+  int32_t max_iterations;
+  /** The solver's current energy (0 for methods without one). */
+  double energy;
+} mf_progress;
+
+/** Progress callback: called on the task's thread before the work starts and
+ *  now and then during long methods. Return 0 to continue, non-zero to cancel
+ *  (the task then returns MF_ERROR_CANCELLED and produces nothing). */
+typedef int (*mf_progress_fn)(void *user_data, const mf_progress *progress);
+
+/* ================================================================ methods */
+
+/** The method needs a model (the prior). */
+#define MF_METHOD_NEEDS_MODEL 1u
+/** The method does in-betweening and gap filling. */
+#define MF_METHOD_COMPLETES 2u
+/** The method does resampling. */
+#define MF_METHOD_RESAMPLES 4u
+
+/** Number of registered methods ("interp", "zerovel", the prior's, ...). */
+MF_API int mf_method_count(int32_t *out);
+/** Facts about method `index` (0 <= index < mf_method_count()). Each out-param
+ *  may be NULL; the strings are static. `flags` is a combination of
+ *  MF_METHOD_* bits. */
+MF_API int mf_method_get(int32_t index, const char **name, const char **description, uint32_t *flags);
+/** Index of the method named `name`; MF_ERROR_INVALID_ARGUMENT naming the
+ *  available methods if there is none. */
+MF_API int mf_method_find(const char *name, int32_t *index);
+/** The method used when an options struct gives none: the best measured method
+ *  that can run with `model` (which may be NULL: then a method that does not
+ *  need one). The string is static. */
+MF_API int mf_default_method(const mf_model *model, const char **name);
+
+/* ================================================================ model */
+
+/** Path of the default model: $MF_MODEL if set, else the model installed next
+ *  to the library (<prefix>/share/motionfield/motionfield-prior.mfm), else the
+ *  source tree's models/motionfield-prior.mfm; "" (and MF_OK) when none exists.
+ *  A string getter (see "Arrays" above). */
+MF_API int mf_model_default_path(char *out, size_t capacity, size_t *needed);
+
+/** Loads a model file (.mfm). path == NULL loads the default model
+ *  (MF_ERROR_IO if there is none). MF_ERROR_IO if the file cannot be read,
+ *  MF_ERROR_MODEL if it is not a valid model. */
+MF_API int mf_model_load(const char *path, mf_model **out);
+/** Loads a model from the bytes of a model file (copied; the buffer may be
+ *  freed after the call). */
+MF_API int mf_model_load_from_memory(const void *data, size_t size, mf_model **out);
+/** Destroys a model (NULL is fine). Motions and tasks do not need it to stay
+ *  alive once they have returned. */
+MF_API void mf_model_destroy(mf_model *model);
+
+/** The model's skeleton: joint count, names, parent indices (-1 for the root,
+ *  joint 0) and rest offsets [joints][3] in metres. */
+MF_API int mf_model_get_joint_count(const mf_model *model, int32_t *out);
+MF_API int mf_model_get_joint_name(const mf_model *model, int32_t joint, char *out, size_t capacity, size_t *needed);
+MF_API int mf_model_get_parents(const mf_model *model, int32_t *out, size_t capacity, size_t *needed);
+MF_API int mf_model_get_offsets(const mf_model *model, float *out, size_t capacity, size_t *needed);
+/** Frame rate of the training data (frames per second). */
+MF_API int mf_model_get_fps(const mf_model *model, double *out);
+/** Frames per window: the longest span one latent code describes. */
+MF_API int mf_model_get_window(const mf_model *model, int32_t *out);
+/** Sizes of the local (pose) and global (root orientation) latent codes. */
+MF_API int mf_model_get_latent_sizes(const mf_model *model, int32_t *local_size, int32_t *global_size);
+
+/* ================================================================ motion */
+
+/** BVH reading and writing options. */
+typedef struct mf_bvh_options {
+  uint32_t struct_size;
+  /** Metres per file length unit; 0 = 0.01 (centimetres, as most mocap BVH). */
+  double length_scale;
+} mf_bvh_options;
+
+MF_API int mf_bvh_options_init(mf_bvh_options *options);
+
+/** A motion on an explicit skeleton. joint_names: joint_count NUL-terminated
+ *  unique names; parents: joint_count indices, -1 for joint 0 (the only root),
+ *  every parent before its child; offsets: [joint_count][3] metres;
+ *  frame_count >= 1; fps finite and positive; rotations
+ *  [frame_count][joint_count][4] (w, x, y, z; normalised by consumers, norm at
+ *  least 1e-6); root_positions [frame_count][3]. Every number must be finite.
+ *  The arrays are copied. */
+MF_API int mf_motion_create(int32_t joint_count, const char *const *joint_names, const int32_t *parents,
+                            const float *offsets, int32_t frame_count, double fps, const float *rotations,
+                            const float *root_positions, mf_motion **out);
+/** The same on the model's skeleton; joint_count must equal the model's. */
+MF_API int mf_motion_create_for_model(const mf_model *model, int32_t joint_count, int32_t frame_count, double fps,
+                                      const float *rotations, const float *root_positions, mf_motion **out);
+/** The same on the skeleton of `like` (joint_count must equal its joint
+ *  count); the new motion also keeps the BVH layout of `like`. */
+MF_API int mf_motion_create_like(const mf_motion *like, int32_t joint_count, int32_t frame_count, double fps,
+                                 const float *rotations, const float *root_positions, mf_motion **out);
+
+/** Reads a BVH file (any channel order, position channels on any joint, End
+ *  Sites). MF_ERROR_IO if it cannot be opened, MF_ERROR_INVALID_ARGUMENT with
+ *  "<path>:<line>: ..." if it is malformed. The motion remembers the file's
+ *  layout (hierarchy, channel order, frame time) for mf_motion_save_bvh. */
+MF_API int mf_motion_load_bvh(const char *path, const mf_bvh_options *options, mf_motion **out);
+/** The same from BVH text in memory (`size` bytes, no NUL needed). */
+MF_API int mf_motion_load_bvh_from_memory(const char *data, size_t size, const mf_bvh_options *options,
+                                          mf_motion **out);
+/** Writes a BVH file, atomically (through a temporary file and a rename). A
+ *  motion that came from BVH, or from a task or mf_motion_create_like on one,
+ *  keeps that file's hierarchy, channel layout and joint order, and its frame
+ *  time as written when the frame rate is unchanged; other motions get a
+ *  default layout (root "Xposition Yposition Zposition Zrotation Xrotation
+ *  Yrotation", other joints "Zrotation Xrotation Yrotation"). */
+MF_API int mf_motion_save_bvh(const mf_motion *motion, const char *path, const mf_bvh_options *options);
+/** The same BVH text into a caller buffer (a string getter: capacity in bytes
+ *  including the terminating NUL). */
+MF_API int mf_motion_save_bvh_to_memory(const mf_motion *motion, const mf_bvh_options *options, char *out,
+                                        size_t capacity, size_t *needed);
+MF_API void mf_motion_destroy(mf_motion *motion);
+
+MF_API int mf_motion_get_joint_count(const mf_motion *motion, int32_t *out);
+MF_API int mf_motion_get_frame_count(const mf_motion *motion, int32_t *out);
+MF_API int mf_motion_get_fps(const mf_motion *motion, double *out);
+/** Seconds between frames as mf_motion_save_bvh writes them (for a motion read
+ *  from BVH: the file's frame time as written, e.g. 0.0333333). */
+MF_API int mf_motion_get_frame_time(const mf_motion *motion, double *out);
+MF_API int mf_motion_get_joint_name(const mf_motion *motion, int32_t joint, char *out, size_t capacity,
+                                    size_t *needed);
+MF_API int mf_motion_get_parents(const mf_motion *motion, int32_t *out, size_t capacity, size_t *needed);
+MF_API int mf_motion_get_offsets(const mf_motion *motion, float *out, size_t capacity, size_t *needed);
+/** [frames][joints][4] local rotations (w, x, y, z). */
+MF_API int mf_motion_get_rotations(const mf_motion *motion, float *out, size_t capacity, size_t *needed);
+/** [frames][3] root positions, metres. */
+MF_API int mf_motion_get_root_positions(const mf_motion *motion, float *out, size_t capacity, size_t *needed);
+/** [frames][joints][3] global joint positions (forward kinematics), metres. */
+MF_API int mf_motion_get_global_positions(const mf_motion *motion, float *out, size_t capacity, size_t *needed);
+
+/* ================================================================ tasks */
+
+/** Options of every task. Fields a task does not use are ignored. */
+typedef struct mf_task_options {
+  uint32_t struct_size;
+  /** Method name (see mf_method_get); NULL or "" = mf_default_method(model). */
+  const char *method;
+  /** Seed of the method's random choices; equal seeds give equal results. */
+  uint64_t seed;
+  /** Optional progress callback and the pointer it is given. */
+  mf_progress_fn progress;
+  void *user_data;
+  /** Optional cancel token (may be cancelled from another thread). */
+  mf_cancel_token *cancel;
+} mf_task_options;
+
+MF_API int mf_task_options_init(mf_task_options *options);
+
+/* Every task takes an optional model (NULL is fine for methods without
+ * MF_METHOD_NEEDS_MODEL; a method that needs one fails with MF_ERROR_MODEL
+ * without), an input motion that is not modified, optional options, and
+ * returns a new motion through `out` on the input's skeleton (and BVH layout).
+ * When the method needs the model, the input must have the model's joint count
+ * (MF_ERROR_INVALID_ARGUMENT otherwise). Unknown frames of the input are never
+ * read (they must still be finite); known frames are copied exactly. */
+
+/** Keyframe in-betweening: keyframes (0-based frame indices, strictly
+ *  increasing, at least two, each in [0, frames)) are kept; every other frame
+ *  is produced. The output has the input's length and frame rate. */
+MF_API int mf_inbetween(const mf_model *model, const mf_motion *input, const int32_t *keyframes,
+                        size_t keyframe_count, const mf_task_options *options, mf_motion **out);
+/** Gap filling: frames gap_begin..gap_end-1 are unknown, every other frame is
+ *  kept; 1 <= gap_begin < gap_end <= frames - 1. */
+MF_API int mf_fill(const mf_model *model, const mf_motion *input, int32_t gap_begin, int32_t gap_end,
+                   const mf_task_options *options, mf_motion **out);
+/** Resampling to `fps`, keeping the time span: output frame i sits at i / fps
+ *  seconds and the output has mf_resample_frame_count() frames. */
+MF_API int mf_resample(const mf_model *model, const mf_motion *input, double fps, const mf_task_options *options,
+                       mf_motion **out);
+/** Frame count of resampling `frame_count` frames from fps_in to fps_out:
+ *  (frame_count - 1) * fps_out / fps_in + 1, taken as the nearest integer when
+ *  within 1e-5 relative of it (BVH frame times carry about six digits),
+ *  otherwise rounded down; then *rounded (optional) is 1, else 0. */
+MF_API int mf_resample_frame_count(int32_t frame_count, double fps_in, double fps_out, int32_t *out,
+                                   int32_t *rounded);
+
+/* ================================================================ encode, decode */
+
+/* The prior as a codec. A motion (at least 2 frames, any frame rate, on the
+ * model's skeleton: same joint names and parents) is resampled to the model's
+ * frame rate if needed and cut into overlapping windows of
+ * mf_model_get_window() model frames; each window is encoded to a local latent
+ * (mf_model_get_latent_sizes: local_size floats) and a global latent
+ * (global_size floats), the encoder's mean, so encoding is deterministic.
+ * Decoding evaluates the decoder at any times (seconds from the motion's first
+ * frame; times outside the encoded span hold the ends) and blends the windows
+ * with raised-cosine weights. The root translation comes from the model's
+ * global motion predictor (MF_ROOT_FROM_PRIOR) or from the encoded input's root
+ * path (MF_ROOT_FROM_INPUT). */
+
+#define MF_ROOT_FROM_PRIOR 0
+#define MF_ROOT_FROM_INPUT 1
+
+typedef struct mf_codec_options {
+  uint32_t struct_size;
+  /** Encoding: model frames between window starts, in [1, window - 1];
+   *  0 = window / 2. */
+  int32_t hop;
+  /** Decoding: MF_ROOT_FROM_PRIOR (0, the default) or MF_ROOT_FROM_INPUT. */
+  int32_t root_source;
+} mf_codec_options;
+
+MF_API int mf_codec_options_init(mf_codec_options *options);
+
+/** Encodes `input` with `model`. The encoding keeps a reference to the model
+ *  (the model handle itself may be destroyed) and the input's BVH layout. */
+MF_API int mf_encode(const mf_model *model, const mf_motion *input, const mf_codec_options *options,
+                     mf_encoding **out);
+MF_API void mf_encoding_destroy(mf_encoding *encoding);
+
+/** Number of windows. */
+MF_API int mf_encoding_get_window_count(const mf_encoding *encoding, int32_t *out);
+/** Seconds from the first to the last frame of the encoded input. */
+MF_API int mf_encoding_get_duration(const mf_encoding *encoding, double *out);
+/** [windows] start time of each window, seconds. */
+MF_API int mf_encoding_get_window_times(const mf_encoding *encoding, double *out, size_t capacity, size_t *needed);
+/** [windows][local_size] local latents. */
+MF_API int mf_encoding_get_local_latents(const mf_encoding *encoding, float *out, size_t capacity, size_t *needed);
+/** [windows][global_size] global latents. */
+MF_API int mf_encoding_get_global_latents(const mf_encoding *encoding, float *out, size_t capacity, size_t *needed);
+/** A copy of `encoding` with other latents (for editing or interpolating in
+ *  latent space): local [windows][local_size] and global [windows][global_size]
+ *  floats, `*_count` giving each array's length; NULL (with count 0) keeps
+ *  that part. Every value must be finite. */
+MF_API int mf_encoding_with_latents(const mf_encoding *encoding, const float *local_latents, size_t local_count,
+                                    const float *global_latents, size_t global_count, mf_encoding **out);
+
+/** Decodes at times i / fps, i = 0 .. frame_count - 1; frame_count 0 means
+ *  the frames that fit the encoded input's time span,
+ *  mf_resample_frame_count(input frames, input fps, fps). The motion is on
+ *  the encoded input's skeleton and BVH layout, at `fps`. */
+MF_API int mf_decode(const mf_encoding *encoding, double fps, int32_t frame_count, const mf_codec_options *options,
+                     mf_motion **out);
+/** Decodes at `time_count` (>= 1) arbitrary finite times (seconds, any order):
+ *  one frame per time; the motion carries `fps` as its frame rate. */
+MF_API int mf_decode_times(const mf_encoding *encoding, const double *times, size_t time_count, double fps,
+                           const mf_codec_options *options, mf_motion **out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* MOTIONFIELD_H */

@@ -1,0 +1,138 @@
+// Internals of the C API shared by its translation units: the handle structs,
+// the exception guard every exported body runs in, and helpers for options
+// structs and caller buffers. Not installed.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "motionfield.h"
+#include "prior/motion/bvh.h"
+#include "prior/motion/motion.h"
+
+namespace mf {
+class NemfModel;
+}
+
+struct mf_model {
+  std::shared_ptr<const mf::NemfModel> model;
+};
+
+struct mf_motion {
+  mf::Motion motion;
+  /// The BVH document the motion (or the task input it came from) was read
+  /// from, without its values; null for motions made from arrays.
+  std::shared_ptr<const mf::BvhDocument> layout;
+  /// The fps motion_from_bvh derived from layout->frame_time: a motion at this
+  /// fps is written with the layout's frame time as written.
+  double layout_fps = 0.0;
+  /// Metres per BVH unit the motion was read with: the default for writing.
+  double length_scale = 0.01;
+};
+
+struct mf_cancel_token {
+  std::atomic<int> flag{0};
+};
+
+namespace mf::capi {
+
+/// An error with its status code, thrown inside exported bodies.
+class ApiError : public std::runtime_error {
+ public:
+  ApiError(int status, const std::string& message) : std::runtime_error(message), status_(status) {}
+  int status() const { return status_; }
+
+ private:
+  int status_;
+};
+
+/// Records `message` as this thread's last error and returns `status`.
+int fail(int status, const char* message) noexcept;
+
+/// Maps the exception being handled to a status code and records its message.
+int fail_current_exception() noexcept;
+
+/// Runs `body` and maps every exception to a status code and message.
+template <class Body>
+int guard(Body&& body) noexcept {
+  try {
+    body();
+    return MF_OK;
+  } catch (...) {
+    return fail_current_exception();
+  }
+}
+
+/// Throws MF_ERROR_INVALID_ARGUMENT "<what> is NULL" when p is null.
+inline void require(const void* p, const char* what) {
+  if (!p) throw ApiError(MF_ERROR_INVALID_ARGUMENT, std::string(what) + " is NULL");
+}
+
+/// Copies a caller's options struct of type T into a default-initialised T,
+/// reading only what fits in its struct_size; larger (newer) structs must have
+/// zeros in the part this library does not know. Every default is zero.
+template <class T>
+T read_options(const T* user, const char* type_name) {
+  T out;
+  std::memset(&out, 0, sizeof out);
+  out.struct_size = static_cast<uint32_t>(sizeof(T));
+  if (!user) return out;
+  const uint32_t size = user->struct_size;
+  if (size < sizeof(uint32_t) || size > 65536)
+    throw ApiError(MF_ERROR_INVALID_ARGUMENT, std::string(type_name) + ".struct_size is " + std::to_string(size) +
+                                                  ": call " + type_name + "_init() first");
+  std::memcpy(&out, user, size < sizeof(T) ? size : sizeof(T));
+  if (size > sizeof(T)) {
+    const unsigned char* tail = reinterpret_cast<const unsigned char*>(user) + sizeof(T);
+    for (size_t i = 0; i < size - sizeof(T); ++i) {
+      if (tail[i] != 0)
+        throw ApiError(MF_ERROR_UNSUPPORTED, std::string(type_name) + " sets a field (at byte " +
+                                                 std::to_string(sizeof(T) + i) +
+                                                 ") that this version of motionfield (" MF_VERSION_STRING
+                                                 ") does not know");
+    }
+  }
+  out.struct_size = static_cast<uint32_t>(sizeof(T));
+  return out;
+}
+
+/// The common part of every buffer getter: checks out/capacity against the
+/// result's size and copies. See "Arrays" in motionfield.h.
+template <class T>
+void write_buffer(const T* data, size_t count, T* out, size_t capacity, size_t* needed) {
+  if (!out && capacity != 0) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the output buffer is NULL but its capacity is not 0");
+  if (!out) {
+    if (!needed) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "a size query (NULL buffer) needs a non-NULL `needed`");
+    *needed = count;
+    return;
+  }
+  if (capacity < count) {
+    if (needed) *needed = count;
+    throw ApiError(MF_ERROR_BUFFER_TOO_SMALL, "the buffer holds " + std::to_string(capacity) + " elements, " +
+                                                  std::to_string(count) + " are needed");
+  }
+  if (count) std::memcpy(out, data, count * sizeof(T));
+  if (needed) *needed = count;
+}
+
+/// A string into a caller buffer (capacity in bytes, including the NUL).
+void write_string(const std::string& s, char* out, size_t capacity, size_t* needed);
+
+/// Skeleton getters shared by models and motions.
+void skeleton_joint_name(const Skeleton& s, int32_t joint, char* out, size_t capacity, size_t* needed);
+void skeleton_parents(const Skeleton& s, int32_t* out, size_t capacity, size_t* needed);
+void skeleton_offsets(const Skeleton& s, float* out, size_t capacity, size_t* needed);
+
+/// A new motion handle carrying `motion` and the BVH layout of `like` (if any).
+mf_motion* derived_motion(Motion motion, const mf_motion& like);
+
+/// Applies the thread count of mf_set_num_threads() to the calling thread.
+void apply_num_threads();
+
+}  // namespace mf::capi

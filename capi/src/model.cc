@@ -1,0 +1,159 @@
+// mf_model: loading (file, memory, default model) and skeleton/config queries.
+#include <dlfcn.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "capi/src/capi_internal.h"
+#include "prior/model/model_file.h"
+#include "prior/model/nemf.h"
+#include "prior/motion/errors.h"
+
+namespace mf::capi {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kModelFileName[] = "motionfield-prior.mfm";
+
+// The directory holding libmotionfield.so itself.
+fs::path library_directory() {
+  Dl_info info;
+  if (dladdr(reinterpret_cast<void*>(&mf_version_string), &info) == 0 || !info.dli_fname) return {};
+  std::error_code ec;
+  const fs::path lib = fs::canonical(info.dli_fname, ec);
+  return ec ? fs::path() : lib.parent_path();
+}
+
+std::string default_path() {
+  if (const char* env = std::getenv("MF_MODEL"); env && *env) return env;
+  // Installed: <prefix>/<libdir>/libmotionfield.so and
+  // <prefix>/share/motionfield/motionfield-prior.mfm, libdir being "lib" or
+  // "lib/<multiarch>".
+  const fs::path dir = library_directory();
+  if (!dir.empty()) {
+    std::error_code ec;
+    for (const fs::path& prefix : {dir.parent_path(), dir.parent_path().parent_path()}) {
+      const fs::path candidate = prefix / "share" / "motionfield" / kModelFileName;
+      if (fs::is_regular_file(candidate, ec)) return candidate.string();
+    }
+  }
+  return mf::default_model_path();
+}
+
+mf_model* make_model(NemfModel model) {
+  model.set_requires_grad(false);
+  auto handle = std::make_unique<mf_model>();
+  handle->model = std::make_shared<const NemfModel>(std::move(model));
+  return handle.release();
+}
+
+mf_model* load_bytes(const uint8_t* data, size_t size, const std::string& source) {
+  try {
+    return make_model(deserialize_nemf(data, size, source));
+  } catch (const InputError& e) {
+    throw ApiError(MF_ERROR_MODEL, e.what());
+  }
+}
+
+const NemfModel& get(const mf_model* model) {
+  require(model, "model");
+  return *model->model;
+}
+
+}  // namespace
+}  // namespace mf::capi
+
+using mf::capi::ApiError;
+using mf::capi::guard;
+using mf::capi::require;
+
+extern "C" {
+
+int mf_model_default_path(char* out, size_t capacity, size_t* needed) {
+  return guard([&] { mf::capi::write_string(mf::capi::default_path(), out, capacity, needed); });
+}
+
+int mf_model_load(const char* path, mf_model** out) {
+  return guard([&] {
+    require(out, "out");
+    std::string file;
+    if (path) {
+      file = path;
+      if (file.empty()) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the model path is empty");
+    } else {
+      file = mf::capi::default_path();
+      if (file.empty())
+        throw ApiError(MF_ERROR_IO,
+                       "no default model: set MF_MODEL or install models/motionfield-prior.mfm (see README)");
+    }
+    std::ifstream in(file, std::ios::binary);
+    if (!in) throw ApiError(MF_ERROR_IO, "cannot open model file " + file + ": " + std::strerror(errno));
+    std::error_code ec;
+    if (std::filesystem::is_directory(file, ec)) throw ApiError(MF_ERROR_IO, "cannot read model file " + file + ": it is a directory");
+    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) throw ApiError(MF_ERROR_IO, "cannot read model file " + file);
+    *out = mf::capi::load_bytes(bytes.data(), bytes.size(), file);
+  });
+}
+
+int mf_model_load_from_memory(const void* data, size_t size, mf_model** out) {
+  return guard([&] {
+    require(out, "out");
+    if (!data && size != 0) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "data is NULL");
+    static const uint8_t kEmpty = 0;
+    *out = mf::capi::load_bytes(data ? static_cast<const uint8_t*>(data) : &kEmpty, size, "<memory>");
+  });
+}
+
+void mf_model_destroy(mf_model* model) { delete model; }
+
+int mf_model_get_joint_count(const mf_model* model, int32_t* out) {
+  return guard([&] {
+    const mf::NemfModel& m = mf::capi::get(model);
+    require(out, "out");
+    *out = m.rig().num_joints();
+  });
+}
+
+int mf_model_get_joint_name(const mf_model* model, int32_t joint, char* out, size_t capacity, size_t* needed) {
+  return guard([&] { mf::capi::skeleton_joint_name(mf::capi::get(model).rig().skeleton, joint, out, capacity, needed); });
+}
+
+int mf_model_get_parents(const mf_model* model, int32_t* out, size_t capacity, size_t* needed) {
+  return guard([&] { mf::capi::skeleton_parents(mf::capi::get(model).rig().skeleton, out, capacity, needed); });
+}
+
+int mf_model_get_offsets(const mf_model* model, float* out, size_t capacity, size_t* needed) {
+  return guard([&] { mf::capi::skeleton_offsets(mf::capi::get(model).rig().skeleton, out, capacity, needed); });
+}
+
+int mf_model_get_fps(const mf_model* model, double* out) {
+  return guard([&] {
+    const mf::NemfModel& m = mf::capi::get(model);
+    require(out, "out");
+    *out = m.config().fps;
+  });
+}
+
+int mf_model_get_window(const mf_model* model, int32_t* out) {
+  return guard([&] {
+    const mf::NemfModel& m = mf::capi::get(model);
+    require(out, "out");
+    *out = m.config().window;
+  });
+}
+
+int mf_model_get_latent_sizes(const mf_model* model, int32_t* local_size, int32_t* global_size) {
+  return guard([&] {
+    const mf::NemfModel& m = mf::capi::get(model);
+    if (!local_size && !global_size) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "local_size and global_size are both NULL");
+    if (local_size) *local_size = m.config().zl;
+    if (global_size) *global_size = m.config().zg;
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,128 @@
+// The tasks: in-betweening, gap filling, resampling (tasks/jobs.h by method name).
+#include <cmath>
+
+#include "capi/src/capi_internal.h"
+#include "prior/model/nemf.h"
+#include "prior/motion/errors.h"
+#include "tasks/jobs.h"
+
+namespace mf::capi {
+namespace {
+
+// The context of one task call from its options; checks what the C boundary
+// can check before the method runs.
+TaskContext make_context(const mf_model* model, const mf_motion& input, const mf_task_options& o,
+                         std::string* method) {
+  TaskContext ctx;
+  if (model) ctx.model = model->model;
+  ctx.seed = o.seed;
+  if (o.progress) {
+    const mf_progress_fn fn = o.progress;
+    void* const user_data = o.user_data;
+    ctx.progress = [fn, user_data](const TaskProgress& p) {
+      mf_progress cp;
+      std::memset(&cp, 0, sizeof cp);
+      cp.struct_size = sizeof cp;
+      cp.iteration = p.iteration;
+      cp.max_iterations = p.max_iterations;
+      cp.energy = p.energy;
+      return fn(user_data, &cp) == 0;
+    };
+  }
+  if (o.cancel) ctx.cancel = &o.cancel->flag;
+
+  *method = o.method ? o.method : "";
+  const std::string name = method->empty() ? default_method(ctx) : *method;
+  const Method* found = nullptr;
+  std::string list;
+  for (const Method& m : registered_methods()) {
+    list += (list.empty() ? "" : ", ") + m.name;
+    if (m.name == name) found = &m;
+  }
+  if (!found) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "unknown method '" + name + "' (available: " + list + ")");
+  if (found->needs_model) {
+    if (!ctx.model)
+      throw ApiError(MF_ERROR_MODEL, "method '" + name + "' needs a model (the prior), and none was given");
+    const int model_joints = ctx.model->rig().num_joints();
+    if (input.motion.num_joints() != model_joints)
+      throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the motion has " + std::to_string(input.motion.num_joints()) +
+                                                    " joints but the model's skeleton has " +
+                                                    std::to_string(model_joints) + " (method '" + name + "')");
+  }
+  return ctx;
+}
+
+// Called by each task once its arguments are validated: the first progress
+// report, which also honours a cancel token cancelled before the call.
+void start(const TaskContext& ctx) { ctx.report(TaskProgress{}); }
+
+template <class Run>
+int run_task(const mf_model* model, const mf_motion* input, const mf_task_options* options, mf_motion** out,
+             Run&& run) {
+  return guard([&] {
+    require(input, "input");
+    require(out, "out");
+    const mf_task_options o = read_options(options, "mf_task_options");
+    std::string method;
+    const TaskContext ctx = make_context(model, *input, o, &method);
+    apply_num_threads();
+    Motion result = run(input->motion, method, ctx);
+    *out = derived_motion(std::move(result), *input);
+  });
+}
+
+}  // namespace
+}  // namespace mf::capi
+
+using mf::capi::ApiError;
+using mf::capi::guard;
+using mf::capi::require;
+
+extern "C" {
+
+int mf_inbetween(const mf_model* model, const mf_motion* input, const int32_t* keyframes, size_t keyframe_count,
+                 const mf_task_options* options, mf_motion** out) {
+  return mf::capi::run_task(model, input, options, out,
+                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
+                              if (!keyframes && keyframe_count != 0)
+                                throw ApiError(MF_ERROR_INVALID_ARGUMENT, "keyframes is NULL");
+                              const std::vector<int> keys(keyframes, keyframes + keyframe_count);
+                              mf::validate_keyframes(keys, in.num_frames());
+                              mf::capi::start(ctx);
+                              return mf::run_inbetween(in, keys, method, ctx);
+                            });
+}
+
+int mf_fill(const mf_model* model, const mf_motion* input, int32_t gap_begin, int32_t gap_end,
+            const mf_task_options* options, mf_motion** out) {
+  return mf::capi::run_task(model, input, options, out,
+                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
+                              mf::known_frames_outside_gap(in.num_frames(), gap_begin, gap_end);
+                              mf::capi::start(ctx);
+                              return mf::run_fill(in, gap_begin, gap_end, method, ctx);
+                            });
+}
+
+int mf_resample(const mf_model* model, const mf_motion* input, double fps, const mf_task_options* options,
+                mf_motion** out) {
+  return mf::capi::run_task(model, input, options, out,
+                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
+                              if (!(std::isfinite(fps) && fps > 0))
+                                throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the target fps must be finite and positive");
+                              mf::resampled_frame_count(in.num_frames(), in.fps, fps, nullptr);
+                              mf::capi::start(ctx);
+                              return mf::run_resample(in, fps, method, nullptr, ctx);
+                            });
+}
+
+int mf_resample_frame_count(int32_t frame_count, double fps_in, double fps_out, int32_t* out, int32_t* rounded) {
+  return guard([&] {
+    require(out, "out");
+    bool r = false;
+    const int n = mf::resampled_frame_count(frame_count, fps_in, fps_out, &r);
+    *out = n;
+    if (rounded) *rounded = r ? 1 : 0;
+  });
+}
+
+}  // extern "C"

@@ -1,0 +1,226 @@
+"""ctypes declarations of libmotionfield.so's C API (motionfield.h).
+
+Every function's argtypes and restype is set here, once; the rest of the
+package calls only what this module declares. The library is found by
+``library_path()``: $MOTIONFIELD_LIBRARY, then next to this package (an
+installed tree), then a build tree of the source checkout, then the system's
+library path.
+"""
+
+import ctypes
+import ctypes.util
+import glob
+import os
+
+ABI_VERSION = 0  # MF_ABI_VERSION of the header this module mirrors
+
+# Status codes (MF_OK, MF_ERROR_*).
+OK = 0
+ERROR_INVALID_ARGUMENT = 1
+ERROR_BUFFER_TOO_SMALL = 2
+ERROR_IO = 3
+ERROR_MODEL = 4
+ERROR_CANCELLED = 5
+ERROR_INTERNAL = 6
+ERROR_UNSUPPORTED = 7
+ERROR_OUT_OF_MEMORY = 8
+
+METHOD_NEEDS_MODEL = 1
+METHOD_COMPLETES = 2
+METHOD_RESAMPLES = 4
+
+ROOT_FROM_PRIOR = 0
+ROOT_FROM_INPUT = 1
+
+
+class MfModel(ctypes.Structure):
+    """Opaque mf_model."""
+
+
+class MfMotion(ctypes.Structure):
+    """Opaque mf_motion."""
+
+
+class MfEncoding(ctypes.Structure):
+    """Opaque mf_encoding."""
+
+
+class MfCancelToken(ctypes.Structure):
+    """Opaque mf_cancel_token."""
+
+
+class MfProgress(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("iteration", ctypes.c_int32),
+        ("max_iterations", ctypes.c_int32),
+        ("energy", ctypes.c_double),
+    ]
+
+
+PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.POINTER(MfProgress))
+
+
+class MfBvhOptions(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("length_scale", ctypes.c_double),
+    ]
+
+
+class MfTaskOptions(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("method", ctypes.c_char_p),
+        ("seed", ctypes.c_uint64),
+        ("progress", PROGRESS_FN),
+        ("user_data", ctypes.c_void_p),
+        ("cancel", ctypes.POINTER(MfCancelToken)),
+    ]
+
+
+class MfCodecOptions(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("hop", ctypes.c_int32),
+        ("root_source", ctypes.c_int32),
+    ]
+
+
+_LIB_NAMES = ("libmotionfield.so.0", "libmotionfield.so")
+
+
+def _candidates():
+    env = os.environ.get("MOTIONFIELD_LIBRARY")
+    if env:
+        yield env
+        return
+    here = os.path.dirname(os.path.abspath(__file__))
+    # Next to the package: inside it, beside it, or an installed prefix
+    # (<prefix>/lib/python3/dist-packages/motionfield -> <prefix>/lib[/<multiarch>]).
+    prefix = os.path.normpath(os.path.join(here, "..", "..", "..", ".."))
+    dirs = [here, os.path.dirname(here), os.path.join(prefix, "lib")]
+    dirs += sorted(glob.glob(os.path.join(prefix, "lib", "*-linux-gnu")))
+    dirs += [os.path.join(prefix, "lib64")]
+    # The source checkout's build trees (python/motionfield -> <root>/build*/capi).
+    root = os.path.normpath(os.path.join(here, "..", ".."))
+    builds = [os.path.join(root, "build")] + sorted(
+        (d for d in glob.glob(os.path.join(root, "build*")) if os.path.basename(d) != "build"),
+        key=lambda d: -os.path.getmtime(d))
+    dirs += [os.path.join(b, "capi") for b in builds]
+    for d in dirs:
+        for name in _LIB_NAMES:
+            path = os.path.join(d, name)
+            if os.path.isfile(path):
+                yield path
+    found = ctypes.util.find_library("motionfield")
+    yield found or "libmotionfield.so.0"
+
+
+def _load():
+    errors = []
+    for path in _candidates():
+        try:
+            return ctypes.CDLL(path), path
+        except OSError as e:
+            errors.append("%s: %s" % (path, e))
+    raise ImportError("cannot load libmotionfield.so (set MOTIONFIELD_LIBRARY to its path):\n  " +
+                      "\n  ".join(errors))
+
+
+lib, library_path = _load()
+
+_i32 = ctypes.c_int32
+_u32 = ctypes.c_uint32
+_u64 = ctypes.c_uint64
+_f32 = ctypes.c_float
+_f64 = ctypes.c_double
+_size = ctypes.c_size_t
+_int = ctypes.c_int
+_str = ctypes.c_char_p
+_P = ctypes.POINTER
+_model = _P(MfModel)
+_motion = _P(MfMotion)
+_encoding = _P(MfEncoding)
+_token = _P(MfCancelToken)
+
+
+def _declare(name, restype, *argtypes):
+    f = getattr(lib, name)
+    f.restype = restype
+    f.argtypes = list(argtypes)
+    globals()[name] = f
+
+
+_declare("mf_abi_version", _u32)
+_declare("mf_version_number", _u32)
+_declare("mf_version_string", _str)
+_declare("mf_last_error_message", _str)
+_declare("mf_status_name", _str, _int)
+_declare("mf_set_num_threads", _int, _i32)
+_declare("mf_get_num_threads", _int, _P(_i32))
+
+_declare("mf_cancel_token_create", _int, _P(_token))
+_declare("mf_cancel_token_cancel", _int, _token)
+_declare("mf_cancel_token_reset", _int, _token)
+_declare("mf_cancel_token_is_cancelled", _int, _token, _P(_i32))
+_declare("mf_cancel_token_destroy", None, _token)
+
+_declare("mf_method_count", _int, _P(_i32))
+_declare("mf_method_get", _int, _i32, _P(_str), _P(_str), _P(_u32))
+_declare("mf_method_find", _int, _str, _P(_i32))
+_declare("mf_default_method", _int, _model, _P(_str))
+
+_declare("mf_model_default_path", _int, ctypes.c_char_p, _size, _P(_size))
+_declare("mf_model_load", _int, _str, _P(_model))
+_declare("mf_model_load_from_memory", _int, ctypes.c_void_p, _size, _P(_model))
+_declare("mf_model_destroy", None, _model)
+_declare("mf_model_get_joint_count", _int, _model, _P(_i32))
+_declare("mf_model_get_joint_name", _int, _model, _i32, ctypes.c_char_p, _size, _P(_size))
+_declare("mf_model_get_parents", _int, _model, _P(_i32), _size, _P(_size))
+_declare("mf_model_get_offsets", _int, _model, _P(_f32), _size, _P(_size))
+_declare("mf_model_get_fps", _int, _model, _P(_f64))
+_declare("mf_model_get_window", _int, _model, _P(_i32))
+_declare("mf_model_get_latent_sizes", _int, _model, _P(_i32), _P(_i32))
+
+_declare("mf_bvh_options_init", _int, _P(MfBvhOptions))
+_declare("mf_motion_create", _int, _i32, _P(_str), _P(_i32), _P(_f32), _i32, _f64, _P(_f32), _P(_f32), _P(_motion))
+_declare("mf_motion_create_for_model", _int, _model, _i32, _i32, _f64, _P(_f32), _P(_f32), _P(_motion))
+_declare("mf_motion_create_like", _int, _motion, _i32, _i32, _f64, _P(_f32), _P(_f32), _P(_motion))
+_declare("mf_motion_load_bvh", _int, _str, _P(MfBvhOptions), _P(_motion))
+_declare("mf_motion_load_bvh_from_memory", _int, ctypes.c_char_p, _size, _P(MfBvhOptions), _P(_motion))
+_declare("mf_motion_save_bvh", _int, _motion, _str, _P(MfBvhOptions))
+_declare("mf_motion_save_bvh_to_memory", _int, _motion, _P(MfBvhOptions), ctypes.c_char_p, _size, _P(_size))
+_declare("mf_motion_destroy", None, _motion)
+_declare("mf_motion_get_joint_count", _int, _motion, _P(_i32))
+_declare("mf_motion_get_frame_count", _int, _motion, _P(_i32))
+_declare("mf_motion_get_fps", _int, _motion, _P(_f64))
+_declare("mf_motion_get_frame_time", _int, _motion, _P(_f64))
+_declare("mf_motion_get_joint_name", _int, _motion, _i32, ctypes.c_char_p, _size, _P(_size))
+_declare("mf_motion_get_parents", _int, _motion, _P(_i32), _size, _P(_size))
+_declare("mf_motion_get_offsets", _int, _motion, _P(_f32), _size, _P(_size))
+_declare("mf_motion_get_rotations", _int, _motion, _P(_f32), _size, _P(_size))
+_declare("mf_motion_get_root_positions", _int, _motion, _P(_f32), _size, _P(_size))
+_declare("mf_motion_get_global_positions", _int, _motion, _P(_f32), _size, _P(_size))
+
+_declare("mf_task_options_init", _int, _P(MfTaskOptions))
+_declare("mf_inbetween", _int, _model, _motion, _P(_i32), _size, _P(MfTaskOptions), _P(_motion))
+_declare("mf_fill", _int, _model, _motion, _i32, _i32, _P(MfTaskOptions), _P(_motion))
+_declare("mf_resample", _int, _model, _motion, _f64, _P(MfTaskOptions), _P(_motion))
+_declare("mf_resample_frame_count", _int, _i32, _f64, _f64, _P(_i32), _P(_i32))
+
+_declare("mf_codec_options_init", _int, _P(MfCodecOptions))
+_declare("mf_encode", _int, _model, _motion, _P(MfCodecOptions), _P(_encoding))
+_declare("mf_encoding_destroy", None, _encoding)
+_declare("mf_encoding_get_window_count", _int, _encoding, _P(_i32))
+_declare("mf_encoding_get_duration", _int, _encoding, _P(_f64))
+_declare("mf_encoding_get_window_times", _int, _encoding, _P(_f64), _size, _P(_size))
+_declare("mf_encoding_get_local_latents", _int, _encoding, _P(_f32), _size, _P(_size))
+_declare("mf_encoding_get_global_latents", _int, _encoding, _P(_f32), _size, _P(_size))
+_declare("mf_encoding_with_latents", _int, _encoding, _P(_f32), _size, _P(_f32), _size, _P(_encoding))
+_declare("mf_decode", _int, _encoding, _f64, _i32, _P(MfCodecOptions), _P(_motion))
+_declare("mf_decode_times", _int, _encoding, _P(_f64), _size, _f64, _P(MfCodecOptions), _P(_motion))
+
+if mf_abi_version() != ABI_VERSION:  # noqa: F821 (declared above)
+    raise ImportError("%s has ABI version %d; this package needs %d" %
+                      (library_path, mf_abi_version(), ABI_VERSION))  # noqa: F821

@@ -1,0 +1,265 @@
+"""Tests of the ctypes package (run by CTest through /usr/bin/python3):
+
+    MOTIONFIELD_LIBRARY=build/capi/libmotionfield.so PYTHONPATH=python \\
+        /usr/bin/python3 -m unittest discover -s python/tests -v
+
+The model tests need a model file: $MF_TEST_MODEL (CTest writes a tiny random
+one with mf_capi_tiny_model); they are skipped without it.
+"""
+
+import os
+import sys
+import tempfile
+import threading
+import unittest
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SOURCE = os.environ.get("MF_SOURCE_DIR", os.path.normpath(os.path.join(HERE, "..", "..")))
+SAMPLE = os.path.join(SOURCE, "samples", "walk_keyframes.bvh")
+
+
+def mapped_libraries():
+    with open("/proc/self/maps") as f:
+        return {line.split()[-1] for line in f if "/" in line}
+
+
+# Loaded before anything imports motionfield: the process must have no libtorch
+# of its own.
+TORCH_BEFORE_IMPORT = [p for p in mapped_libraries() if "libtorch" in os.path.basename(p)]
+
+import motionfield as mf  # noqa: E402
+
+
+def small_skeleton():
+    names = ["Hips", "Spine", "Head", "UpperLeg_L", "Foot_L", "UpperLeg_R", "Foot_R"]
+    parents = [-1, 0, 1, 0, 3, 0, 5]
+    offsets = np.array([[0, 0, 0], [0, 0.2, 0], [0, 0.4, 0], [0.1, -0.05, 0], [0, -0.8, 0], [-0.1, -0.05, 0],
+                        [0, -0.8, 0]], dtype=np.float32)
+    return names, parents, offsets
+
+
+def random_rotations(frames, joints, seed):
+    rng = np.random.default_rng(seed)
+    q = rng.normal(size=(frames, joints, 4)).astype(np.float32)
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    return q
+
+
+class LibraryTest(unittest.TestCase):
+    def test_loads_without_a_libtorch_of_its_own(self):
+        self.assertEqual(TORCH_BEFORE_IMPORT, [])
+        self.assertNotIn("torch", sys.modules)
+        loaded = [p for p in mapped_libraries() if "libtorch" in os.path.basename(p)]
+        self.assertTrue(loaded, "libmotionfield.so brings libtorch along")
+
+    def test_versions(self):
+        self.assertEqual(mf.abi_version(), 0)
+        self.assertRegex(mf.version(), r"^\d+\.\d+\.\d+$")
+        self.assertTrue(os.path.exists(mf.library_path()))
+        if os.environ.get("MOTIONFIELD_LIBRARY"):
+            self.assertEqual(mf.library_path(), os.environ["MOTIONFIELD_LIBRARY"])
+
+    def test_every_exported_function_is_declared(self):
+        from motionfield import _capi
+        with open(os.path.join(SOURCE, "tests", "capi", "exported_symbols.txt")) as f:
+            names = [line.strip() for line in f if line.strip() and not line.startswith("#")]
+        self.assertGreater(len(names), 50)
+        for name in names:
+            f = getattr(_capi, name, None)
+            self.assertIsNotNone(f, name)
+            self.assertIsNotNone(f.argtypes, name)
+            self.assertIsNotNone(f.restype if not name.endswith("_destroy") else True, name)
+
+    def test_threads(self):
+        mf.set_num_threads(1)
+        self.assertEqual(mf.get_num_threads(), 1)
+        with self.assertRaises(mf.InvalidArgumentError) as cm:
+            mf.set_num_threads(0)
+        self.assertEqual(cm.exception.status, 1)
+        self.assertEqual(cm.exception.status_name, "MF_ERROR_INVALID_ARGUMENT")
+        self.assertIsInstance(cm.exception, ValueError)
+
+    def test_methods(self):
+        names = {m.name: m for m in mf.methods()}
+        self.assertIn("interp", names)
+        self.assertIn("zerovel", names)
+        self.assertTrue(names["interp"].completes and names["interp"].resamples)
+        self.assertFalse(names["interp"].needs_model)
+        self.assertIn(mf.default_method(), names)
+        self.assertFalse(names[mf.default_method()].needs_model)
+
+
+class MotionTest(unittest.TestCase):
+    def test_bvh(self):
+        m = mf.Motion.load_bvh(SAMPLE)
+        self.assertEqual(m.frame_count, 61)
+        self.assertEqual(m.joint_count, 21)
+        self.assertEqual(m.fps, 30.0)
+        self.assertAlmostEqual(m.frame_time, 0.0333333333, places=12)
+        self.assertEqual(m.joint_names[0], "Hips")
+        self.assertEqual(m.parents[0], -1)
+        r = m.rotations
+        self.assertEqual(r.shape, (61, 21, 4))
+        self.assertEqual(r.dtype, np.float32)
+        np.testing.assert_allclose(np.linalg.norm(r, axis=-1), 1.0, atol=1e-5)
+        self.assertEqual(m.root_positions.shape, (61, 3))
+        self.assertEqual(m.global_positions.shape, (61, 21, 3))
+        self.assertEqual(m.offsets.shape, (21, 3))
+        text = m.to_bvh_text()
+        self.assertTrue(text.startswith("HIERARCHY\nROOT joint_Root"))
+        back = mf.Motion.from_bvh_text(text)
+        np.testing.assert_allclose(back.rotations, r, atol=1e-6)
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "out.bvh")
+            m.save_bvh(path)
+            with open(path) as f:
+                self.assertEqual(f.read(), text)
+
+    def test_arrays_round_trip(self):
+        names, parents, offsets = small_skeleton()
+        rot = random_rotations(12, 7, 1)
+        root = np.linspace(0, 1, 36, dtype=np.float32).reshape(12, 3)
+        m = mf.Motion.from_arrays(rot, root, 24.0, joint_names=names, parents=parents, offsets=offsets)
+        np.testing.assert_array_equal(m.rotations, rot)
+        np.testing.assert_array_equal(m.root_positions, root)
+        np.testing.assert_array_equal(m.offsets, offsets)
+        self.assertEqual(m.joint_names, names)
+        self.assertEqual(list(m.parents), parents)
+        self.assertEqual(m.fps, 24.0)
+        like = mf.Motion.from_arrays(rot[:5], root[:5], 24.0, like=m)
+        self.assertEqual(like.frame_count, 5)
+        # float64 input is converted; non-contiguous input too.
+        m2 = mf.Motion.from_arrays(rot.astype(np.float64)[::1], root.T.copy().T, 24.0, like=m)
+        np.testing.assert_array_equal(m2.rotations, rot)
+
+    def test_bad_input_raises_with_the_message(self):
+        names, parents, offsets = small_skeleton()
+        rot = random_rotations(4, 7, 2)
+        root = np.zeros((4, 3), np.float32)
+        bad = rot.copy()
+        bad[1, 2, 0] = np.nan
+        with self.assertRaisesRegex(mf.InvalidArgumentError, "not a finite non-zero quaternion"):
+            mf.Motion.from_arrays(bad, root, 30.0, joint_names=names, parents=parents, offsets=offsets)
+        with self.assertRaisesRegex(mf.InvalidArgumentError, "shape"):
+            mf.Motion.from_arrays(rot[:, :, :3], root, 30.0, joint_names=names, parents=parents, offsets=offsets)
+        with self.assertRaises(mf.FileError) as cm:
+            mf.Motion.load_bvh("/nonexistent/walk.bvh")
+        self.assertIsInstance(cm.exception, OSError)
+        with self.assertRaisesRegex(mf.InvalidArgumentError, "<memory>:"):
+            mf.Motion.from_bvh_text("HIERARCHY\nROOT a\n{\n OFFSET 0 0 zero\n}\n")
+        with self.assertRaisesRegex(mf.ModelError, "not a motionfield model file"):
+            mf.Model(SAMPLE)
+        with self.assertRaisesRegex(mf.ModelError, "not a motionfield model file"):
+            mf.Model.from_bytes(b"not a model at all")
+        walk = mf.Motion.load_bvh(SAMPLE)
+        with self.assertRaisesRegex(mf.InvalidArgumentError, "keyframe 61 is out of range"):
+            mf.inbetween(walk, [0, 30, 61])
+        with self.assertRaisesRegex(mf.InvalidArgumentError, "unknown method 'magic'"):
+            mf.inbetween(walk, [0, 60], method="magic")
+        for m in mf.methods():
+            if m.needs_model and m.resamples:
+                with self.assertRaisesRegex(mf.ModelError, "needs a model"):
+                    mf.resample(walk, 60.0, method=m.name)
+        walk.close()
+        with self.assertRaisesRegex(mf.InvalidArgumentError, "closed"):
+            walk.frame_count
+
+
+class TaskTest(unittest.TestCase):
+    def setUp(self):
+        self.walk = mf.Motion.load_bvh(SAMPLE)
+
+    def test_inbetween_keeps_keyframes(self):
+        keys = [0, 20, 40, 60]
+        out = mf.inbetween(self.walk, keys, method="interp")
+        self.assertEqual(out.frame_count, 61)
+        np.testing.assert_array_equal(out.rotations[keys], self.walk.rotations[keys])
+        self.assertFalse(np.array_equal(out.rotations[10], self.walk.rotations[10]))
+        self.assertEqual(out.frame_time, self.walk.frame_time)
+        self.assertEqual(out.to_bvh_text().split("MOTION")[0], self.walk.to_bvh_text().split("MOTION")[0])
+
+    def test_fill_and_resample(self):
+        out = mf.fill(self.walk, 10, 40, method="zerovel")
+        np.testing.assert_array_equal(out.root_positions[:10], self.walk.root_positions[:10])
+        np.testing.assert_array_equal(out.root_positions[10:40], np.repeat(self.walk.root_positions[9:10], 30, 0))
+        up = mf.resample(self.walk, 60.0)
+        self.assertEqual(up.frame_count, 121)
+        self.assertEqual(up.fps, 60.0)
+        np.testing.assert_array_equal(up.root_positions[::2], self.walk.root_positions)
+        self.assertEqual(mf.resample_frame_count(61, 30.0, 23.3), (47, True))
+        self.assertEqual(mf.resample_frame_count(61, 30.0, 60.0), (121, False))
+
+    def test_progress_and_cancel(self):
+        seen = []
+        mf.inbetween(self.walk, [0, 60], progress=lambda p: seen.append(p))
+        self.assertGreaterEqual(len(seen), 1)
+        self.assertIsInstance(seen[0], mf.Progress)
+        with self.assertRaises(mf.CancelledError):
+            mf.inbetween(self.walk, [0, 60], progress=lambda p: True)
+
+        class Boom(Exception):
+            pass
+
+        def explode(p):
+            raise Boom()
+
+        with self.assertRaises(Boom):
+            mf.inbetween(self.walk, [0, 60], progress=explode)
+        token = mf.CancelToken()
+        token.cancel()
+        self.assertTrue(token.cancelled)
+        with self.assertRaises(mf.CancelledError):
+            mf.resample(self.walk, 60.0, cancel=token)
+        token.reset()
+        self.assertEqual(mf.resample(self.walk, 60.0, cancel=token).frame_count, 121)
+
+    def test_threads_give_the_same_results(self):
+        keys = [[0, 30, 60], [0, 10, 60], [0, 45, 60], [0, 5, 20, 60]]
+        sequential = [mf.inbetween(self.walk, k).rotations for k in keys]
+        results = [None] * len(keys)
+
+        def work(i):
+            results[i] = mf.inbetween(self.walk, keys[i]).rotations
+
+        threads = [threading.Thread(target=work, args=(i,)) for i in range(len(keys))]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        for a, b in zip(sequential, results):
+            np.testing.assert_array_equal(a, b)
+
+
+@unittest.skipUnless(os.environ.get("MF_TEST_MODEL"), "set MF_TEST_MODEL to a (tiny) model file")
+class ModelTest(unittest.TestCase):
+    def test_model_and_codec(self):
+        model = mf.Model(os.environ["MF_TEST_MODEL"])
+        self.assertGreater(model.joint_count, 0)
+        self.assertEqual(len(model.joint_names), model.joint_count)
+        self.assertEqual(model.offsets.shape, (model.joint_count, 3))
+        zl, zg = model.latent_sizes
+        with open(os.environ["MF_TEST_MODEL"], "rb") as f:
+            same = mf.Model.from_bytes(f.read())
+        self.assertEqual(same.joint_names, model.joint_names)
+        J = model.joint_count
+        rot = random_rotations(40, J, 3)
+        root = np.zeros((40, 3), np.float32)
+        root[:, 1] = 0.9
+        m = mf.Motion.from_arrays(rot, root, 30.0, model=model)
+        code = mf.encode(model, m)
+        self.assertEqual(code.local_latents.shape, (code.window_count, zl))
+        self.assertEqual(code.global_latents.shape, (code.window_count, zg))
+        self.assertAlmostEqual(code.duration, 39 / 30.0)
+        dec = code.decode(60.0)
+        self.assertEqual(dec.frame_count, 79)
+        picked = code.decode_times([0.5, 0.0], 60.0)
+        np.testing.assert_allclose(picked.rotations[0], dec.rotations[30], atol=1e-5)
+        np.testing.assert_allclose(code.decode(30.0, root="input").root_positions, root, atol=1e-5)
+        same_code = code.with_latents(code.local_latents, code.global_latents)
+        np.testing.assert_array_equal(same_code.decode(60.0).rotations, dec.rotations)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,438 @@
+#include "tasks/energies.h"
+
+#include <ATen/ATen.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "prior/model/nemf.h"
+#include "prior/motion/errors.h"
+#include "prior/motion/kinematics_torch.h"
+#include "prior/motion/rotations_torch.h"
+
+namespace mf {
+namespace {
+
+Eigen::Matrix3d rot_y(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
+
+// sum(values * mask) / count, count > 0 known by the caller.
+at::Tensor masked_mean(const at::Tensor& values, const at::Tensor& mask, double count) {
+  return (values * mask).sum() / count;
+}
+
+// Squared penalty of a residual given as its square (d2) or as a non-negative value.
+at::Tensor penalty_of_squared(const at::Tensor& d2, Penalty p) {
+  return p == Penalty::Squared ? d2 : at::sqrt(d2 + 1e-12);
+}
+at::Tensor penalty_of_angle(const at::Tensor& angle, Penalty p) {
+  return p == Penalty::Squared ? angle.square() : angle;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// Constraints
+
+MotionConstraints MotionConstraints::full_pose(const std::vector<int>& frames) {
+  MotionConstraints c;
+  c.keys.reserve(frames.size());
+  for (int f : frames) {
+    PoseKey k;
+    k.frame = f;
+    c.keys.push_back(k);
+  }
+  return c;
+}
+
+bool MotionConstraints::key_has_joint(size_t k, int joint) const {
+  const std::vector<int>& j = keys[k].joints;
+  return j.empty() || std::binary_search(j.begin(), j.end(), joint);
+}
+
+bool MotionConstraints::key_fixes_root(size_t k) const { return keys[k].root_position && key_has_joint(k, 0); }
+
+void MotionConstraints::validate(int frames, int joints) const {
+  auto range = [&](int f) { return "(the motion has " + std::to_string(frames) + " frames)"; };
+  bool anchor = false;
+  for (size_t k = 0; k < keys.size(); ++k) {
+    const PoseKey& key = keys[k];
+    if (key.frame < 0 || key.frame >= frames)
+      throw InputError("key frame " + std::to_string(key.frame) + " is out of range " + range(key.frame));
+    if (k > 0 && key.frame <= keys[k - 1].frame)
+      throw InputError("key frames must be strictly increasing (" + std::to_string(keys[k - 1].frame) +
+                       " is followed by " + std::to_string(key.frame) + ")");
+    for (size_t i = 0; i < key.joints.size(); ++i) {
+      const int j = key.joints[i];
+      if (j < 0 || j >= joints)
+        throw InputError("key at frame " + std::to_string(key.frame) + ": joint " + std::to_string(j) +
+                         " is out of range (the skeleton has " + std::to_string(joints) + " joints)");
+      if (i > 0 && j <= key.joints[i - 1])
+        throw InputError("key at frame " + std::to_string(key.frame) +
+                         ": constrained joints must be listed once each, in increasing order");
+    }
+    anchor = anchor || key_fixes_root(k);
+  }
+  for (const EffectorTarget& e : effectors) {
+    if (e.frame < 0 || e.frame >= frames)
+      throw InputError("end-effector target frame " + std::to_string(e.frame) + " is out of range " + range(e.frame));
+    if (e.joint < 0 || e.joint >= joints)
+      throw InputError("end-effector target joint " + std::to_string(e.joint) + " is out of range (the skeleton has " +
+                       std::to_string(joints) + " joints)");
+    if (!e.position.allFinite()) throw InputError("end-effector target position is not finite");
+    if (!(std::isfinite(e.weight) && e.weight >= 0.0))
+      throw InputError("end-effector target weight must be finite and non-negative");
+  }
+  if (!anchor) {
+    throw InputError(
+        "at least one key must give the root's rotation and position (the solver places the motion relative to it)");
+  }
+}
+
+MotionConstraints MotionConstraints::slice(int begin, int length) const {
+  MotionConstraints out;
+  for (const PoseKey& k : keys) {
+    if (k.frame < begin || k.frame >= begin + length) continue;
+    PoseKey s = k;
+    s.frame -= begin;
+    out.keys.push_back(s);
+  }
+  for (const EffectorTarget& e : effectors) {
+    if (e.frame < begin || e.frame >= begin + length) continue;
+    EffectorTarget s = e;
+    s.frame -= begin;
+    out.effectors.push_back(s);
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------
+// Window problems
+
+int WindowProblem::num_keys() const { return key_frames.defined() ? static_cast<int>(key_frames.size(0)) : 0; }
+int WindowProblem::num_effectors() const {
+  return effector_frames.defined() ? static_cast<int>(effector_frames.size(0)) : 0;
+}
+
+WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int begin, int length,
+                                  const MotionConstraints& constraints, int anchor) {
+  const Skeleton& s = rig.skeleton;
+  const int J = s.num_joints();
+  if (motion.num_joints() != J || motion.skeleton.names != s.names || motion.skeleton.parents != s.parents) {
+    throw InputError("the motion's skeleton does not match the model's (" + std::to_string(motion.num_joints()) +
+                     " joints given, the model has " + std::to_string(J) + "; names and parents must agree)");
+  }
+  if (begin < 0 || length < 2 || begin + length > motion.num_frames())
+    throw InputError("window [" + std::to_string(begin) + ", " + std::to_string(begin + length) +
+                     ") does not fit the motion (at least 2 frames)");
+  const int K = static_cast<int>(constraints.keys.size());
+  int anchor_key = -1;
+  for (int k = 0; k < K; ++k) {
+    const int f = constraints.keys[k].frame;
+    if (f < 0 || f >= length) throw InputError("a key lies outside its window");
+    if (f == anchor && constraints.key_fixes_root(k)) anchor_key = k;
+  }
+  if (anchor_key < 0) throw InputError("the window's anchor frame must be a key that fixes the root");
+
+  WindowProblem p;
+  p.length = length;
+  p.anchor = anchor;
+  {
+    const Eigen::Quaterniond& r = motion.rotation(begin + anchor, 0);
+    Eigen::Vector3d f = r.normalized() * rig.root_forward;
+    p.transform.yaw = (f.x() * f.x() + f.z() * f.z() < 1e-12) ? 0.0 : std::atan2(f.x(), f.z());
+    p.transform.x = motion.root_positions[begin + anchor].x();
+    p.transform.z = motion.root_positions[begin + anchor].z();
+  }
+  const Eigen::Matrix3d unturn = rot_y(-p.transform.yaw);
+  const Eigen::Vector3d origin(p.transform.x, 0.0, p.transform.z);
+
+  p.key_frames = at::empty({K}, at::kLong);
+  p.key_rotations = at::eye(3, at::kFloat).repeat({K, J, 1, 1}).contiguous();
+  p.key_rotation_mask = at::zeros({K, J}, at::kFloat);
+  p.key_position_mask = at::zeros({K, J}, at::kFloat);
+  p.key_root = at::zeros({K, 3}, at::kFloat);
+  p.key_root_mask = at::zeros({K}, at::kFloat);
+  int64_t* kf = p.key_frames.data_ptr<int64_t>();
+  float* rot = p.key_rotations.data_ptr<float>();
+  float* rmask = p.key_rotation_mask.data_ptr<float>();
+  float* pmask = p.key_position_mask.data_ptr<float>();
+  float* root = p.key_root.data_ptr<float>();
+  float* root_mask = p.key_root_mask.data_ptr<float>();
+  std::vector<char> chain(J);
+  for (int k = 0; k < K; ++k) {
+    const PoseKey& key = constraints.keys[k];
+    const int f = begin + key.frame;
+    kf[k] = key.frame;
+    for (int j = 0; j < J; ++j) {
+      const bool on = constraints.key_has_joint(k, j);
+      chain[j] = on && (j == 0 || chain[s.parents[j]]);
+      if (j > 0 && chain[j]) pmask[k * J + j] = 1.0f;
+      if (!on) continue;
+      rmask[k * J + j] = 1.0f;
+      Eigen::Matrix3d m = motion.rotation(f, j).normalized().toRotationMatrix();
+      if (j == 0) m = unturn * m;
+      float* out = rot + (static_cast<int64_t>(k) * J + j) * 9;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) out[a * 3 + b] = static_cast<float>(m(a, b));
+    }
+    if (key.root_position) {
+      Eigen::Vector3d x = unturn * (motion.root_positions[f] - origin);
+      for (int a = 0; a < 3; ++a) root[k * 3 + a] = static_cast<float>(x[a]);
+      root_mask[k] = 1.0f;
+    }
+  }
+  at::Tensor offsets = offsets_tensor(s);
+  p.key_positions = forward_kinematics(s.parents, offsets, p.key_rotations, at::zeros({K, 3}, at::kFloat)).positions;
+
+  const int E = static_cast<int>(constraints.effectors.size());
+  p.effector_frames = at::empty({E}, at::kLong);
+  p.effector_joints = at::empty({E}, at::kLong);
+  p.effector_targets = at::empty({E, 3}, at::kFloat);
+  p.effector_weights = at::empty({E}, at::kFloat);
+  for (int e = 0; e < E; ++e) {
+    const EffectorTarget& t = constraints.effectors[e];
+    if (t.frame < 0 || t.frame >= length) throw InputError("an end-effector target lies outside its window");
+    if (t.joint < 0 || t.joint >= J) throw InputError("end-effector joint out of range");
+    p.effector_frames[e] = t.frame;
+    p.effector_joints[e] = t.joint;
+    Eigen::Vector3d x = unturn * (t.position - origin);
+    for (int a = 0; a < 3; ++a) p.effector_targets[e][a] = static_cast<float>(x[a]);
+    p.effector_weights[e] = static_cast<float>(t.weight);
+  }
+  return p;
+}
+
+// ---------------------------------------------------------------------------
+// Energies
+
+namespace {
+
+// The GMP's root path of a dense decode, its ground position at the anchor moved
+// to the anchor key's (the canonical origin).
+at::Tensor aligned_root_path(const NemfModel& model, const WindowProblem& problem, const at::Tensor& rotations,
+                             GmpOutput* gmp_out) {
+  GmpOutput gmp = model.predict_global(rotations);
+  at::Tensor path = model.root_positions(rotations, gmp);  // [1, T, 3], starts at the origin
+  at::Tensor xz_mask = at::tensor({1.0f, 0.0f, 1.0f}, path.options());
+  at::Tensor shift = path.select(1, problem.anchor) * xz_mask;  // [1, 3]
+  if (gmp_out) *gmp_out = gmp;
+  return path - shift.unsqueeze(1);
+}
+
+double smoothstep(double t) { return t * t * (3.0 - 2.0 * t); }
+
+// Where each frame takes its residual from: the keys a and b around it that
+// constrain the joint (or the root position) and the smoothstep weight of b.
+struct Brackets {
+  at::Tensor a, b;  // [n] int64 key indices
+  at::Tensor s;     // [n] float
+  at::Tensor has;   // [n] float: 0 where no key constrains the joint
+};
+
+// frames_of[k] = frame of key k; on[k] = whether key k constrains the series.
+void bracket_series(const std::vector<int64_t>& key_frame, const std::vector<char>& on, int T, int64_t* a, int64_t* b,
+                    float* s, float* has, int64_t stride) {
+  std::vector<std::pair<int64_t, int64_t>> keys;  // (frame, key index)
+  for (size_t k = 0; k < on.size(); ++k) {
+    if (on[k]) keys.emplace_back(key_frame[k], static_cast<int64_t>(k));
+  }
+  std::sort(keys.begin(), keys.end());
+  size_t next = 0;
+  for (int f = 0; f < T; ++f) {
+    const int64_t i = static_cast<int64_t>(f) * stride;
+    if (keys.empty()) {
+      a[i] = b[i] = 0;
+      s[i] = 0.0f;
+      has[i] = 0.0f;
+      continue;
+    }
+    has[i] = 1.0f;
+    while (next < keys.size() && keys[next].first < f) ++next;
+    if (next == keys.size()) {
+      a[i] = b[i] = keys.back().second;
+      s[i] = 0.0f;
+    } else if (keys[next].first == f || next == 0) {
+      a[i] = b[i] = keys[next].second;
+      s[i] = 0.0f;
+    } else {
+      a[i] = keys[next - 1].second;
+      b[i] = keys[next].second;
+      s[i] = static_cast<float>(
+          smoothstep(static_cast<double>(f - keys[next - 1].first) / (keys[next].first - keys[next - 1].first)));
+    }
+  }
+}
+
+// Brackets of every (frame, joint) [T * J] and of the root position [T].
+void residual_brackets(const WindowProblem& p, int J, Brackets* joints, Brackets* root) {
+  const int K = p.num_keys(), T = p.length;
+  const at::Tensor key_frames = p.key_frames.contiguous();
+  const std::vector<int64_t> frames(key_frames.data_ptr<int64_t>(), key_frames.data_ptr<int64_t>() + K);
+  const at::Tensor rmask = p.key_rotation_mask.contiguous();
+  const float* m = rmask.data_ptr<float>();
+  auto alloc = [](Brackets* br, int64_t n) {
+    br->a = at::empty({n}, at::kLong);
+    br->b = at::empty({n}, at::kLong);
+    br->s = at::empty({n}, at::kFloat);
+    br->has = at::empty({n}, at::kFloat);
+  };
+  alloc(joints, static_cast<int64_t>(T) * J);
+  alloc(root, T);
+  std::vector<char> on(K);
+  for (int j = 0; j < J; ++j) {
+    for (int k = 0; k < K; ++k) on[k] = m[k * J + j] > 0;
+    bracket_series(frames, on, T, joints->a.data_ptr<int64_t>() + j, joints->b.data_ptr<int64_t>() + j,
+                   joints->s.data_ptr<float>() + j, joints->has.data_ptr<float>() + j, J);
+  }
+  const at::Tensor rootmask = p.key_root_mask.contiguous();
+  for (int k = 0; k < K; ++k) on[k] = rootmask.data_ptr<float>()[k] > 0;
+  bracket_series(frames, on, T, root->a.data_ptr<int64_t>(), root->b.data_ptr<int64_t>(), root->s.data_ptr<float>(),
+                 root->has.data_ptr<float>(), 1);
+}
+
+// The window after the known-value overwrite of complete_motion(): the
+// residual at each key, blended between keys with smoothstep weights (the same
+// rule, in float and differentiable). rotations [1, T, J, 3, 3], path [1, T, 3].
+void blend_residuals(const WindowProblem& p, const at::Tensor& rotations, const at::Tensor& path,
+                     at::Tensor* out_rotations, at::Tensor* out_path) {
+  const int K = p.num_keys(), T = p.length;
+  const int J = static_cast<int>(rotations.size(2));
+  if (K == 0) {
+    *out_rotations = rotations;
+    *out_path = path;
+    return;
+  }
+  Brackets bj, br;
+  residual_brackets(p, J, &bj, &br);
+  const at::TensorOptions opt = rotations.options();
+  at::Tensor raw_keys = rotations.squeeze(0).index_select(0, p.key_frames);  // [K, J, 3, 3]
+  at::Tensor residual = torch_rot::matrix_to_quat(
+      torch_rot::matmul3(p.key_rotations.to(opt), raw_keys.transpose(-1, -2)));  // [K, J, 4]
+  at::Tensor flat = residual.reshape({K * J, 4});
+  at::Tensor joint_index = at::arange(J, at::kLong).repeat({T});
+  at::Tensor qa = flat.index_select(0, bj.a * J + joint_index);
+  at::Tensor qb = flat.index_select(0, bj.b * J + joint_index);
+  at::Tensor q = torch_rot::quat_slerp(qa, qb, bj.s.unsqueeze(-1));  // [T * J, 4]
+  at::Tensor identity = at::tensor({1.0f, 0.0f, 0.0f, 0.0f}, opt);
+  at::Tensor has = bj.has.unsqueeze(-1);
+  q = q * has + identity * (1 - has);
+  *out_rotations = torch_rot::matmul3(torch_rot::quat_to_matrix(q).view({1, T, J, 3, 3}), rotations);
+  at::Tensor d = p.key_root - path.squeeze(0).index_select(0, p.key_frames);  // [K, 3]
+  at::Tensor s = br.s.unsqueeze(-1);
+  at::Tensor correction = (d.index_select(0, br.a) * (1 - s) + d.index_select(0, br.b) * s) * br.has.unsqueeze(-1);
+  *out_path = path + correction.unsqueeze(0);
+}
+
+}  // namespace
+
+EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& w,
+                            const at::Tensor& z_l, const at::Tensor& z_g) {
+  const RigInfo& rig = model.rig();
+  const Skeleton& skel = rig.skeleton;
+  const int J = rig.num_joints();
+  const int K = problem.num_keys();
+  const int E = problem.num_effectors();
+  const int T = problem.length;
+  const double fps = model.config().fps;
+  const at::TensorOptions opt = z_l.options();
+
+  // Normalisers: how many items each term averages over.
+  double n_rot = 0, n_root_rot = 0, n_pos = 0, n_root = 0;
+  if (K > 0) {
+    n_rot = problem.key_rotation_mask.narrow(1, 1, J - 1).sum().item<double>();
+    n_root_rot = problem.key_rotation_mask.select(1, 0).sum().item<double>();
+    n_pos = problem.key_position_mask.sum().item<double>();
+    n_root = problem.key_root_mask.sum().item<double>();
+  }
+  const bool use_rot = w.rotation > 0 && n_rot > 0;
+  const bool use_root_rot = w.root_orientation > 0 && n_root_rot > 0;
+  const bool use_pos = w.position > 0 && n_pos > 0;
+  const bool use_root = w.root_translation > 0 && n_root > 0;
+  const bool use_eff = w.effector > 0 && E > 0;
+  const bool use_skate = w.foot_skating > 0 && rig.num_feet() > 0 && T >= 2;
+  const bool use_smooth = w.smoothness > 0 && T >= 3;
+  const bool dense = use_root || use_eff || use_skate || use_smooth;
+  const bool keyed = use_rot || use_root_rot || use_pos;
+
+  EnergyTerms out;
+  auto add = [&](const char* name, double weight, const at::Tensor& value) {
+    out.terms.emplace_back(name, value * weight);
+  };
+
+  at::Tensor dense_rot, key_rot;
+  if (dense) {
+    dense_rot = model.decode(at::arange(T, at::kFloat), z_l, z_g);  // [1, T, J, 3, 3]
+    if (keyed) key_rot = dense_rot.index_select(1, problem.key_frames).squeeze(0);
+  } else if (keyed) {
+    key_rot = model.decode(problem.key_frames.to(at::kFloat), z_l, z_g).squeeze(0);  // [K, J, 3, 3]
+  }
+
+  if (use_rot || use_root_rot) {
+    at::Tensor pen = penalty_of_angle(torch_rot::geodesic_angle(key_rot, problem.key_rotations.to(opt)), w.penalty);
+    if (use_rot) {
+      add("rotation", w.rotation,
+          masked_mean(pen.narrow(1, 1, J - 1), problem.key_rotation_mask.narrow(1, 1, J - 1), n_rot));
+    }
+    if (use_root_rot) {
+      add("root_orientation", w.root_orientation,
+          masked_mean(pen.select(1, 0), problem.key_rotation_mask.select(1, 0), n_root_rot));
+    }
+  }
+  const at::Tensor offsets = offsets_tensor(skel).to(opt);
+  if (use_pos) {
+    at::Tensor p = forward_kinematics(skel.parents, offsets, key_rot, at::zeros({K, 3}, opt)).positions;
+    at::Tensor d2 = (p - problem.key_positions).square().sum(-1);  // [K, J]
+    add("position", w.position, masked_mean(penalty_of_squared(d2, w.penalty), problem.key_position_mask, n_pos));
+  }
+
+  if (dense) {
+    GmpOutput gmp;
+    at::Tensor path = aligned_root_path(model, problem, dense_rot, &gmp);  // [1, T, 3]
+    if (use_root) {
+      at::Tensor d2 = (path.squeeze(0).index_select(0, problem.key_frames) - problem.key_root).square().sum(-1);
+      add("root_translation", w.root_translation,
+          masked_mean(penalty_of_squared(d2, w.penalty), problem.key_root_mask, n_root));
+    }
+    if (use_eff || use_skate || use_smooth) {
+      at::Tensor out_rot = dense_rot, out_path = path;
+      if (w.on_output) blend_residuals(problem, dense_rot, path, &out_rot, &out_path);
+      at::Tensor pos = forward_kinematics(skel.parents, offsets, out_rot, out_path).positions;  // [1, T, J, 3]
+      if (use_eff) {
+        at::Tensor idx = problem.effector_frames * J + problem.effector_joints;
+        at::Tensor p = pos.reshape({T * J, 3}).index_select(0, idx);
+        at::Tensor d2 = (p - problem.effector_targets).square().sum(-1);
+        add("effector", w.effector, (penalty_of_squared(d2, w.penalty) * problem.effector_weights).sum() / E);
+      }
+      if (use_skate) {
+        at::Tensor feet = at::tensor(std::vector<int64_t>(rig.foot_joints.begin(), rig.foot_joints.end()), at::kLong);
+        at::Tensor fp = pos.index_select(2, feet);                             // [1, T, F, 3]
+        at::Tensor v = (fp.narrow(1, 1, T - 1) - fp.narrow(1, 0, T - 1)) * fps;  // [1, T-1, F, 3]
+        at::Tensor speed2 = v.select(-1, 0).square() + v.select(-1, 2).square();
+        at::Tensor contact = at::sigmoid(gmp.contact_logits.narrow(1, 1, T - 1)).detach();
+        add("foot_skating", w.foot_skating, (contact * speed2).mean());
+      }
+      if (use_smooth) {
+        at::Tensor rel = pos - out_path.unsqueeze(2);
+        at::Tensor acc = (rel.narrow(1, 2, T - 2) - 2 * rel.narrow(1, 1, T - 2) + rel.narrow(1, 0, T - 2)) * (fps * fps);
+        add("smoothness", w.smoothness, acc.square().sum(-1).mean());
+      }
+    }
+  }
+  if (w.latent_prior > 0) add("latent_prior", w.latent_prior, 0.5 * (z_l.square().sum() + z_g.square().sum()));
+
+  out.total = at::zeros({}, opt);
+  for (const auto& t : out.terms) out.total = out.total + t.second;
+  return out;
+}
+
+DecodedWindow decode_window(const NemfModel& model, const WindowProblem& problem, const at::Tensor& z_l,
+                            const at::Tensor& z_g) {
+  at::NoGradGuard no_grad;
+  DecodedWindow d;
+  d.local_rotations = model.decode(at::arange(problem.length, at::kFloat), z_l, z_g);
+  d.root_positions = aligned_root_path(model, problem, d.local_rotations, nullptr);
+  return d;
+}
+
+}  // namespace mf

@@ -1,0 +1,180 @@
+// Constraints and energies of the latent solvers: what the animator asks for
+// (pose keys, partial keys, end-effector targets), its canonical form for one
+// window of the prior, and the differentiable energy terms the solvers minimise
+// over the latent codes (z_l, z_g) with the network frozen.
+//
+// Frames and coordinates. A MotionConstraints refers to frames of a Motion and
+// to world coordinates (metres, Y up; prior/motion/skeleton.h). A WindowProblem
+// holds the same constraints for frames [begin, begin + length) of that motion
+// in the window's canonical frame (prior/model/representation.h): the ground
+// transform of the *anchor* frame, a key that fixes the root, maps the window to
+// the origin facing +Z. Decoded motion is compared with the targets there.
+//
+// Energy terms (each a weighted mean over the constrained items, so that the
+// weights do not depend on how many keys there are; a zero weight disables a
+// term, and what only it needs is then not computed):
+//   rotation          local rotations of the non-root joints at the keys:
+//                     geodesic angle (rad) through the penalty
+//   position          FK positions relative to the root (canonical axes, m) of
+//                     the joints whose rotation and every ancestor's rotation
+//                     (root included) are constrained
+//   root_orientation  geodesic angle of the root's rotation at keys that give it
+//   root_translation  root path predicted by the global motion predictor (GMP)
+//                     on a dense decode of the window, integrated and aligned at
+//                     the anchor frame (its ground position set to the target's),
+//                     against the root position of keys that give it (m)
+//   effector          world (canonical) position of chosen joints at chosen
+//                     frames (m), each target with its own weight
+//   latent_prior      0.5 * (|z_l|^2 + |z_g|^2): a Gaussian prior on the codes
+//   foot_skating      mean over frames and feet of p_contact * |v_xz|^2, the
+//                     horizontal foot velocity (m/s) weighted by the GMP's
+//                     contact probability (detached: the solver may not turn
+//                     contacts off to escape the term)
+//   smoothness        mean squared second difference of the root-relative
+//                     joint positions (m/s^2), on the dense decode
+// The effector, foot-skating and smoothness terms are measured on the output
+// motion (EnergyWeights::on_output): the decoded motion with the residual at
+// each key blended in, as complete_motion() will return it, so that the
+// overwrite of the known values cannot undo what they ask for.
+// Penalty: Squared (default: r^2, smooth, what L-BFGS wants) or Absolute (r, with
+// a 1e-6 smoothing for positions; NeMF's L1 / geodesic).
+//
+// What is decoded: only the key frames when no dense term is active; the whole
+// window (frames 0..length-1) once when root_translation (with root keys),
+// effector, foot_skating or smoothness is active, the key frames then being
+// gathered from it.
+#pragma once
+
+#include <ATen/core/Tensor.h>
+#include <Eigen/Core>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "prior/model/representation.h"
+#include "prior/motion/motion.h"
+
+namespace mf {
+
+class NemfModel;
+
+/// A pose constraint at one frame: the local rotations of `joints` (joint 0's
+/// is the root's world rotation) and, if `root_position`, the root's world
+/// position, as the input motion holds them at that frame. Nothing else of the
+/// frame is read.
+struct PoseKey {
+  int frame = 0;
+  std::vector<int> joints;     ///< constrained joints, increasing; empty means every joint
+  bool root_position = true;   ///< the root translation is constrained too
+};
+
+/// An end-effector target: the world position (metres) of `joint` at `frame`,
+/// without a pose. Not enforced exactly (that would need IK): the solver pulls
+/// toward it with the effector weight times `weight`.
+struct EffectorTarget {
+  int frame = 0;
+  int joint = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double weight = 1.0;
+};
+
+/// Everything known about a motion to complete.
+struct MotionConstraints {
+  std::vector<PoseKey> keys;              ///< strictly increasing frames
+  std::vector<EffectorTarget> effectors;  ///< any order, any frames in range
+
+  /// Full-pose keys (every joint and the root position) at `frames`.
+  static MotionConstraints full_pose(const std::vector<int>& frames);
+
+  /// Throws mf::InputError unless: keys are in range and strictly increasing,
+  /// key joints are in range, increasing and unique, effector frames and joints
+  /// are in range with finite positions and non-negative finite weights, and at
+  /// least one key fixes the root (rotation of joint 0 and root position), which
+  /// the canonical frame needs.
+  void validate(int frames, int joints) const;
+
+  /// True when key `k` constrains `joint`'s rotation.
+  bool key_has_joint(size_t k, int joint) const;
+  /// True when key `k` gives the root's rotation and position (it can anchor a window).
+  bool key_fixes_root(size_t k) const;
+  /// Constraints of frames [begin, begin + length), renumbered from 0.
+  MotionConstraints slice(int begin, int length) const;
+};
+
+/// The constraints of one window in its canonical frame, as tensors (float).
+struct WindowProblem {
+  int length = 0;   ///< T, frames of the window (2 <= T <= the model's window)
+  int anchor = 0;   ///< window frame of the canonical transform (a key that fixes the root)
+  GroundTransform transform;  ///< canonical -> world of the window
+
+  // K pose keys.
+  at::Tensor key_frames;          ///< [K] int64, window frames
+  at::Tensor key_rotations;       ///< [K, J, 3, 3] targets (identity where unconstrained)
+  at::Tensor key_rotation_mask;   ///< [K, J] 1 where the joint's rotation is constrained
+  at::Tensor key_positions;       ///< [K, J, 3] root-relative FK positions of the targets, canonical axes
+  at::Tensor key_position_mask;   ///< [K, J] 1 where the joint and all its ancestors are constrained
+  at::Tensor key_root;            ///< [K, 3] canonical root positions (zero where unconstrained)
+  at::Tensor key_root_mask;       ///< [K] 1 where the root position is constrained
+
+  // E end-effector targets.
+  at::Tensor effector_frames;   ///< [E] int64
+  at::Tensor effector_joints;   ///< [E] int64
+  at::Tensor effector_targets;  ///< [E, 3] canonical positions
+  at::Tensor effector_weights;  ///< [E]
+
+  int num_keys() const;
+  int num_effectors() const;
+};
+
+/// Builds the canonical problem of frames [begin, begin + length) of `motion`
+/// under `constraints` (window-relative, i.e. already sliced), anchored at
+/// window frame `anchor`, which must be a key that fixes the root. Reads only
+/// what the keys constrain. Throws mf::InputError on a skeleton that does not
+/// match the rig, a bad range or a bad anchor.
+WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int begin, int length,
+                                  const MotionConstraints& constraints, int anchor);
+
+/// How residuals are penalised (see the top of this file).
+enum class Penalty { Squared, Absolute };
+
+/// Weights of the energy terms (see the top of this file for each term's
+/// definition and unit). Defaults were chosen by measurement (docs/BENCHMARKS.md,
+/// "Latent solvers").
+struct EnergyWeights {
+  double rotation = 1.0;
+  double position = 10.0;
+  double root_orientation = 1.0;
+  double root_translation = 10.0;
+  double effector = 100.0;
+  double latent_prior = 0.0;
+  double foot_skating = 0.0;
+  double smoothness = 0.0;
+  Penalty penalty = Penalty::Squared;
+  /// The dense output terms (effector, foot_skating, smoothness) see the
+  /// motion as complete_motion() returns it: after the overwrite of the known
+  /// values, whose residuals are blended into the frames between keys (see
+  /// tasks/latent_solver.h); otherwise the raw decoded motion.
+  bool on_output = true;
+};
+
+/// The energy of one latent code: the weighted terms and their sum.
+struct EnergyTerms {
+  at::Tensor total;                                      ///< scalar
+  std::vector<std::pair<std::string, at::Tensor>> terms;  ///< active terms, weighted, in the order above
+};
+
+/// Evaluates the energy of (z_l [1, zl], z_g [1, zg]) on `problem`.
+/// Differentiable with respect to the latents (the caller freezes the network).
+EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& weights,
+                            const at::Tensor& z_l, const at::Tensor& z_g);
+
+/// The solution of a window, canonical: local rotations [1, T, J, 3, 3] at
+/// frames 0..T-1 and the GMP's root path [1, T, 3] aligned at the anchor frame.
+struct DecodedWindow {
+  at::Tensor local_rotations;
+  at::Tensor root_positions;
+};
+DecodedWindow decode_window(const NemfModel& model, const WindowProblem& problem, const at::Tensor& z_l,
+                            const at::Tensor& z_g);
+
+}  // namespace mf

@@ -1,0 +1,84 @@
+// Initialisers of the latent solvers: where the optimisation of (z_l, z_g)
+// starts. The solver asks an initialiser for the codes of one window, given the
+// window's constraints; the default is NeMF's (fill the unknown frames by
+// interpolation, encode the filled window, take the posterior means). Other
+// initialisers (the transformer issue's) implement the same interface and are
+// passed to the solver through LatentSolverOptions::initializer, or made by name
+// with make_initializer().
+#pragma once
+
+#include <ATen/core/Tensor.h>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "prior/motion/motion.h"
+#include "tasks/energies.h"
+#include "tasks/method.h"
+
+namespace mf {
+
+class NemfModel;
+
+/// Starting codes of one window.
+struct InitialGuess {
+  at::Tensor z_l;  ///< [1, zl]
+  at::Tensor z_g;  ///< [1, zg]
+};
+
+/// What an initialiser knows about a window. `window` holds the window's frames
+/// (world coordinates, the input's skeleton); only what `constraints` names is
+/// meaningful, everything else must not be read. `constraints` are
+/// window-relative and `anchor` is the window frame the solver canonicalises at
+/// (a key that fixes the root).
+struct InitRequest {
+  const NemfModel* model = nullptr;
+  const Motion* window = nullptr;
+  const MotionConstraints* constraints = nullptr;
+  int anchor = 0;
+  const TaskContext* context = nullptr;  ///< seed for initialisers that sample
+};
+
+/// The interface. Implementations must be deterministic for a given request
+/// and seed, thread-safe (const), and must not keep references to the request.
+class LatentInitializer {
+ public:
+  virtual ~LatentInitializer() = default;
+  virtual std::string name() const = 0;
+  virtual InitialGuess initialize(const InitRequest& request) const = 0;
+};
+
+/// NeMF's initialiser ("interp-encoder"): unknown frames filled by interpolation
+/// (tasks/baselines.h interpolate_motion when every key is a full pose; with
+/// partial keys each joint is interpolated over the keys that constrain it, the
+/// root position over the keys that give it, and a joint no key constrains
+/// keeps the identity), the filled window canonicalised at the anchor and
+/// encoded; the codes are the posterior means.
+class InterpolationEncoderInitializer : public LatentInitializer {
+ public:
+  std::string name() const override { return "interp-encoder"; }
+  InitialGuess initialize(const InitRequest& request) const override;
+};
+
+/// The prior's mean codes (zeros), for comparison.
+class ZeroInitializer : public LatentInitializer {
+ public:
+  std::string name() const override { return "zero"; }
+  InitialGuess initialize(const InitRequest& request) const override;
+};
+
+/// Names accepted by make_initializer(), the default first.
+std::vector<std::string> initializer_names();
+/// The initialiser called `name`; throws mf::InputError listing the names otherwise.
+std::shared_ptr<const LatentInitializer> make_initializer(const std::string& name);
+
+/// The window `window` (all frames meaningful) canonicalised at `anchor` and
+/// encoded: the posterior means. For initialisers that produce a full motion.
+InitialGuess encode_window(const NemfModel& model, const Motion& window, int anchor);
+
+/// The fill of InterpolationEncoderInitializer: a motion of the window's length
+/// whose constrained values are those of `window` and every other value is
+/// interpolated as described there. Reads only what `constraints` names.
+Motion fill_by_interpolation(const Motion& window, const MotionConstraints& constraints);
+
+}  // namespace mf

@@ -1,0 +1,511 @@
+#include "tasks/latent_solver.h"
+
+#include <ATen/ATen.h>
+#include <ceres/first_order_function.h>
+#include <ceres/gradient_problem.h>
+#include <ceres/gradient_problem_solver.h>
+#include <ceres/iteration_callback.h>
+#include <torch/csrc/autograd/autograd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <sstream>
+
+#include "prior/model/nemf.h"
+#include "prior/motion/errors.h"
+#include "prior/motion/rotations.h"
+
+namespace mf {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+int default_iterations(SolverMethod m) { return m == SolverMethod::Adam ? 600 : 50; }
+
+// The energy of a flat latent vector x = [z_l, z_g] (float, [zl + zg]).
+struct FlatEnergy {
+  const NemfModel& model;
+  const WindowProblem& problem;
+  const EnergyWeights& weights;
+  int zl, zg;
+
+  EnergyTerms operator()(const at::Tensor& x) const {
+    return evaluate_energy(model, problem, weights, x.narrow(0, 0, zl).view({1, zl}), x.narrow(0, zl, zg).view({1, zg}));
+  }
+  // Cost and gradient at x (a fresh leaf is made from it).
+  double with_gradient(const at::Tensor& x, at::Tensor* gradient) const {
+    at::Tensor leaf = x.detach().clone().requires_grad_(true);
+    EnergyTerms e = (*this)(leaf);
+    *gradient = torch::autograd::grad({e.total}, {leaf})[0];
+    return e.total.item<double>();
+  }
+  double cost(const at::Tensor& x) const {
+    at::NoGradGuard no_grad;
+    return (*this)(x).total.item<double>();
+  }
+  std::vector<std::pair<std::string, double>> terms(const at::Tensor& x, double* total) const {
+    at::NoGradGuard no_grad;
+    EnergyTerms e = (*this)(x);
+    std::vector<std::pair<std::string, double>> out;
+    for (const auto& t : e.terms) out.emplace_back(t.first, t.second.item<double>());
+    *total = e.total.item<double>();
+    return out;
+  }
+};
+
+class CeresEnergy final : public ceres::FirstOrderFunction {
+ public:
+  explicit CeresEnergy(const FlatEnergy& e) : energy_(e) {}
+  int NumParameters() const override { return energy_.zl + energy_.zg; }
+  bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
+    ++evaluations_;
+    try {
+      at::Tensor x = at::from_blob(const_cast<double*>(parameters), {NumParameters()}, at::kDouble).to(at::kFloat);
+      if (!gradient) {
+        *cost = energy_.cost(x);
+        return std::isfinite(*cost);
+      }
+      at::Tensor g;
+      *cost = energy_.with_gradient(x, &g);
+      at::Tensor gd = g.to(at::kDouble).contiguous();
+      std::copy(gd.data_ptr<double>(), gd.data_ptr<double>() + NumParameters(), gradient);
+      if (!std::isfinite(*cost)) return false;
+      for (int i = 0; i < NumParameters(); ++i) {
+        if (!std::isfinite(gradient[i])) return false;
+      }
+      return true;
+    } catch (...) {
+      if (!error_) error_ = std::current_exception();
+      return false;
+    }
+  }
+  int evaluations() const { return evaluations_; }
+  std::exception_ptr error() const { return error_; }
+
+ private:
+  FlatEnergy energy_;
+  mutable int evaluations_ = 0;
+  mutable std::exception_ptr error_;
+};
+
+class ProgressCallback final : public ceres::IterationCallback {
+ public:
+  ProgressCallback(const TaskContext& ctx, int offset, int total) : ctx_(ctx), offset_(offset), total_(total) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    try {
+      ctx_.report({offset_ + s.iteration, total_, s.cost});
+    } catch (const CancelledError&) {
+      cancelled = true;
+      return ceres::SOLVER_ABORT;
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+  bool cancelled = false;
+
+ private:
+  const TaskContext& ctx_;
+  int offset_, total_;
+};
+
+at::Tensor solve_lbfgs(const FlatEnergy& energy, const at::Tensor& x0, const LatentSolverOptions& o, int cap,
+                       const TaskContext& ctx, int offset, int total, SolveSummary* summary) {
+  const int n = energy.zl + energy.zg;
+  std::vector<double> x(n);
+  {
+    at::Tensor d = x0.to(at::kDouble).contiguous();
+    std::copy(d.data_ptr<double>(), d.data_ptr<double>() + n, x.begin());
+  }
+  auto* function = new CeresEnergy(energy);
+  ceres::GradientProblem problem(function);  // takes ownership
+  ceres::GradientProblemSolver::Options options;
+  options.line_search_direction_type = ceres::LBFGS;
+  options.max_lbfgs_rank = o.lbfgs_rank;
+  options.use_approximate_eigenvalue_bfgs_scaling = o.lbfgs_eigenvalue_scaling;
+  options.max_num_iterations = cap;
+  options.function_tolerance = o.function_tolerance;
+  options.gradient_tolerance = o.gradient_tolerance;
+  options.parameter_tolerance = o.parameter_tolerance;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  ProgressCallback progress(ctx, offset, total);
+  options.callbacks.push_back(&progress);
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("invalid L-BFGS options: " + why);
+  ceres::GradientProblemSolver::Summary s;
+  ceres::Solve(options, problem, x.data(), &s);
+  if (progress.cancelled) throw CancelledError();
+  if (function->error()) std::rethrow_exception(function->error());
+  summary->iterations = std::max(0, static_cast<int>(s.iterations.size()) - 1);
+  summary->evaluations = function->evaluations();
+  summary->converged = s.termination_type == ceres::CONVERGENCE;
+  summary->message = s.message;
+  return at::from_blob(x.data(), {n}, at::kDouble).to(at::kFloat);
+}
+
+at::Tensor solve_adam(const FlatEnergy& energy, const at::Tensor& x0, const LatentSolverOptions& o, int cap,
+                      const TaskContext& ctx, int offset, int total, SolveSummary* summary) {
+  const double b1 = 0.9, b2 = 0.999, eps = 1e-8;
+  at::Tensor x = x0.clone();
+  at::Tensor m = at::zeros_like(x), v = at::zeros_like(x);
+  at::Tensor best_x = x.clone();
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<double> best_history;
+  summary->message = "iteration cap reached";
+  int it = 0;
+  for (; it < cap; ++it) {
+    at::Tensor g;
+    const double f = energy.with_gradient(x, &g);
+    ++summary->evaluations;
+    if (!std::isfinite(f)) {
+      summary->message = "non-finite energy";
+      break;
+    }
+    if (f < best) {
+      best = f;
+      best_x = x.clone();
+    }
+    best_history.push_back(best);
+    ctx.report({offset + it, total, f});
+    if (it >= o.adam_patience) {
+      const double before = best_history[it - o.adam_patience];
+      if (before - best <= o.adam_tolerance * std::abs(before)) {
+        summary->converged = true;
+        summary->message = "converged: the energy improved by less than the tolerance over the patience window";
+        ++it;
+        break;
+      }
+    }
+    const double lr = o.adam_lr * std::pow(o.adam_decay, it / std::max(1, o.adam_decay_every));
+    at::NoGradGuard no_grad;
+    m.mul_(b1).add_(g, 1 - b1);
+    v.mul_(b2).addcmul_(g, g, 1 - b2);
+    const double c1 = 1 - std::pow(b1, it + 1), c2 = 1 - std::pow(b2, it + 1);
+    x = x - (m / c1) / ((v / c2).sqrt() + eps) * lr;
+  }
+  summary->iterations = it;
+  return best_x;
+}
+
+// ---------------------------------------------------------------------------
+// Windows
+
+double smoothstep(double t) { return t * t * (3.0 - 2.0 * t); }
+
+Eigen::Quaterniond residual_rotation(const Eigen::Quaterniond& given, const Eigen::Quaterniond& raw) {
+  return (given.normalized() * raw.normalized().conjugate()).normalized();
+}
+
+// Blend weights of the residual of sorted `frames` at frame f: the residual is
+// r(a) * (1 - s) + r(b) * s with s = smoothstep, held outside. Returns (a, b, s).
+struct Bracket {
+  int a, b;
+  double s;
+};
+Bracket bracket(int f, const std::vector<int>& frames) {
+  auto it = std::lower_bound(frames.begin(), frames.end(), f);
+  if (it == frames.end()) return {frames.back(), frames.back(), 0.0};
+  if (*it == f || it == frames.begin()) return {*it, *it, 0.0};
+  const int b = *it, a = *(it - 1);
+  return {a, b, smoothstep(static_cast<double>(f - a) / (b - a))};
+}
+
+void measure_effectors(const Motion& motion, const MotionConstraints& c, EffectorError* e) {
+  *e = EffectorError{};
+  if (c.effectors.empty()) return;
+  GlobalPose pose = forward_kinematics(motion);
+  double sum = 0.0;
+  for (const EffectorTarget& t : c.effectors) {
+    const double d = (pose.position(t.frame, t.joint) - t.position).norm() * 100.0;
+    e->max_cm = std::max(e->max_cm, d);
+    sum += d;
+    ++e->count;
+  }
+  e->mean_cm = sum / e->count;
+}
+
+// Makes the constrained values of `out` exactly the input's, spreading the
+// residuals (see the header). Records the raw error first.
+void overwrite_known(const Motion& input, const MotionConstraints& c, Motion* out, ConstraintError* err) {
+  const int N = input.num_frames(), J = input.num_joints();
+  *err = ConstraintError{};
+  double rot_sum = 0.0, root_sum = 0.0;
+  const Motion raw = *out;
+  for (int j = 0; j < J; ++j) {
+    std::vector<int> frames;
+    std::vector<Eigen::Quaterniond> residual;
+    for (size_t k = 0; k < c.keys.size(); ++k) {
+      if (!c.key_has_joint(k, j)) continue;
+      const int f = c.keys[k].frame;
+      frames.push_back(f);
+      residual.push_back(residual_rotation(input.rotation(f, j), raw.rotation(f, j)));
+      const double deg = geodesic_angle(input.rotation(f, j).normalized(), raw.rotation(f, j)) * 180.0 / M_PI;
+      err->rotation_max_deg = std::max(err->rotation_max_deg, deg);
+      rot_sum += deg;
+      ++err->rotations;
+    }
+    if (frames.empty()) continue;
+    size_t next = 0;
+    for (int f = 0; f < N; ++f) {
+      if (next < frames.size() && frames[next] == f) {
+        out->rotation(f, j) = input.rotation(f, j);  // bit for bit
+        ++next;
+        continue;
+      }
+      const Bracket br = bracket(f, frames);
+      const size_t ia = std::lower_bound(frames.begin(), frames.end(), br.a) - frames.begin();
+      const size_t ib = std::lower_bound(frames.begin(), frames.end(), br.b) - frames.begin();
+      const Eigen::Quaterniond r = slerp(residual[ia], residual[ib], br.s);
+      out->rotation(f, j) = (r * raw.rotation(f, j).normalized()).normalized();
+    }
+  }
+  std::vector<int> frames;
+  std::vector<Eigen::Vector3d> residual;
+  for (const PoseKey& k : c.keys) {
+    if (!k.root_position) continue;
+    frames.push_back(k.frame);
+    residual.push_back(input.root_positions[k.frame] - raw.root_positions[k.frame]);
+    const double cm = residual.back().norm() * 100.0;
+    err->root_max_cm = std::max(err->root_max_cm, cm);
+    root_sum += cm;
+    ++err->roots;
+  }
+  if (!frames.empty()) {
+    size_t next = 0;
+    for (int f = 0; f < N; ++f) {
+      if (next < frames.size() && frames[next] == f) {
+        out->root_positions[f] = input.root_positions[f];
+        ++next;
+        continue;
+      }
+      const Bracket br = bracket(f, frames);
+      const size_t ia = std::lower_bound(frames.begin(), frames.end(), br.a) - frames.begin();
+      const size_t ib = std::lower_bound(frames.begin(), frames.end(), br.b) - frames.begin();
+      out->root_positions[f] = raw.root_positions[f] + residual[ia] * (1.0 - br.s) + residual[ib] * br.s;
+    }
+  }
+  if (err->rotations) err->rotation_mean_deg = rot_sum / err->rotations;
+  if (err->roots) err->root_mean_cm = root_sum / err->roots;
+}
+
+// Window starts for N frames, windows of W frames overlapping by at least `overlap`.
+std::vector<int> window_starts(int N, int W, int overlap) {
+  if (N <= W) return {0};
+  std::vector<int> starts;
+  int s = 0;
+  for (; s + W < N; s += W - overlap) starts.push_back(s);
+  starts.push_back(N - W);
+  return starts;
+}
+
+}  // namespace
+
+std::string LatentSolverOptions::validate() const {
+  std::ostringstream e;
+  if (max_iterations < 0) e << "max_iterations must be >= 0; ";
+  if (lbfgs_rank < 1) e << "lbfgs_rank must be >= 1; ";
+  if (!(function_tolerance >= 0) || !(gradient_tolerance >= 0) || !(parameter_tolerance >= 0))
+    e << "tolerances must be >= 0; ";
+  if (!(adam_lr > 0) || !std::isfinite(adam_lr)) e << "adam_lr must be positive; ";
+  if (adam_decay_every < 1 || !(adam_decay > 0 && adam_decay <= 1)) e << "bad Adam decay; ";
+  if (!(adam_tolerance >= 0) || adam_patience < 1) e << "bad Adam convergence settings; ";
+  if (overlap < 1) e << "overlap must be >= 1; ";
+  if (keyed_iterations < 0) e << "keyed_iterations must be >= 0; ";
+  const EnergyWeights& w = weights;
+  for (double v : {w.rotation, w.position, w.root_orientation, w.root_translation, w.effector, w.latent_prior,
+                   w.foot_skating, w.smoothness}) {
+    if (!(v >= 0) || !std::isfinite(v)) {
+      e << "energy weights must be finite and non-negative; ";
+      break;
+    }
+  }
+  return e.str();
+}
+
+LatentSolverOptions default_solver_options(SolverMethod method) {
+  LatentSolverOptions o;
+  o.method = method;
+  return o;
+}
+
+LatentSolution solve_latents(const NemfModel& model, const WindowProblem& problem, const InitialGuess& start,
+                             const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset,
+                             int iteration_total) {
+  const std::string bad = options.validate();
+  if (!bad.empty()) throw InputError("invalid solver options: " + bad);
+  const int zl = model.config().zl, zg = model.config().zg;
+  if (!start.z_l.defined() || !start.z_g.defined() || start.z_l.numel() != zl || start.z_g.numel() != zg)
+    throw InputError("initial codes must have " + std::to_string(zl) + " + " + std::to_string(zg) + " values");
+  const auto t0 = Clock::now();
+  const FlatEnergy energy{model, problem, options.weights, zl, zg};
+  const at::Tensor x0 = at::cat({start.z_l.reshape({zl}), start.z_g.reshape({zg})}).to(at::kFloat).detach();
+  const int cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.method);
+  const int total = iteration_total > 0 ? iteration_total : cap;
+
+  LatentSolution out;
+  SolveSummary& s = out.summary;
+  s.initial_terms = energy.terms(x0, &s.initial_energy);
+  at::Tensor x = x0;
+  const EnergyWeights& w = options.weights;
+  const bool dense = w.root_translation > 0 || w.effector > 0 || w.foot_skating > 0 || w.smoothness > 0;
+  if (options.method == SolverMethod::Lbfgs && options.keyed_iterations > 0 && dense) {
+    EnergyWeights keyed = w;
+    keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
+    const FlatEnergy cheap{model, problem, keyed, zl, zg};
+    SolveSummary first;
+    x = solve_lbfgs(cheap, x, options, options.keyed_iterations, ctx, iteration_offset, total, &first);
+    s.keyed_iterations = first.iterations;
+    s.evaluations += first.evaluations;
+  }
+  SolveSummary main;
+  x = options.method == SolverMethod::Lbfgs
+          ? solve_lbfgs(energy, x, options, cap, ctx, iteration_offset + s.keyed_iterations, total, &main)
+          : solve_adam(energy, x, options, cap, ctx, iteration_offset, total, &main);
+  s.iterations = s.keyed_iterations + main.iterations;
+  s.evaluations += main.evaluations;
+  s.converged = main.converged;
+  s.message = main.message;
+  s.final_terms = energy.terms(x, &s.final_energy);
+  out.z_l = x.narrow(0, 0, zl).reshape({1, zl}).clone();
+  out.z_g = x.narrow(0, zl, zg).reshape({1, zg}).clone();
+  s.wall_ms = ms_since(t0);
+  return out;
+}
+
+Motion complete_motion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
+                       const LatentSolverOptions& options, const TaskContext& ctx, CompletionReport* report) {
+  const auto t0 = Clock::now();
+  const std::string bad = options.validate();
+  if (!bad.empty()) throw InputError("invalid solver options: " + bad);
+  const RigInfo& rig = model.rig();
+  const int N = input.num_frames(), J = input.num_joints();
+  if (J != rig.num_joints() || input.skeleton.names != rig.skeleton.names ||
+      input.skeleton.parents != rig.skeleton.parents) {
+    throw InputError("the motion's skeleton does not match the model's: " + std::to_string(J) + " joints given, the model has " +
+                     std::to_string(rig.num_joints()) + " (joint names and parents must agree)");
+  }
+  if (N < 2) throw InputError("the motion needs at least two frames");
+  if (input.rotations.size() != static_cast<size_t>(N) * J)
+    throw InputError("the motion's rotation count does not match its frames and joints");
+  constraints.validate(N, J);
+
+  const int W = model.config().window;
+  if (N > W && options.overlap > W / 2)
+    throw InputError("the window overlap must be at most half the model's window (" + std::to_string(W / 2) + ")");
+  const std::vector<int> starts = window_starts(N, W, options.overlap);
+  const int windows = static_cast<int>(starts.size());
+  auto length_of = [&](int k) { return std::min(W, N - starts[k]); };
+
+  // First window holding a key that fixes the root.
+  int first = -1;
+  for (size_t k = 0; k < constraints.keys.size() && first < 0; ++k) {
+    if (!constraints.key_fixes_root(k)) continue;
+    for (int w = 0; w < windows; ++w) {
+      if (constraints.keys[k].frame >= starts[w] && constraints.keys[k].frame < starts[w] + length_of(w)) {
+        first = w;
+        break;
+      }
+    }
+  }
+  std::vector<int> order;
+  for (int w = first; w < windows; ++w) order.push_back(w);
+  for (int w = first - 1; w >= 0; --w) order.push_back(w);
+
+  std::shared_ptr<const LatentInitializer> init = options.initializer;
+  if (!init) init = std::make_shared<InterpolationEncoderInitializer>();
+  const int cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.method);
+
+  CompletionReport rep;
+  Motion out = Motion::identity(input.skeleton, N, input.fps);
+  std::vector<char> solved(N, 0);
+  int iterations = 0;
+  for (int w : order) {
+    const int s = starts[w], T = length_of(w);
+    MotionConstraints wc = constraints.slice(s, T);
+    Motion src = input.slice(s, s + T);
+    // Overlap with an already solved neighbour: full-pose keys from its solution
+    // (the user's own constrained values kept where there are some).
+    int ov_a = T, ov_b = 0;
+    for (int f = 0; f < T; ++f) {
+      if (!solved[s + f]) continue;
+      ov_a = std::min(ov_a, f);
+      ov_b = std::max(ov_b, f + 1);
+    }
+    if (ov_a < ov_b) {
+      std::vector<PoseKey> merged;
+      size_t u = 0;
+      for (int f = 0; f < T; ++f) {
+        while (u < wc.keys.size() && wc.keys[u].frame < f) merged.push_back(wc.keys[u++]);
+        const bool user = u < wc.keys.size() && wc.keys[u].frame == f;
+        if (f < ov_a || f >= ov_b) continue;
+        for (int j = 0; j < J; ++j) {
+          if (!(user && wc.key_has_joint(u, j))) src.rotation(f, j) = out.rotation(s + f, j);
+        }
+        if (!(user && wc.keys[u].root_position)) src.root_positions[f] = out.root_positions[s + f];
+        PoseKey full;
+        full.frame = f;
+        merged.push_back(full);
+        if (user) ++u;
+      }
+      while (u < wc.keys.size()) merged.push_back(wc.keys[u++]);
+      wc.keys = merged;
+    }
+    int anchor = -1;
+    for (size_t k = 0; k < wc.keys.size() && anchor < 0; ++k) {
+      if (wc.key_fixes_root(k)) anchor = wc.keys[k].frame;
+    }
+    if (anchor < 0) {
+      throw InputError("frames " + std::to_string(s) + ".." + std::to_string(s + T - 1) +
+                       " hold no key that fixes the root");  // cannot happen after validation
+    }
+    const WindowProblem problem = make_window_problem(rig, src, 0, T, wc, anchor);
+    InitRequest request;
+    request.model = &model;
+    request.window = &src;
+    request.constraints = &wc;
+    request.anchor = anchor;
+    request.context = &ctx;
+    const InitialGuess start = init->initialize(request);
+    LatentSolution sol = solve_latents(model, problem, start, options, ctx, iterations, cap * windows);
+    iterations += sol.summary.iterations;
+    rep.windows.push_back(sol.summary);
+    rep.window_starts.push_back(s);
+
+    const DecodedWindow dec = decode_window(model, problem, sol.z_l, sol.z_g);
+    Motion piece = Motion::identity(input.skeleton, T, input.fps);
+    write_window(dec.local_rotations, dec.root_positions, problem.transform, &piece, 0);
+    // Cross-fade over the overlap; the new window's weight rises away from the solved side.
+    const bool solved_before = ov_a < ov_b && ov_a == 0;
+    const int n_ov = ov_b - ov_a;
+    for (int f = 0; f < T; ++f) {
+      const int g = s + f;
+      double wn = 1.0;
+      if (solved[g]) {
+        const int pos = solved_before ? f - ov_a + 1 : ov_b - f;
+        wn = static_cast<double>(pos) / (n_ov + 1);
+      }
+      for (int j = 0; j < J; ++j) {
+        out.rotation(g, j) = wn >= 1.0 ? piece.rotation(f, j) : slerp(out.rotation(g, j), piece.rotation(f, j), wn);
+      }
+      out.root_positions[g] =
+          wn >= 1.0 ? piece.root_positions[f] : Eigen::Vector3d(out.root_positions[g] * (1.0 - wn) + piece.root_positions[f] * wn);
+      solved[g] = 1;
+    }
+  }
+
+  measure_effectors(out, constraints, &rep.raw_effectors);
+  overwrite_known(input, constraints, &out, &rep.raw_known);
+  measure_effectors(out, constraints, &rep.effectors);
+  rep.iterations = iterations;
+  rep.wall_ms = ms_since(t0);
+  if (report) *report = std::move(rep);
+  return out;
+}
+
+}  // namespace mf

@@ -1,0 +1,157 @@
+// The latent solvers: in-betweening, gap filling, partial and end-effector
+// constraints by optimising the prior's latent codes (z_l, z_g) of each window
+// with the network frozen (tasks/energies.h defines the energy).
+//
+// Two optimisers, selectable:
+//   Lbfgs (default)  Ceres' GradientProblemSolver with L-BFGS and a Wolfe line
+//                    search; cost and gradient by torch autograd (the double
+//                    parameters of Ceres converted to float tensors and back).
+//   Adam             NeMF's reference: lr 0.1, 600 iterations, x0.7 every 200;
+//                    returns the lowest-energy iterate.
+// L-BFGS may run a cheap keys-only stage first (keyed_iterations). Both stop
+// early on convergence, report iterations and the final energy per
+// term and wall time, and call TaskContext::report() once per iteration, so a
+// progress callback or the cancel flag can stop them (CancelledError).
+// Deterministic for a given input, options, seed and torch thread count.
+//
+// complete_motion() is the task: it splits the input into windows of the
+// model's length, canonicalises each at its first key that fixes the root,
+// initialises (LatentSolverOptions::initializer), solves, decodes every frame
+// (root translation from the global motion predictor), and then makes the
+// constrained values exact:
+//  * Known values come out exactly as given (bit for bit). The residual between
+//    the input and the raw solution at each key is spread over the frames
+//    around it: between two keys constraining the same joint (or the root
+//    position) the residual is blended with smoothstep weights from one key's
+//    to the other's; before the first and after the last such key it is held.
+//    The error of the raw solution at the keys, before this overwrite, is
+//    reported (CompletionReport::raw_known).
+//  * End-effector targets are not enforced exactly; their error after the
+//    blend is reported.
+//  * Inputs longer than a window: windows of the model's length overlapping by
+//    `overlap` frames, solved one after the other starting from the first
+//    window that holds a key fixing the root; each later (or earlier) window
+//    is also constrained by full-pose keys at the overlap frames, taken from
+//    the solution of its already solved neighbour, and the two solutions are
+//    cross-faded over the overlap (SLERP / LERP with linear weights), so
+//    there is no seam.
+#pragma once
+
+#include <ATen/core/Tensor.h>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "prior/motion/motion.h"
+#include "tasks/energies.h"
+#include "tasks/initializers.h"
+#include "tasks/method.h"
+
+namespace mf {
+
+class NemfModel;
+
+enum class SolverMethod { Lbfgs, Adam };
+
+struct LatentSolverOptions {
+  SolverMethod method = SolverMethod::Lbfgs;
+  EnergyWeights weights;
+  /// Iteration cap per window; 0 means the method's default (L-BFGS 50, Adam 600).
+  int max_iterations = 0;
+
+  // L-BFGS (Ceres GradientProblemSolver).
+  int lbfgs_rank = 20;               ///< memory of the Hessian approximation
+  /// Ceres' use_approximate_eigenvalue_bfgs_scaling: scales the initial
+  /// inverse Hessian (helps when the energy's scale is far from 1).
+  bool lbfgs_eigenvalue_scaling = false;
+  /// L-BFGS only: first up to this many iterations on the terms that need
+  /// only the key frames decoded (rotation, position, root orientation, latent
+  /// prior), which cost a fraction of a dense evaluation, then the full energy
+  /// (max_iterations). 0 = a single stage.
+  int keyed_iterations = 0;
+  double function_tolerance = 1e-4;  ///< stop when |delta f| / f falls below this
+  double gradient_tolerance = 1e-8;  ///< ... or max |gradient| relative to the initial one below this
+  double parameter_tolerance = 1e-6; ///< ... or the step relative to |z| below this
+
+  // Adam (NeMF's reference).
+  double adam_lr = 0.1;
+  int adam_decay_every = 200;
+  double adam_decay = 0.7;
+  /// Converged when the best energy improved by less than this fraction over
+  /// the last `adam_patience` iterations.
+  double adam_tolerance = 1e-4;
+  int adam_patience = 100;
+
+  /// Null means InterpolationEncoderInitializer.
+  std::shared_ptr<const LatentInitializer> initializer;
+
+  /// Frames shared by consecutive windows of long inputs (1 .. window / 2).
+  int overlap = 32;
+
+  /// Empty when valid, else what is wrong (Ceres' Options::IsValid style).
+  std::string validate() const;
+};
+
+/// The options of the registered methods: "nemf" (L-BFGS) and "nemf-adam".
+LatentSolverOptions default_solver_options(SolverMethod method = SolverMethod::Lbfgs);
+
+/// What one window's solve did.
+struct SolveSummary {
+  int iterations = 0;        ///< all stages
+  int keyed_iterations = 0;  ///< of them, in the keys-only first stage
+  int evaluations = 0;       ///< energy evaluations (with or without gradient)
+  bool converged = false;    ///< stopped by a tolerance, not by the iteration cap
+  double initial_energy = 0.0;
+  double final_energy = 0.0;
+  std::vector<std::pair<std::string, double>> initial_terms;  ///< weighted, as in EnergyTerms
+  std::vector<std::pair<std::string, double>> final_terms;
+  double wall_ms = 0.0;      ///< initialisation excluded
+  std::string message;       ///< the optimiser's stop reason
+};
+
+struct LatentSolution {
+  at::Tensor z_l;  ///< [1, zl]
+  at::Tensor z_g;  ///< [1, zg]
+  SolveSummary summary;
+};
+
+/// Optimises the codes of one window from `start`. `iteration_offset` and
+/// `iteration_total` only shape the progress reports (iteration =
+/// offset + this window's iteration, max_iterations = total; 0 = this window's
+/// cap). Throws CancelledError when the context asks to stop.
+LatentSolution solve_latents(const NemfModel& model, const WindowProblem& problem, const InitialGuess& start,
+                             const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset = 0,
+                             int iteration_total = 0);
+
+/// Error of the raw solution at the constrained values, before the overwrite.
+struct ConstraintError {
+  double rotation_max_deg = 0.0, rotation_mean_deg = 0.0;  ///< constrained local rotations (root included)
+  double root_max_cm = 0.0, root_mean_cm = 0.0;            ///< constrained root positions
+  long rotations = 0, roots = 0;                           ///< counts
+};
+
+struct EffectorError {
+  double max_cm = 0.0, mean_cm = 0.0;
+  long count = 0;
+};
+
+struct CompletionReport {
+  std::vector<SolveSummary> windows;   ///< in solve order
+  std::vector<int> window_starts;      ///< first frame of each window, in solve order
+  ConstraintError raw_known;           ///< raw solution vs keys, before the overwrite
+  EffectorError raw_effectors;         ///< raw solution vs end-effector targets
+  EffectorError effectors;             ///< output vs end-effector targets (after the blend)
+  int iterations = 0;                  ///< summed over windows
+  double wall_ms = 0.0;                ///< the whole call
+};
+
+/// Completes `input` under `constraints` (validated; unconstrained values of
+/// the input are never read). The output has the input's skeleton, length and
+/// fps. Throws mf::InputError on bad constraints, a skeleton that does not
+/// match the model or bad options; CancelledError when cancelled.
+Motion complete_motion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
+                       const LatentSolverOptions& options, const TaskContext& ctx = {},
+                       CompletionReport* report = nullptr);
+
+}  // namespace mf

@@ -1,0 +1,362 @@
+// The latent solvers (tasks/latent_solver.h) on tiny random models: energy
+// decrease with L-BFGS and Adam, cancellation, exact known frames, unknown
+// values never read, determinism, partial and end-effector constraints, long
+// inputs in overlapping windows, and the registered methods.
+#include <ATen/ATen.h>
+#include <ATen/Parallel.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "prior/model/nemf.h"
+#include "prior/model/representation.h"
+#include "prior/motion/errors.h"
+#include "prior/motion/kinematics_torch.h"
+#include "prior/motion/rotations.h"
+#include "tasks/jobs.h"
+#include "tasks/latent_solver.h"
+#include "tests/test_util.h"
+
+namespace mf {
+namespace {
+
+NemfConfig tiny_config() {
+  NemfConfig c;
+  c.window = 32;
+  c.decoder_width = 32;
+  c.decoder_layers = 3;
+  c.zl = 8;
+  c.zg = 4;
+  c.zg_layers = 2;
+  c.encoder_channels = 4;
+  c.gmp_width = 8;
+  c.gmp_blocks = 1;
+  c.pe_frequencies = 4;  // periods of 12+ frames: a random decoder that does not jitter from frame to frame
+  return c;
+}
+
+// A tiny random prior whose global motion predictor stands still at 0.9 m
+// (its output layer zeroed, the height mean set): a random GMP walks off in
+// random directions, which no window could agree on. Its root faces +Z.
+NemfModel tiny_model() {
+  Skeleton s = test::small_skeleton();
+  Motion m = test::random_motion(s, 60, 30.0, 3);
+  RigInfo rig = measure_rig(s, {&m});
+  rig.root_forward = Eigen::Vector3d::UnitZ();  // the gentle motions below face +Z
+  at::manual_seed(11);
+  NemfModel model(tiny_config(), rig);
+  model.set_requires_grad(false);
+  at::NoGradGuard no_grad;
+  for (auto& p : model.named_parameters()) {
+    if (p.first.rfind("gmp.output.", 0) == 0) p.second.zero_();
+  }
+  model.stats().gmp_out_mean[3] = 0.9f;
+  return model;
+}
+
+LatentSolverOptions quick(SolverMethod method) {
+  LatentSolverOptions o = default_solver_options(method);
+  o.max_iterations = method == SolverMethod::Adam ? 60 : 20;
+  return o;
+}
+
+// A keyframe problem whose targets the model can reach: exactly what z*
+// decodes to, in the model's own canonical frame.
+struct Reachable {
+  WindowProblem problem;
+  InitialGuess start;
+};
+Reachable reachable_problem(const NemfModel& model) {
+  at::manual_seed(21);
+  at::Tensor zl = at::randn({1, 8}), zg = at::randn({1, 4});
+  const RigInfo& rig = model.rig();
+  const int T = 24, J = rig.num_joints();
+  const std::vector<int64_t> keys = {0, 8, 16, 23};
+  const int K = static_cast<int>(keys.size());
+  Reachable r;
+  WindowProblem& p = r.problem;
+  p.length = T;
+  p.anchor = 0;
+  DecodedWindow d = decode_window(model, p, zl, zg);
+  p.key_frames = at::tensor(keys, at::kLong);
+  p.key_rotations = d.local_rotations.squeeze(0).index_select(0, p.key_frames).clone();
+  p.key_rotation_mask = at::ones({K, J});
+  p.key_position_mask = at::ones({K, J});
+  p.key_positions = forward_kinematics(rig.skeleton.parents, offsets_tensor(rig.skeleton), p.key_rotations,
+                                       at::zeros({K, 3}))
+                        .positions;
+  p.key_root = d.root_positions.squeeze(0).index_select(0, p.key_frames).clone();
+  p.key_root_mask = at::ones({K});
+  p.effector_frames = at::zeros({0}, at::kLong);
+  p.effector_joints = at::zeros({0}, at::kLong);
+  p.effector_targets = at::zeros({0, 3});
+  p.effector_weights = at::zeros({0});
+  r.start = {at::zeros({1, 8}), at::zeros({1, 4})};
+  return r;
+}
+
+double max_abs_difference(const Motion& a, const Motion& b) {
+  double d = 0.0;
+  for (size_t i = 0; i < a.rotations.size(); ++i)
+    d = std::max(d, (a.rotations[i].coeffs() - b.rotations[i].coeffs()).cwiseAbs().maxCoeff());
+  for (size_t i = 0; i < a.root_positions.size(); ++i)
+    d = std::max(d, (a.root_positions[i] - b.root_positions[i]).cwiseAbs().maxCoeff());
+  return d;
+}
+
+// A random motion with small rotations (a quarter of random_motion's angles)
+// and a root that sways in place: what a tiny random prior can come close to.
+Motion gentle_motion(const Skeleton& s, int frames, uint32_t seed) {
+  Motion m = test::random_motion(s, frames, 30.0, seed);
+  for (auto& q : m.rotations) q = slerp(Eigen::Quaterniond::Identity(), q, 0.25);
+  for (int f = 0; f < frames; ++f) m.root_positions[f] = Eigen::Vector3d(0.02 * std::sin(0.2 * f), 0.9, 0.01 * f);
+  return m;
+}
+
+TEST(LatentSolver, LbfgsAndAdamBothReduceAKeyframeEnergy) {
+  at::set_num_threads(1);
+  NemfModel model = tiny_model();
+  Reachable r = reachable_problem(model);
+  for (SolverMethod method : {SolverMethod::Lbfgs, SolverMethod::Adam}) {
+    LatentSolution s = solve_latents(model, r.problem, r.start, quick(method), {});
+    EXPECT_GT(s.summary.iterations, 0);
+    EXPECT_GE(s.summary.evaluations, s.summary.iterations);
+    EXPECT_LT(s.summary.final_energy, 0.5 * s.summary.initial_energy)
+        << (method == SolverMethod::Adam ? "adam" : "lbfgs");
+    EXPECT_GT(s.summary.wall_ms, 0.0);
+    ASSERT_EQ(s.summary.final_terms.size(), s.summary.initial_terms.size());
+    double sum = 0.0;
+    for (const auto& t : s.summary.final_terms) sum += t.second;
+    EXPECT_NEAR(sum, s.summary.final_energy, 1e-5 * std::max(1.0, sum));
+    EXPECT_FALSE(s.summary.message.empty());
+    EXPECT_EQ(s.z_l.sizes(), (std::vector<int64_t>{1, 8}));
+  }
+}
+
+TEST(LatentSolver, LbfgsStopsEarlyOnConvergence) {
+  at::set_num_threads(1);
+  NemfModel model = tiny_model();
+  Reachable r = reachable_problem(model);
+  LatentSolverOptions o = default_solver_options();
+  o.max_iterations = 500;
+  o.function_tolerance = 1e-3;
+  LatentSolution s = solve_latents(model, r.problem, r.start, o, {});
+  EXPECT_TRUE(s.summary.converged) << s.summary.message;
+  EXPECT_LT(s.summary.iterations, 500);
+}
+
+TEST(LatentSolver, ProgressObservesAndCancels) {
+  at::set_num_threads(1);
+  NemfModel model = tiny_model();
+  Reachable r = reachable_problem(model);
+  for (SolverMethod method : {SolverMethod::Lbfgs, SolverMethod::Adam}) {
+    std::vector<int> seen;
+    TaskContext ctx;
+    ctx.progress = [&](const TaskProgress& p) {
+      seen.push_back(p.iteration);
+      EXPECT_GT(p.max_iterations, 0);
+      EXPECT_TRUE(std::isfinite(p.energy));
+      return p.iteration < 3;
+    };
+    EXPECT_THROW(solve_latents(model, r.problem, r.start, quick(method), ctx), CancelledError);
+    ASSERT_FALSE(seen.empty());
+    EXPECT_EQ(seen.back(), 3);
+
+    std::atomic<int> cancel{1};
+    TaskContext flagged;
+    flagged.cancel = &cancel;
+    Motion m = test::random_motion(model.rig().skeleton, 20, 30.0, 2);
+    EXPECT_THROW(complete_motion(model, m, MotionConstraints::full_pose({0, 19}), quick(method), flagged),
+                 CancelledError);
+  }
+}
+
+TEST(LatentSolver, KnownFramesComeOutExactlyAndUnknownFramesAreNeverRead) {
+  at::set_num_threads(1);
+  NemfModel model = tiny_model();
+  Motion m = test::random_motion(model.rig().skeleton, 26, 30.0, 7);
+  const std::vector<int> keys = {0, 6, 13, 25};
+  CompletionReport report;
+  Motion out = complete_motion(model, m, MotionConstraints::full_pose(keys), quick(SolverMethod::Lbfgs), {}, &report);
+  ASSERT_EQ(out.num_frames(), 26);
+  for (int f : keys) {
+    EXPECT_EQ(out.root_positions[f], m.root_positions[f]);
+    for (int j = 0; j < m.num_joints(); ++j) EXPECT_EQ(out.rotation(f, j).coeffs(), m.rotation(f, j).coeffs());
+  }
+  EXPECT_EQ(report.raw_known.rotations, 4 * m.num_joints());
+  EXPECT_EQ(report.raw_known.roots, 4);
+  EXPECT_GT(report.raw_known.rotation_max_deg, 0.0);  // a random tiny model does not hit them by itself
+  ASSERT_EQ(report.windows.size(), 1u);
+
+  Motion poisoned = m;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int f = 0; f < 26; ++f) {
+    if (std::find(keys.begin(), keys.end(), f) != keys.end()) continue;
+    for (int j = 0; j < m.num_joints(); ++j) poisoned.rotation(f, j) = Eigen::Quaterniond(nan, nan, nan, nan);
+    poisoned.root_positions[f] = Eigen::Vector3d(nan, nan, nan);
+  }
+  Motion again = complete_motion(model, poisoned, MotionConstraints::full_pose(keys), quick(SolverMethod::Lbfgs));
+  EXPECT_EQ(max_abs_difference(out, again), 0.0);
+}
+
+TEST(LatentSolver, DeterministicForTheSameInput) {
+  at::set_num_threads(1);
+  NemfModel model = tiny_model();
+  Motion m = test::random_motion(model.rig().skeleton, 30, 30.0, 8);
+  for (SolverMethod method : {SolverMethod::Lbfgs, SolverMethod::Adam}) {
+    TaskContext ctx;
+    ctx.seed = 5;
+    Motion a = complete_motion(model, m, MotionConstraints::full_pose({0, 10, 29}), quick(method), ctx);
+    Motion b = complete_motion(model, m, MotionConstraints::full_pose({0, 10, 29}), quick(method), ctx);
+    EXPECT_EQ(max_abs_difference(a, b), 0.0);
+  }
+}
+
+TEST(LatentSolver, PartialConstraintsIgnoreUnconstrainedJoints) {
+  at::set_num_threads(1);
+  NemfModel model = tiny_model();
+  Motion m = test::random_motion(model.rig().skeleton, 24, 30.0, 9);
+  MotionConstraints c = MotionConstraints::full_pose({0, 23});
+  PoseKey legs;  // frame 12: only the left leg (UpperLeg_L, Foot_L)
+  legs.frame = 12;
+  legs.joints = {3, 4};
+  legs.root_position = false;
+  c.keys.insert(c.keys.begin() + 1, legs);
+  Motion a = complete_motion(model, m, c, quick(SolverMethod::Lbfgs));
+  for (int j : {3, 4}) EXPECT_EQ(a.rotation(12, j).coeffs(), m.rotation(12, j).coeffs());
+  // Whatever the other joints and the root hold at frame 12 does not matter.
+  Motion other = m;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int j : {0, 1, 2, 5, 6}) other.rotation(12, j) = Eigen::Quaterniond(nan, nan, nan, nan);
+  other.root_positions[12] = Eigen::Vector3d(nan, nan, nan);
+  Motion b = complete_motion(model, other, c, quick(SolverMethod::Lbfgs));
+  EXPECT_EQ(max_abs_difference(a, b), 0.0);
+  // A constrained joint does matter.
+  Motion moved = m;
+  moved.rotation(12, 4) = Eigen::Quaterniond(Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitX())) * m.rotation(12, 4);
+  Motion d = complete_motion(model, moved, c, quick(SolverMethod::Lbfgs));
+  EXPECT_GT(max_abs_difference(a, d), 1e-3);
+}
+
+TEST(LatentSolver, EndEffectorPullsTheJointTowardItsTarget) {
+  at::set_num_threads(1);
+  NemfModel model = tiny_model();
+  const int foot = model.rig().foot_joints[0];
+  Motion m = gentle_motion(model.rig().skeleton, 24, 10);
+  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  o.max_iterations = 60;
+  MotionConstraints c = MotionConstraints::full_pose({0, 23});
+  const Eigen::Vector3d target = forward_kinematics(m).position(12, foot) + Eigen::Vector3d(0.08, 0.0, 0.0);
+  c.effectors.push_back({12, foot, target, 0.0});  // measured, not pulled
+  CompletionReport free_report;
+  complete_motion(model, m, c, o, {}, &free_report);
+  c.effectors[0].weight = 1.0;
+  CompletionReport report;
+  Motion pulled = complete_motion(model, m, c, o, {}, &report);
+  // The output (after the overwrite of the keys) is what is pulled: the raw
+  // solution may move away to make up for the residuals blended in.
+  EXPECT_LT(report.effectors.max_cm, 0.5 * free_report.effectors.max_cm)
+      << "free " << free_report.effectors.max_cm << " cm, pulled " << report.effectors.max_cm << " cm";
+  EXPECT_EQ(report.effectors.count, 1);
+  EXPECT_NEAR(report.effectors.max_cm, (forward_kinematics(pulled).position(12, foot) - target).norm() * 100.0, 1e-6);
+}
+
+TEST(LatentSolver, LongInputsUseOverlappingWindowsWithoutSeams) {
+  at::set_num_threads(1);
+  NemfModel model = tiny_model();
+  const int N = 100;
+  Motion m = gentle_motion(model.rig().skeleton, N, 12);
+  std::vector<int> keys;
+  for (int f = 0; f < N; f += 6) keys.push_back(f);
+  keys.push_back(N - 1);
+  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  o.overlap = 8;
+  CompletionReport report;
+  Motion out = complete_motion(model, m, MotionConstraints::full_pose(keys), o, {}, &report);
+  ASSERT_EQ(report.window_starts, (std::vector<int>{0, 24, 48, 68}));  // 32-frame windows, 8+ frames shared
+  for (int f : keys) EXPECT_EQ(out.root_positions[f], m.root_positions[f]);
+  // No seam: the largest frame-to-frame change of any joint anywhere stays on
+  // the scale of the input's own motion.
+  auto max_step = [](const Motion& x, int from, int to) {
+    double s = 0.0;
+    for (int f = from; f + 1 < to; ++f) {
+      for (int j = 0; j < x.num_joints(); ++j) s = std::max(s, geodesic_angle(x.rotation(f, j), x.rotation(f + 1, j)));
+      s = std::max(s, (x.root_positions[f + 1] - x.root_positions[f]).norm());
+    }
+    return s;
+  };
+  const double input_step = max_step(m, 0, N);
+  const double output_step = max_step(out, 0, N);
+  for (int f = 0; f + 1 < N; ++f) std::printf("%d:%.3f/%.3f ", f, max_step(out, f, f + 2), max_step(m, f, f + 2));
+  std::printf("\n");
+  for (size_t w = 0; w < report.windows.size(); ++w) {
+    std::printf("window %d:", report.window_starts[w]);
+    for (auto& t : report.windows[w].initial_terms) std::printf(" %s %g", t.first.c_str(), t.second);
+    std::printf(" ->");
+    for (auto& t : report.windows[w].final_terms) std::printf(" %s %g", t.first.c_str(), t.second);
+    std::printf(" it %d %s\n", report.windows[w].iterations, report.windows[w].message.c_str());
+  }
+  EXPECT_LT(output_step, 2.0 * input_step) << "input " << input_step << " output " << output_step;
+  for (int s : {24, 48, 68}) {
+    const double seam = max_step(out, s, s + 9);
+    EXPECT_LT(seam, 2.0 * input_step) << "window starting at " << s;
+  }
+  // The start may be any window: a root key only late in the clip.
+  MotionConstraints late;
+  PoseKey hand;
+  hand.frame = 10;
+  hand.joints = {1, 2};
+  hand.root_position = false;
+  late.keys = {hand, PoseKey{90, {}, true}};
+  CompletionReport late_report;
+  Motion late_out = complete_motion(model, m, late, o, {}, &late_report);
+  EXPECT_EQ(late_report.window_starts.front(), 68);
+  EXPECT_EQ(late_report.windows.size(), 4u);
+  EXPECT_EQ(late_out.rotation(10, 2).coeffs(), m.rotation(10, 2).coeffs());
+}
+
+TEST(LatentSolver, BadInputIsAnInputError) {
+  NemfModel model = tiny_model();
+  Motion m = test::random_motion(model.rig().skeleton, 20, 30.0, 1);
+  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  Skeleton other = model.rig().skeleton;
+  other.names[2] = "Neck";
+  Motion wrong = test::random_motion(other, 20, 30.0, 1);
+  EXPECT_THROW(complete_motion(model, wrong, MotionConstraints::full_pose({0, 19}), o), InputError);
+  MotionConstraints no_root;
+  PoseKey legs;
+  legs.joints = {3};
+  no_root.keys = {legs};
+  EXPECT_THROW(complete_motion(model, m, no_root, o), InputError);
+  LatentSolverOptions bad = o;
+  bad.weights.rotation = -1.0;
+  EXPECT_FALSE(bad.validate().empty());
+  EXPECT_THROW(complete_motion(model, m, MotionConstraints::full_pose({0, 19}), bad), InputError);
+  EXPECT_TRUE(default_solver_options().validate().empty());
+}
+
+TEST(SolverMethods, NemfMethodsAreRegisteredAndRunThroughTheJobs) {
+  at::set_num_threads(1);
+  bool nemf = false, adam = false;
+  for (const Method& m : registered_methods()) {
+    if (m.name == "nemf") nemf = m.needs_model && static_cast<bool>(m.complete);
+    if (m.name == "nemf-adam") adam = m.needs_model && static_cast<bool>(m.complete);
+  }
+  EXPECT_TRUE(nemf);
+  EXPECT_TRUE(adam);
+  TaskContext ctx;
+  ctx.model = std::make_shared<const NemfModel>(tiny_model());
+  Motion m = test::random_motion(ctx.model->rig().skeleton, 20, 30.0, 4);
+  EXPECT_THROW(run_fill(m, 5, 10, "nemf"), InputError);  // no model in the context
+  int calls = 0;
+  ctx.progress = [&](const TaskProgress&) { return ++calls < 1000000; };
+  Motion out = run_fill(m, 5, 10, "nemf", ctx);
+  EXPECT_GT(calls, 0);
+  for (int f : {0, 4, 10, 19}) EXPECT_EQ(out.root_positions[f], m.root_positions[f]);
+}
+
+}  // namespace
+}  // namespace mf
