@@ -2,16 +2,25 @@
 // against interpolation, on the windows of the benchmark protocol
 // (bench/protocol.h: gap filling 10 + T + 1 frames, sparse keyframes in
 // 128-frame windows), with every solver setting on the command line so that
-// weights and tolerances can be tuned on training clips and reported on
-// validation clips. Prints markdown tables (docs/BENCHMARKS.md, "Latent solvers").
+// weights and tolerances can be tuned on training clips (--split train) and
+// reported on validation clips. Prints markdown tables (docs/BENCHMARKS.md,
+// "Latent solvers").
 //
 //   solver-bench --model FILE [--split validation|train] [--threads N] [--max-windows N]
-//                [--tasks gap,sparse] [--methods interp,nemf,nemf-adam] [--lengths 5,15] [--spacings 5,10]
-//                [--iterations N] [--ftol X] [--rank N] [--penalty squared|absolute] [--init NAME]
+//                [--tasks gap,sparse,effector,partial,long,none] [--methods interp,nemf,nemf-adam]
+//                [--lengths 5,15] [--spacings 5,10] [--speed N] [--out FILE]
+//                [--iterations N] [--ftol X] [--ptol X] [--rank N] [--eigen-scaling 0|1]
+//                [--keyed-iterations N] [--adam-iterations N] [--adam-tol X] [--lock-ramp N] [--overwrite 0|1]
+//                [--penalty squared|absolute] [--init NAME]
 //                [--w-rot X] [--w-pos X] [--w-root-rot X] [--w-root X] [--w-prior X] [--w-skate X]
-//                [--w-smooth X] [--speed N] [--out FILE]
+//                [--w-smooth X] [--w-effector X]
 //
-// --speed N adds the speed table: N sparse windows (every 15th frame a key),
+// Tasks: gap and sparse as in the protocol; effector and partial add targets
+// (hands, feet) or partial keys (root only, legs only) at frames 15, 45, 75,
+// 105 of 128-frame windows with full keys every 30 frames; long solves
+// 300-frame clips (several overlapping windows) and compares the acceleration
+// at the window joins with elsewhere; none runs only --speed.
+// --speed N adds the speed table: N sparse windows (a key every 15th frame),
 // each solved by every solver method; wall time, iterations, evaluations and
 // the floor (one decoder forward + backward over 128 frames, times the
 // iterations) per solve.
@@ -19,6 +28,7 @@
 #include <ATen/Parallel.h>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -35,6 +45,7 @@
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/motion/rotations.h"
 #include "tasks/baselines.h"
 #include "tasks/latent_solver.h"
 
@@ -142,6 +153,8 @@ mf::LatentSolverOptions solver_options(const Args& a, const std::string& method)
   }
   n.erase("adam-iterations");
   n.erase("adam-tol");
+  take("overwrite", &o.overwrite_known);
+  take("lock-ramp", &o.foot_lock_ramp);
   take("w-rot", &o.weights.rotation);
   take("w-pos", &o.weights.position);
   take("w-root-rot", &o.weights.root_orientation);
@@ -226,6 +239,207 @@ std::string table(const std::string& title, const char* param, const std::vector
   return s.str();
 }
 
+std::vector<int> joints_named(const mf::Skeleton& s, const std::vector<std::string>& parts) {
+  std::vector<int> out;
+  for (int j = 0; j < s.num_joints(); ++j) {
+    for (const std::string& p : parts) {
+      if (s.names[j].find(p) != std::string::npos) {
+        out.push_back(j);
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+// End-effector and partial constraints on 128-frame windows with full keys
+// every 30 frames: the same windows solved with and without the extra
+// constraints at the midpoints 15, 45, 75, 105.
+std::string constraint_table(const std::string& task, const std::string& method, const Runner& runner,
+                             const std::vector<mf::Clip>& clips, const mf::bench::EvalStats& stats, const Args& args,
+                             const Eigen::Vector3d& forward) {
+  const int length = 128;
+  const auto windows = mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, 40), args.max_windows);
+  const std::vector<int> keys = mf::bench::sparse_keyframes(length, 30);
+  const std::vector<int> mids = {15, 45, 75, 105};
+  const mf::Skeleton& skel = runner.model.rig().skeleton;
+  struct Variant {
+    std::string name;
+    std::vector<int> joints;  // partial: constrained joints; effector: target joints
+    bool root_position = false;
+  };
+  std::vector<Variant> variants;
+  if (task == "effector") {
+    variants.push_back({"none (keys every 30 only)", {}, false});
+    variants.push_back({"hands", joints_named(skel, {"Hand"}), false});
+    variants.push_back({"hands and feet", joints_named(skel, {"Hand", "Foot"}), false});
+  } else {
+    variants.push_back({"none (keys every 30 only)", {}, false});
+    variants.push_back({"root only (rotation and position)", {0}, true});
+    variants.push_back({"legs only (local rotations)", joints_named(skel, {"Leg", "Foot", "Toe"}), false});
+  }
+  std::ostringstream s;
+  s << "#### " << (task == "effector" ? "End-effector targets" : "Partial keys")
+    << " at frames 15, 45, 75, 105 (128-frame windows, full keys every 30 frames), `" << method << "`\n\n"
+    << "| constraint | windows | L2P | L2Q | NPSS | skating (cm) | skating GT (cm) | constrained error, raw: max / mean"
+    << " | constrained error, output: max / mean | ms / window |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (const Variant& v : variants) {
+    mf::bench::MetricAccumulator acc(stats);
+    double raw_max = 0, raw_sum = 0, out_max = 0, out_sum = 0, ms = 0;
+    long count = 0;
+    for (const mf::Window& w : windows) {
+      const mf::Motion truth = mf::bench::canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, forward);
+      const mf::GlobalPose tp = mf::forward_kinematics(truth);
+      mf::MotionConstraints c = mf::MotionConstraints::full_pose(keys);
+      std::vector<int> shown = keys;
+      if (!v.joints.empty()) {
+        for (int f : mids) {
+          if (task == "effector") {
+            for (int j : v.joints) c.effectors.push_back({f, j, tp.position(f, j), 1.0});
+          } else {
+            c.keys.push_back({f, v.joints, v.root_position});
+            shown.push_back(f);
+          }
+        }
+        std::sort(c.keys.begin(), c.keys.end(), [](const mf::PoseKey& a, const mf::PoseKey& b) { return a.frame < b.frame; });
+        std::sort(shown.begin(), shown.end());
+      }
+      const mf::Motion input = mf::bench::hide_unknown_frames(truth, shown);
+      std::vector<int> evaluated;
+      for (int f = 0; f < length; ++f) {
+        if (!std::binary_search(keys.begin(), keys.end(), f)) evaluated.push_back(f);
+      }
+      mf::CompletionReport report;
+      const auto t0 = Clock::now();
+      const mf::Motion out = mf::complete_motion(runner.model, input, c, solver_options(args, method), {}, &report);
+      ms += ms_since(t0);
+      acc.add(truth, out, evaluated, keys);
+      if (v.joints.empty()) continue;
+      if (task == "effector") {
+        raw_max = std::max(raw_max, report.raw_effectors.max_cm);
+        raw_sum += report.raw_effectors.mean_cm * report.raw_effectors.count;
+        out_max = std::max(out_max, report.effectors.max_cm);
+        out_sum += report.effectors.mean_cm * report.effectors.count;
+        count += report.effectors.count;
+      } else {
+        raw_max = std::max(raw_max, report.raw_known.rotation_max_deg);
+        raw_sum += report.raw_known.rotation_mean_deg * report.raw_known.rotations;
+        count += report.raw_known.rotations;
+        for (int f : mids) {
+          for (int j : v.joints) {
+            const double d = mf::geodesic_angle(out.rotation(f, j), truth.rotation(f, j)) * 180.0 / M_PI;
+            out_max = std::max(out_max, d);
+            out_sum += d;
+          }
+          if (v.root_position) {
+            const double cm = (out.root_positions[f] - truth.root_positions[f]).norm() * 100.0;
+            out_max = std::max(out_max, cm);
+          }
+        }
+      }
+    }
+    const mf::bench::MetricSummary m = acc.summary();
+    const char* unit = task == "effector" ? " cm" : " deg";
+    const long mid_count = static_cast<long>(windows.size() * mids.size() * v.joints.size());
+    s << "| " << v.name << " | " << m.windows << " | " << fixed(m.l2p, 3) << " | " << fixed(m.l2q, 3) << " | "
+      << fixed(m.npss, 4) << " | " << fixed(m.skating_cm, 3) << " | " << fixed(m.truth_skating_cm, 3) << " | ";
+    if (v.joints.empty()) {
+      s << "- | - | ";
+    } else {
+      s << fixed(raw_max, 2) << " / " << fixed(count ? raw_sum / count : 0.0, 2) << unit << " | " << fixed(out_max, 2)
+        << " / " << fixed(task == "effector" ? (count ? out_sum / count : 0.0) : (mid_count ? out_sum / mid_count : 0.0), 2)
+        << unit << " | ";
+    }
+    s << fixed(ms / std::max<size_t>(1, windows.size()), 0) << " |\n";
+    std::cerr << task << " " << v.name << " done\n";
+  }
+  if (task == "partial")
+    s << "\nRaw error: every constrained local rotation (all keys) before the overwrite; output error: the "
+         "constrained rotations (deg) and root positions (cm) at the partial keys after it.\n";
+  return s.str();
+}
+
+// Mean acceleration (cm / frame^2) of the global joint positions at frames f
+// (second difference around f), over the frames where `select` is true.
+double mean_acceleration(const mf::GlobalPose& p, const std::vector<char>& select) {
+  double sum = 0;
+  long n = 0;
+  for (int f = 1; f + 1 < p.frames; ++f) {
+    if (!select[f]) continue;
+    for (int j = 0; j < p.joints; ++j) {
+      sum += (p.position(f + 1, j) - 2 * p.position(f, j) + p.position(f - 1, j)).norm() * 100.0;
+      ++n;
+    }
+  }
+  return n ? sum / n : 0.0;
+}
+
+// Clips longer than a window: 300-frame windows, keys every 20 frames; the
+// acceleration near window joins (the cross-fades) against elsewhere.
+std::string long_table(const std::string& method, const Runner& runner, const std::vector<mf::Clip>& clips,
+                       const mf::bench::EvalStats& stats, const Args& args, const Eigen::Vector3d& forward) {
+  const int length = 300;
+  const auto windows = mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, length), args.max_windows);
+  const std::vector<int> keys = mf::bench::sparse_keyframes(length, 20);
+  std::vector<int> evaluated;
+  for (int f = 0; f < length; ++f) {
+    if (!std::binary_search(keys.begin(), keys.end(), f)) evaluated.push_back(f);
+  }
+  mf::bench::MetricAccumulator acc(stats), acc_interp(stats);
+  double seam_out = 0, rest_out = 0, seam_truth = 0, rest_truth = 0, seam_interp = 0, rest_interp = 0, ms = 0;
+  int solved_windows = 0;
+  for (const mf::Window& w : windows) {
+    const mf::Motion truth = mf::bench::canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, forward);
+    const mf::Motion input = mf::bench::hide_unknown_frames(truth, keys);
+    mf::CompletionReport report;
+    const auto t0 = Clock::now();
+    const mf::Motion out = mf::complete_motion(runner.model, input, mf::MotionConstraints::full_pose(keys),
+                                               solver_options(args, method), {}, &report);
+    ms += ms_since(t0);
+    solved_windows += static_cast<int>(report.windows.size());
+    const mf::Motion interp = mf::interpolate_motion(input, keys);
+    acc.add(truth, out, evaluated, keys);
+    acc_interp.add(truth, interp, evaluated, keys);
+    // Frames where two windows are cross-faded, and 4 frames either side.
+    std::vector<char> seam(length, 0), rest(length, 1);
+    std::vector<int> starts = report.window_starts;
+    std::sort(starts.begin(), starts.end());
+    const int W = runner.model.config().window;
+    for (size_t i = 1; i < starts.size(); ++i) {
+      const int a = starts[i], b = std::min(length, starts[i - 1] + W);
+      for (int f = std::max(0, a - 4); f < std::min(length, b + 4); ++f) {
+        seam[f] = 1;
+        rest[f] = 0;
+      }
+    }
+    const mf::GlobalPose po = mf::forward_kinematics(out), pt = mf::forward_kinematics(truth),
+                         pi = mf::forward_kinematics(interp);
+    seam_out += mean_acceleration(po, seam);
+    rest_out += mean_acceleration(po, rest);
+    seam_truth += mean_acceleration(pt, seam);
+    rest_truth += mean_acceleration(pt, rest);
+    seam_interp += mean_acceleration(pi, seam);
+    rest_interp += mean_acceleration(pi, rest);
+  }
+  const double n = std::max<size_t>(1, windows.size());
+  const mf::bench::MetricSummary m = acc.summary(), mi = acc_interp.summary();
+  std::ostringstream s;
+  s << "#### Clips longer than a window: 300 frames, keys every 20 frames, `" << method << "`\n\n"
+    << m.windows << " clips, " << fixed(solved_windows / n, 1) << " solver windows per clip, "
+    << fixed(ms / n, 0) << " ms per clip. Acceleration: mean |second difference| of the global joint positions "
+    << "(cm / frame^2), at the cross-fades (+-4 frames) and elsewhere.\n\n"
+    << "| motion | L2P | L2Q | NPSS | skating (cm) | acceleration at joins | acceleration elsewhere |\n"
+    << "|---|---:|---:|---:|---:|---:|---:|\n"
+    << "| `" << method << "` | " << fixed(m.l2p, 3) << " | " << fixed(m.l2q, 3) << " | " << fixed(m.npss, 4) << " | "
+    << fixed(m.skating_cm, 3) << " | " << fixed(seam_out / n, 3) << " | " << fixed(rest_out / n, 3) << " |\n"
+    << "| `interp` | " << fixed(mi.l2p, 3) << " | " << fixed(mi.l2q, 3) << " | " << fixed(mi.npss, 4) << " | "
+    << fixed(mi.skating_cm, 3) << " | " << fixed(seam_interp / n, 3) << " | " << fixed(rest_interp / n, 3) << " |\n"
+    << "| ground truth | | | | " << fixed(m.truth_skating_cm, 3) << " | " << fixed(seam_truth / n, 3) << " | "
+    << fixed(rest_truth / n, 3) << " |\n";
+  std::cerr << "long " << method << " done\n";
+  return s.str();
+}
+
 // Median wall time of one decoder forward + backward to the latents over 128 frames.
 double decoder_step_ms(const mf::NemfModel& model) {
   const mf::NemfConfig& c = model.config();
@@ -276,6 +490,7 @@ int run(int argc, char** argv) {
   mf::bench::ProtocolOptions protocol;
   const Eigen::Vector3d forward = model.rig().root_forward;
   for (const std::string& task : args.tasks) {
+    if (task == "none") continue;
     for (const std::string& method : args.methods) {
       std::vector<Row> rows;
       if (task == "gap") {
@@ -323,6 +538,12 @@ int run(int argc, char** argv) {
           std::cerr << "sparse " << k << " " << method << " done\n";
         }
         emit(table("#### Sparse keyframes (128 frames), `" + method + "`", "k", rows) + "\n");
+      } else if (task == "long") {
+        if (method == "interp") continue;
+        emit(long_table(method, runner, clips, stats, args, forward) + "\n");
+      } else if (task == "effector" || task == "partial") {
+        if (method == "interp") continue;
+        emit(constraint_table(task, method, runner, clips, stats, args, forward) + "\n");
       } else {
         throw mf::InputError("unknown task " + task);
       }

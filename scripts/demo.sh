@@ -2,8 +2,10 @@
 # The README's demo (`make demo`): in-betweening and resampling of the bundled,
 # hand-made sample clip samples/walk_keyframes.bvh with the motionfield CLI.
 #   usage: scripts/demo.sh BUILD_DIR OUT_DIR
-# Until the trained prior exists, in-betweening uses the interpolation baseline
-# (--method interp: root LERP, rotation SLERP).
+# Resampling uses the bundled prior (models/motionfield-prior.mfm, method
+# "prior": encode, decode at the new times, input frames kept exactly);
+# in-betweening uses the interpolation baseline until the latent solvers are
+# measured to beat it (docs/BENCHMARKS.md).
 set -euo pipefail
 
 if [ $# -ne 2 ]; then
@@ -14,6 +16,7 @@ ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 MF="$1/capi/motionfield"
 OUT="$2"
 SAMPLE="$ROOT/samples/walk_keyframes.bvh"
+MODEL="$ROOT/models/motionfield-prior.mfm"
 
 if [ ! -x "$MF" ]; then
   echo "demo: $MF not found; build first (make build)" >&2
@@ -30,6 +33,8 @@ if [ $(((frames - 1) % 10)) -ne 0 ]; then keyframes="$keyframes,$((frames - 1))"
 echo "demo: sample $SAMPLE ($frames frames at $fps fps)"
 "$MF" inbetween --in "$SAMPLE" --keyframes "$keyframes" --method interp --out "$OUT/walk_inbetween.bvh"
 echo "demo: in-betweened from keyframes $keyframes -> $OUT/walk_inbetween.bvh"
-"$MF" resample --in "$SAMPLE" --fps 60 --out "$OUT/walk_60fps.bvh"
-echo "demo: resampled to 60 fps ($(awk '/^Frames:/ { print $2; exit }' "$OUT/walk_60fps.bvh") frames) -> $OUT/walk_60fps.bvh"
+resample_method=interp
+if [ -f "$MODEL" ]; then resample_method=prior; fi
+"$MF" resample --in "$SAMPLE" --fps 60 --method "$resample_method" --out "$OUT/walk_60fps.bvh"
+echo "demo: resampled to 60 fps with method '$resample_method' ($(awk '/^Frames:/ { print $2; exit }' "$OUT/walk_60fps.bvh") frames) -> $OUT/walk_60fps.bvh"
 echo "demo: done; open the .bvh files in $OUT in any BVH viewer, e.g. Blender: File > Import > Motion Capture (.bvh); lengths are in centimetres, Y up"

@@ -431,7 +431,9 @@ DecodedWindow decode_window(const NemfModel& model, const WindowProblem& problem
   at::NoGradGuard no_grad;
   DecodedWindow d;
   d.local_rotations = model.decode(at::arange(problem.length, at::kFloat), z_l, z_g);
-  d.root_positions = aligned_root_path(model, problem, d.local_rotations, nullptr);
+  GmpOutput gmp;
+  d.root_positions = aligned_root_path(model, problem, d.local_rotations, &gmp);
+  d.contacts = at::sigmoid(gmp.contact_logits);
   return d;
 }
 

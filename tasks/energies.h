@@ -169,10 +169,12 @@ EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem
                             const at::Tensor& z_l, const at::Tensor& z_g);
 
 /// The solution of a window, canonical: local rotations [1, T, J, 3, 3] at
-/// frames 0..T-1 and the GMP's root path [1, T, 3] aligned at the anchor frame.
+/// frames 0..T-1, the GMP's root path [1, T, 3] aligned at the anchor frame
+/// and its foot contact probabilities [1, T, F] (RigInfo::foot_joints order).
 struct DecodedWindow {
   at::Tensor local_rotations;
   at::Tensor root_positions;
+  at::Tensor contacts;
 };
 DecodedWindow decode_window(const NemfModel& model, const WindowProblem& problem, const at::Tensor& z_l,
                             const at::Tensor& z_g);

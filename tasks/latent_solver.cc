@@ -8,6 +8,7 @@
 #include <torch/csrc/autograd/autograd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -27,7 +28,7 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-int default_iterations(SolverMethod m) { return m == SolverMethod::Adam ? 600 : 50; }
+int default_iterations(SolverMethod m) { return m == SolverMethod::Adam ? 600 : 20; }
 
 // The energy of a flat latent vector x = [z_l, z_g] (float, [zl + zg]).
 struct FlatEnergy {
@@ -294,6 +295,135 @@ void overwrite_known(const Motion& input, const MotionConstraints& c, Motion* ou
   if (err->roots) err->root_mean_cm = root_sum / err->roots;
 }
 
+// Moves the ankle at `frame` to `target` (world) by turning the hip and the
+// knee (two-bone IK), keeping the ankle's global rotation. `pose` holds the
+// global transforms of the motion's current state and is updated for the
+// three joints.
+void two_bone_ik(Motion* m, GlobalPose* pose, int frame, int hip, int knee, int ankle, const Eigen::Vector3d& target) {
+  const int J = m->num_joints();
+  auto gpos = [&](int j) -> Eigen::Vector3d& { return pose->positions[static_cast<size_t>(frame) * J + j]; };
+  auto grot = [&](int j) -> Eigen::Quaterniond& { return pose->rotations[static_cast<size_t>(frame) * J + j]; };
+  const Eigen::Vector3d H = gpos(hip), K = gpos(knee), A = gpos(ankle);
+  const double a = (K - H).norm(), b = (A - K).norm();
+  if (a < 1e-6 || b < 1e-6) return;
+  const double d = std::clamp((target - H).norm(), std::abs(a - b) + 1e-4, a + b - 1e-4);
+  const Eigen::Vector3d u = H - K, v = A - K;
+  Eigen::Vector3d n = u.cross(v);
+  Eigen::Quaterniond knee_delta = Eigen::Quaterniond::Identity();
+  if (n.norm() > 1e-8 * a * b) {
+    n.normalize();
+    const double now = std::acos(std::clamp(u.dot(v) / (a * b), -1.0, 1.0));
+    const double want = std::acos(std::clamp((a * a + b * b - d * d) / (2 * a * b), -1.0, 1.0));
+    knee_delta = Eigen::Quaterniond(Eigen::AngleAxisd(want - now, n));
+  }
+  const Eigen::Vector3d A1 = K + knee_delta * v;
+  const Eigen::Quaterniond hip_delta = Eigen::Quaterniond::FromTwoVectors(A1 - H, target - H);
+  const Eigen::Quaterniond ankle_global = grot(ankle);
+  const Eigen::Quaterniond hip_global = (hip_delta * grot(hip)).normalized();
+  const Eigen::Quaterniond knee_global = (hip_delta * knee_delta * grot(knee)).normalized();
+  const int hip_parent = m->skeleton.parents[hip];
+  const Eigen::Quaterniond parent_global = hip_parent >= 0 ? grot(hip_parent) : Eigen::Quaterniond::Identity();
+  m->rotation(frame, hip) = (parent_global.conjugate() * hip_global).normalized();
+  m->rotation(frame, knee) = (hip_global.conjugate() * knee_global).normalized();
+  m->rotation(frame, ankle) = (knee_global.conjugate() * ankle_global).normalized();
+  grot(hip) = hip_global;
+  grot(knee) = knee_global;
+  gpos(knee) = H + hip_delta * (K - H);
+  gpos(ankle) = H + hip_delta * (A1 - H);
+}
+
+// Foot locking: while the global motion predictor says an ankle is in contact
+// (probability > 0.5 for at least two frames) and the ankle is within its
+// contact threshold of its standing height, its ground position is held (at
+// the known frames' positions when the contact holds known frames,
+// interpolated between them, else at the contact's mean position) by
+// two-bone IK on hip and knee, with a linear ramp of `ramp` frames on each
+// side. Frames whose leg joints are constrained, or that carry an end-effector
+// target on the leg or above it, are not touched.
+void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector<float>& contacts, int ramp,
+               Motion* out) {
+  const int N = out->num_frames(), F = rig.num_feet();
+  const Skeleton& skel = out->skeleton;
+  for (int k = 0; k < F; ++k) {
+    const int ankle = rig.foot_joints[k];
+    std::string name = skel.names[ankle];
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char ch) { return std::tolower(ch); });
+    if (name.find("toe") != std::string::npos) continue;
+    const int knee = skel.parents[ankle];
+    const int hip = knee > 0 ? skel.parents[knee] : -1;
+    if (hip <= 0) continue;  // needs a thigh and a shin below the root
+    // Frames the IK may not change.
+    std::vector<char> fixed(N, 0), known(N, 0);
+    for (size_t i = 0; i < c.keys.size(); ++i) {
+      const int f = c.keys[i].frame;
+      if (c.key_has_joint(i, hip) || c.key_has_joint(i, knee) || c.key_has_joint(i, ankle)) fixed[f] = 1;
+      if (c.key_has_joint(i, hip) && c.key_has_joint(i, knee) && c.key_has_joint(i, ankle) && c.key_fixes_root(i))
+        known[f] = 1;
+    }
+    for (const EffectorTarget& e : c.effectors) {
+      for (int j = e.joint; j >= 0; j = skel.parents[j]) {
+        if (j == ankle || j == knee || j == hip) fixed[e.frame] = 1;
+      }
+      for (int j = ankle; j >= 0; j = skel.parents[j]) {
+        if (j == e.joint) fixed[e.frame] = 1;  // an effector on the root or the spine above the hip
+      }
+    }
+    GlobalPose pose = forward_kinematics(*out);
+    // In contact: the predictor says so and the output's ankle is low enough.
+    const double low = rig.foot_heights[k] + rig.foot_thresholds[k];
+    std::vector<char> on(N);
+    for (int f = 0; f < N; ++f) on[f] = contacts[static_cast<size_t>(f) * F + k] > 0.5f && pose.position(f, ankle).y() < low;
+    std::vector<Eigen::Vector3d> goal(N);
+    std::vector<double> weight(N, 0.0);
+    for (int s = 0; s < N;) {
+      if (!on[s]) {
+        ++s;
+        continue;
+      }
+      int e = s;
+      while (e + 1 < N && on[e + 1]) ++e;
+      if (e > s) {
+        // The lock point: the known ankle positions inside the contact,
+        // interpolated between them (so that nothing jumps at a known frame),
+        // else the contact's mean position.
+        std::vector<int> inside;
+        for (int f = s; f <= e; ++f) {
+          if (known[f]) inside.push_back(f);
+        }
+        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+        for (int f = s; f <= e; ++f) mean += pose.position(f, ankle);
+        mean /= (e - s + 1);
+        auto lock_at = [&](int f) -> Eigen::Vector3d {
+          if (inside.empty()) return mean;
+          if (f <= inside.front()) return pose.position(inside.front(), ankle);
+          if (f >= inside.back()) return pose.position(inside.back(), ankle);
+          const auto it = std::lower_bound(inside.begin(), inside.end(), f);
+          const int b = *it, a = *(it - 1);
+          const double t = static_cast<double>(f - a) / (b - a);
+          return pose.position(a, ankle) * (1.0 - t) + pose.position(b, ankle) * t;
+        };
+        for (int f = std::max(0, s - ramp); f <= std::min(N - 1, e + ramp); ++f) {
+          const double w = f < s ? 1.0 - static_cast<double>(s - f) / (ramp + 1)
+                                 : f > e ? 1.0 - static_cast<double>(f - e) / (ramp + 1) : 1.0;
+          if (w > weight[f]) {
+            weight[f] = w;
+            goal[f] = lock_at(std::clamp(f, s, e));
+          }
+        }
+      }
+      s = e + 1;
+    }
+    for (int f = 0; f < N; ++f) {
+      if (weight[f] <= 0.0 || fixed[f]) continue;
+      const Eigen::Vector3d now = pose.position(f, ankle);
+      Eigen::Vector3d target = now;
+      target.x() += weight[f] * (goal[f].x() - now.x());
+      target.z() += weight[f] * (goal[f].z() - now.z());
+      two_bone_ik(out, &pose, f, hip, knee, ankle, target);
+    }
+  }
+}
+
 // Window starts for N frames, windows of W frames overlapping by at least `overlap`.
 std::vector<int> window_starts(int N, int W, int overlap) {
   if (N <= W) return {0};
@@ -394,11 +524,21 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
   if (input.rotations.size() != static_cast<size_t>(N) * J)
     throw InputError("the motion's rotation count does not match its frames and joints");
   constraints.validate(N, J);
+  for (size_t k = 0; k < constraints.keys.size(); ++k) {
+    const int f = constraints.keys[k].frame;
+    for (int j = 0; j < J; ++j) {
+      if (!constraints.key_has_joint(k, j)) continue;
+      const Eigen::Quaterniond& q = input.rotation(f, j);
+      if (!q.coeffs().allFinite() || q.norm() < 1e-6)
+        throw InputError("the rotation of joint " + input.skeleton.names[j] + " at known frame " + std::to_string(f) +
+                         " is not a finite, non-zero quaternion");
+    }
+    if (constraints.keys[k].root_position && !input.root_positions[f].allFinite())
+      throw InputError("the root position at known frame " + std::to_string(f) + " is not finite");
+  }
 
   const int W = model.config().window;
-  if (N > W && options.overlap > W / 2)
-    throw InputError("the window overlap must be at most half the model's window (" + std::to_string(W / 2) + ")");
-  const std::vector<int> starts = window_starts(N, W, options.overlap);
+  const std::vector<int> starts = window_starts(N, W, std::min(options.overlap, W / 2));
   const int windows = static_cast<int>(starts.size());
   auto length_of = [&](int k) { return std::min(W, N - starts[k]); };
 
@@ -424,6 +564,8 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
   CompletionReport rep;
   Motion out = Motion::identity(input.skeleton, N, input.fps);
   std::vector<char> solved(N, 0);
+  const int F = rig.num_feet();
+  std::vector<float> contacts(static_cast<size_t>(N) * F, 0.0f);
   int iterations = 0;
   for (int w : order) {
     const int s = starts[w], T = length_of(w);
@@ -480,6 +622,8 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
     const DecodedWindow dec = decode_window(model, problem, sol.z_l, sol.z_g);
     Motion piece = Motion::identity(input.skeleton, T, input.fps);
     write_window(dec.local_rotations, dec.root_positions, problem.transform, &piece, 0);
+    const at::Tensor piece_contacts = dec.contacts.contiguous();
+    const float* pc = piece_contacts.data_ptr<float>();
     // Cross-fade over the overlap; the new window's weight rises away from the solved side.
     const bool solved_before = ov_a < ov_b && ov_a == 0;
     const int n_ov = ov_b - ov_a;
@@ -495,12 +639,22 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
       }
       out.root_positions[g] =
           wn >= 1.0 ? piece.root_positions[f] : Eigen::Vector3d(out.root_positions[g] * (1.0 - wn) + piece.root_positions[f] * wn);
+      for (int k = 0; k < F; ++k) {
+        float& c = contacts[static_cast<size_t>(g) * F + k];
+        c = static_cast<float>(c * (1.0 - wn) + pc[f * F + k] * wn);
+      }
       solved[g] = 1;
     }
   }
 
   measure_effectors(out, constraints, &rep.raw_effectors);
-  overwrite_known(input, constraints, &out, &rep.raw_known);
+  if (options.overwrite_known) {
+    overwrite_known(input, constraints, &out, &rep.raw_known);
+    if (options.foot_lock_ramp >= 0) lock_feet(rig, constraints, contacts, options.foot_lock_ramp, &out);
+  } else {
+    Motion copy = out;
+    overwrite_known(input, constraints, &copy, &rep.raw_known);
+  }
   measure_effectors(out, constraints, &rep.effectors);
   rep.iterations = iterations;
   rep.wall_ms = ms_since(t0);

@@ -12,7 +12,14 @@
 // early on convergence, report iterations and the final energy per
 // term and wall time, and call TaskContext::report() once per iteration, so a
 // progress callback or the cancel flag can stop them (CancelledError).
-// Deterministic for a given input, options, seed and torch thread count.
+// Deterministic for a given input, options, seed and torch thread count (no
+// step is random: the seed is handed to initialisers that sample).
+//
+// Defaults (docs/BENCHMARKS.md, "Latent solvers", has the measurements):
+// L-BFGS, at most 20 iterations, function tolerance 1e-3; weights rotation 1,
+// position 10, root orientation 1, root translation 10 (the GMP path), no
+// prior, skating or smoothness term (they bought nothing measurable with the
+// pilot prior); squared penalties; foot locking with a 3-frame ramp.
 //
 // complete_motion() is the task: it splits the input into windows of the
 // model's length, canonicalises each at its first key that fixes the root,
@@ -27,7 +34,15 @@
 //    The error of the raw solution at the keys, before this overwrite, is
 //    reported (CompletionReport::raw_known).
 //  * End-effector targets are not enforced exactly; their error after the
-//    blend is reported.
+//    blend is reported. The effector, foot-skating and smoothness energies are
+//    measured on the blended motion (EnergyWeights::on_output), so the solver
+//    places the raw solution such that the output hits the target.
+//  * Foot locking (foot_lock_ramp >= 0, on by default): where the global
+//    motion predictor reports an ankle in contact and the output's ankle is
+//    low, the ankle's ground position is held by two-bone IK on thigh and
+//    shin (known frames, constrained legs and effector frames untouched).
+//    The overwrite spreads key residuals over whole gaps, which makes planted
+//    feet slide; this takes most of that back.
 //  * Inputs longer than a window: windows of the model's length overlapping by
 //    `overlap` frames, solved one after the other starting from the first
 //    window that holds a key fixing the root; each later (or earlier) window
@@ -57,7 +72,7 @@ enum class SolverMethod { Lbfgs, Adam };
 struct LatentSolverOptions {
   SolverMethod method = SolverMethod::Lbfgs;
   EnergyWeights weights;
-  /// Iteration cap per window; 0 means the method's default (L-BFGS 50, Adam 600).
+  /// Iteration cap per window; 0 means the method's default (L-BFGS 20, Adam 600).
   int max_iterations = 0;
 
   // L-BFGS (Ceres GradientProblemSolver).
@@ -70,7 +85,7 @@ struct LatentSolverOptions {
   /// prior), which cost a fraction of a dense evaluation, then the full energy
   /// (max_iterations). 0 = a single stage.
   int keyed_iterations = 0;
-  double function_tolerance = 1e-4;  ///< stop when |delta f| / f falls below this
+  double function_tolerance = 1e-3;  ///< stop when |delta f| / f falls below this
   double gradient_tolerance = 1e-8;  ///< ... or max |gradient| relative to the initial one below this
   double parameter_tolerance = 1e-6; ///< ... or the step relative to |z| below this
 
@@ -86,7 +101,16 @@ struct LatentSolverOptions {
   /// Null means InterpolationEncoderInitializer.
   std::shared_ptr<const LatentInitializer> initializer;
 
-  /// Frames shared by consecutive windows of long inputs (1 .. window / 2).
+  /// Foot locking after the overwrite (see the top of this file): the ramp in
+  /// frames on each side of a contact; negative disables it.
+  int foot_lock_ramp = 3;
+
+  /// Diagnostics only: false returns the raw solution, without the overwrite
+  /// of the known values (which then do not come out as given).
+  bool overwrite_known = true;
+
+  /// Frames shared by consecutive windows of long inputs (at least 1; at most
+  /// half the model's window is used).
   int overlap = 32;
 
   /// Empty when valid, else what is wrong (Ceres' Options::IsValid style).

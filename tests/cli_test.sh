@@ -63,7 +63,7 @@ FT=$(frame_time_of "$SAMPLE")
 expect_rc 0 "--version" -- "$MF" --version
 grep -q "^motionfield [0-9]" "$TMP/out" && pass || fail "--version prints 'motionfield <version>'"
 expect_rc 0 "--help" -- "$MF" --help
-for cmd in inbetween fill resample batch; do
+for cmd in inbetween fill resample renav batch; do
   expect_rc 0 "$cmd --help" -- "$MF" "$cmd" --help
   grep -q "usage: motionfield $cmd" "$TMP/out" && pass || fail "$cmd --help prints its usage"
 done
@@ -182,6 +182,73 @@ fi
 # Baselines need no model: a broken default model does not stop them.
 MF_MODEL="$TMP/none.mfm" expect_rc 0 "baselines ignore the default model" -- \
   "$MF" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/nomodel.bvh" --method interp
+
+# ------------------------------------------------------------ renav
+# A tiny random model on the 7-joint test skeleton (written by the C API tests'
+# helper next to the CLI, or $MF_TEST_MODEL) and a reference clip on that
+# skeleton: a 40-frame walk along +Z at 1.2 m/s.
+expect_rc 0 "renav --help" -- "$MF" renav --help
+grep -q "usage: motionfield renav" "$TMP/out" && pass || fail "renav --help prints its usage"
+TINY=${MF_TEST_MODEL:-}
+if [ -z "$TINY" ] && [ -x "$(dirname "$MF")/mf_capi_tiny_model" ]; then
+  "$(dirname "$MF")/mf_capi_tiny_model" "$TMP/tiny.mfm" && TINY="$TMP/tiny.mfm"
+fi
+SMALL="$TMP/small.bvh"
+awk 'BEGIN {
+  print "HIERARCHY"; print "ROOT Hips"; print "{"; print " OFFSET 0 90 0"
+  print " CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation"
+  print " JOINT Spine"; print " {"; print "  OFFSET 0 20 0"; print "  CHANNELS 3 Zrotation Xrotation Yrotation"
+  print "  JOINT Head"; print "  {"; print "   OFFSET 0 40 0"; print "   CHANNELS 3 Zrotation Xrotation Yrotation"
+  print "   End Site"; print "   {"; print "    OFFSET 0 10 0"; print "   }"; print "  }"; print " }"
+  split("L R", side, " ")
+  for (k = 1; k <= 2; ++k) {
+    x = (k == 1) ? 10 : -10
+    print " JOINT UpperLeg_" side[k]; print " {"; print "  OFFSET " x " -5 0"; print "  CHANNELS 3 Zrotation Xrotation Yrotation"
+    print "  JOINT Foot_" side[k]; print "  {"; print "   OFFSET 0 -80 0"; print "   CHANNELS 3 Zrotation Xrotation Yrotation"
+    print "   End Site"; print "   {"; print "    OFFSET 0 -5 10"; print "   }"; print "  }"; print " }"
+  }
+  print "}"; print "MOTION"; print "Frames: 40"; print "Frame Time: 0.0333333"
+  for (f = 0; f < 40; ++f) {
+    a = 25 * sin(f * 0.35)
+    printf "0 %.3f %.3f 0 0 %.3f  0 %.3f 0  0 0 0  0 %.3f 0  0 %.3f 0  0 %.3f 0  0 %.3f 0\n",
+      90 + 2 * sin(f * 0.7), 4 * f, 5 * sin(f * 0.1), 3 * sin(f * 0.35), a, (a > 0 ? -a : 0), -a, (a < 0 ? a : 0)
+  }
+}' >"$SMALL"
+printf 'x,z\n# a curve, 50 frames\n' >"$TMP/path50.csv"
+awk 'BEGIN { for (f = 0; f < 50; ++f) printf "%.4f,%.4f\n", 0.5 * sin(f * 0.06), 0.04 * f }' >>"$TMP/path50.csv"
+printf '0,0\n1,0\n1,1\n' >"$TMP/poly.csv"
+printf 'x,z\n0,0\n' >"$TMP/one-point.csv"
+printf '0,0\n0.1,nan\n0.2,0.2\n' >"$TMP/nan.csv"
+printf '0,0\n0.1;0.1\n' >"$TMP/malformed.csv"
+printf '1,1\n1,1\n1,1\n' >"$TMP/still.csv"
+if [ -n "$TINY" ]; then
+  expect_rc 0 "renav along a 50-frame path" -- "$MF" --model "$TINY" --threads 1 renav --in "$SMALL" --path "$TMP/path50.csv" --out "$TMP/renav.bvh"
+  expect_frames "$TMP/renav.bvh" 50
+  expect_frame_time "$TMP/renav.bvh" 0.0333333
+  expect_rc 0 "renav --polyline --frames --method nemf-adam --fps 60" -- "$MF" --model "$TINY" --threads 1 renav --in "$SMALL" \
+    --polyline "$TMP/poly.csv" --frames 30 --fps 60 --method nemf-adam --out "$TMP/renav-poly.bvh"
+  expect_frames "$TMP/renav-poly.bvh" 30
+  expect_frame_time "$TMP/renav-poly.bvh" 0.0166666667
+  bad "renav: a path with one point" --model "$TINY" renav --in "$SMALL" --path "$TMP/one-point.csv" --out "$TMP/bad.bvh"
+  expect_stderr "at least two points" "one-point path message"
+  bad "renav: a non-finite value" --model "$TINY" renav --in "$SMALL" --path "$TMP/nan.csv" --out "$TMP/bad.bvh"
+  expect_stderr "nan.csv:2: non-finite" "non-finite path message names the line"
+  bad "renav: a malformed CSV" --model "$TINY" renav --in "$SMALL" --path "$TMP/malformed.csv" --out "$TMP/bad.bvh"
+  expect_stderr "malformed.csv:2:" "malformed path message names the line"
+  bad "renav: a zero-length path" --model "$TINY" renav --in "$SMALL" --path "$TMP/still.csv" --out "$TMP/bad.bvh"
+  bad "renav: a missing path file" --model "$TINY" renav --in "$SMALL" --path "$TMP/none.csv" --out "$TMP/bad.bvh"
+  bad "renav: a skeleton that does not match the model" --model "$TINY" renav --in "$SAMPLE" --path "$TMP/path50.csv" --out "$TMP/bad.bvh"
+  expect_stderr "joints" "skeleton mismatch message"
+  bad "renav: unknown method" --model "$TINY" renav --in "$SMALL" --path "$TMP/path50.csv" --out "$TMP/bad.bvh" --method magic
+  expect_stderr "unknown re-navigation method 'magic'" "renav unknown method message"
+  bad "renav: --frames with --path" --model "$TINY" renav --in "$SMALL" --path "$TMP/path50.csv" --frames 10 --out "$TMP/bad.bvh"
+  bad "renav: --path and --polyline" --model "$TINY" renav --in "$SMALL" --path "$TMP/path50.csv" --polyline "$TMP/poly.csv" --out "$TMP/bad.bvh"
+  bad "renav: --fps 0" --model "$TINY" renav --in "$SMALL" --path "$TMP/path50.csv" --fps 0 --out "$TMP/bad.bvh"
+else
+  echo "cli_test: no tiny model (mf_capi_tiny_model not built, MF_TEST_MODEL unset): renav runs skipped"
+fi
+bad "renav without a path" renav --in "$SMALL" --out "$TMP/bad.bvh"
+MF_MODEL="$TMP/none.mfm" bad "renav without a model" renav --in "$SMALL" --path "$TMP/path50.csv" --out "$TMP/bad.bvh"
 
 # ------------------------------------------------------------ batch
 mkdir -p "$TMP/batch"

@@ -1,6 +1,7 @@
 // motionfield: the command-line front end (in-betweening, gap filling,
-// resampling, batch runs). It is a client of the C API (motionfield.h) and
-// calls nothing else of motionfield; the JSON Lines parser (jsonl.h) is its own.
+// resampling, re-navigation, batch runs). It is a client of the C API
+// (motionfield.h) and calls nothing else of motionfield; the JSON Lines parser
+// (jsonl.h) is its own.
 // Exit codes: 0 ok, 2 bad input, 1 internal error; every message goes to
 // stderr, prefixed with "motionfield: ".
 #include <unistd.h>
@@ -231,7 +232,7 @@ class Models {
 // ---------------------------------------------------------------- help texts
 
 const char* kMainHelp =
-    "motionfield " MF_VERSION_STRING ": motion in-betweening, gap filling and resampling of BVH clips\n"
+    "motionfield " MF_VERSION_STRING ": motion in-betweening, gap filling, resampling and re-navigation of BVH clips\n"
     "\n"
     "usage: motionfield [--threads N] [--model PATH] [--verbose] <command> [options]\n"
     "\n"
@@ -239,6 +240,7 @@ const char* kMainHelp =
     "  inbetween  fill the frames between sparse keyframes\n"
     "  fill       fill a gap of unknown frames\n"
     "  resample   change the frame rate, keeping the time span\n"
+    "  renav      make a reference clip follow a new ground path (needs the model)\n"
     "  batch      run many jobs from a JSON Lines file in one process\n"
     "\n"
     "global options:\n"
@@ -287,6 +289,35 @@ const char* kResampleHelp =
     "  --fps F     target frame rate, e.g. 60\n"
     "  --out PATH  output BVH (written atomically)\n"
     "  --method M  one of the methods below (default: the best available)\n";
+
+const char* kRenavHelp =
+    "usage: motionfield renav --in REF.bvh (--path PATH.csv | --polyline PATH.csv) --out OUT.bvh\n"
+    "                         [--method M] [--fps F] [--frames N]\n"
+    "\n"
+    "Re-navigation: a motion in the style of the reference clip REF.bvh that follows\n"
+    "a new ground path (the prior's latent codes optimised against NeMF's energy: the\n"
+    "root path, and soft-DTW divergences of the pose and of the facing relative to\n"
+    "the path, against the reference). Needs the model (--model or the default one);\n"
+    "the reference must be on its skeleton.\n"
+    "\n"
+    "The path CSV has one \"x,z\" pair per line, metres, in the BVH's world frame\n"
+    "(Y up); an optional header line \"x,z\"; blank lines and lines starting with #\n"
+    "are skipped. At least two points, all finite, at least 1 mm long.\n"
+    "\n"
+    "  --in PATH        reference BVH\n"
+    "  --path PATH      one point per output frame: the output has as many frames\n"
+    "  --polyline PATH  the vertices of a polyline, walked at constant speed: the\n"
+    "                   reference's mean ground speed, or --frames N frames\n"
+    "  --out PATH       output BVH (written atomically; the reference's skeleton\n"
+    "                   and channel layout)\n"
+    "  --method M       nemf (L-BFGS, the default) or nemf-adam (NeMF's Adam\n"
+    "                   reference, slower)\n"
+    "  --fps F          frame rate of the path's points and of the output\n"
+    "                   (default: the reference's)\n"
+    "  --frames N       with --polyline: the output's frame count\n"
+    "\n"
+    "The output starts exactly at the path's first point. Paths longer than the\n"
+    "model's window (128 frames) are solved in overlapping windows.\n";
 
 const char* kBatchHelp =
     "usage: motionfield batch JOBS.jsonl\n"
@@ -541,6 +572,79 @@ int command_single(const std::string& command, const std::vector<std::string>& a
   return kExitOk;
 }
 
+std::vector<float> read_path(const std::string& path) {
+  size_t n = 0;
+  check(mf_path_load_csv(path.c_str(), nullptr, 0, &n));
+  std::vector<float> xz(n);
+  check(mf_path_load_csv(path.c_str(), xz.data(), xz.size(), &n));
+  return xz;
+}
+
+int command_renav(const std::vector<std::string>& args, const Settings& settings) {
+  using Clock = std::chrono::steady_clock;
+  const CommandArgs a = parse_command_args("renav", args, {"in", "out", "method", "path", "polyline", "fps", "frames"});
+  if (a.help) {
+    std::fputs(kRenavHelp, stdout);
+    return kExitOk;
+  }
+  if (!a.positional.empty())
+    throw InputError("renav: unexpected argument '" + a.positional.front() + "' (see motionfield renav --help)");
+  const std::string in = a.required("in", "renav"), out = a.required("out", "renav");
+  if (a.has("path") == a.has("polyline"))
+    throw InputError("renav: give exactly one of --path and --polyline (see motionfield renav --help)");
+  const bool polyline = a.has("polyline");
+  const std::string path_file = a.get(polyline ? "polyline" : "path");
+  std::string method;
+  if (a.has("method")) {
+    method = a.get("method");
+    if (method.empty()) throw InputError("renav: --method needs a value");
+  }
+  mf_renav_options renav;
+  check(mf_renav_options_init(&renav));
+  renav.path_kind = polyline ? MF_PATH_POLYLINE : MF_PATH_PER_FRAME;
+  if (a.has("fps")) {
+    renav.fps = parse_double(a.get("fps"), "--fps");
+    if (!(renav.fps > 0)) throw InputError("renav: --fps must be positive");
+  }
+  if (a.has("frames")) {
+    if (!polyline) throw InputError("renav: --frames goes with --polyline (a --path has one point per frame)");
+    renav.frame_count = parse_int(a.get("frames"), "--frames");
+    if (renav.frame_count < 2) throw InputError("renav: --frames must be at least 2");
+  }
+  check_output_path(out);
+  const auto t0 = Clock::now();
+  Models models(settings.model);
+  const mf_model* model = models.for_method("nemf");  // re-navigation always needs the prior
+  const MotionPtr reference = load_motion(in);
+  const std::vector<float> xz = read_path(path_file);
+  const auto t1 = Clock::now();
+
+  mf_task_options options;
+  check(mf_task_options_init(&options));
+  options.method = method.empty() ? nullptr : method.c_str();
+  mf_motion* raw = nullptr;
+  check(mf_renav(model, reference.get(), xz.data(), xz.size() / 2, &renav, &options, &raw));
+  const MotionPtr result(raw);
+  const auto t2 = Clock::now();
+  const int32_t frames_out = frame_count(result.get());
+  const int32_t expected = polyline ? renav.frame_count : static_cast<int32_t>(xz.size() / 2);
+  if (expected > 0 && frames_out != expected)
+    throw std::logic_error("the result has " + std::to_string(frames_out) + " frames, expected " +
+                           std::to_string(expected));
+  check(mf_motion_save_bvh(result.get(), out.c_str(), nullptr));
+  const auto t3 = Clock::now();
+  if (settings.verbose) {
+    auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
+    std::fprintf(stderr,
+                 "motionfield: renav %s along %s (%zu %s) -> %s: %d frames, method %s, model %s, %d threads; "
+                 "read %.1f ms, solve %.1f ms, write %.1f ms\n",
+                 in.c_str(), path_file.c_str(), xz.size() / 2, polyline ? "vertices" : "points", out.c_str(),
+                 frames_out, method.empty() ? "nemf" : method.c_str(), models.path().c_str(), settings.threads,
+                 ms(t1 - t0), ms(t2 - t1), ms(t3 - t2));
+  }
+  return kExitOk;
+}
+
 bool blank(const std::string& line) {
   for (char c : line)
     if (c != ' ' && c != '\t' && c != '\r' && c != '\n') return false;
@@ -769,6 +873,7 @@ int run(int argc, char** argv) {
   const std::vector<std::string> args(rest.begin() + 1, rest.end());
   if (command == "inbetween" || command == "fill" || command == "resample")
     return command_single(command, args, settings);
+  if (command == "renav") return command_renav(args, settings);
   if (command == "batch") return command_batch(args, settings);
   if (command == "diff") return command_diff(args);
   throw InputError("unknown command '" + command + "' (see motionfield --help)");

@@ -417,6 +417,63 @@ MF_API int mf_decode(const mf_encoding *encoding, double fps, int32_t frame_coun
 MF_API int mf_decode_times(const mf_encoding *encoding, const double *times, size_t time_count, double fps,
                            const mf_codec_options *options, mf_motion **out);
 
+/* ================================================================ re-navigation */
+
+/* Re-navigation: a reference motion (on the model's skeleton: same joint names
+ * and parents, at least 2 frames, any frame rate) and a new ground path give
+ * a motion that follows the path in the reference's style, by optimising the
+ * prior's latent codes (NeMF's energy: path L1 + soft-DTW divergence of the
+ * joint positions in the heading frame + soft-DTW divergence of the
+ * heading-vs-path-tangent signal, against the reference). Always needs a model.
+ *
+ * A path is `point_count` (>= 2) ground points (x, z) in metres, world frame,
+ * as floats [point_count][2]; every value finite; a total length of at least
+ * 1 mm. Either one point per output frame (MF_PATH_PER_FRAME) at
+ * mf_renav_options.fps, or the vertices of a polyline (MF_PATH_POLYLINE)
+ * resampled by arc length at constant speed to mf_renav_options.frame_count
+ * frames (0: as many as walking it at the reference's mean ground speed
+ * takes; MF_ERROR_INVALID_ARGUMENT if the reference barely moves). Paths
+ * longer than the model's window are solved in overlapping windows that agree
+ * where they overlap. The output has the reference's skeleton and BVH layout,
+ * starts exactly at the path's first point, and has as many frames as the
+ * (resampled) path at mf_renav_options.fps.
+ *
+ * Methods (mf_task_options.method): "nemf" (L-BFGS, the default; NULL or "")
+ * and "nemf-adam" (NeMF's Adam reference, slower). The progress callback
+ * reports iterations summed over windows; cancelling returns
+ * MF_ERROR_CANCELLED. */
+
+#define MF_PATH_PER_FRAME 0
+#define MF_PATH_POLYLINE 1
+
+typedef struct mf_renav_options {
+  uint32_t struct_size;
+  /** MF_PATH_PER_FRAME (0, the default) or MF_PATH_POLYLINE. */
+  int32_t path_kind;
+  /** MF_PATH_POLYLINE: output frames (>= 2); 0 = at the reference's mean
+   *  ground speed. Must be 0 for MF_PATH_PER_FRAME. */
+  int32_t frame_count;
+  /** Frame rate of the path's points and of the output; 0 = the reference's. */
+  double fps;
+} mf_renav_options;
+
+MF_API int mf_renav_options_init(mf_renav_options *options);
+
+/** Re-navigates `reference` along `path_xz` ([point_count][2] floats, see
+ *  above). `renav` and `options` may be NULL (defaults). MF_ERROR_MODEL
+ *  without a model; MF_ERROR_INVALID_ARGUMENT for a bad path, a skeleton
+ *  that does not match the model or an unknown method. */
+MF_API int mf_renav(const mf_model *model, const mf_motion *reference, const float *path_xz, size_t point_count,
+                    const mf_renav_options *renav, const mf_task_options *options, mf_motion **out);
+
+/** Reads a path CSV file into [points][2] floats (x, z, metres), a buffer
+ *  getter (see "Arrays": `needed` counts floats, twice the points). Format:
+ *  one "x,z" pair per line; an optional first line "x,z"; blank lines and
+ *  lines starting with '#' are skipped. MF_ERROR_IO if the file cannot be
+ *  read, MF_ERROR_INVALID_ARGUMENT "<path>:<line>: ..." on a malformed line
+ *  or a non-finite value, or when fewer than two points remain. */
+MF_API int mf_path_load_csv(const char *path, float *out, size_t capacity, size_t *needed);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,5 +1,5 @@
 """motionfield from Python: a learned human-motion prior for keyframe
-in-betweening, gap filling and resampling.
+in-betweening, gap filling, resampling and re-navigation along a new path.
 
 A pure ctypes binding of libmotionfield.so's C API (no compiled extension):
 numpy arrays in and out, exceptions from the C status codes. Conventions are
@@ -38,6 +38,7 @@ __all__ = [
     "Method", "methods", "default_method", "default_model_path",
     "Model", "Motion", "CancelToken", "Progress", "Encoding",
     "inbetween", "fill", "resample", "resample_frame_count", "encode",
+    "renav", "load_path_csv",
 ]
 
 # ------------------------------------------------------------------ errors
@@ -530,6 +531,40 @@ def resample_frame_count(frames, fps_in, fps_out):
     _check(_c.mf_resample_frame_count(int(frames), float(fps_in), float(fps_out), ctypes.byref(n),
                                       ctypes.byref(rounded)))
     return n.value, bool(rounded.value)
+
+
+def load_path_csv(path):
+    """Reads a path CSV (one "x,z" pair per line, metres; an optional header
+    "x,z"; blank lines and lines starting with # skipped) into a float32 array
+    [points, 2]."""
+    name = str(path).encode()
+    needed = ctypes.c_size_t(0)
+    _check(_c.mf_path_load_csv(name, None, 0, ctypes.byref(needed)))
+    out = np.empty(needed.value, dtype=np.float32)
+    _check(_c.mf_path_load_csv(name, _f32_ptr(out), out.size, ctypes.byref(needed)))
+    return out.reshape(-1, 2)
+
+
+def renav(reference, path, model, method=None, polyline=False, frames=0, fps=0.0, seed=0, progress=None,
+          cancel=None):
+    """Re-navigation: a motion in the style of `reference` (on the model's
+    skeleton) whose root follows `path`, an array [points, 2] of ground (x, z)
+    positions in metres. By default one point per output frame at `fps` (0:
+    the reference's frame rate); with polyline=True the points are the
+    vertices of a polyline walked at constant speed, in `frames` frames (0:
+    at the reference's mean ground speed). method: "nemf" (L-BFGS, the
+    default) or "nemf-adam". Needs a Model. progress/cancel as in inbetween()."""
+    xz = np.ascontiguousarray(path, dtype=np.float32)
+    if xz.ndim != 2 or xz.shape[1] != 2:
+        raise InvalidArgumentError("path must have shape [points, 2], not %s" % list(xz.shape))
+    o = _c.MfRenavOptions()
+    _check(_c.mf_renav_options_init(ctypes.byref(o)))
+    o.path_kind = _c.PATH_POLYLINE if polyline else _c.PATH_PER_FRAME
+    o.frame_count = int(frames)
+    o.fps = float(fps)
+    call = _TaskCall(method, seed, progress, cancel)
+    return call.run(lambda *args: _c.mf_renav(*args[:4], ctypes.byref(o), *args[4:]), _model_handle(model),
+                    reference._live(), _f32_ptr(xz), xz.shape[0])
 
 
 # ------------------------------------------------------------------ encode, decode

@@ -32,6 +32,9 @@ METHOD_RESAMPLES = 4
 ROOT_FROM_PRIOR = 0
 ROOT_FROM_INPUT = 1
 
+PATH_PER_FRAME = 0
+PATH_POLYLINE = 1
+
 
 class MfModel(ctypes.Structure):
     """Opaque mf_model."""
@@ -84,6 +87,15 @@ class MfCodecOptions(ctypes.Structure):
         ("struct_size", ctypes.c_uint32),
         ("hop", ctypes.c_int32),
         ("root_source", ctypes.c_int32),
+    ]
+
+
+class MfRenavOptions(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("path_kind", ctypes.c_int32),
+        ("frame_count", ctypes.c_int32),
+        ("fps", ctypes.c_double),
     ]
 
 
@@ -220,6 +232,10 @@ _declare("mf_encoding_get_global_latents", _int, _encoding, _P(_f32), _size, _P(
 _declare("mf_encoding_with_latents", _int, _encoding, _P(_f32), _size, _P(_f32), _size, _P(_encoding))
 _declare("mf_decode", _int, _encoding, _f64, _i32, _P(MfCodecOptions), _P(_motion))
 _declare("mf_decode_times", _int, _encoding, _P(_f64), _size, _f64, _P(MfCodecOptions), _P(_motion))
+
+_declare("mf_renav_options_init", _int, _P(MfRenavOptions))
+_declare("mf_renav", _int, _model, _motion, _P(_f32), _size, _P(MfRenavOptions), _P(MfTaskOptions), _P(_motion))
+_declare("mf_path_load_csv", _int, _str, _P(_f32), _size, _P(_size))
 
 if mf_abi_version() != ABI_VERSION:  # noqa: F821 (declared above)
     raise ImportError("%s has ABI version %d; this package needs %d" %

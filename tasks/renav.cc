@@ -1,0 +1,835 @@
+#include "tasks/renav.h"
+
+#include <ATen/ATen.h>
+#include <ceres/first_order_function.h>
+#include <ceres/gradient_problem.h>
+#include <ceres/gradient_problem_solver.h>
+#include <ceres/iteration_callback.h>
+#include <torch/csrc/autograd/autograd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <sstream>
+
+#include "prior/model/nemf.h"
+#include "prior/motion/errors.h"
+#include "prior/motion/kinematics_torch.h"
+#include "prior/motion/rotations.h"
+#include "prior/motion/rotations_torch.h"
+#include "tasks/baselines.h"
+#include "tasks/initializers.h"
+
+namespace mf {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+constexpr double kPi = 3.14159265358979323846;
+
+double wrap_angle(double a) {
+  a = std::fmod(a + kPi, 2.0 * kPi);
+  if (a < 0) a += 2.0 * kPi;
+  return a - kPi;
+}
+
+Eigen::Matrix3d rot_y(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
+
+double heading_yaw(const Eigen::Quaterniond& root, const Eigen::Vector3d& forward, double fallback = 0.0) {
+  const Eigen::Vector3d f = root.normalized() * forward;
+  if (f.x() * f.x() + f.z() * f.z() < 1e-12) return fallback;
+  return std::atan2(f.x(), f.z());
+}
+
+std::string trim(const std::string& s) {
+  size_t b = 0, e = s.size();
+  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
+  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
+  return s.substr(b, e - b);
+}
+
+// A number of a CSV field, locale-independent; false if it is not one number.
+bool parse_number(const std::string& field, double* out) {
+  std::string f = trim(field);
+  if (!f.empty() && f[0] == '+') f.erase(0, 1);
+  if (f.empty()) return false;
+  const char* b = f.data();
+  const char* e = b + f.size();
+  const auto r = std::from_chars(b, e, *out);
+  return r.ec == std::errc() && r.ptr == e;
+}
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+// Window starts for N frames, windows of W frames overlapping by at least `overlap`.
+std::vector<int> window_starts(int N, int W, int overlap) {
+  if (N <= W) return {0};
+  std::vector<int> starts;
+  int s = 0;
+  for (; s + W < N; s += W - overlap) starts.push_back(s);
+  starts.push_back(N - W);
+  return starts;
+}
+
+int default_iterations(RenavSolver s) { return s == RenavSolver::Adam ? 600 : 100; }
+
+}  // namespace
+
+// ---------------------------------------------------------------- paths
+
+std::vector<Eigen::Vector2d> parse_path_csv(const std::string& text, const std::string& source) {
+  std::vector<Eigen::Vector2d> out;
+  size_t pos = 0;
+  int line_no = 0;
+  bool first_content = true;
+  std::string body = text;
+  if (body.compare(0, 3, "\xEF\xBB\xBF") == 0) body.erase(0, 3);  // UTF-8 BOM
+  while (pos <= body.size()) {
+    size_t end = body.find('\n', pos);
+    if (end == std::string::npos) end = body.size();
+    const std::string line = trim(body.substr(pos, end - pos));
+    pos = end + 1;
+    ++line_no;
+    if (line.empty() || line[0] == '#') {
+      if (end == body.size()) break;
+      continue;
+    }
+    const std::string where = source + ":" + std::to_string(line_no) + ": ";
+    if (first_content) {
+      first_content = false;
+      std::string compact;
+      for (char c : line) {
+        if (c != ' ' && c != '\t') compact += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      }
+      if (compact == "x,z") {
+        if (end == body.size()) break;
+        continue;
+      }
+    }
+    const size_t comma = line.find(',');
+    if (comma == std::string::npos || line.find(',', comma + 1) != std::string::npos)
+      throw InputError(where + "expected two comma-separated numbers x,z (metres), got '" + line + "'");
+    double x = 0, z = 0;
+    if (!parse_number(line.substr(0, comma), &x) || !parse_number(line.substr(comma + 1), &z))
+      throw InputError(where + "expected two comma-separated numbers x,z (metres), got '" + line + "'");
+    if (!std::isfinite(x) || !std::isfinite(z)) throw InputError(where + "non-finite value in '" + line + "'");
+    if (out.size() >= static_cast<size_t>(kMaxPathFrames))
+      throw InputError(where + "the path has more than " + std::to_string(kMaxPathFrames) + " points");
+    out.emplace_back(x, z);
+    if (end == body.size()) break;
+  }
+  if (out.size() < 2)
+    throw InputError(source + ": a path needs at least two points (x,z rows), got " + std::to_string(out.size()));
+  return out;
+}
+
+std::vector<Eigen::Vector2d> read_path_csv(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError(path + ": cannot open the path file");
+  std::ostringstream text;
+  text << file.rdbuf();
+  if (file.bad()) throw InputError(path + ": cannot read the path file");
+  return parse_path_csv(text.str(), path);
+}
+
+double path_length(const std::vector<Eigen::Vector2d>& path) {
+  double L = 0.0;
+  for (size_t i = 1; i < path.size(); ++i) L += (path[i] - path[i - 1]).norm();
+  return L;
+}
+
+void validate_path(const std::vector<Eigen::Vector2d>& path) {
+  if (path.size() < 2)
+    throw InputError("a path needs at least two points, got " + std::to_string(path.size()));
+  if (path.size() > static_cast<size_t>(kMaxPathFrames))
+    throw InputError("the path has more than " + std::to_string(kMaxPathFrames) + " points");
+  for (size_t i = 0; i < path.size(); ++i) {
+    if (!path[i].allFinite()) throw InputError("path point " + std::to_string(i) + " is not finite");
+  }
+  if (path_length(path) < 1e-3)
+    throw InputError("the path has zero length: its points are all the same (at least 1 mm of travel is needed)");
+}
+
+double mean_ground_speed(const Motion& motion) {
+  const int N = motion.num_frames();
+  if (N < 2 || !(motion.fps > 0)) return 0.0;
+  double L = 0.0;
+  for (int f = 1; f < N; ++f) {
+    const Eigen::Vector3d d = motion.root_positions[f] - motion.root_positions[f - 1];
+    L += std::hypot(d.x(), d.z());
+  }
+  return L / ((N - 1) / motion.fps);
+}
+
+int polyline_frame_count(const std::vector<Eigen::Vector2d>& vertices, double speed, double fps) {
+  validate_path(vertices);
+  if (!(std::isfinite(fps) && fps > 0)) throw InputError("the path's frame rate must be finite and positive");
+  if (!std::isfinite(speed) || speed < 0.01)
+    throw InputError("the reference barely moves (mean ground speed " + fmt(speed) +
+                     " m/s): give the polyline's frame count explicitly");
+  const double frames = std::round(path_length(vertices) / speed * fps) + 1.0;
+  if (frames > kMaxPathFrames)
+    throw InputError("the polyline would take more than " + std::to_string(kMaxPathFrames) + " frames");
+  return std::max(2, static_cast<int>(frames));
+}
+
+std::vector<Eigen::Vector2d> resample_polyline(const std::vector<Eigen::Vector2d>& vertices, int frames) {
+  validate_path(vertices);
+  if (frames < 2 || frames > kMaxPathFrames)
+    throw InputError("a resampled path needs 2 to " + std::to_string(kMaxPathFrames) + " frames, not " +
+                     std::to_string(frames));
+  std::vector<double> cum(vertices.size(), 0.0);
+  for (size_t i = 1; i < vertices.size(); ++i) cum[i] = cum[i - 1] + (vertices[i] - vertices[i - 1]).norm();
+  const double L = cum.back();
+  std::vector<Eigen::Vector2d> out(frames);
+  size_t seg = 1;
+  for (int i = 0; i < frames; ++i) {
+    if (i == frames - 1) {
+      out[i] = vertices.back();
+      break;
+    }
+    const double s = L * i / (frames - 1);
+    while (seg + 1 < vertices.size() && cum[seg] < s) ++seg;
+    const double len = cum[seg] - cum[seg - 1];
+    const double t = len > 0 ? std::clamp((s - cum[seg - 1]) / len, 0.0, 1.0) : 0.0;
+    out[i] = vertices[seg - 1] + (vertices[seg] - vertices[seg - 1]) * t;
+  }
+  return out;
+}
+
+std::vector<double> tangent_yaws(const std::vector<Eigen::Vector2d>& p, const std::vector<double>& fallback) {
+  const int N = static_cast<int>(p.size());
+  constexpr int k = 2;
+  constexpr double eps = 1e-3;
+  std::vector<double> yaw(N, 0.0);
+  std::vector<char> valid(N, 0);
+  for (int f = 0; f < N; ++f) {
+    const Eigen::Vector2d d = p[std::min(N - 1, f + k)] - p[std::max(0, f - k)];
+    if (d.norm() >= eps) {
+      yaw[f] = std::atan2(d.x(), d.y());
+      valid[f] = 1;
+    }
+  }
+  // Where no tangent is defined, hold the nearest valid one (the earlier on a tie).
+  std::vector<int> left(N, -1), right(N, -1);
+  for (int f = 0, last = -1; f < N; ++f) {
+    if (valid[f]) last = f;
+    left[f] = last;
+  }
+  for (int f = N - 1, next = -1; f >= 0; --f) {
+    if (valid[f]) next = f;
+    right[f] = next;
+  }
+  if (left[N - 1] < 0) {
+    for (int f = 0; f < N; ++f) yaw[f] = fallback.size() == static_cast<size_t>(N) ? fallback[f] : 0.0;
+    return yaw;
+  }
+  std::vector<double> held(yaw);
+  for (int f = 0; f < N; ++f) {
+    if (valid[f]) continue;
+    const int a = left[f], b = right[f];
+    held[f] = (a >= 0 && (b < 0 || f - a <= b - f)) ? yaw[a] : yaw[b];
+  }
+  return held;
+}
+
+// ---------------------------------------------------------------- the window
+
+RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, int ref_begin, int ref_length,
+                              const std::vector<Eigen::Vector2d>& path, int begin, int length, const Motion* previous,
+                              int shared) {
+  const RigInfo& rig = model.rig();
+  const int J = rig.num_joints();
+  const int W = model.config().window;
+  if (reference.num_joints() != J || reference.skeleton.names != rig.skeleton.names ||
+      reference.skeleton.parents != rig.skeleton.parents) {
+    throw InputError("the reference's skeleton does not match the model's: " + std::to_string(reference.num_joints()) +
+                     " joints given, the model has " + std::to_string(J) + " (joint names and parents must agree)");
+  }
+  if (ref_begin < 0 || ref_length < 2 || ref_begin + ref_length > reference.num_frames())
+    throw InputError("reference segment [" + std::to_string(ref_begin) + ", " + std::to_string(ref_begin + ref_length) +
+                     ") does not fit the reference (" + std::to_string(reference.num_frames()) + " frames, at least 2)");
+  if (ref_length > W) throw InputError("a reference segment may have at most the model's window of frames");
+  const int N = static_cast<int>(path.size());
+  if (begin < 0 || length < 2 || length > W || begin + length > N)
+    throw InputError("window [" + std::to_string(begin) + ", " + std::to_string(begin + length) +
+                     ") does not fit the path (" + std::to_string(N) + " points, 2 to " + std::to_string(W) +
+                     " frames per window)");
+  if (shared < 0 || shared >= length || (shared > 0 && !previous))
+    throw InputError("bad number of frames shared with the previous window");
+  if (previous && shared > 0 &&
+      (previous->num_joints() != J || begin + shared > previous->num_frames()))
+    throw InputError("the previous solution does not cover the shared frames");
+
+  RenavWindow w;
+  w.length = length;
+  const Eigen::Vector3d fwd = rig.root_forward;
+
+  // The reference: heading, travel direction, facing offset, signals.
+  Motion seg = reference.slice(ref_begin, ref_begin + ref_length);
+  const int R = ref_length;
+  std::vector<double> ref_heading(R);
+  std::vector<Eigen::Vector2d> ref_xz(R);
+  for (int f = 0; f < R; ++f) {
+    ref_heading[f] = heading_yaw(seg.rotation(f, 0), fwd);
+    ref_xz[f] = Eigen::Vector2d(seg.root_positions[f].x(), seg.root_positions[f].z());
+  }
+  const std::vector<double> ref_travel = tangent_yaws(ref_xz, ref_heading);
+  {
+    at::NoGradGuard no_grad;
+    const WindowTensors t = window_tensors(seg, 0, R, rig, 0);
+    w.reference_joints = heading_relative_positions(t.local_rotations, rig).flatten(-2).contiguous();
+    w.reference_heading = at::empty({1, R, 1}, at::kFloat);
+    float* c = w.reference_heading.data_ptr<float>();
+    for (int f = 0; f < R; ++f) c[f] = static_cast<float>(std::cos(ref_heading[f] - ref_travel[f]));
+  }
+
+  // The target's tangents over the whole path (context beyond the window's ends).
+  const std::vector<double> target_yaw = tangent_yaws(path);
+
+  // The canonical frame.
+  Eigen::Vector2d origin;
+  double yaw;
+  if (previous && shared > 0) {
+    const Eigen::Vector3d& r = previous->root_positions[begin];
+    origin = Eigen::Vector2d(r.x(), r.z());
+    yaw = heading_yaw(previous->rotation(begin, 0), fwd, target_yaw[begin]);
+  } else {
+    origin = path[begin];
+    yaw = wrap_angle(target_yaw[begin] + (ref_heading[0] - ref_travel[0]));
+  }
+  w.transform.yaw = yaw;
+  w.transform.x = origin.x();
+  w.transform.z = origin.y();
+  const Eigen::Matrix3d unturn = rot_y(-yaw);
+  auto to_canonical = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector3d c = unturn * Eigen::Vector3d(p.x() - origin.x(), 0.0, p.y() - origin.y());
+    return Eigen::Vector2d(c.x(), c.z());
+  };
+
+  w.target_xz = at::empty({length, 2}, at::kFloat);
+  w.target_tangent = at::empty({length, 2}, at::kFloat);
+  {
+    float* t = w.target_xz.data_ptr<float>();
+    float* g = w.target_tangent.data_ptr<float>();
+    for (int f = 0; f < length; ++f) {
+      const Eigen::Vector2d c = to_canonical(path[begin + f]);
+      t[2 * f] = static_cast<float>(c.x());
+      t[2 * f + 1] = static_cast<float>(c.y());
+      const double a = target_yaw[begin + f] - yaw;
+      g[2 * f] = static_cast<float>(std::sin(a));
+      g[2 * f + 1] = static_cast<float>(std::cos(a));
+    }
+  }
+  w.start_xz = at::zeros({1, 2}, at::kFloat);
+
+  // The reference turned to follow the target: each frame's root turned about +Y
+  // by (target travel - reference travel), placed on the path with the
+  // reference's height; then one rigid ground motion so that frame 0 sits at the
+  // canonical origin with the canonical heading.
+  const int Tt = std::min(R, length);
+  Motion turned = seg.slice(0, Tt);
+  for (int f = 0; f < Tt; ++f) {
+    const double delta = target_yaw[begin + f] - ref_travel[f];
+    turned.rotation(f, 0) = (Eigen::Quaterniond(Eigen::AngleAxisd(delta, Eigen::Vector3d::UnitY())) *
+                             seg.rotation(f, 0).normalized())
+                                .normalized();
+    turned.root_positions[f] = Eigen::Vector3d(path[begin + f].x(), seg.root_positions[f].y(), path[begin + f].y());
+  }
+  {
+    const double fix = wrap_angle(yaw - heading_yaw(turned.rotation(0, 0), fwd));
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(fix, Eigen::Vector3d::UnitY()));
+    const Eigen::Vector3d pivot(path[begin].x(), 0.0, path[begin].y());
+    const Eigen::Vector3d target(origin.x(), 0.0, origin.y());
+    for (int f = 0; f < Tt; ++f) {
+      turned.rotation(f, 0) = (q * turned.rotation(f, 0)).normalized();
+      const Eigen::Vector3d p = turned.root_positions[f];
+      const Eigen::Vector3d g = q * Eigen::Vector3d(p.x() - pivot.x(), 0.0, p.z() - pivot.z());
+      turned.root_positions[f] = Eigen::Vector3d(g.x() + target.x(), p.y(), g.z() + target.z());
+    }
+  }
+  w.reference_segment = std::move(seg);
+  w.turned_segment = std::move(turned);
+
+  // Continuity with the previous solution on the shared frames.
+  if (previous && shared > 0) {
+    at::NoGradGuard no_grad;
+    w.shared_frames = at::arange(shared, at::kLong);
+    at::Tensor rot = at::empty({1, shared, J, 3, 3}, at::kFloat);
+    float* r = rot.data_ptr<float>();
+    for (int f = 0; f < shared; ++f) {
+      for (int j = 0; j < J; ++j) {
+        Eigen::Matrix3d m = previous->rotation(begin + f, j).normalized().toRotationMatrix();
+        if (j == 0) m = unturn * m;
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) *r++ = static_cast<float>(m(a, b));
+      }
+    }
+    w.shared_rotations = rot.squeeze(0).contiguous();
+    w.shared_joints = heading_relative_positions(rot, rig).squeeze(0).contiguous();
+  }
+  return w;
+}
+
+// ---------------------------------------------------------------- the energy
+
+RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindow& window, const RenavWeights& w,
+                                const at::Tensor& rot, const at::Tensor& root, const at::Tensor& contacts) {
+  const int T = window.length;
+  if (rot.dim() != 5 || rot.size(0) != 1 || rot.size(1) != T || root.dim() != 3 || root.size(1) != T)
+    throw InputError("renav_motion_energy: expected rotations [1, T, J, 3, 3] and root positions [1, T, 3] with T = " +
+                     std::to_string(T));
+  const at::TensorOptions opt = rot.options();
+  RenavEnergy out;
+  auto add = [&](const char* name, double weight, const at::Tensor& value) {
+    out.terms.emplace_back(name, value * weight);
+  };
+  if (w.path > 0) {
+    at::Tensor d = ground_xz(root).squeeze(0) - window.target_xz.to(opt);
+    add("path", w.path, at::sqrt(d.square() + 1e-6).mean());
+  }
+  const bool use_cont = w.continuity > 0 && window.num_shared() > 0;
+  at::Tensor hp;
+  if (w.joints > 0 || use_cont) hp = heading_relative_positions(rot, rig);  // [1, T, J, 3]
+  if (w.joints > 0) {
+    add("joints", w.joints,
+        soft_dtw_divergence(hp.flatten(-2), window.reference_joints.to(opt), w.gamma).squeeze(0));
+  }
+  if (w.heading > 0) {
+    at::Tensor h = heading_rotation(rot.select(-3, 0), rig.root_forward);  // [1, T, 3, 3]
+    at::Tensor s = h.select(-2, 0).select(-1, 2), c = h.select(-2, 2).select(-1, 2);  // heading = (s, 0, c)
+    at::Tensor tangent = window.target_tangent.to(opt);
+    at::Tensor signal = (s * tangent.select(-1, 0) + c * tangent.select(-1, 1)).unsqueeze(-1);  // [1, T, 1]
+    add("heading", w.heading, soft_dtw_divergence(signal, window.reference_heading.to(opt), w.gamma).squeeze(0));
+  }
+  if (w.foot_skating > 0 && rig.num_feet() > 0 && T >= 2) {
+    if (!contacts.defined()) throw InputError("renav_motion_energy: foot skating needs the contact probabilities");
+    const at::Tensor offsets = offsets_tensor(rig.skeleton).to(opt);
+    at::Tensor pos = forward_kinematics(rig.skeleton.parents, offsets, rot, root).positions;  // [1, T, J, 3]
+    at::Tensor feet = at::tensor(std::vector<int64_t>(rig.foot_joints.begin(), rig.foot_joints.end()), at::kLong);
+    at::Tensor fp = pos.index_select(2, feet);
+    at::Tensor v = (fp.narrow(1, 1, T - 1) - fp.narrow(1, 0, T - 1)) * fps;
+    at::Tensor speed2 = v.select(-1, 0).square() + v.select(-1, 2).square();
+    add("foot_skating", w.foot_skating, (contacts.narrow(1, 1, T - 1).detach().to(opt) * speed2).mean());
+  }
+  if (use_cont) {
+    at::Tensor r = rot.squeeze(0).index_select(0, window.shared_frames);
+    at::Tensor angle = torch_rot::geodesic_angle(r, window.shared_rotations.to(opt));
+    at::Tensor p = hp.squeeze(0).index_select(0, window.shared_frames);
+    at::Tensor d2 = (p - window.shared_joints.to(opt)).square().sum(-1);
+    add("continuity", w.continuity, angle.square().mean() + 10.0 * d2.mean());
+  }
+  out.total = at::zeros({}, opt);
+  for (const auto& t : out.terms) out.total = out.total + t.second;
+  return out;
+}
+
+RenavEnergy evaluate_renav_energy(const NemfModel& model, const RenavWindow& window, const RenavWeights& weights,
+                                  const at::Tensor& z_l, const at::Tensor& z_g) {
+  at::Tensor rot = model.decode(at::arange(window.length, at::kFloat), z_l, z_g);
+  GmpOutput gmp = model.predict_global(rot);
+  at::Tensor root = model.root_positions(rot, gmp, window.start_xz);
+  at::Tensor contacts;
+  if (weights.foot_skating > 0) contacts = at::sigmoid(gmp.contact_logits);
+  return renav_motion_energy(model.rig(), model.config().fps, window, weights, rot, root, contacts);
+}
+
+RenavDecoded decode_renav_window(const NemfModel& model, const RenavWindow& window, const at::Tensor& z_l,
+                                 const at::Tensor& z_g) {
+  at::NoGradGuard no_grad;
+  RenavDecoded d;
+  d.local_rotations = model.decode(at::arange(window.length, at::kFloat), z_l, z_g);
+  GmpOutput gmp = model.predict_global(d.local_rotations);
+  d.root_positions = model.root_positions(d.local_rotations, gmp, window.start_xz);
+  d.contacts = at::sigmoid(gmp.contact_logits);
+  return d;
+}
+
+// ---------------------------------------------------------------- solvers
+
+namespace {
+
+// The energy of a flat latent vector x = [z_l, z_g] (float, [zl + zg]).
+struct FlatEnergy {
+  const NemfModel& model;
+  const RenavWindow& window;
+  const RenavWeights& weights;
+  int zl, zg;
+
+  RenavEnergy operator()(const at::Tensor& x) const {
+    return evaluate_renav_energy(model, window, weights, x.narrow(0, 0, zl).view({1, zl}),
+                                 x.narrow(0, zl, zg).view({1, zg}));
+  }
+  double with_gradient(const at::Tensor& x, at::Tensor* gradient) const {
+    at::Tensor leaf = x.detach().clone().requires_grad_(true);
+    RenavEnergy e = (*this)(leaf);
+    *gradient = torch::autograd::grad({e.total}, {leaf})[0];
+    return e.total.item<double>();
+  }
+  double cost(const at::Tensor& x) const {
+    at::NoGradGuard no_grad;
+    return (*this)(x).total.item<double>();
+  }
+  std::vector<std::pair<std::string, double>> terms(const at::Tensor& x, double* total) const {
+    at::NoGradGuard no_grad;
+    RenavEnergy e = (*this)(x);
+    std::vector<std::pair<std::string, double>> out;
+    for (const auto& t : e.terms) out.emplace_back(t.first, t.second.item<double>());
+    *total = e.total.item<double>();
+    return out;
+  }
+};
+
+class CeresEnergy final : public ceres::FirstOrderFunction {
+ public:
+  explicit CeresEnergy(const FlatEnergy& e) : energy_(e) {}
+  int NumParameters() const override { return energy_.zl + energy_.zg; }
+  bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
+    ++evaluations_;
+    try {
+      at::Tensor x = at::from_blob(const_cast<double*>(parameters), {NumParameters()}, at::kDouble).to(at::kFloat);
+      if (!gradient) {
+        *cost = energy_.cost(x);
+        return std::isfinite(*cost);
+      }
+      at::Tensor g;
+      *cost = energy_.with_gradient(x, &g);
+      at::Tensor gd = g.to(at::kDouble).contiguous();
+      std::copy(gd.data_ptr<double>(), gd.data_ptr<double>() + NumParameters(), gradient);
+      if (!std::isfinite(*cost)) return false;
+      for (int i = 0; i < NumParameters(); ++i) {
+        if (!std::isfinite(gradient[i])) return false;
+      }
+      return true;
+    } catch (...) {
+      if (!error_) error_ = std::current_exception();
+      return false;
+    }
+  }
+  int evaluations() const { return evaluations_; }
+  std::exception_ptr error() const { return error_; }
+
+ private:
+  FlatEnergy energy_;
+  mutable int evaluations_ = 0;
+  mutable std::exception_ptr error_;
+};
+
+class ProgressCallback final : public ceres::IterationCallback {
+ public:
+  ProgressCallback(const TaskContext& ctx, int offset, int total) : ctx_(ctx), offset_(offset), total_(total) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
+    try {
+      ctx_.report({offset_ + s.iteration, total_, s.cost});
+    } catch (const CancelledError&) {
+      cancelled = true;
+      return ceres::SOLVER_ABORT;
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+  bool cancelled = false;
+
+ private:
+  const TaskContext& ctx_;
+  int offset_, total_;
+};
+
+at::Tensor solve_lbfgs(const FlatEnergy& energy, const at::Tensor& x0, const RenavOptions& o, int cap,
+                       const TaskContext& ctx, int offset, int total, RenavWindowSummary* summary) {
+  const int n = energy.zl + energy.zg;
+  std::vector<double> x(n);
+  {
+    at::Tensor d = x0.to(at::kDouble).contiguous();
+    std::copy(d.data_ptr<double>(), d.data_ptr<double>() + n, x.begin());
+  }
+  auto* function = new CeresEnergy(energy);
+  ceres::GradientProblem problem(function);  // takes ownership
+  ceres::GradientProblemSolver::Options options;
+  options.line_search_direction_type = ceres::LBFGS;
+  options.max_lbfgs_rank = o.lbfgs_rank;
+  options.max_num_iterations = cap;
+  options.function_tolerance = o.function_tolerance;
+  options.gradient_tolerance = o.gradient_tolerance;
+  options.parameter_tolerance = o.parameter_tolerance;
+  options.logging_type = ceres::SILENT;
+  options.minimizer_progress_to_stdout = false;
+  ProgressCallback progress(ctx, offset, total);
+  options.callbacks.push_back(&progress);
+  std::string why;
+  if (!options.IsValid(&why)) throw InputError("invalid L-BFGS options: " + why);
+  ceres::GradientProblemSolver::Summary s;
+  ceres::Solve(options, problem, x.data(), &s);
+  if (progress.cancelled) throw CancelledError();
+  if (function->error()) std::rethrow_exception(function->error());
+  summary->iterations = std::max(0, static_cast<int>(s.iterations.size()) - 1);
+  summary->evaluations = function->evaluations();
+  summary->converged = s.termination_type == ceres::CONVERGENCE;
+  summary->message = s.message;
+  return at::from_blob(x.data(), {n}, at::kDouble).to(at::kFloat);
+}
+
+at::Tensor solve_adam(const FlatEnergy& energy, const at::Tensor& x0, const RenavOptions& o, int cap,
+                      const TaskContext& ctx, int offset, int total, RenavWindowSummary* summary) {
+  const double b1 = 0.9, b2 = 0.999, eps = 1e-8;
+  at::Tensor x = x0.clone();
+  at::Tensor m = at::zeros_like(x), v = at::zeros_like(x);
+  at::Tensor best_x = x.clone();
+  double best = std::numeric_limits<double>::infinity();
+  std::vector<double> history;
+  summary->message = "iteration cap reached";
+  int it = 0;
+  for (; it < cap; ++it) {
+    at::Tensor g;
+    const double f = energy.with_gradient(x, &g);
+    ++summary->evaluations;
+    if (!std::isfinite(f)) {
+      summary->message = "non-finite energy";
+      break;
+    }
+    if (f < best) {
+      best = f;
+      best_x = x.clone();
+    }
+    history.push_back(best);
+    ctx.report({offset + it, total, f});
+    if (it >= o.adam_patience) {
+      const double before = history[it - o.adam_patience];
+      if (before - best <= o.adam_tolerance * std::abs(before)) {
+        summary->converged = true;
+        summary->message = "converged: the energy improved by less than the tolerance over the patience window";
+        ++it;
+        break;
+      }
+    }
+    const double lr = o.adam_lr * std::pow(o.adam_decay, it / std::max(1, o.adam_decay_every));
+    at::NoGradGuard no_grad;
+    m.mul_(b1).add_(g, 1 - b1);
+    v.mul_(b2).addcmul_(g, g, 1 - b2);
+    const double c1 = 1 - std::pow(b1, it + 1), c2 = 1 - std::pow(b2, it + 1);
+    x = x - (m / c1) / ((v / c2).sqrt() + eps) * lr;
+  }
+  summary->iterations = it;
+  return best_x;
+}
+
+const std::vector<std::string>& init_names() {
+  static const std::vector<std::string> names{"turned", "reference", "random"};
+  return names;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- the solve
+
+std::string RenavOptions::validate() const {
+  std::ostringstream e;
+  if (max_iterations < 0) e << "max_iterations must be >= 0; ";
+  if (lbfgs_rank < 1) e << "lbfgs_rank must be >= 1; ";
+  if (!(function_tolerance >= 0) || !(gradient_tolerance >= 0) || !(parameter_tolerance >= 0))
+    e << "tolerances must be >= 0; ";
+  if (!(adam_lr > 0) || !std::isfinite(adam_lr)) e << "adam_lr must be positive; ";
+  if (adam_decay_every < 1 || !(adam_decay > 0 && adam_decay <= 1)) e << "bad Adam decay; ";
+  if (!(adam_tolerance >= 0) || adam_patience < 1) e << "bad Adam convergence settings; ";
+  if (overlap < 0) e << "overlap must be >= 0; ";
+  const RenavWeights& w = weights;
+  for (double v : {w.path, w.joints, w.heading, w.foot_skating, w.continuity}) {
+    if (!(v >= 0) || !std::isfinite(v)) {
+      e << "energy weights must be finite and non-negative; ";
+      break;
+    }
+  }
+  if (!(w.gamma > 0) || !std::isfinite(w.gamma)) e << "gamma must be finite and positive; ";
+  for (const std::string& n : inits) {
+    if (std::find(init_names().begin(), init_names().end(), n) == init_names().end())
+      e << "unknown initialisation '" << n << "' (turned, reference, random); ";
+  }
+  return e.str();
+}
+
+RenavOptions default_renav_options(RenavSolver solver) {
+  RenavOptions o;
+  o.solver = solver;
+  return o;
+}
+
+Motion renavigate(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
+                  double path_fps, const RenavOptions& options, const TaskContext& ctx, RenavReport* report) {
+  const auto t0 = Clock::now();
+  const std::string bad = options.validate();
+  if (!bad.empty()) throw InputError("invalid re-navigation options: " + bad);
+  const RigInfo& rig = model.rig();
+  const int J = rig.num_joints();
+  if (reference.num_joints() != J || reference.skeleton.names != rig.skeleton.names ||
+      reference.skeleton.parents != rig.skeleton.parents) {
+    throw InputError("the reference's skeleton does not match the model's: " + std::to_string(reference.num_joints()) +
+                     " joints given, the model has " + std::to_string(J) + " (joint names and parents must agree)");
+  }
+  if (reference.num_frames() < 2) throw InputError("the reference needs at least two frames");
+  reference.validate();
+  validate_path(path);
+  if (!(std::isfinite(path_fps) && path_fps > 0)) throw InputError("the path's frame rate must be finite and positive");
+
+  const double fm = model.config().fps;
+  const int W = model.config().window;
+  auto same_rate = [](double a, double b) { return std::abs(a - b) <= 1e-5 * b; };
+
+  // Everything at the model's rate.
+  Motion ref_m = reference;
+  if (!same_rate(reference.fps, fm)) {
+    const int frames = static_cast<int>(std::floor((reference.num_frames() - 1) * fm / reference.fps + 1e-6)) + 1;
+    if (frames < 2)
+      throw InputError("the reference is too short: it needs at least two frames at the model's " + fmt(fm) + " fps");
+    ref_m = resample_interpolate(reference, fm, frames);
+  }
+  ref_m.fps = fm;
+  const int N = static_cast<int>(path.size());
+  std::vector<Eigen::Vector2d> path_m;
+  if (same_rate(path_fps, fm)) {
+    path_m = path;
+  } else {
+    const double span = (N - 1) * fm / path_fps;
+    const int M = static_cast<int>(std::ceil(span - 1e-6)) + 1;
+    if (M > kMaxPathFrames) throw InputError("the path is too long at the model's frame rate");
+    path_m.resize(std::max(2, M));
+    for (int i = 0; i < static_cast<int>(path_m.size()); ++i) {
+      const double u = std::min<double>(N - 1, i * path_fps / fm);
+      const int a = std::min(N - 2, static_cast<int>(std::floor(u)));
+      const double t = u - a;
+      path_m[i] = path[a] * (1.0 - t) + path[a + 1] * t;
+    }
+  }
+  const int M = static_cast<int>(path_m.size());
+  const int R = ref_m.num_frames();
+
+  const int overlap = options.overlap > 0 ? std::min(options.overlap, W / 2) : std::max(1, W / 4);
+  const std::vector<int> starts = window_starts(M, W, overlap);
+  const int windows = static_cast<int>(starts.size());
+  const int cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.solver);
+  const int zl = model.config().zl, zg = model.config().zg;
+  const std::vector<std::string> inits = options.inits.empty() ? init_names() : options.inits;
+
+  RenavReport rep;
+  Motion out = Motion::identity(reference.skeleton, M, fm);
+  int iterations = 0;
+  for (int k = 0; k < windows; ++k) {
+    const auto tw = Clock::now();
+    const int s = starts[k];
+    const int T = std::min(W, M - s);
+    int ref_begin = 0, ref_len = std::min(R, T);
+    if (R >= M) {
+      ref_begin = s;  // time-aligned
+    } else if (R > T && M > T) {
+      ref_begin = static_cast<int>(std::lround(static_cast<double>(s) * (R - T) / (M - T)));  // spread over the reference
+    }
+    ref_begin = std::clamp(ref_begin, 0, R - ref_len);
+    const int shared = k > 0 ? std::max(0, starts[k - 1] + std::min(W, M - starts[k - 1]) - s) : 0;
+    ctx.report({iterations, cap * windows, 0.0});
+    const RenavWindow window =
+        make_renav_window(model, ref_m, ref_begin, ref_len, path_m, s, T, k > 0 ? &out : nullptr, shared);
+
+    // Initial codes: z_l from the reference, z_g from each candidate; keep the lowest energy.
+    RenavWindowSummary sum;
+    sum.begin = s;
+    sum.length = T;
+    const InitialGuess ref_code = encode_window(model, window.reference_segment, 0);
+    const FlatEnergy energy{model, window, options.weights, zl, zg};
+    at::Tensor x0;
+    double best = std::numeric_limits<double>::infinity();
+    for (const std::string& name : inits) {
+      at::Tensor z_g;
+      if (name == "turned") {
+        z_g = encode_window(model, window.turned_segment, 0).z_g;
+      } else if (name == "reference") {
+        z_g = ref_code.z_g;
+      } else {
+        std::mt19937_64 rng(ctx.seed * 0x9E3779B97F4A7C15ull + static_cast<uint64_t>(k));
+        std::normal_distribution<float> normal(0.0f, 1.0f);
+        z_g = at::empty({1, zg}, at::kFloat);
+        for (int i = 0; i < zg; ++i) z_g.data_ptr<float>()[i] = normal(rng);
+      }
+      const at::Tensor x = at::cat({ref_code.z_l.reshape({zl}), z_g.reshape({zg})}).to(at::kFloat).detach();
+      const double e = energy.cost(x);
+      sum.init_energies.emplace_back(name, e);
+      if (e < best || !x0.defined()) {
+        best = e;
+        x0 = x;
+        sum.init = name;
+      }
+    }
+    sum.initial_terms = energy.terms(x0, &sum.initial_energy);
+    const at::Tensor x = options.solver == RenavSolver::Lbfgs
+                             ? solve_lbfgs(energy, x0, options, cap, ctx, iterations, cap * windows, &sum)
+                             : solve_adam(energy, x0, options, cap, ctx, iterations, cap * windows, &sum);
+    sum.final_terms = energy.terms(x, &sum.final_energy);
+    iterations += sum.iterations;
+
+    const RenavDecoded dec =
+        decode_renav_window(model, window, x.narrow(0, 0, zl).reshape({1, zl}), x.narrow(0, zl, zg).reshape({1, zg}));
+    Motion piece = Motion::identity(reference.skeleton, T, fm);
+    write_window(dec.local_rotations, dec.root_positions, window.transform, &piece, 0);
+    for (int f = 0; f < T; ++f) {
+      const int g = s + f;
+      const double wn = f < shared ? static_cast<double>(f + 1) / (shared + 1) : 1.0;
+      for (int j = 0; j < J; ++j) {
+        out.rotation(g, j) = wn >= 1.0 ? piece.rotation(f, j) : slerp(out.rotation(g, j), piece.rotation(f, j), wn);
+      }
+      out.root_positions[g] = wn >= 1.0 ? piece.root_positions[f]
+                                        : Eigen::Vector3d(out.root_positions[g] * (1.0 - wn) + piece.root_positions[f] * wn);
+    }
+    sum.wall_ms = ms_since(tw);
+    rep.windows.push_back(std::move(sum));
+  }
+
+  Motion result = same_rate(path_fps, fm) ? out : resample_interpolate(out, path_fps, N);
+  result.fps = path_fps;
+  double err_sum = 0.0;
+  for (int f = 0; f < N; ++f) {
+    const Eigen::Vector3d& r = result.root_positions[f];
+    const double e = std::hypot(r.x() - path[f].x(), r.z() - path[f].y()) * 100.0;
+    err_sum += e;
+    rep.path_error_max_cm = std::max(rep.path_error_max_cm, e);
+  }
+  rep.path_error_mean_cm = err_sum / N;
+  rep.iterations = iterations;
+  rep.wall_ms = ms_since(t0);
+  if (report) *report = std::move(rep);
+  return result;
+}
+
+std::vector<std::string> renav_methods() { return {"nemf", "nemf-adam"}; }
+
+Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double path_fps,
+                 const std::string& method, const TaskContext& ctx, RenavReport* report) {
+  const std::string m = method.empty() ? renav_methods().front() : method;
+  RenavSolver solver;
+  if (m == "nemf") {
+    solver = RenavSolver::Lbfgs;
+  } else if (m == "nemf-adam") {
+    solver = RenavSolver::Adam;
+  } else {
+    std::string list;
+    for (const std::string& n : renav_methods()) list += (list.empty() ? "" : ", ") + n;
+    throw InputError("unknown re-navigation method '" + method + "' (available: " + list + ")");
+  }
+  if (!ctx.model) throw InputError("re-navigation needs the prior, and no model is loaded (name one with --model)");
+  if (reference.num_frames() < 2) throw InputError("the reference needs at least two frames");
+  if (!(std::isfinite(reference.fps) && reference.fps > 0))
+    throw InputError("the reference's fps must be finite and positive");
+  if (!std::isfinite(path_fps) || path_fps < 0) throw InputError("the path's frame rate must be finite and positive");
+  const double fps = path_fps > 0 ? path_fps : reference.fps;
+  return renavigate(*ctx.model, reference, path, fps, default_renav_options(solver), ctx, report);
+}
+
+}  // namespace mf

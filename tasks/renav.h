@@ -1,0 +1,295 @@
+// Re-navigation: a reference clip plus a new ground path -> a motion that
+// follows the path in the reference's style, by optimising the prior's latent
+// codes (z_l, z_g) with the network frozen. NeMF's formulation (REFERENCE.md
+// section 1) with the soft-DTW divergence of tasks/soft_dtw.h.
+//
+// Paths. A ground path is a list of (x, z) points in metres, world frame (Y up,
+// prior/motion/skeleton.h). It comes either
+//   * per frame: one point per output frame, at the path's frame rate (by
+//     default the reference's); the output has exactly as many frames, or
+//   * as a polyline: a few vertices, resampled by arc length at constant speed
+//     (resample_polyline()) to a number of frames that is given, or by default
+//     the one that makes the speed the reference's mean horizontal root speed
+//     (polyline_frame_count()).
+// Both read from CSV text (parse_path_csv()): one "x,z" pair per line, metres;
+// an optional first line "x,z" (a header); blank lines and lines starting with
+// '#' (after spaces) are skipped; a third column is an error. Bad input throws
+// mf::InputError naming the source and line.
+//
+// Energy of one window of T frames (the model's window or less), in the
+// window's canonical frame (below), with weights RenavWeights:
+//   path      1   * mean over frames and the two ground axes of the smoothed
+//                   absolute difference sqrt(d^2 + 1e-6) (metres) between the
+//                   root path the global motion predictor (GMP) gives for the
+//                   decoded motion and the target path: NeMF's L1
+//   joints    0.5 * soft-DTW divergence (gamma 0.1, squared Euclidean cost) of
+//                   the root-relative joint positions in the per-frame heading
+//                   frame (heading_relative_positions(), [T, J*3], metres)
+//                   between the decoded window and the reference segment
+//   heading   1   * soft-DTW divergence of c(t) = cos(angle between the root's
+//                   heading and the path tangent at t): for the output, the
+//                   decoded heading against the *target* path's tangent; for
+//                   the reference, its heading against its own root path's
+//                   tangent. So the output keeps the reference's facing
+//                   relative to its direction of travel (forward, backward,
+//                   sideways) while it follows the new path.
+//   foot_skating  (default 0: measured, see docs/BENCHMARKS.md) mean over
+//                   frames and feet of p_contact * |v_xz|^2 of the foot joints
+//                   (m/s), contacts from the GMP, detached
+//   continuity    windows after the first only: over the frames they share
+//                   with the already solved previous window, mean squared
+//                   geodesic angle of every local rotation (root included) plus
+//                   10 x mean squared distance of the heading-frame joint
+//                   positions (m^2) against that window's solution
+// Tangents: direction of p(t + 2) - p(t - 2) (clamped at the ends); where it
+// is shorter than 1 mm the nearest valid tangent is held; a reference that
+// never moves uses its own heading (c = 1).
+//
+// Windows. The solve runs at the model's frame rate: a reference at another
+// rate is resampled first (interpolation), the path is resampled in time to
+// model frames, and the result is resampled back to the path's rate (so the
+// output has exactly as many frames as the path). Paths longer than the
+// model's window are cut into windows of the window's length overlapping by a
+// quarter of it, solved one after the other: each later window starts where
+// the previous solution is at its first frame (position and heading), is
+// pulled toward that solution on the shared frames (continuity) and is
+// cross-faded with it there (SLERP / LERP, linear weights), so there is no
+// seam. Each window is compared with a reference segment of its own length:
+// the same frames of the reference when the reference is at least as long as
+// the (model-rate) path; otherwise segments spread evenly over the reference
+// (window k of K starts at reference frame round(s_k (R - T) / (M - T))), so
+// a short reference is replayed with overlaps; a reference shorter than one
+// window is used whole (soft-DTW aligns sequences of different lengths).
+//
+// Canonical frame of a window: origin at the path's first point (later
+// windows: the previous solution's root there), turned about +Y so that the
+// expected heading at the first frame (path tangent plus the reference's
+// facing offset; later windows: the previous solution's heading) is +Z.
+// The GMP's root path starts at that origin, so the output starts exactly at
+// the path's first point.
+//
+// Initialisation (per window), NeMF's and ours, the lowest energy kept:
+// z_l is the encoder's mean on the reference segment; z_g is, in turn, the
+// encoder's mean on the reference segment turned to follow the target path
+// (each frame's root turned about +Y by the angle between the target's and
+// the reference's travel directions, root placed on the path: "turned"), on
+// the untouched reference ("reference"), and NeMF's random draw from N(0, I)
+// seeded by TaskContext::seed ("random").
+//
+// Solvers: L-BFGS (Ceres GradientProblemSolver, the default, method "nemf")
+// or NeMF's Adam (lr 0.1, decay x0.7 every 200, up to 600 iterations, method
+// "nemf-adam"), both with early stopping, progress reports once per iteration
+// (TaskContext::report: the callback and the cancel flag can stop them:
+// CancelledError) and a per-window summary. Deterministic for a given input,
+// options, seed and thread count.
+#pragma once
+
+#include <ATen/core/Tensor.h>
+#include <Eigen/Core>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "prior/model/representation.h"
+#include "prior/motion/motion.h"
+#include "tasks/method.h"
+#include "tasks/soft_dtw.h"
+
+namespace mf {
+
+class NemfModel;
+
+// ---------------------------------------------------------------- paths
+
+/// Longest path accepted (points per frame, or frames of a resampled polyline).
+constexpr int kMaxPathFrames = 1'000'000;
+
+/// Parses path CSV text (see the top of this file) into (x, z) points, metres.
+/// Throws mf::InputError "<source>:<line>: ..." on a malformed line (not two
+/// comma-separated numbers, a third column, text after the numbers), on a
+/// non-finite value, and "<source>: ..." when fewer than two points remain or
+/// there are more than kMaxPathFrames. Does not check the path's length (see
+/// validate_path()). Numbers are parsed independently of the locale.
+std::vector<Eigen::Vector2d> parse_path_csv(const std::string& text, const std::string& source);
+/// Reads a file and parses it; InputError "<path>: cannot open ..." if it cannot be read.
+std::vector<Eigen::Vector2d> read_path_csv(const std::string& path);
+
+/// Throws mf::InputError unless the path has at least two points, at most
+/// kMaxPathFrames, every value finite, and a total length (sum of the
+/// distances between consecutive points) of at least 1 mm.
+void validate_path(const std::vector<Eigen::Vector2d>& path);
+
+/// Total length of a polyline, metres.
+double path_length(const std::vector<Eigen::Vector2d>& path);
+
+/// Mean horizontal root speed of a motion (m/s): the summed ground distance
+/// between consecutive root positions over the duration. 0 for one frame.
+double mean_ground_speed(const Motion& motion);
+
+/// Frames of a polyline walked at `speed` (m/s) and `fps`:
+/// round(length / speed * fps) + 1, at least 2. Throws mf::InputError if the
+/// speed is below 1 cm/s (the reference barely moves: give a frame count),
+/// fps or speed are not finite and positive, or the result exceeds
+/// kMaxPathFrames.
+int polyline_frame_count(const std::vector<Eigen::Vector2d>& vertices, double speed, double fps);
+
+/// `frames` (>= 2) points at equal arc-length spacing along the polyline
+/// `vertices` (validated with validate_path()): point i at arc length
+/// L * i / (frames - 1); the first and last points are the first and last
+/// vertices. Zero-length segments (repeated vertices) are skipped.
+std::vector<Eigen::Vector2d> resample_polyline(const std::vector<Eigen::Vector2d>& vertices, int frames);
+
+/// Yaw (radians, atan2(dx, dz): 0 = +Z, the heading convention of
+/// representation.h) of the ground tangent of `points` at every point, as
+/// described at the top of this file; `fallback` (one value per point, or
+/// empty for 0) where no point of the path moves.
+std::vector<double> tangent_yaws(const std::vector<Eigen::Vector2d>& points, const std::vector<double>& fallback = {});
+
+// ---------------------------------------------------------------- the energy
+
+struct RenavWeights {
+  double path = 1.0;
+  double joints = 0.5;
+  double heading = 1.0;
+  double foot_skating = 0.0;
+  double continuity = 1.0;
+  double gamma = kNemfSoftDtwGamma;  ///< soft-DTW smoothing (squared Euclidean cost)
+};
+
+/// One window of a re-navigation problem, canonical (see the top of this file).
+struct RenavWindow {
+  int length = 0;                    ///< T, output frames of the window (2 <= T <= the model's window)
+  GroundTransform transform;         ///< canonical -> world
+  at::Tensor target_xz;              ///< [T, 2] target ground path (x, z), canonical
+  at::Tensor target_tangent;         ///< [T, 2] unit tangent (x, z) of the target path, canonical
+  at::Tensor start_xz;               ///< [1, 2] where the GMP's root path starts (the origin, or the previous solution)
+  at::Tensor reference_joints;       ///< [1, R, J*3] heading-frame joint positions of the reference segment
+  at::Tensor reference_heading;      ///< [1, R, 1] the reference's c(t)
+  // Continuity with the previous window (undefined when there is none).
+  at::Tensor shared_frames;          ///< [S] int64 window frames shared with the previous window
+  at::Tensor shared_rotations;       ///< [S, J, 3, 3] its local rotations there (root in this window's canonical frame)
+  at::Tensor shared_joints;          ///< [S, J, 3] its heading-frame joint positions there
+  // For the initialisation.
+  Motion reference_segment;          ///< the reference frames of this window (model fps, world)
+  Motion turned_segment;             ///< the same turned to follow the target, canonicalising at frame 0 to `transform`
+
+  int num_shared() const { return shared_frames.defined() ? static_cast<int>(shared_frames.size(0)) : 0; }
+};
+
+/// The problem of output frames [begin, begin + length) of a model-rate target
+/// path `path` (world (x, z) per model frame): the reference segment
+/// [ref_begin, ref_begin + ref_length) of `reference` (model fps, the model's
+/// skeleton). `previous` (optional) is the already solved output so far (model
+/// fps, world) whose frames [begin, begin + shared) are shared with this window;
+/// with shared = 0 the window starts at path[begin] heading along the target
+/// with the reference's facing offset. Throws mf::InputError on bad ranges or a
+/// skeleton that does not match the model.
+RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, int ref_begin, int ref_length,
+                              const std::vector<Eigen::Vector2d>& path, int begin, int length,
+                              const Motion* previous = nullptr, int shared = 0);
+
+/// The energy and its weighted terms (names "path", "joints", "heading",
+/// "foot_skating", "continuity"; only the active ones, in that order).
+struct RenavEnergy {
+  at::Tensor total;  ///< scalar
+  std::vector<std::pair<std::string, at::Tensor>> terms;
+};
+
+/// The energy of a given canonical window motion: local rotations
+/// [1, T, J, 3, 3] (root in the canonical frame), root positions [1, T, 3]
+/// (canonical) and foot contact probabilities [1, T, F] (may be undefined when
+/// foot_skating is 0). Differentiable in the rotations and positions.
+RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindow& window, const RenavWeights& weights,
+                                const at::Tensor& local_rotations, const at::Tensor& root_positions,
+                                const at::Tensor& contacts);
+
+/// The energy of latent codes z_l [1, zl], z_g [1, zg]: the window decoded at
+/// frames 0..T-1, root path from the GMP starting at window.start_xz, then
+/// renav_motion_energy(). Differentiable with respect to the codes (the caller
+/// freezes the network).
+RenavEnergy evaluate_renav_energy(const NemfModel& model, const RenavWindow& window, const RenavWeights& weights,
+                                  const at::Tensor& z_l, const at::Tensor& z_g);
+
+/// The decoded window (no grad): local rotations [1, T, J, 3, 3], root
+/// positions [1, T, 3] and contact probabilities [1, T, F], canonical.
+struct RenavDecoded {
+  at::Tensor local_rotations, root_positions, contacts;
+};
+RenavDecoded decode_renav_window(const NemfModel& model, const RenavWindow& window, const at::Tensor& z_l,
+                                 const at::Tensor& z_g);
+
+// ---------------------------------------------------------------- the solve
+
+enum class RenavSolver { Lbfgs, Adam };
+
+struct RenavOptions {
+  RenavSolver solver = RenavSolver::Lbfgs;
+  RenavWeights weights;
+  /// Iteration cap per window; 0 = the solver's default (L-BFGS 100, Adam 600).
+  int max_iterations = 0;
+  // L-BFGS.
+  int lbfgs_rank = 20;
+  double function_tolerance = 1e-5;   ///< stop when |delta f| / f falls below this
+  double gradient_tolerance = 1e-8;
+  double parameter_tolerance = 1e-7;
+  // Adam (NeMF's reference).
+  double adam_lr = 0.1;
+  int adam_decay_every = 200;
+  double adam_decay = 0.7;
+  double adam_tolerance = 1e-4;       ///< relative improvement of the best energy ...
+  int adam_patience = 100;            ///< ... over this many iterations, else stop
+  /// Initial z_g candidates tried, among "turned", "reference", "random"
+  /// (see the top of this file); the lowest energy is kept. Empty = all three.
+  std::vector<std::string> inits;
+  /// Frames shared by consecutive windows (at most half the model's window);
+  /// 0 = a quarter of the model's window.
+  int overlap = 0;
+
+  /// Empty when valid, else what is wrong.
+  std::string validate() const;
+};
+
+/// The options of the methods "nemf" (L-BFGS) and "nemf-adam".
+RenavOptions default_renav_options(RenavSolver solver = RenavSolver::Lbfgs);
+
+/// What one window's solve did.
+struct RenavWindowSummary {
+  int begin = 0, length = 0;           ///< output frames (model fps)
+  std::string init;                    ///< the initial z_g kept
+  std::vector<std::pair<std::string, double>> init_energies;  ///< each candidate's energy
+  int iterations = 0;
+  int evaluations = 0;
+  bool converged = false;
+  double initial_energy = 0.0, final_energy = 0.0;
+  std::vector<std::pair<std::string, double>> initial_terms, final_terms;  ///< weighted
+  double wall_ms = 0.0;                ///< initialisation included
+  std::string message;
+};
+
+struct RenavReport {
+  std::vector<RenavWindowSummary> windows;
+  int iterations = 0;                  ///< summed over windows
+  double path_error_mean_cm = 0.0;     ///< output root vs target path, horizontal, over output frames
+  double path_error_max_cm = 0.0;
+  double wall_ms = 0.0;
+};
+
+/// Re-navigates `reference` (>= 2 frames, any fps, on the model's skeleton:
+/// same joint names and parents) along `path` (per-frame points at
+/// `path_fps`, validated with validate_path()). The output has the
+/// reference's skeleton, path.size() frames, fps = path_fps. Throws
+/// mf::InputError on bad input or options, CancelledError when cancelled.
+Motion renavigate(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
+                  double path_fps, const RenavOptions& options, const TaskContext& ctx = {},
+                  RenavReport* report = nullptr);
+
+/// The re-navigation methods, the default first: {"nemf", "nemf-adam"}.
+std::vector<std::string> renav_methods();
+
+/// The task entry point (the CLI, the C API, the benchmark): `method` empty =
+/// "nemf"; an unknown name throws InputError listing renav_methods(); no model
+/// in `ctx` throws InputError. path_fps <= 0 means the reference's fps.
+Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double path_fps,
+                 const std::string& method, const TaskContext& ctx, RenavReport* report = nullptr);
+
+}  // namespace mf

@@ -1,0 +1,350 @@
+// Re-navigation (tasks/renav.h) on tiny random models: path CSV parsing and
+// its errors, polyline resampling by arc length, tangents, the energy (lower for
+// a motion that follows the path, gradients reaching the latent codes only),
+// the solve (energy decrease, cancellation, output length and frame rate,
+// windows, determinism) and the task entry point's errors.
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <string>
+
+#include "prior/model/nemf.h"
+#include "prior/model/representation.h"
+#include "prior/motion/errors.h"
+#include "tasks/renav.h"
+#include "tests/test_util.h"
+
+namespace mf {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::shared_ptr<NemfModel> tiny_model() {
+  at::manual_seed(5);
+  auto model = std::make_shared<NemfModel>(test::tiny_nemf_config(), test::tiny_rig());
+  model->set_requires_grad(false);
+  return model;
+}
+
+// The message of the InputError `fn` throws ("" if none).
+template <class Fn>
+std::string input_error(Fn&& fn) {
+  try {
+    fn();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+std::vector<Eigen::Vector2d> root_path(const Motion& m) {
+  std::vector<Eigen::Vector2d> p;
+  for (const Eigen::Vector3d& r : m.root_positions) p.emplace_back(r.x(), r.z());
+  return p;
+}
+
+std::vector<Eigen::Vector2d> line_path(int frames, double step) {
+  std::vector<Eigen::Vector2d> p;
+  for (int f = 0; f < frames; ++f) p.emplace_back(0.3 * std::sin(0.2 * f), step * f);
+  return p;
+}
+
+// ---------------------------------------------------------------- paths
+
+TEST(RenavPath, ParsesCsvWithHeaderCommentsAndBlankLines) {
+  const auto p = parse_path_csv("x,z\n# a comment\n0,0\n\n  1.5 , -2\r\n   # indented comment\n+3,4e-1\n", "p.csv");
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_EQ(p[0], Eigen::Vector2d(0, 0));
+  EXPECT_EQ(p[1], Eigen::Vector2d(1.5, -2));
+  EXPECT_EQ(p[2], Eigen::Vector2d(3, 0.4));
+  // Without a header, without a final newline; a header-like line is only a header first.
+  EXPECT_EQ(parse_path_csv("1,2\n3,4", "p.csv").size(), 2u);
+  EXPECT_EQ(parse_path_csv(" X , Z \n1,2\n3,4\n", "p.csv").size(), 2u);
+}
+
+TEST(RenavPath, CsvErrorsNameTheSourceAndLine) {
+  auto error = [](const std::string& text) { return input_error([&] { parse_path_csv(text, "path.csv"); }); };
+  EXPECT_NE(error("").find("path.csv: a path needs at least two points"), std::string::npos) << error("");
+  EXPECT_NE(error("x,z\n1,2\n").find("at least two points"), std::string::npos);
+  EXPECT_NE(error("0,0\n1,nan\n").find("path.csv:2: non-finite"), std::string::npos) << error("0,0\n1,nan\n");
+  EXPECT_NE(error("0,0\n# c\ninf,1\n").find("path.csv:3: non-finite"), std::string::npos);
+  EXPECT_NE(error("0,0\n1;2\n").find("path.csv:2: expected two comma-separated numbers"), std::string::npos);
+  EXPECT_NE(error("0,0\n1,2,3\n").find("path.csv:2:"), std::string::npos);
+  EXPECT_NE(error("0,0\n1,\n").find("path.csv:2:"), std::string::npos);
+  EXPECT_NE(error("0,0\nabc,1\n").find("path.csv:2:"), std::string::npos);
+  EXPECT_NE(error("0,0\n1,2 m\n").find("path.csv:2:"), std::string::npos);
+  EXPECT_NE(error("0,0\nx,z\n1,1\n").find("path.csv:2:"), std::string::npos);  // a header after data
+  EXPECT_NE(input_error([] { read_path_csv("/nonexistent/dir/p.csv"); }).find("cannot open"), std::string::npos);
+}
+
+TEST(RenavPath, Validation) {
+  EXPECT_NE(input_error([] { validate_path({{0, 0}}); }).find("at least two points"), std::string::npos);
+  EXPECT_NE(input_error([] { validate_path({{0, 0}, {0, 0}, {0, 0}}); }).find("zero length"), std::string::npos);
+  EXPECT_NE(input_error([] { validate_path({{0, 0}, {NAN, 1}}); }).find("point 1 is not finite"), std::string::npos);
+  EXPECT_EQ(input_error([] { validate_path({{0, 0}, {0, 0.01}}); }), "");
+}
+
+TEST(RenavPath, PolylineResampledByArcLength) {
+  // An L of length 3 + 4 = 7 m: 8 frames are 1 m apart, around the corner.
+  const std::vector<Eigen::Vector2d> l = {{0, 0}, {3, 0}, {3, 4}};
+  const auto p = resample_polyline(l, 8);
+  const std::vector<Eigen::Vector2d> want = {{0, 0}, {1, 0}, {2, 0}, {3, 0}, {3, 1}, {3, 2}, {3, 3}, {3, 4}};
+  ASSERT_EQ(p.size(), want.size());
+  for (size_t i = 0; i < want.size(); ++i) EXPECT_LT((p[i] - want[i]).norm(), 1e-12) << i;
+  // 3 frames: the middle one at 3.5 m, half a metre past the corner; a repeated vertex changes nothing.
+  const auto q = resample_polyline({{0, 0}, {3, 0}, {3, 0}, {3, 4}}, 3);
+  EXPECT_LT((q[1] - Eigen::Vector2d(3, 0.5)).norm(), 1e-12);
+  EXPECT_EQ(q[2], Eigen::Vector2d(3, 4));
+  // Frame count at a walking speed: 7 m at 1.4 m/s and 30 fps = 150 steps.
+  EXPECT_EQ(polyline_frame_count(l, 1.4, 30.0), 151);
+  EXPECT_EQ(polyline_frame_count({{0, 0}, {0, 0.001}}, 1.0, 30.0), 2);
+  EXPECT_NE(input_error([&] { polyline_frame_count(l, 0.001, 30.0); }).find("barely moves"), std::string::npos);
+  EXPECT_NE(input_error([&] { resample_polyline(l, 1); }), "");
+  EXPECT_NE(input_error([&] { resample_polyline({{1, 1}, {1, 1}}, 5); }).find("zero length"), std::string::npos);
+  EXPECT_DOUBLE_EQ(path_length(l), 7.0);
+}
+
+TEST(RenavPath, GroundSpeedAndTangents) {
+  Motion m = Motion::identity(test::small_skeleton(), 31, 30.0);
+  for (int f = 0; f < 31; ++f) m.root_positions[f] = Eigen::Vector3d(0.03 * f, 0.9 + 0.1 * f, -0.04 * f);
+  EXPECT_NEAR(mean_ground_speed(m), 1.5, 1e-12);  // 5 cm per frame on the ground; height ignored
+
+  // Along +X: yaw +90 degrees; a pause in the middle holds the nearest tangent.
+  std::vector<Eigen::Vector2d> p;
+  for (int f = 0; f < 10; ++f) p.emplace_back(0.1 * f, 0.0);
+  for (int f = 0; f < 10; ++f) p.emplace_back(0.9, 0.0);
+  for (int f = 1; f <= 10; ++f) p.emplace_back(0.9, 0.1 * f);
+  const std::vector<double> yaw = tangent_yaws(p);
+  EXPECT_NEAR(yaw[0], kPi / 2, 1e-12);
+  EXPECT_NEAR(yaw[12], kPi / 2, 1e-12);  // paused, nearer to the +X part
+  EXPECT_NEAR(yaw[17], 0.0, 1e-12);      // paused, nearer to the +Z part
+  EXPECT_NEAR(yaw[29], 0.0, 1e-12);
+  // A path that never moves takes the fallback.
+  const std::vector<double> still = tangent_yaws({{1, 1}, {1, 1}, {1, 1}}, {0.1, 0.2, 0.3});
+  EXPECT_DOUBLE_EQ(still[1], 0.2);
+}
+
+// ---------------------------------------------------------------- the energy
+
+TEST(RenavEnergyTest, LowerForAMotionThatFollowsThePath) {
+  auto model = tiny_model();
+  const RigInfo& rig = model->rig();
+  const Motion ref = test::random_motion(rig.skeleton, 32, 30.0, 7);
+  // The target is the reference's own root path: the reference itself follows
+  // it in its own style (joints and heading divergences 0).
+  const std::vector<Eigen::Vector2d> path = root_path(ref);
+  const RenavWindow w = make_renav_window(*model, ref, 0, 32, path, 0, 32);
+  const RenavWeights weights;
+  // The energy of a world motion, given in the window's canonical frame.
+  auto energy = [&](const Motion& m) {
+    const Eigen::Matrix3d unturn = Eigen::AngleAxisd(-w.transform.yaw, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const int J = rig.num_joints();
+    at::Tensor rot = at::empty({1, 32, J, 3, 3});
+    at::Tensor pos = at::empty({1, 32, 3});
+    for (int f = 0; f < 32; ++f) {
+      for (int j = 0; j < J; ++j) {
+        Eigen::Matrix3d r = m.rotation(f, j).normalized().toRotationMatrix();
+        if (j == 0) r = unturn * r;
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) rot[0][f][j][a][b] = static_cast<float>(r(a, b));
+      }
+      const Eigen::Vector3d& r = m.root_positions[f];
+      const Eigen::Vector3d c = unturn * Eigen::Vector3d(r.x() - w.transform.x, r.y(), r.z() - w.transform.z);
+      for (int a = 0; a < 3; ++a) pos[0][f][a] = static_cast<float>(c[a]);
+    }
+    return renav_motion_energy(rig, 30.0, w, weights, rot, pos, {}).total.item<double>();
+  };
+  const double follows = energy(ref);
+  Motion sideways = ref;  // same motion, 40 cm to the side
+  for (auto& r : sideways.root_positions) r.x() += 0.4;
+  Motion other = test::random_motion(rig.skeleton, 32, 30.0, 8);  // another motion moved onto the path
+  for (int f = 0; f < 32; ++f) {
+    other.root_positions[f].x() = path[f].x();
+    other.root_positions[f].z() = path[f].y();
+  }
+  const double off_path = energy(sideways), other_style = energy(other);
+  EXPECT_LT(follows, 0.01);  // the smoothed L1's floor is 1e-3
+  EXPECT_GT(off_path, follows + 0.15);
+  EXPECT_GT(other_style, follows + 0.01);
+}
+
+TEST(RenavEnergyTest, GradientsReachTheCodesOnly) {
+  auto model = tiny_model();
+  const RigInfo& rig = model->rig();
+  const Motion ref = test::random_motion(rig.skeleton, 40, 30.0, 9);
+  const RenavWindow w = make_renav_window(*model, ref, 0, 32, line_path(40, 0.04), 4, 32);
+  RenavWeights weights;
+  weights.foot_skating = 1.0;
+  at::manual_seed(3);
+  at::Tensor z_l = at::randn({1, model->config().zl}).requires_grad_(true);
+  at::Tensor z_g = at::randn({1, model->config().zg}).requires_grad_(true);
+  const RenavEnergy e = evaluate_renav_energy(*model, w, weights, z_l, z_g);
+  ASSERT_EQ(e.terms.size(), 4u);  // path, joints, heading, foot_skating (no previous window)
+  EXPECT_EQ(e.terms[0].first, "path");
+  EXPECT_EQ(e.terms[3].first, "foot_skating");
+  e.total.backward();
+  ASSERT_TRUE(z_l.grad().defined());
+  ASSERT_TRUE(z_g.grad().defined());
+  EXPECT_TRUE(at::isfinite(z_l.grad()).all().item<bool>());
+  EXPECT_GT(z_l.grad().abs().sum().item<double>(), 0.0);
+  EXPECT_GT(z_g.grad().abs().sum().item<double>(), 0.0);
+  for (const auto& p : model->named_parameters()) {
+    EXPECT_FALSE(p.second.requires_grad()) << p.first;
+    EXPECT_FALSE(p.second.grad().defined()) << p.first;
+  }
+  for (const at::Tensor& t : {w.target_xz, w.target_tangent, w.reference_joints, w.reference_heading}) {
+    EXPECT_FALSE(t.requires_grad());
+  }
+}
+
+TEST(RenavEnergyTest, WindowStartsOnThePathWithTheReferencesFacing) {
+  auto model = tiny_model();
+  const RigInfo& rig = model->rig();
+  const Motion ref = test::random_motion(rig.skeleton, 32, 30.0, 10);
+  const auto path = line_path(32, 0.05);
+  const RenavWindow w = make_renav_window(*model, ref, 0, 32, path, 0, 32);
+  EXPECT_DOUBLE_EQ(w.transform.x, path[0].x());
+  EXPECT_DOUBLE_EQ(w.transform.z, path[0].y());
+  EXPECT_NEAR(w.target_xz[0][0].item<double>(), 0.0, 1e-6);
+  EXPECT_NEAR(w.target_xz[0][1].item<double>(), 0.0, 1e-6);
+  // The turned reference canonicalises at frame 0 to the window's frame.
+  const GroundTransform g = canonical_transform(w.turned_segment, 0, rig);
+  EXPECT_NEAR(std::remainder(g.yaw - w.transform.yaw, 2 * kPi), 0.0, 1e-9);
+  EXPECT_NEAR(g.x, w.transform.x, 1e-9);
+  EXPECT_NEAR(g.z, w.transform.z, 1e-9);
+  // ...and its root follows the target path.
+  for (int f = 0; f < 32; ++f) {
+    EXPECT_NEAR(w.turned_segment.root_positions[f].x(), path[f].x(), 1e-9);
+    EXPECT_NEAR(w.turned_segment.root_positions[f].z(), path[f].y(), 1e-9);
+  }
+}
+
+// ---------------------------------------------------------------- the solve
+
+RenavOptions quick(RenavSolver solver, int iterations) {
+  RenavOptions o = default_renav_options(solver);
+  o.max_iterations = iterations;
+  return o;
+}
+
+TEST(Renavigate, DecreasesTheEnergyAndHasThePathsLength) {
+  auto model = tiny_model();
+  const Motion ref = test::random_motion(model->rig().skeleton, 40, 30.0, 11);
+  const auto path = line_path(50, 0.04);  // 50 frames: two windows of 32
+  RenavReport report;
+  const Motion out = renavigate(*model, ref, path, 30.0, quick(RenavSolver::Lbfgs, 25), {}, &report);
+  EXPECT_EQ(out.num_frames(), 50);
+  EXPECT_EQ(out.fps, 30.0);
+  EXPECT_TRUE(out.skeleton.same_as(ref.skeleton));
+  EXPECT_NO_THROW(out.validate());
+  ASSERT_EQ(report.windows.size(), 2u);
+  EXPECT_EQ(report.windows[0].begin, 0);
+  EXPECT_EQ(report.windows[1].begin, 18);
+  EXPECT_EQ(report.windows[1].length, 32);
+  for (const RenavWindowSummary& w : report.windows) {
+    EXPECT_LT(w.final_energy, w.initial_energy);
+    EXPECT_GT(w.iterations, 0);
+    EXPECT_EQ(w.init_energies.size(), 3u);
+  }
+  EXPECT_EQ(report.windows[1].final_terms.back().first, "continuity");
+  // The output starts exactly on the path.
+  EXPECT_NEAR(out.root_positions[0].x(), path[0].x(), 1e-6);
+  EXPECT_NEAR(out.root_positions[0].z(), path[0].y(), 1e-6);
+  EXPECT_GT(report.path_error_mean_cm, 0.0);
+}
+
+TEST(Renavigate, AdamAndOtherFrameRates) {
+  auto model = tiny_model();
+  const Motion ref = test::random_motion(model->rig().skeleton, 30, 30.0, 12);
+  // 45 points at 60 fps: 22 model frames (one window), resampled back to 45 frames at 60 fps.
+  RenavReport report;
+  const Motion out = renavigate(*model, ref, line_path(45, 0.02), 60.0, quick(RenavSolver::Adam, 30), {}, &report);
+  EXPECT_EQ(out.num_frames(), 45);
+  EXPECT_EQ(out.fps, 60.0);
+  ASSERT_EQ(report.windows.size(), 1u);
+  EXPECT_EQ(report.windows[0].length, 23);
+  EXPECT_LE(report.windows[0].final_energy, report.windows[0].initial_energy);
+  // A reference at another frame rate is resampled to the model's.
+  Motion ref60 = test::random_motion(model->rig().skeleton, 40, 60.0, 13);
+  const Motion out2 = renavigate(*model, ref60, line_path(20, 0.04), 30.0, quick(RenavSolver::Lbfgs, 5));
+  EXPECT_EQ(out2.num_frames(), 20);
+}
+
+TEST(Renavigate, RespectsCancelAndProgress) {
+  auto model = tiny_model();
+  const Motion ref = test::random_motion(model->rig().skeleton, 32, 30.0, 14);
+  const auto path = line_path(32, 0.04);
+  std::atomic<int> cancel{1};
+  TaskContext ctx;
+  ctx.cancel = &cancel;
+  EXPECT_THROW(renavigate(*model, ref, path, 30.0, quick(RenavSolver::Lbfgs, 50), ctx), CancelledError);
+  int calls = 0;
+  TaskContext ctx2;
+  ctx2.progress = [&](const TaskProgress& p) {
+    EXPECT_EQ(p.max_iterations, 50);
+    return ++calls < 4;
+  };
+  EXPECT_THROW(renavigate(*model, ref, path, 30.0, quick(RenavSolver::Lbfgs, 50), ctx2), CancelledError);
+  EXPECT_EQ(calls, 4);
+  calls = 0;
+  EXPECT_THROW(renavigate(*model, ref, path, 30.0, quick(RenavSolver::Adam, 50), ctx2), CancelledError);
+  EXPECT_EQ(calls, 4);
+}
+
+TEST(Renavigate, Deterministic) {
+  auto model = tiny_model();
+  const Motion ref = test::random_motion(model->rig().skeleton, 32, 30.0, 15);
+  const auto path = line_path(40, 0.03);
+  TaskContext ctx;
+  ctx.seed = 7;
+  const Motion a = renavigate(*model, ref, path, 30.0, quick(RenavSolver::Lbfgs, 10), ctx);
+  const Motion b = renavigate(*model, ref, path, 30.0, quick(RenavSolver::Lbfgs, 10), ctx);
+  for (int f = 0; f < a.num_frames(); ++f) {
+    ASSERT_EQ(a.root_positions[f], b.root_positions[f]) << f;
+    for (int j = 0; j < a.num_joints(); ++j) ASSERT_EQ(a.rotation(f, j).coeffs(), b.rotation(f, j).coeffs());
+  }
+}
+
+TEST(RunRenav, EntryPointAndErrors) {
+  auto model = tiny_model();
+  const Motion ref = test::random_motion(model->rig().skeleton, 32, 30.0, 16);
+  TaskContext ctx;
+  ctx.model = model;
+  RenavReport report;
+  const Motion out = run_renav(ref, line_path(20, 0.05), 0.0, "", ctx, &report);  // default method, reference fps
+  EXPECT_EQ(out.num_frames(), 20);
+  EXPECT_EQ(out.fps, 30.0);
+  EXPECT_LT(report.windows[0].final_energy, report.windows[0].initial_energy);
+  EXPECT_EQ(renav_methods().front(), "nemf");
+  std::atomic<int> stop{1};
+  TaskContext cancelled = ctx;
+  cancelled.cancel = &stop;
+  EXPECT_THROW(run_renav(ref, line_path(20, 0.05), 0.0, "nemf-adam", cancelled), CancelledError);
+
+  const auto path = line_path(20, 0.05);
+  EXPECT_NE(input_error([&] { run_renav(ref, path, 0, "magic", ctx); }).find("unknown re-navigation method 'magic'"),
+            std::string::npos);
+  EXPECT_NE(input_error([&] { run_renav(ref, path, 0, "nemf", TaskContext{}); }).find("needs the prior"),
+            std::string::npos);
+  EXPECT_NE(input_error([&] { run_renav(ref, {{0, 0}}, 0, "", ctx); }).find("at least two points"), std::string::npos);
+  EXPECT_NE(input_error([&] { run_renav(ref, {{0, 0}, {INFINITY, 1}}, 0, "", ctx); }).find("not finite"),
+            std::string::npos);
+  EXPECT_NE(input_error([&] { run_renav(ref, path, std::nan(""), "", ctx); }).find("frame rate"), std::string::npos);
+  Skeleton other = test::small_skeleton();
+  other.names[2] = "Neck";
+  const Motion stranger = test::random_motion(other, 32, 30.0, 17);
+  EXPECT_NE(input_error([&] { run_renav(stranger, path, 0, "", ctx); }).find("does not match the model"),
+            std::string::npos);
+  EXPECT_NE(input_error([&] { run_renav(ref.slice(0, 1), path, 0, "", ctx); }).find("at least two frames"),
+            std::string::npos);
+  RenavOptions bad;
+  bad.inits = {"psychic"};
+  EXPECT_NE(bad.validate().find("psychic"), std::string::npos);
+  EXPECT_THROW(renavigate(*model, ref, path, 30.0, bad), InputError);
+}
+
+}  // namespace
+}  // namespace mf
