@@ -10,7 +10,7 @@
 //                [--tasks gap,sparse,effector,partial,long,none] [--methods interp,nemf,nemf-adam]
 //                [--lengths 5,15] [--spacings 5,10] [--speed N] [--out FILE]
 //                [--iterations N] [--ftol X] [--ptol X] [--rank N] [--eigen-scaling 0|1]
-//                [--keyed-iterations N] [--adam-iterations N] [--adam-tol X] [--lock-ramp N] [--overwrite 0|1]
+//                [--keyed-iterations N] [--adam-iterations N] [--adam-tol X] [--lock-ramp N] [--effector-falloff N] [--overwrite 0|1]
 //                [--penalty squared|absolute] [--init NAME]
 //                [--w-rot X] [--w-pos X] [--w-root-rot X] [--w-root X] [--w-prior X] [--w-skate X]
 //                [--w-smooth X] [--w-effector X]
@@ -155,6 +155,7 @@ mf::LatentSolverOptions solver_options(const Args& a, const std::string& method)
   n.erase("adam-tol");
   take("overwrite", &o.overwrite_known);
   take("lock-ramp", &o.foot_lock_ramp);
+  take("effector-falloff", &o.effector_falloff);
   take("w-rot", &o.weights.rotation);
   take("w-pos", &o.weights.position);
   take("w-root-rot", &o.weights.root_orientation);

@@ -30,6 +30,21 @@ double ms_since(Clock::time_point t0) {
 
 int default_iterations(SolverMethod m) { return m == SolverMethod::Adam ? 600 : 20; }
 
+// L-BFGS cap for one window when the options leave it open: 20, or 60 when
+// the window has end-effector targets or 40+ frames in a row without a key
+// (long gaps keep improving with iterations; short ones and sparse keys do not).
+int window_iterations(const LatentSolverOptions& o, const MotionConstraints& wc, int T) {
+  if (o.max_iterations > 0) return o.max_iterations;
+  if (o.method == SolverMethod::Adam) return default_iterations(o.method);
+  int longest = 0, previous = -1;
+  for (const PoseKey& k : wc.keys) {
+    longest = std::max(longest, k.frame - previous - 1);
+    previous = k.frame;
+  }
+  longest = std::max(longest, T - previous - 1);
+  return (!wc.effectors.empty() || longest >= 40) ? 60 : default_iterations(o.method);
+}
+
 // The energy of a flat latent vector x = [z_l, z_g] (float, [zl + zg]).
 struct FlatEnergy {
   const NemfModel& model;
@@ -424,6 +439,37 @@ void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector
   }
 }
 
+// End-effector IK: each target is reached exactly (when within the reach of
+// its two-bone chain: the joint, its parent and grandparent, the grandparent
+// not the root) by two-bone IK, and the same displacement is applied with a
+// raised-cosine falloff over `falloff` frames on each side, stopping at frames
+// whose chain is constrained by a key.
+void reach_effectors(const MotionConstraints& c, int falloff, Motion* out) {
+  const Skeleton& skel = out->skeleton;
+  const int N = out->num_frames();
+  for (const EffectorTarget& e : c.effectors) {
+    if (e.weight <= 0) continue;
+    const int j = e.joint, mid = skel.parents[j];
+    const int top = mid > 0 ? skel.parents[mid] : -1;
+    if (top <= 0) continue;
+    std::vector<char> fixed(N, 0);
+    for (size_t i = 0; i < c.keys.size(); ++i) {
+      if (c.key_has_joint(i, top) || c.key_has_joint(i, mid) || c.key_has_joint(i, j)) fixed[c.keys[i].frame] = 1;
+    }
+    if (fixed[e.frame]) continue;  // the pose there is given
+    GlobalPose pose = forward_kinematics(*out);
+    const Eigen::Vector3d delta = e.position - pose.position(e.frame, j);
+    for (int dir : {-1, 1}) {
+      for (int d = dir < 0 ? 0 : 1; d <= falloff; ++d) {
+        const int f = e.frame + dir * d;
+        if (f < 0 || f >= N || fixed[f]) break;
+        const double w = 0.5 * (1.0 + std::cos(M_PI * d / (falloff + 1.0)));
+        two_bone_ik(out, &pose, f, top, mid, j, pose.position(f, j) + w * delta);
+      }
+    }
+  }
+}
+
 // Window starts for N frames, windows of W frames overlapping by at least `overlap`.
 std::vector<int> window_starts(int N, int W, int overlap) {
   if (N <= W) return {0};
@@ -559,7 +605,8 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
 
   std::shared_ptr<const LatentInitializer> init = options.initializer;
   if (!init) init = std::make_shared<InterpolationEncoderInitializer>();
-  const int cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.method);
+  const int cap = options.max_iterations > 0 ? options.max_iterations
+                 : options.method == SolverMethod::Adam ? default_iterations(options.method) : 60;
 
   CompletionReport rep;
   Motion out = Motion::identity(input.skeleton, N, input.fps);
@@ -614,7 +661,9 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
     request.anchor = anchor;
     request.context = &ctx;
     const InitialGuess start = init->initialize(request);
-    LatentSolution sol = solve_latents(model, problem, start, options, ctx, iterations, cap * windows);
+    LatentSolverOptions window_options = options;
+    window_options.max_iterations = window_iterations(options, wc, T);
+    LatentSolution sol = solve_latents(model, problem, start, window_options, ctx, iterations, cap * windows);
     iterations += sol.summary.iterations;
     rep.windows.push_back(sol.summary);
     rep.window_starts.push_back(s);
@@ -651,6 +700,7 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
   if (options.overwrite_known) {
     overwrite_known(input, constraints, &out, &rep.raw_known);
     if (options.foot_lock_ramp >= 0) lock_feet(rig, constraints, contacts, options.foot_lock_ramp, &out);
+    if (options.effector_falloff >= 0) reach_effectors(constraints, options.effector_falloff, &out);
   } else {
     Motion copy = out;
     overwrite_known(input, constraints, &copy, &rep.raw_known);

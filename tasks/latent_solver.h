@@ -16,7 +16,8 @@
 // step is random: the seed is handed to initialisers that sample).
 //
 // Defaults (docs/BENCHMARKS.md, "Latent solvers", has the measurements):
-// L-BFGS, at most 20 iterations, function tolerance 1e-3; weights rotation 1,
+// L-BFGS, at most 20 iterations (60 with long gaps or end-effector targets),
+// function tolerance 1e-3; weights rotation 1,
 // position 10, root orientation 1, root translation 10 (the GMP path), no
 // prior, skating or smoothness term (they bought nothing measurable with the
 // pilot prior); squared penalties; foot locking with a 3-frame ramp.
@@ -33,10 +34,13 @@
 //    to the other's; before the first and after the last such key it is held.
 //    The error of the raw solution at the keys, before this overwrite, is
 //    reported (CompletionReport::raw_known).
-//  * End-effector targets are not enforced exactly; their error after the
-//    blend is reported. The effector, foot-skating and smoothness energies are
-//    measured on the blended motion (EnergyWeights::on_output), so the solver
-//    places the raw solution such that the output hits the target.
+//  * End-effector targets: the energy pulls the motion toward them (measured on
+//    the blended motion, EnergyWeights::on_output, so that the overwrite does
+//    not undo it), and a final two-bone IK on the target joint's chain (the
+//    joint, its parent and grandparent) places the joint exactly when the
+//    target is within reach, spreading the same displacement over
+//    `effector_falloff` frames on each side with raised-cosine weights. The
+//    error of the raw solution and of the output are reported.
 //  * Foot locking (foot_lock_ramp >= 0, on by default): where the global
 //    motion predictor reports an ankle in contact and the output's ankle is
 //    low, the ankle's ground position is held by two-bone IK on thigh and
@@ -72,7 +76,10 @@ enum class SolverMethod { Lbfgs, Adam };
 struct LatentSolverOptions {
   SolverMethod method = SolverMethod::Lbfgs;
   EnergyWeights weights;
-  /// Iteration cap per window; 0 means the method's default (L-BFGS 20, Adam 600).
+  /// Iteration cap per window; 0 means the method's default: Adam 600; L-BFGS
+  /// 20, or 60 for a window with end-effector targets or with 40 or more
+  /// frames in a row without a key (measured: long gaps and effectors keep
+  /// improving with iterations, sparse keys do not).
   int max_iterations = 0;
 
   // L-BFGS (Ceres GradientProblemSolver).
@@ -104,6 +111,11 @@ struct LatentSolverOptions {
   /// Foot locking after the overwrite (see the top of this file): the ramp in
   /// frames on each side of a contact; negative disables it.
   int foot_lock_ramp = 3;
+
+  /// End-effector IK after the overwrite and the foot locking (see the top of
+  /// this file): the falloff in frames on each side of a target; negative
+  /// disables it (the targets are then only as close as the energy pulls them).
+  int effector_falloff = 10;
 
   /// Diagnostics only: false returns the raw solution, without the overwrite
   /// of the known values (which then do not come out as given).

@@ -309,10 +309,15 @@ TEST(LatentSolver, LongInputsUseOverlappingWindowsWithoutSeams) {
   EXPECT_EQ(late_out.rotation(10, 2).coeffs(), m.rotation(10, 2).coeffs());
 }
 
-TEST(LatentSolver, FeetInContactAreLockedAndKnownFramesStay) {
-  at::set_num_threads(1);
-  // Legs with a thigh, a shin and a foot; a predictor that reports contact everywhere.
-  Skeleton s;
+// A rig with thighs, shins and feet, whose predictor stands still at 0.9 m and
+// reports foot contact everywhere (`contact_logit`).
+struct LeggedModel {
+  Skeleton skeleton;
+  std::unique_ptr<NemfModel> model;
+};
+LeggedModel legged_model(float contact_logit) {
+  LeggedModel out;
+  Skeleton& s = out.skeleton;
   s.names = {"Hips", "Spine", "UpperLeg_L", "LowerLeg_L", "Foot_L", "UpperLeg_R", "LowerLeg_R", "Foot_R"};
   s.parents = {-1, 0, 0, 2, 3, 0, 5, 6};
   s.offsets = {{0, 0, 0}, {0, 0.2, 0}, {0.1, -0.05, 0}, {0, -0.42, 0.02}, {0, -0.42, -0.02},
@@ -320,19 +325,27 @@ TEST(LatentSolver, FeetInContactAreLockedAndKnownFramesStay) {
   Motion m = gentle_motion(s, 24, 14);
   RigInfo rig = measure_rig(s, {&m});
   rig.root_forward = Eigen::Vector3d::UnitZ();
-  ASSERT_EQ(rig.num_feet(), 2);
   rig.foot_thresholds = {10.0, 10.0};  // every height counts as low
   at::manual_seed(11);
-  NemfModel model(tiny_config(), rig);
+  out.model = std::make_unique<NemfModel>(tiny_config(), rig);
+  NemfModel& model = *out.model;
   model.set_requires_grad(false);
-  {
-    at::NoGradGuard no_grad;
-    for (auto& p : model.named_parameters()) {
-      if (p.first.rfind("gmp.output.", 0) == 0) p.second.zero_();
-      if (p.first == "gmp.output.bias") p.second.narrow(0, 4, 2).fill_(10.0f);  // contact logits
-    }
-    model.stats().gmp_out_mean[3] = 0.9f;
+  at::NoGradGuard no_grad;
+  for (auto& p : model.named_parameters()) {
+    if (p.first.rfind("gmp.output.", 0) == 0) p.second.zero_();
+    if (p.first == "gmp.output.bias") p.second.narrow(0, 4, 2).fill_(contact_logit);
   }
+  model.stats().gmp_out_mean[3] = 0.9f;
+  return out;
+}
+
+TEST(LatentSolver, FeetInContactAreLockedAndKnownFramesStay) {
+  at::set_num_threads(1);
+  LeggedModel legged = legged_model(10.0f);
+  const Skeleton& s = legged.skeleton;
+  const NemfModel& model = *legged.model;
+  ASSERT_EQ(model.rig().num_feet(), 2);
+  Motion m = gentle_motion(s, 24, 14);
   LatentSolverOptions o = quick(SolverMethod::Lbfgs);
   const std::vector<int> keys = {0, 23};
   Motion locked = complete_motion(model, m, MotionConstraints::full_pose(keys), o);
@@ -360,6 +373,30 @@ TEST(LatentSolver, FeetInContactAreLockedAndKnownFramesStay) {
     EXPECT_EQ(locked.root_positions[f], free.root_positions[f]);
     for (int j : {0, 1}) EXPECT_EQ(locked.rotation(f, j).coeffs(), free.rotation(f, j).coeffs());
   }
+}
+
+TEST(LatentSolver, EndEffectorIkReachesTheTarget) {
+  at::set_num_threads(1);
+  LeggedModel legged = legged_model(-10.0f);  // no contacts: no foot locking
+  const NemfModel& model = *legged.model;
+  Motion m = gentle_motion(legged.skeleton, 24, 15);
+  MotionConstraints c = MotionConstraints::full_pose({0, 23});
+  const Eigen::Vector3d target = forward_kinematics(m).position(12, 4) + Eigen::Vector3d(0.05, 0.03, -0.02);
+  c.effectors.push_back({12, 4, target, 1.0});
+  CompletionReport report;
+  Motion out = complete_motion(model, m, c, quick(SolverMethod::Lbfgs), {}, &report);
+  const GlobalPose p = forward_kinematics(out);
+  EXPECT_LT((p.position(12, 4) - target).norm(), 1e-3);
+  EXPECT_LT(report.effectors.max_cm, 0.1);
+  // The neighbours follow smoothly: no frame-to-frame jump of the foot beyond the input's own steps.
+  const GlobalPose pm = forward_kinematics(m);
+  double step_out = 0.0, step_in = 0.0;
+  for (int f = 1; f < 24; ++f) {
+    step_out = std::max(step_out, (p.position(f, 4) - p.position(f - 1, 4)).norm());
+    step_in = std::max(step_in, (pm.position(f, 4) - pm.position(f - 1, 4)).norm());
+  }
+  EXPECT_LT(step_out, step_in + 0.03);
+  for (int f : {0, 23}) EXPECT_EQ(out.rotation(f, 3).coeffs(), m.rotation(f, 3).coeffs());  // keys untouched
 }
 
 TEST(LatentSolver, BadInputIsAnInputError) {
