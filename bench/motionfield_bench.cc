@@ -23,7 +23,9 @@
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/inbetween/inbetweener.h"
 #include "tasks/jobs.h"
+#include "tasks/transformer_methods.h"
 
 namespace {
 
@@ -34,12 +36,17 @@ const char* kUsage =
     "                    (default: gap, sparse, resample, plus the prior's four when a model is loaded)\n"
     "  --model PATH      the prior (default: the default model, see mf::default_model_path())\n"
     "  --no-model        run without a prior (methods that need one are skipped)\n"
+    "  --twostage PATH   the two-stage transformer (methods context, detail, nemf-context, nemf-detail;\n"
+    "                    default: motionfield-twostage.mfm next to the model, if present)\n"
+    "  --citl PATH       the CITL transformer (methods citl, nemf-citl; default: motionfield-citl.mfm\n"
+    "                    next to the model, if present)\n"
     "  --samples N       windows drawn for the sample task (default 256)\n"
     "  --seed N          seed of the sample task (default 1)\n"
     "  --threads N       torch intra-op threads (default 2)\n"
     "  --source PATH     BVH folder or archive (default: the shared training archive)\n"
     "  --cache-dir DIR   extraction and parse cache (default: <project>/.cache)\n"
     "  --max-windows N   at most N windows per table row, spread evenly (default: all)\n"
+    "  --split NAME      validation (default) or train: the clips the tables are measured on (tune on train)\n"
     "  --out FILE        also write the markdown to FILE\n"
     "  --l2p-axes        add columns splitting L2P into horizontal (x, z) and vertical (y) parts\n"
     "  --print-stats     add the table of training statistics (position mean / std, standing heights)\n"
@@ -82,6 +89,7 @@ struct Args {
   std::vector<std::string> prior_tasks;
   bool tasks_given = false;
   std::string model;
+  std::string twostage, citl;  // transformer files (default: next to the model)
   bool no_model = false;
   int samples = 256;
   int seed = 1;
@@ -89,6 +97,7 @@ struct Args {
   std::string source;
   std::string cache_dir;
   int max_windows = 0;
+  std::string split = "validation";
   std::string out;
   bool l2p_axes = false;
   bool print_stats = false;
@@ -132,6 +141,10 @@ Args parse_args(int argc, char** argv) {
       }
     } else if (flag == "--model") {
       args.model = value;
+    } else if (flag == "--twostage") {
+      args.twostage = value;
+    } else if (flag == "--citl") {
+      args.citl = value;
     } else if (flag == "--samples") {
       args.samples = parse_int(flag, value, 1);
     } else if (flag == "--seed") {
@@ -142,6 +155,9 @@ Args parse_args(int argc, char** argv) {
       args.source = value;
     } else if (flag == "--cache-dir") {
       args.cache_dir = value;
+    } else if (flag == "--split") {
+      if (value != "validation" && value != "train") throw mf::InputError("--split: validation or train, not '" + value + "'");
+      args.split = value;
     } else if (flag == "--max-windows") {
       args.max_windows = parse_int(flag, value, 0);
     } else if (flag == "--out") {
@@ -198,6 +214,13 @@ int run(int argc, char** argv) {
     model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));
     model->set_requires_grad(false);
     ctx.model = model;
+    for (const std::string kind : {mf::kTwoStageKind, mf::kCitlKind}) {
+      const std::string given = kind == mf::kCitlKind ? args.citl : args.twostage;
+      const std::string path = given.empty() ? mf::inbetweener_path_next_to(args.model, kind) : given;
+      if (given.empty() && !std::ifstream(path)) continue;
+      std::cerr << "loading transformer " << path << "\n";
+      (kind == mf::kCitlKind ? ctx.citl : ctx.twostage) = mf::load_frozen_inbetweener(path, kind);
+    }
   }
 
   mf::DatasetOptions data_options;
@@ -211,6 +234,7 @@ int run(int argc, char** argv) {
             << " validation clips in "
             << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() << " s\n";
   if (data.validation.empty()) throw mf::InputError("the validation split of " + args.source + " is empty");
+  const std::vector<mf::Clip>& clips = args.split == "train" ? data.train : data.validation;
 
   const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);
   long validation_frames = 0;
@@ -220,8 +244,13 @@ int run(int argc, char** argv) {
   md << "## motionfield-bench\n\n";
   md << "- command: `" << command << "`\n";
   md << "- model: " << (model ? args.model + " (" + model->config().describe() + ")" : std::string("none")) << "\n";
+  for (const char* kind : {mf::kTwoStageKind, mf::kCitlKind}) {
+    const mf::InbetweenModel* t = ctx.inbetweener(kind);
+    md << "- " << kind << " transformer: " << (t ? t->describe() : std::string("not loaded")) << "\n";
+  }
   md << "- validation clips: " << data.validation.size() << " (" << validation_frames << " frames)"
      << ", training clips: " << data.train.size() << "\n";
+  md << "- tables measured on the " << args.split << " split\n";
   md << "- L2P statistics: " << stats.windows << " training windows of 50 frames every 20, canonicalised at frame 9\n";
   md << "- standing heights (median of per-clip 5th percentiles, training split):";
   for (size_t i = 0; i < stats.feet.size(); ++i) {
@@ -250,14 +279,27 @@ int run(int argc, char** argv) {
         continue;
       }
       bool needs_model = false;
-      for (const mf::Method& m : mf::registered_methods()) needs_model = needs_model || (m.name == method && m.needs_model);
+      std::string needs_inbetweener;
+      for (const mf::Method& m : mf::registered_methods()) {
+        if (m.name != method) continue;
+        needs_model = m.needs_model;
+        needs_inbetweener = m.needs_inbetweener;
+      }
       if (needs_model && !ctx.model) {
         emit("Method `" + method + "` needs a model and none was given (--model PATH): skipped on the " +
              mf::bench::task_name(task) + " task.\n\n");
         continue;
       }
+      if (!needs_inbetweener.empty() && !ctx.inbetweener(needs_inbetweener)) {
+        if (args.methods_given) {
+          emit("Method `" + method + "` needs the " + needs_inbetweener + " transformer (" +
+               mf::inbetweener_file_name(needs_inbetweener) + " next to the model, or --" + needs_inbetweener +
+               " PATH): skipped.\n\n");
+        }
+        continue;
+      }
       std::cerr << "running " << mf::bench::task_name(task) << " / " << method << "\n";
-      const mf::bench::TaskResult result = mf::bench::run_task(task, data.validation, stats, method, options, ctx);
+      const mf::bench::TaskResult result = mf::bench::run_task(task, clips, stats, method, options, ctx);
       emit(mf::bench::format_table(result, args.l2p_axes) + "\n");
     }
   }
@@ -271,15 +313,15 @@ int run(int argc, char** argv) {
     const auto t0 = std::chrono::steady_clock::now();
     std::string table;
     if (task == "recon") {
-      table = mf::bench::format_recon(mf::bench::run_recon(*model, data.validation, stats, prior_options));
+      table = mf::bench::format_recon(mf::bench::run_recon(*model, clips, stats, prior_options));
     } else if (task == "fps") {
-      table = mf::bench::format_fps(mf::bench::run_fps(*model, data.validation, prior_options));
+      table = mf::bench::format_fps(mf::bench::run_fps(*model, clips, prior_options));
     } else if (task == "seams") {
-      table = mf::bench::format_seams(mf::bench::run_seams(*model, data.validation, prior_options),
+      table = mf::bench::format_seams(mf::bench::run_seams(*model, clips, prior_options),
                                       prior_options.seam_radius);
     } else {
       table = mf::bench::format_sample(
-          mf::bench::run_sample(*model, data.validation, data.train, stats, prior_options));
+          mf::bench::run_sample(*model, clips, data.train, stats, prior_options));
     }
     emit(table + "\nTask wall time: " + fixed(seconds_since(t0), 1) + " s.\n\n");
   }

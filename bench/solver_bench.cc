@@ -11,7 +11,7 @@
 //                [--lengths 5,15] [--spacings 5,10] [--speed N] [--out FILE]
 //                [--iterations N] [--ftol X] [--ptol X] [--rank N] [--eigen-scaling 0|1]
 //                [--keyed-iterations N] [--adam-iterations N] [--adam-tol X] [--lock-ramp N] [--effector-falloff N] [--overwrite 0|1]
-//                [--penalty squared|absolute] [--init NAME]
+//                [--penalty squared|absolute] [--init NAME] [--twostage FILE] [--citl FILE]
 //                [--w-rot X] [--w-pos X] [--w-root-rot X] [--w-root X] [--w-prior X] [--w-skate X]
 //                [--w-smooth X] [--w-effector X]
 //
@@ -24,6 +24,14 @@
 // each solved by every solver method; wall time, iterations, evaluations and
 // the floor (one decoder forward + backward over 128 frames, times the
 // iterations) per solve.
+//
+// Transformers (tasks/transformer_methods.h): --twostage/--citl FILE, else
+// motionfield-twostage.mfm / motionfield-citl.mfm next to --model when they
+// exist. With them, --methods also takes "context", "detail", "citl" (one
+// pass of the transformer; no solver; speed = inference time per window) and
+// "nemf-context", "nemf-detail", "nemf-citl" (L-BFGS, with the L-BFGS options
+// above, started from that transformer's initialiser), and --init takes
+// "context-encoder", "detail-encoder", "citl-encoder".
 #include <ATen/ATen.h>
 #include <ATen/Parallel.h>
 
@@ -47,7 +55,10 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "tasks/baselines.h"
+#include "prior/inbetween/inbetweener.h"
+#include "tasks/initializers.h"
 #include "tasks/latent_solver.h"
+#include "tasks/transformer_methods.h"
 
 namespace {
 
@@ -92,7 +103,22 @@ struct Args {
   std::map<std::string, double> numbers;  // solver overrides
   std::string penalty;
   std::string init;
+  std::string twostage, citl;   // transformer files (default: next to --model)
+  mf::TaskContext transformers;  // the loaded transformers (filled by run())
 };
+
+// "context", "detail", "citl": one transformer pass, no solver.
+bool is_transformer_method(const std::string& method) {
+  return method == "context" || method == "detail" || method == "citl";
+}
+
+// The initialiser of "nemf-context" etc.; "" for the other methods.
+std::string transformer_initializer(const std::string& method) {
+  if (method == "nemf-context") return "context-encoder";
+  if (method == "nemf-detail") return "detail-encoder";
+  if (method == "nemf-citl") return "citl-encoder";
+  return "";
+}
 
 Args parse_args(int argc, char** argv) {
   Args a;
@@ -116,6 +142,8 @@ Args parse_args(int argc, char** argv) {
     else if (flag == "--out") a.out = v;
     else if (flag == "--penalty") a.penalty = v;
     else if (flag == "--init") a.init = v;
+    else if (flag == "--twostage") a.twostage = v;
+    else if (flag == "--citl") a.citl = v;
     else if (flag.rfind("--", 0) == 0) a.numbers[flag.substr(2)] = std::atof(v.c_str());
     else throw mf::InputError("unknown argument " + flag);
   }
@@ -134,7 +162,7 @@ mf::LatentSolverOptions solver_options(const Args& a, const std::string& method)
     *field = static_cast<std::remove_reference_t<decltype(*field)>>(it->second);
     n.erase(it);
   };
-  if (method == "nemf") {
+  if (method == "nemf" || !transformer_initializer(method).empty()) {
     take("iterations", &o.max_iterations);
     take("ftol", &o.function_tolerance);
     take("ptol", &o.parameter_tolerance);
@@ -167,7 +195,11 @@ mf::LatentSolverOptions solver_options(const Args& a, const std::string& method)
   if (!n.empty()) throw mf::InputError("unknown option --" + n.begin()->first);
   if (a.penalty == "absolute") o.weights.penalty = mf::Penalty::Absolute;
   else if (!a.penalty.empty() && a.penalty != "squared") throw mf::InputError("--penalty is squared or absolute");
-  if (!a.init.empty()) o.initializer = mf::make_initializer(a.init);
+  if (!transformer_initializer(method).empty()) {
+    o.initializer = mf::make_initializer(transformer_initializer(method), a.transformers);
+  } else if (!a.init.empty()) {
+    o.initializer = mf::make_initializer(a.init, a.transformers);
+  }
   return o;
 }
 
@@ -183,6 +215,19 @@ std::string describe(const mf::LatentSolverOptions& o) {
     << ", foot skating " << w.foot_skating << ", smoothness " << w.smoothness << "; penalty "
     << (w.penalty == mf::Penalty::Squared ? "squared" : "absolute");
   return s.str();
+}
+
+// A solver method (complete_motion with solver_options) or a transformer pass
+// (inbetweener_fill; `report` stays empty).
+mf::Motion complete(const mf::NemfModel& model, const Args& args, const std::string& method, const mf::Motion& input,
+                    const mf::MotionConstraints& constraints, mf::CompletionReport* report) {
+  if (is_transformer_method(method)) {
+    const bool citl = method == "citl";
+    const mf::InbetweenModel* t = args.transformers.inbetweener(citl ? "citl" : "twostage");
+    if (!t) throw mf::InputError(mf::missing_inbetweener_message("method '" + method + "'", citl ? "citl" : "twostage"));
+    return mf::inbetweener_fill(*t, method == "context" ? 0 : -1, input, constraints, mf::LongGapPolicy::Throw);
+  }
+  return mf::complete_motion(model, input, constraints, solver_options(args, method), {}, report);
 }
 
 struct Row {
@@ -205,8 +250,7 @@ struct Runner {
     }
     mf::CompletionReport report;
     const auto t0 = Clock::now();
-    mf::Motion out = mf::complete_motion(model, input, mf::MotionConstraints::full_pose(known),
-                                         solver_options(args, method), {}, &report);
+    mf::Motion out = complete(model, args, method, input, mf::MotionConstraints::full_pose(known), &report);
     row->ms += ms_since(t0);
     row->iterations += report.iterations;
     for (const auto& w : report.windows) row->evaluations += w.evaluations;
@@ -312,7 +356,7 @@ std::string constraint_table(const std::string& task, const std::string& method,
       }
       mf::CompletionReport report;
       const auto t0 = Clock::now();
-      const mf::Motion out = mf::complete_motion(runner.model, input, c, solver_options(args, method), {}, &report);
+      const mf::Motion out = complete(runner.model, args, method, input, c, &report);
       ms += ms_since(t0);
       acc.add(truth, out, evaluated, keys);
       if (v.joints.empty()) continue;
@@ -394,8 +438,7 @@ std::string long_table(const std::string& method, const Runner& runner, const st
     const mf::Motion input = mf::bench::hide_unknown_frames(truth, keys);
     mf::CompletionReport report;
     const auto t0 = Clock::now();
-    const mf::Motion out = mf::complete_motion(runner.model, input, mf::MotionConstraints::full_pose(keys),
-                                               solver_options(args, method), {}, &report);
+    const mf::Motion out = complete(runner.model, args, method, input, mf::MotionConstraints::full_pose(keys), &report);
     ms += ms_since(t0);
     solved_windows += static_cast<int>(report.windows.size());
     const mf::Motion interp = mf::interpolate_motion(input, keys);
@@ -460,13 +503,19 @@ double decoder_step_ms(const mf::NemfModel& model) {
 }
 
 int run(int argc, char** argv) {
-  const Args args = parse_args(argc, argv);
+  Args args = parse_args(argc, argv);
   at::set_num_threads(args.threads);
   std::string command = "solver-bench";
   for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
 
   mf::NemfModel model = mf::load_nemf(args.model);
   model.set_requires_grad(false);
+  for (const std::string kind : {"twostage", "citl"}) {
+    const std::string given = kind == "citl" ? args.citl : args.twostage;
+    const std::string path = given.empty() ? mf::inbetweener_path_next_to(args.model, kind) : given;
+    if (given.empty() && !std::ifstream(path)) continue;
+    (kind == "citl" ? args.transformers.citl : args.transformers.twostage) = mf::load_frozen_inbetweener(path, kind);
+  }
   mf::DatasetOptions data_options;
   data_options.source = mf::default_train_archive();
   data_options.cache_dir = mf::default_cache_dir();
@@ -482,8 +531,13 @@ int run(int argc, char** argv) {
   emit("## solver-bench\n\n- command: `" + command + "`\n- model: " + args.model + " (" + model.config().describe() +
        ")\n- split: " + args.split + " (" + std::to_string(clips.size()) + " clips)\n- torch threads: " +
        std::to_string(at::get_num_threads()) + "\n");
+  for (const char* kind : {"twostage", "citl"}) {
+    const mf::InbetweenModel* t = args.transformers.inbetweener(kind);
+    emit(std::string("- ") + kind + " transformer: " + (t ? t->describe() : std::string("not loaded")) + "\n");
+  }
   for (const std::string& m : args.methods) {
-    if (m != "interp") emit("- `" + m + "`: " + describe(solver_options(args, m)) + "\n");
+    if (is_transformer_method(m)) emit("- `" + m + "`: one pass of the transformer (no solver)\n");
+    else if (m != "interp") emit("- `" + m + "`: " + describe(solver_options(args, m)) + "\n");
   }
   emit("\n");
 
@@ -576,8 +630,7 @@ int run(int argc, char** argv) {
         const mf::Motion input = mf::bench::hide_unknown_frames(truth, keys);
         mf::CompletionReport report;
         const auto t0 = Clock::now();
-        mf::Motion out = mf::complete_motion(model, input, mf::MotionConstraints::full_pose(keys),
-                                             solver_options(args, method), {}, &report);
+        mf::Motion out = complete(model, args, method, input, mf::MotionConstraints::full_pose(keys), &report);
         ms.push_back(ms_since(t0));
         iters += report.iterations;
         for (const auto& r : report.windows) evals += r.evaluations;

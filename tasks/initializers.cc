@@ -6,6 +6,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "tasks/baselines.h"
+#include "tasks/transformer_methods.h"
 
 namespace mf {
 
@@ -84,14 +85,53 @@ InitialGuess ZeroInitializer::initialize(const InitRequest& r) const {
   return {at::zeros({1, r.model->config().zl}, at::kFloat), at::zeros({1, r.model->config().zg}, at::kFloat)};
 }
 
-std::vector<std::string> initializer_names() { return {"interp-encoder", "zero"}; }
+TransformerEncoderInitializer::TransformerEncoderInitializer(std::string name, std::string kind, int stage,
+                                                             std::shared_ptr<const InbetweenModel> bound)
+    : name_(std::move(name)), kind_(std::move(kind)), stage_(stage), bound_(std::move(bound)) {}
 
-std::shared_ptr<const LatentInitializer> make_initializer(const std::string& name) {
+InitialGuess TransformerEncoderInitializer::initialize(const InitRequest& r) const {
+  if (!r.model || !r.window || !r.constraints) throw std::invalid_argument("InitRequest is incomplete");
+  const InbetweenModel* transformer = bound_ ? bound_.get() : r.context ? r.context->inbetweener(kind_) : nullptr;
+  if (!transformer) throw InputError(missing_inbetweener_message("initialiser '" + name_ + "'", kind_));
+  const Motion filled = inbetweener_fill(*transformer, stage_, *r.window, *r.constraints, LongGapPolicy::Interpolate);
+  return encode_window(*r.model, filled, r.anchor);
+}
+
+std::vector<std::string> initializer_names() {
+  return {"interp-encoder", "zero", "context-encoder", "detail-encoder", "citl-encoder"};
+}
+
+namespace {
+
+std::shared_ptr<const LatentInitializer> make_named(const std::string& name, const TaskContext* context) {
   if (name == "interp-encoder") return std::make_shared<InterpolationEncoderInitializer>();
   if (name == "zero") return std::make_shared<ZeroInitializer>();
+  struct Transformer {
+    const char* name;
+    const char* kind;
+    int stage;
+  };
+  for (const Transformer& t : {Transformer{"context-encoder", "twostage", 0}, Transformer{"detail-encoder", "twostage", 1},
+                               Transformer{"citl-encoder", "citl", -1}}) {
+    if (name != t.name) continue;
+    std::shared_ptr<const InbetweenModel> bound;
+    if (context) {
+      bound = t.kind == std::string("citl") ? context->citl : context->twostage;
+      if (!bound) throw InputError(missing_inbetweener_message("initialiser '" + name + "'", t.kind));
+    }
+    return std::make_shared<TransformerEncoderInitializer>(t.name, t.kind, t.stage, std::move(bound));
+  }
   std::string list;
   for (const std::string& n : initializer_names()) list += (list.empty() ? "" : ", ") + n;
   throw InputError("unknown initialiser '" + name + "' (available: " + list + ")");
+}
+
+}  // namespace
+
+std::shared_ptr<const LatentInitializer> make_initializer(const std::string& name) { return make_named(name, nullptr); }
+
+std::shared_ptr<const LatentInitializer> make_initializer(const std::string& name, const TaskContext& context) {
+  return make_named(name, &context);
 }
 
 }  // namespace mf

@@ -2,9 +2,10 @@
 // starts. The solver asks an initialiser for the codes of one window, given the
 // window's constraints; the default is NeMF's (fill the unknown frames by
 // interpolation, encode the filled window, take the posterior means). Other
-// initialisers (the transformer issue's) implement the same interface and are
-// passed to the solver through LatentSolverOptions::initializer, or made by name
-// with make_initializer().
+// initialisers implement the same interface and are passed to the solver
+// through LatentSolverOptions::initializer, or made by name with
+// make_initializer(): the transformer initialisers fill the window with a
+// transformer in-betweener instead of interpolation (TransformerEncoderInitializer).
 #pragma once
 
 #include <ATen/core/Tensor.h>
@@ -19,6 +20,7 @@
 namespace mf {
 
 class NemfModel;
+class InbetweenModel;
 
 /// Starting codes of one window.
 struct InitialGuess {
@@ -67,10 +69,44 @@ class ZeroInitializer : public LatentInitializer {
   InitialGuess initialize(const InitRequest& request) const override;
 };
 
-/// Names accepted by make_initializer(), the default first.
+/// The transformer initialisers: the window's constraints (full and partial
+/// keys, each joint's rotation and the root position known where a key gives
+/// them) -> one pass of a transformer in-betweener (inbetweener_fill() of
+/// tasks/transformer_methods.h: gaps longer than the transformer's window stay
+/// interpolated, frames before the first and after the last key that fixes
+/// the root are held) -> the filled window canonicalised at the anchor and
+/// encoded (encode_window); the codes are the posterior means.
+///   "context-encoder"  stage 0 of the two-stage model (TaskContext::twostage)
+///   "detail-encoder"   stage 1 of the two-stage model
+///   "citl-encoder"     the CITL model (TaskContext::citl)
+/// The transformer is the one bound at construction, else the request
+/// context's; initialize() throws mf::InputError when there is none.
+class TransformerEncoderInitializer : public LatentInitializer {
+ public:
+  /// `kind` "twostage" or "citl"; `stage` 0-based, -1 = the last.
+  TransformerEncoderInitializer(std::string name, std::string kind, int stage,
+                                std::shared_ptr<const InbetweenModel> bound = nullptr);
+  std::string name() const override { return name_; }
+  InitialGuess initialize(const InitRequest& request) const override;
+  const std::string& kind() const { return kind_; }
+
+ private:
+  std::string name_, kind_;
+  int stage_;
+  std::shared_ptr<const InbetweenModel> bound_;
+};
+
+/// Names accepted by make_initializer(), the default first: "interp-encoder",
+/// "zero", "context-encoder", "detail-encoder", "citl-encoder".
 std::vector<std::string> initializer_names();
-/// The initialiser called `name`; throws mf::InputError listing the names otherwise.
+/// The initialiser called `name`; throws mf::InputError listing the names
+/// otherwise. Transformer initialisers made this way take their model from
+/// the request's context at each call.
 std::shared_ptr<const LatentInitializer> make_initializer(const std::string& name);
+/// The same, with a transformer initialiser bound to the transformer of
+/// `context` (InputError naming the missing file when it has none), so that
+/// it needs no context at solve time.
+std::shared_ptr<const LatentInitializer> make_initializer(const std::string& name, const TaskContext& context);
 
 /// The window `window` (all frames meaningful) canonicalised at `anchor` and
 /// encoded: the posterior means. For initialisers that produce a full motion.

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "prior/motion/errors.h"
+#include "tasks/transformer_methods.h"
 
 namespace mf {
 namespace {
@@ -25,6 +26,8 @@ const Method& resolve_method(const std::string& method, const TaskContext& ctx) 
     if (a.needs_model && !ctx.model) {
       throw InputError("method '" + m + "' needs the prior, and no model is loaded (name one with --model)");
     }
+    if (!a.needs_inbetweener.empty() && !ctx.inbetweener(a.needs_inbetweener))
+      throw InputError(missing_inbetweener_message("method '" + m + "'", a.needs_inbetweener));
     return a;
   }
   throw InputError("unknown method '" + method + "' (available: " + method_list() + ")");
@@ -42,7 +45,7 @@ void check_motion(const Motion& input) {
 const std::vector<Method>& registered_methods() {
   static const std::vector<Method> methods = [] {
     std::vector<Method> all = baseline_methods();
-    for (auto family : {prior_methods, solver_methods}) {
+    for (auto family : {prior_methods, solver_methods, transformer_methods}) {
       for (Method& m : family()) all.push_back(std::move(m));
     }
     return all;

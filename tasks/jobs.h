@@ -6,7 +6,9 @@
 // Methods are registered in tasks/method.h. An empty method name means
 // default_method(ctx); an unregistered name throws InputError listing the
 // available ones; a method that needs the prior throws InputError when the
-// context has no model; a method that does not support the task throws
+// context has no model, or the transformer it needs (Method::needs_inbetweener:
+// missing_inbetweener_message() of tasks/transformer_methods.h); a method that
+// does not support the task throws
 // InputError saying so.
 #pragma once
 
@@ -18,7 +20,8 @@
 
 namespace mf {
 
-/// Every registered method (baselines, the prior's, the solvers'), in a fixed order.
+/// Every registered method (baselines, the prior's, the solvers', the
+/// transformers'), in a fixed order.
 const std::vector<Method>& registered_methods();
 /// Names accepted by --method, e.g. {"interp", "zerovel", ...}.
 std::vector<std::string> available_methods();

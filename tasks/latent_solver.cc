@@ -1,11 +1,6 @@
 #include "tasks/latent_solver.h"
 
 #include <ATen/ATen.h>
-#include <ceres/first_order_function.h>
-#include <ceres/gradient_problem.h>
-#include <ceres/gradient_problem_solver.h>
-#include <ceres/iteration_callback.h>
-#include <torch/csrc/autograd/autograd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -18,6 +13,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "tasks/latent_optimizer.h"
 
 namespace mf {
 namespace {
@@ -55,16 +51,8 @@ struct FlatEnergy {
   EnergyTerms operator()(const at::Tensor& x) const {
     return evaluate_energy(model, problem, weights, x.narrow(0, 0, zl).view({1, zl}), x.narrow(0, zl, zg).view({1, zg}));
   }
-  // Cost and gradient at x (a fresh leaf is made from it).
-  double with_gradient(const at::Tensor& x, at::Tensor* gradient) const {
-    at::Tensor leaf = x.detach().clone().requires_grad_(true);
-    EnergyTerms e = (*this)(leaf);
-    *gradient = torch::autograd::grad({e.total}, {leaf})[0];
-    return e.total.item<double>();
-  }
-  double cost(const at::Tensor& x) const {
-    at::NoGradGuard no_grad;
-    return (*this)(x).total.item<double>();
+  LatentEnergy total() const {
+    return [this](const at::Tensor& x) { return (*this)(x).total; };
   }
   std::vector<std::pair<std::string, double>> terms(const at::Tensor& x, double* total) const {
     at::NoGradGuard no_grad;
@@ -76,137 +64,21 @@ struct FlatEnergy {
   }
 };
 
-class CeresEnergy final : public ceres::FirstOrderFunction {
- public:
-  explicit CeresEnergy(const FlatEnergy& e) : energy_(e) {}
-  int NumParameters() const override { return energy_.zl + energy_.zg; }
-  bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
-    ++evaluations_;
-    try {
-      at::Tensor x = at::from_blob(const_cast<double*>(parameters), {NumParameters()}, at::kDouble).to(at::kFloat);
-      if (!gradient) {
-        *cost = energy_.cost(x);
-        return std::isfinite(*cost);
-      }
-      at::Tensor g;
-      *cost = energy_.with_gradient(x, &g);
-      at::Tensor gd = g.to(at::kDouble).contiguous();
-      std::copy(gd.data_ptr<double>(), gd.data_ptr<double>() + NumParameters(), gradient);
-      if (!std::isfinite(*cost)) return false;
-      for (int i = 0; i < NumParameters(); ++i) {
-        if (!std::isfinite(gradient[i])) return false;
-      }
-      return true;
-    } catch (...) {
-      if (!error_) error_ = std::current_exception();
-      return false;
-    }
-  }
-  int evaluations() const { return evaluations_; }
-  std::exception_ptr error() const { return error_; }
-
- private:
-  FlatEnergy energy_;
-  mutable int evaluations_ = 0;
-  mutable std::exception_ptr error_;
-};
-
-class ProgressCallback final : public ceres::IterationCallback {
- public:
-  ProgressCallback(const TaskContext& ctx, int offset, int total) : ctx_(ctx), offset_(offset), total_(total) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    try {
-      ctx_.report({offset_ + s.iteration, total_, s.cost});
-    } catch (const CancelledError&) {
-      cancelled = true;
-      return ceres::SOLVER_ABORT;
-    }
-    return ceres::SOLVER_CONTINUE;
-  }
-  bool cancelled = false;
-
- private:
-  const TaskContext& ctx_;
-  int offset_, total_;
-};
-
-at::Tensor solve_lbfgs(const FlatEnergy& energy, const at::Tensor& x0, const LatentSolverOptions& o, int cap,
-                       const TaskContext& ctx, int offset, int total, SolveSummary* summary) {
-  const int n = energy.zl + energy.zg;
-  std::vector<double> x(n);
-  {
-    at::Tensor d = x0.to(at::kDouble).contiguous();
-    std::copy(d.data_ptr<double>(), d.data_ptr<double>() + n, x.begin());
-  }
-  auto* function = new CeresEnergy(energy);
-  ceres::GradientProblem problem(function);  // takes ownership
-  ceres::GradientProblemSolver::Options options;
-  options.line_search_direction_type = ceres::LBFGS;
-  options.max_lbfgs_rank = o.lbfgs_rank;
-  options.use_approximate_eigenvalue_bfgs_scaling = o.lbfgs_eigenvalue_scaling;
-  options.max_num_iterations = cap;
-  options.function_tolerance = o.function_tolerance;
-  options.gradient_tolerance = o.gradient_tolerance;
-  options.parameter_tolerance = o.parameter_tolerance;
-  options.logging_type = ceres::SILENT;
-  options.minimizer_progress_to_stdout = false;
-  ProgressCallback progress(ctx, offset, total);
-  options.callbacks.push_back(&progress);
-  std::string why;
-  if (!options.IsValid(&why)) throw InputError("invalid L-BFGS options: " + why);
-  ceres::GradientProblemSolver::Summary s;
-  ceres::Solve(options, problem, x.data(), &s);
-  if (progress.cancelled) throw CancelledError();
-  if (function->error()) std::rethrow_exception(function->error());
-  summary->iterations = std::max(0, static_cast<int>(s.iterations.size()) - 1);
-  summary->evaluations = function->evaluations();
-  summary->converged = s.termination_type == ceres::CONVERGENCE;
-  summary->message = s.message;
-  return at::from_blob(x.data(), {n}, at::kDouble).to(at::kFloat);
-}
-
-at::Tensor solve_adam(const FlatEnergy& energy, const at::Tensor& x0, const LatentSolverOptions& o, int cap,
-                      const TaskContext& ctx, int offset, int total, SolveSummary* summary) {
-  const double b1 = 0.9, b2 = 0.999, eps = 1e-8;
-  at::Tensor x = x0.clone();
-  at::Tensor m = at::zeros_like(x), v = at::zeros_like(x);
-  at::Tensor best_x = x.clone();
-  double best = std::numeric_limits<double>::infinity();
-  std::vector<double> best_history;
-  summary->message = "iteration cap reached";
-  int it = 0;
-  for (; it < cap; ++it) {
-    at::Tensor g;
-    const double f = energy.with_gradient(x, &g);
-    ++summary->evaluations;
-    if (!std::isfinite(f)) {
-      summary->message = "non-finite energy";
-      break;
-    }
-    if (f < best) {
-      best = f;
-      best_x = x.clone();
-    }
-    best_history.push_back(best);
-    ctx.report({offset + it, total, f});
-    if (it >= o.adam_patience) {
-      const double before = best_history[it - o.adam_patience];
-      if (before - best <= o.adam_tolerance * std::abs(before)) {
-        summary->converged = true;
-        summary->message = "converged: the energy improved by less than the tolerance over the patience window";
-        ++it;
-        break;
-      }
-    }
-    const double lr = o.adam_lr * std::pow(o.adam_decay, it / std::max(1, o.adam_decay_every));
-    at::NoGradGuard no_grad;
-    m.mul_(b1).add_(g, 1 - b1);
-    v.mul_(b2).addcmul_(g, g, 1 - b2);
-    const double c1 = 1 - std::pow(b1, it + 1), c2 = 1 - std::pow(b2, it + 1);
-    x = x - (m / c1) / ((v / c2).sqrt() + eps) * lr;
-  }
-  summary->iterations = it;
-  return best_x;
+LatentOptimizerSettings optimizer_settings(const LatentSolverOptions& o, int cap) {
+  LatentOptimizerSettings s;
+  s.method = o.method == SolverMethod::Adam ? LatentOptimizer::Adam : LatentOptimizer::Lbfgs;
+  s.max_iterations = cap;
+  s.lbfgs_rank = o.lbfgs_rank;
+  s.lbfgs_eigenvalue_scaling = o.lbfgs_eigenvalue_scaling;
+  s.function_tolerance = o.function_tolerance;
+  s.gradient_tolerance = o.gradient_tolerance;
+  s.parameter_tolerance = o.parameter_tolerance;
+  s.adam_lr = o.adam_lr;
+  s.adam_decay_every = o.adam_decay_every;
+  s.adam_decay = o.adam_decay;
+  s.adam_tolerance = o.adam_tolerance;
+  s.adam_patience = o.adam_patience;
+  return s;
 }
 
 // ---------------------------------------------------------------------------
@@ -534,15 +406,15 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
     EnergyWeights keyed = w;
     keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
     const FlatEnergy cheap{model, problem, keyed, zl, zg};
-    SolveSummary first;
-    x = solve_lbfgs(cheap, x, options, options.keyed_iterations, ctx, iteration_offset, total, &first);
+    LatentOptimizerStats first;
+    x = minimize_latent(cheap.total(), x, optimizer_settings(options, options.keyed_iterations), ctx, &first,
+                        iteration_offset, total);
     s.keyed_iterations = first.iterations;
     s.evaluations += first.evaluations;
   }
-  SolveSummary main;
-  x = options.method == SolverMethod::Lbfgs
-          ? solve_lbfgs(energy, x, options, cap, ctx, iteration_offset + s.keyed_iterations, total, &main)
-          : solve_adam(energy, x, options, cap, ctx, iteration_offset, total, &main);
+  LatentOptimizerStats main;
+  x = minimize_latent(energy.total(), x, optimizer_settings(options, cap), ctx, &main,
+                      iteration_offset + s.keyed_iterations, total);
   s.iterations = s.keyed_iterations + main.iterations;
   s.evaluations += main.evaluations;
   s.converged = main.converged;

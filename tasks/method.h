@@ -16,6 +16,7 @@
 namespace mf {
 
 class NemfModel;
+class InbetweenModel;
 
 /// Progress of a long-running method (a solver's iterations).
 struct TaskProgress {
@@ -35,11 +36,28 @@ struct TaskContext {
   /// The prior; required by methods with needs_model, unused by the baselines.
   /// Immutable and shared between threads.
   std::shared_ptr<const NemfModel> model;
+  /// The transformer in-betweeners (prior/inbetween/inbetweener.h), each null
+  /// when not loaded: `twostage` (kind "twostage": methods "context", "detail",
+  /// the initialisers "context-encoder", "detail-encoder") and `citl` (kind
+  /// "citl": method "citl", initialiser "citl-encoder"). On the prior's
+  /// skeleton; frozen (set_requires_grad(false)), immutable and shared between
+  /// threads like the prior. The C API loads them from
+  /// motionfield-twostage.mfm and motionfield-citl.mfm next to the prior's file.
+  std::shared_ptr<const InbetweenModel> twostage;
+  std::shared_ptr<const InbetweenModel> citl;
   uint64_t seed = 0;
   /// Called now and then by long methods; returning false cancels.
   std::function<bool(const TaskProgress&)> progress;
   /// Non-zero cancels (thread-safe; set from any thread).
   const std::atomic<int>* cancel = nullptr;
+
+  /// The transformer of `kind` ("twostage" or "citl"); null when not loaded
+  /// or for any other kind.
+  const InbetweenModel* inbetweener(const std::string& kind) const {
+    if (kind == "twostage") return twostage.get();
+    if (kind == "citl") return citl.get();
+    return nullptr;
+  }
 
   /// Calls `progress` and checks `cancel`; throws CancelledError when asked to stop.
   void report(const TaskProgress& p) const {
@@ -51,6 +69,9 @@ struct Method {
   std::string name;
   std::string description;
   bool needs_model = false;
+  /// Kind of transformer in-betweener the method needs besides the prior
+  /// ("twostage" or "citl", see TaskContext); empty for none.
+  std::string needs_inbetweener;
   /// Completes a motion from its known frames (sorted, unique, at least two,
   /// in range): every other frame is produced, known frames come out as given.
   /// Unknown input frames must never be read. Null when unsupported.
@@ -64,5 +85,6 @@ struct Method {
 std::vector<Method> baseline_methods();  // tasks/baselines.cc
 std::vector<Method> prior_methods();     // tasks/prior_methods.cc
 std::vector<Method> solver_methods();    // tasks/solver_methods.cc
+std::vector<Method> transformer_methods();  // tasks/transformer_methods.cc
 
 }  // namespace mf

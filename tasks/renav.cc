@@ -1,11 +1,6 @@
 #include "tasks/renav.h"
 
 #include <ATen/ATen.h>
-#include <ceres/first_order_function.h>
-#include <ceres/gradient_problem.h>
-#include <ceres/gradient_problem_solver.h>
-#include <ceres/iteration_callback.h>
-#include <torch/csrc/autograd/autograd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -25,6 +20,7 @@
 #include "prior/motion/rotations_torch.h"
 #include "tasks/baselines.h"
 #include "tasks/initializers.h"
+#include "tasks/latent_optimizer.h"
 
 namespace mf {
 namespace {
@@ -472,11 +468,8 @@ struct FlatEnergy {
     return evaluate_renav_energy(model, window, weights, x.narrow(0, 0, zl).view({1, zl}),
                                  x.narrow(0, zl, zg).view({1, zg}));
   }
-  double with_gradient(const at::Tensor& x, at::Tensor* gradient) const {
-    at::Tensor leaf = x.detach().clone().requires_grad_(true);
-    RenavEnergy e = (*this)(leaf);
-    *gradient = torch::autograd::grad({e.total}, {leaf})[0];
-    return e.total.item<double>();
+  LatentEnergy total() const {
+    return [this](const at::Tensor& x) { return (*this)(x).total; };
   }
   double cost(const at::Tensor& x) const {
     at::NoGradGuard no_grad;
@@ -492,136 +485,20 @@ struct FlatEnergy {
   }
 };
 
-class CeresEnergy final : public ceres::FirstOrderFunction {
- public:
-  explicit CeresEnergy(const FlatEnergy& e) : energy_(e) {}
-  int NumParameters() const override { return energy_.zl + energy_.zg; }
-  bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
-    ++evaluations_;
-    try {
-      at::Tensor x = at::from_blob(const_cast<double*>(parameters), {NumParameters()}, at::kDouble).to(at::kFloat);
-      if (!gradient) {
-        *cost = energy_.cost(x);
-        return std::isfinite(*cost);
-      }
-      at::Tensor g;
-      *cost = energy_.with_gradient(x, &g);
-      at::Tensor gd = g.to(at::kDouble).contiguous();
-      std::copy(gd.data_ptr<double>(), gd.data_ptr<double>() + NumParameters(), gradient);
-      if (!std::isfinite(*cost)) return false;
-      for (int i = 0; i < NumParameters(); ++i) {
-        if (!std::isfinite(gradient[i])) return false;
-      }
-      return true;
-    } catch (...) {
-      if (!error_) error_ = std::current_exception();
-      return false;
-    }
-  }
-  int evaluations() const { return evaluations_; }
-  std::exception_ptr error() const { return error_; }
-
- private:
-  FlatEnergy energy_;
-  mutable int evaluations_ = 0;
-  mutable std::exception_ptr error_;
-};
-
-class ProgressCallback final : public ceres::IterationCallback {
- public:
-  ProgressCallback(const TaskContext& ctx, int offset, int total) : ctx_(ctx), offset_(offset), total_(total) {}
-  ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    try {
-      ctx_.report({offset_ + s.iteration, total_, s.cost});
-    } catch (const CancelledError&) {
-      cancelled = true;
-      return ceres::SOLVER_ABORT;
-    }
-    return ceres::SOLVER_CONTINUE;
-  }
-  bool cancelled = false;
-
- private:
-  const TaskContext& ctx_;
-  int offset_, total_;
-};
-
-at::Tensor solve_lbfgs(const FlatEnergy& energy, const at::Tensor& x0, const RenavOptions& o, int cap,
-                       const TaskContext& ctx, int offset, int total, RenavWindowSummary* summary) {
-  const int n = energy.zl + energy.zg;
-  std::vector<double> x(n);
-  {
-    at::Tensor d = x0.to(at::kDouble).contiguous();
-    std::copy(d.data_ptr<double>(), d.data_ptr<double>() + n, x.begin());
-  }
-  auto* function = new CeresEnergy(energy);
-  ceres::GradientProblem problem(function);  // takes ownership
-  ceres::GradientProblemSolver::Options options;
-  options.line_search_direction_type = ceres::LBFGS;
-  options.max_lbfgs_rank = o.lbfgs_rank;
-  options.max_num_iterations = cap;
-  options.function_tolerance = o.function_tolerance;
-  options.gradient_tolerance = o.gradient_tolerance;
-  options.parameter_tolerance = o.parameter_tolerance;
-  options.logging_type = ceres::SILENT;
-  options.minimizer_progress_to_stdout = false;
-  ProgressCallback progress(ctx, offset, total);
-  options.callbacks.push_back(&progress);
-  std::string why;
-  if (!options.IsValid(&why)) throw InputError("invalid L-BFGS options: " + why);
-  ceres::GradientProblemSolver::Summary s;
-  ceres::Solve(options, problem, x.data(), &s);
-  if (progress.cancelled) throw CancelledError();
-  if (function->error()) std::rethrow_exception(function->error());
-  summary->iterations = std::max(0, static_cast<int>(s.iterations.size()) - 1);
-  summary->evaluations = function->evaluations();
-  summary->converged = s.termination_type == ceres::CONVERGENCE;
-  summary->message = s.message;
-  return at::from_blob(x.data(), {n}, at::kDouble).to(at::kFloat);
-}
-
-at::Tensor solve_adam(const FlatEnergy& energy, const at::Tensor& x0, const RenavOptions& o, int cap,
-                      const TaskContext& ctx, int offset, int total, RenavWindowSummary* summary) {
-  const double b1 = 0.9, b2 = 0.999, eps = 1e-8;
-  at::Tensor x = x0.clone();
-  at::Tensor m = at::zeros_like(x), v = at::zeros_like(x);
-  at::Tensor best_x = x.clone();
-  double best = std::numeric_limits<double>::infinity();
-  std::vector<double> history;
-  summary->message = "iteration cap reached";
-  int it = 0;
-  for (; it < cap; ++it) {
-    at::Tensor g;
-    const double f = energy.with_gradient(x, &g);
-    ++summary->evaluations;
-    if (!std::isfinite(f)) {
-      summary->message = "non-finite energy";
-      break;
-    }
-    if (f < best) {
-      best = f;
-      best_x = x.clone();
-    }
-    history.push_back(best);
-    ctx.report({offset + it, total, f});
-    if (it >= o.adam_patience) {
-      const double before = history[it - o.adam_patience];
-      if (before - best <= o.adam_tolerance * std::abs(before)) {
-        summary->converged = true;
-        summary->message = "converged: the energy improved by less than the tolerance over the patience window";
-        ++it;
-        break;
-      }
-    }
-    const double lr = o.adam_lr * std::pow(o.adam_decay, it / std::max(1, o.adam_decay_every));
-    at::NoGradGuard no_grad;
-    m.mul_(b1).add_(g, 1 - b1);
-    v.mul_(b2).addcmul_(g, g, 1 - b2);
-    const double c1 = 1 - std::pow(b1, it + 1), c2 = 1 - std::pow(b2, it + 1);
-    x = x - (m / c1) / ((v / c2).sqrt() + eps) * lr;
-  }
-  summary->iterations = it;
-  return best_x;
+LatentOptimizerSettings optimizer_settings(const RenavOptions& o, int cap) {
+  LatentOptimizerSettings s;
+  s.method = o.solver == RenavSolver::Adam ? LatentOptimizer::Adam : LatentOptimizer::Lbfgs;
+  s.max_iterations = cap;
+  s.lbfgs_rank = o.lbfgs_rank;
+  s.function_tolerance = o.function_tolerance;
+  s.gradient_tolerance = o.gradient_tolerance;
+  s.parameter_tolerance = o.parameter_tolerance;
+  s.adam_lr = o.adam_lr;
+  s.adam_decay_every = o.adam_decay_every;
+  s.adam_decay = o.adam_decay;
+  s.adam_tolerance = o.adam_tolerance;
+  s.adam_patience = o.adam_patience;
+  return s;
 }
 
 const std::vector<std::string>& init_names() {
@@ -769,9 +646,13 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
       }
     }
     sum.initial_terms = energy.terms(x0, &sum.initial_energy);
-    const at::Tensor x = options.solver == RenavSolver::Lbfgs
-                             ? solve_lbfgs(energy, x0, options, cap, ctx, iterations, cap * windows, &sum)
-                             : solve_adam(energy, x0, options, cap, ctx, iterations, cap * windows, &sum);
+    LatentOptimizerStats stats;
+    const at::Tensor x =
+        minimize_latent(energy.total(), x0, optimizer_settings(options, cap), ctx, &stats, iterations, cap * windows);
+    sum.iterations = stats.iterations;
+    sum.evaluations = stats.evaluations;
+    sum.converged = stats.converged;
+    sum.message = stats.message;
     sum.final_terms = energy.terms(x, &sum.final_energy);
     iterations += sum.iterations;
 

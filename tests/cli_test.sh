@@ -250,6 +250,42 @@ fi
 bad "renav without a path" renav --in "$SMALL" --out "$TMP/bad.bvh"
 MF_MODEL="$TMP/none.mfm" bad "renav without a model" renav --in "$SMALL" --path "$TMP/path50.csv" --out "$TMP/bad.bvh"
 
+# ------------------------------------------------------------ transformer methods
+# Tiny random transformers next to a tiny prior (mf_capi_tiny_model --transformers),
+# so no trained file is needed; skipped when the helper is not built.
+HELPER="$(dirname "$MF")/mf_capi_tiny_model"
+if [ -x "$HELPER" ] && mkdir -p "$TMP/tr" "$TMP/notr" && "$HELPER" "$TMP/tr/prior.mfm" --transformers &&
+   "$HELPER" "$TMP/notr/prior.mfm"; then
+  for method in context detail citl nemf-citl; do
+    expect_rc 0 "inbetween --method $method (transformers next to the model)" -- \
+      "$MF" --model "$TMP/tr/prior.mfm" --threads 1 inbetween --in "$SMALL" --keyframes 0,12,39 \
+      --out "$TMP/tr-$method.bvh" --method "$method"
+    expect_frames "$TMP/tr-$method.bvh" 40
+    expect_rc 0 "$method keeps the keyframes" -- "$MF" diff "$SMALL" "$TMP/tr-$method.bvh" --frames 0,12,39
+  done
+  expect_rc 0 "fill --method detail" -- "$MF" --model "$TMP/tr/prior.mfm" --threads 1 fill --in "$SMALL" --gap 10:25 \
+    --out "$TMP/tr-fill.bvh" --method detail
+  expect_rc 0 "fill --method detail keeps the known frames" -- "$MF" diff "$SMALL" "$TMP/tr-fill.bvh" --frames 0,9,25,39
+  printf '%s\n' "{\"task\": \"inbetween\", \"in\": \"$SMALL\", \"out\": \"$TMP/tr-b1.bvh\", \"keyframes\": [0, 20, 39], \"method\": \"citl\"}" \
+    "{\"task\": \"fill\", \"in\": \"$SMALL\", \"out\": \"$TMP/tr-b2.bvh\", \"gap\": [5, 30], \"method\": \"context\"}" >"$TMP/tr-jobs.jsonl"
+  expect_rc 0 "batch with transformer methods" -- "$MF" --model "$TMP/tr/prior.mfm" --threads 1 batch "$TMP/tr-jobs.jsonl"
+  expect_frames "$TMP/tr-b1.bvh" 40
+  expect_frames "$TMP/tr-b2.bvh" 40
+  bad "citl without its file" --model "$TMP/notr/prior.mfm" inbetween --in "$SMALL" --keyframes 0,39 \
+    --out "$TMP/bad.bvh" --method citl
+  expect_stderr "needs models/motionfield-citl.mfm" "missing transformer message"
+  expect_rc 0 "--citl PATH adds the transformer" -- "$MF" --model "$TMP/notr/prior.mfm" --citl "$TMP/tr/motionfield-citl.mfm" \
+    --threads 1 inbetween --in "$SMALL" --keyframes 0,20,39 --out "$TMP/tr-explicit.bvh" --method citl
+  bad "--twostage naming a prior" --model "$TMP/notr/prior.mfm" --twostage "$TMP/notr/prior.mfm" inbetween --in "$SMALL" \
+    --keyframes 0,39 --out "$TMP/bad.bvh" --method detail
+  expect_stderr "wrong kind" "--twostage with a file of another kind"
+  bad "keys further apart than the transformer's window" --model "$TMP/tr/prior.mfm" inbetween --in "$SMALL" \
+    --keyframes 0,39 --out "$TMP/bad.bvh" --method citl
+  expect_stderr "frames apart" "long-gap message"
+else
+  echo "cli_test: mf_capi_tiny_model not built: transformer method runs skipped"
+fi
+
 # ------------------------------------------------------------ batch
 mkdir -p "$TMP/batch"
 cp "$SAMPLE" "$TMP/batch/walk.bvh"

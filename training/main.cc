@@ -2,8 +2,11 @@
 //
 //   motionfield-train prior --out DIR [--data PATH] [--config FILE] [--width N] [--layers N]
 //                           [--zl N] [--zg N] [--max-minutes M] [--seed S] [--threads N] [--resume] ...
+//   motionfield-train twostage|citl --out DIR [--data PATH] [--hp key=value]... [--config FILE]
+//                           [--max-minutes M] [--seed S] [--threads N] [--resume] [--export PATH] ...
 //
 // Exit codes: 0 ok, 2 bad input, 1 internal error.
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -12,14 +15,20 @@
 #include <string>
 
 #include "prior/data/dataset.h"
+#include "prior/inbetween/inbetweener.h"
 #include "prior/model/model_file.h"
 #include "prior/motion/errors.h"
+#include "training/inbetween_trainer.h"
 #include "training/prior_trainer.h"
 
 namespace {
 
 const char* kUsage =
     "usage: motionfield-train prior --out DIR [options]\n"
+    "       motionfield-train twostage --out DIR [in-betweener options]\n"
+    "       motionfield-train citl --out DIR [in-betweener options]\n"
+    "\n"
+    "prior options:\n"
     "  --data PATH          folder or .tar/.tar.xz/.tar.gz of BVH files (default: the shared training archive)\n"
     "  --cache-dir DIR      extraction and parse cache (default: <project>/.cache)\n"
     "  --config FILE        key = value lines, same keys as the flags below without '--'\n"
@@ -30,7 +39,24 @@ const char* kUsage =
     "  --kl-weight X --kl-warmup X --seed N --threads N (default 2) --max-train-clips N --max-steps N\n"
     "  --resume             continue from DIR/last.* if present\n"
     "  --export PATH        copy the best checkpoint to PATH at the end\n"
-    "  --quiet\n";
+    "  --quiet\n"
+    "\n"
+    "in-betweener options (twostage: context + detail transformers; citl):\n"
+    "  --data PATH --cache-dir DIR   as for the prior (same data, same split)\n"
+    "  --hp KEY=VALUE       a model hyperparameter (repeatable), e.g. --hp width=128 --hp layers=3\n"
+    "                       (keys of the kind: width, layers, heads, ffn, window, fps, ...)\n"
+    "  --config FILE        key = value lines: the options below without '--'; any other key is a\n"
+    "                       hyperparameter\n"
+    "  --max-minutes M      wall-time budget, counting earlier runs when resuming (default 60)\n"
+    "  --max-epochs N --max-steps N --batch N (32) --lr X (5e-4) --lr-final X (1e-5) --warmup F (0.03)\n"
+    "  --min-length N (12) --contact-weight X (0.5) --checkpoint-minutes M (5) --validate-minutes M (6)\n"
+    "  --epoch-steps N (0 = one pass over the training frames) --validation-windows N (256)\n"
+    "  --seed N --threads N (default 1) --max-train-clips N\n"
+    "  --resume             continue from DIR/last.* if present\n"
+    "  --export PATH        copy the best checkpoint to PATH at the end\n"
+    "  --quiet\n"
+    "\n"
+    "Exit codes: 0 ok, 2 bad input, 1 internal error.\n";
 
 double number(const std::string& key, const std::string& value) {
   size_t used = 0;
@@ -78,7 +104,11 @@ void apply(mf::PriorTrainingOptions& o, std::string& export_path, const std::str
   else throw mf::InputError("unknown option --" + key);
 }
 
-void read_config(mf::PriorTrainingOptions& o, std::string& export_path, const std::string& path) {
+void apply(mf::InbetweenTrainingOptions& o, std::string& export_path, const std::string& key,
+           const std::string& value);
+
+template <class Options>
+void read_config(Options& o, std::string& export_path, const std::string& path) {
   std::ifstream in(path);
   if (!in) throw mf::InputError(path + ": cannot open the config file");
   std::string line;
@@ -98,6 +128,91 @@ void read_config(mf::PriorTrainingOptions& o, std::string& export_path, const st
   }
 }
 
+void apply(mf::InbetweenTrainingOptions& o, std::string& export_path, const std::string& key,
+           const std::string& value) {
+  auto i = [&] { return static_cast<int>(number(key, value)); };
+  auto d = [&] { return number(key, value); };
+  if (key == "data") o.data = value;
+  else if (key == "cache-dir") o.cache_dir = value;
+  else if (key == "out") o.out_dir = value;
+  else if (key == "max-minutes") o.max_minutes = d();
+  else if (key == "max-epochs") o.max_epochs = i();
+  else if (key == "max-steps") o.max_steps = i();
+  else if (key == "batch") o.batch = i();
+  else if (key == "lr") o.lr = d();
+  else if (key == "lr-final") o.lr_final = d();
+  else if (key == "warmup") o.warmup = d();
+  else if (key == "min-length") o.min_length = i();
+  else if (key == "contact-weight") o.contact_weight = d();
+  else if (key == "checkpoint-minutes") o.checkpoint_minutes = d();
+  else if (key == "validate-minutes") o.validate_minutes = d();
+  else if (key == "epoch-steps") o.epoch_steps = i();
+  else if (key == "validation-windows") o.validation_windows = i();
+  else if (key == "seed") o.seed = static_cast<uint64_t>(d());
+  else if (key == "threads") o.threads = i();
+  else if (key == "max-train-clips") o.max_train_clips = i();
+  else if (key == "export") export_path = value;
+  else if (key == "hp") {
+    size_t eq = value.find('=');
+    if (eq == std::string::npos || eq == 0) throw mf::InputError("--hp: expected KEY=VALUE, got '" + value + "'");
+    std::string k = value.substr(0, eq);
+    o.hyperparameters[k] = number("hp " + k, value.substr(eq + 1));
+  } else {
+    o.hyperparameters[key] = number(key, value);  // config files: any other key is a hyperparameter
+  }
+}
+
+int train_inbetweener_main(const std::string& kind, int argc, char** argv) {
+  mf::InbetweenTrainingOptions o;
+  o.kind = kind;
+  o.data = mf::default_train_archive();
+  o.cache_dir = mf::default_cache_dir();
+  std::string export_path;
+  for (int i = 2; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a == "--resume") o.resume = true;
+    else if (a == "--quiet") o.verbose = false;
+    else if (a == "--help") {
+      std::fputs(kUsage, stdout);
+      return 0;
+    } else if (a.rfind("--", 0) == 0 && i + 1 < argc) {
+      std::string key = a.substr(2), value = argv[++i];
+      if (key == "config") read_config(o, export_path, value);
+      else {
+        // Flags on the command line must be known options or --hp.
+        static const char* known[] = {"data", "cache-dir", "out", "max-minutes", "max-epochs", "max-steps", "batch",
+                                      "lr", "lr-final", "warmup", "min-length", "contact-weight",
+                                      "checkpoint-minutes", "validate-minutes", "epoch-steps",
+                                      "validation-windows", "seed", "threads", "max-train-clips", "export", "hp"};
+        bool ok = false;
+        for (const char* k : known) ok = ok || key == k;
+        if (!ok) throw mf::InputError("unknown option --" + key + " (model hyperparameters go in --hp KEY=VALUE)");
+        apply(o, export_path, key, value);
+      }
+    } else {
+      throw mf::InputError("unexpected argument '" + a + "' (options take a value)");
+    }
+  }
+  // Fail on bad hyperparameters before loading any data.
+  if (!o.resume) {
+    mf::RigInfo probe;
+    probe.skeleton.names = {"root"};
+    probe.skeleton.parents = {-1};
+    probe.skeleton.offsets = {Eigen::Vector3d::Zero()};
+    mf::make_inbetweener(o.kind, o.hyperparameters, probe);
+  }
+  mf::InbetweenTrainingResult r = mf::train_inbetweener(o);
+  std::printf("trained %s: %d epochs, %lld steps in %.1f min (%.2f steps/s this run, %d threads); best validation "
+              "loss %.4f: %s\n",
+              kind.c_str(), r.epochs, static_cast<long long>(r.steps), r.minutes, r.steps_per_second,
+              std::max(1, o.threads), r.best_validation, r.best_path.c_str());
+  if (!export_path.empty()) {
+    mf::save_inbetweener(*mf::load_inbetweener(r.best_path), export_path);
+    std::printf("exported %s\n", export_path.c_str());
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -106,7 +221,11 @@ int main(int argc, char** argv) {
       std::fputs(kUsage, argc < 2 ? stderr : stdout);
       return argc < 2 ? 2 : 0;
     }
-    if (std::string(argv[1]) != "prior") throw mf::InputError(std::string("unknown model kind '") + argv[1] + "'");
+    const std::string kind = argv[1];
+    if (kind == mf::kTwoStageKind || kind == mf::kCitlKind) return train_inbetweener_main(kind, argc, argv);
+    if (kind != "prior") {
+      throw mf::InputError("unknown model kind '" + kind + "' (expected prior, twostage or citl)");
+    }
     mf::PriorTrainingOptions o;
     o.data = mf::default_train_archive();
     o.cache_dir = mf::default_cache_dir();

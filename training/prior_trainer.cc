@@ -21,6 +21,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations_torch.h"
+#include "training/trainer_util.h"
 
 namespace mf {
 
@@ -28,6 +29,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using at::indexing::Slice;
+using training::masked_mean;
+using training::padded_slice;
 
 // Per-clip ground-truth quantities that do not depend on where a window
 // starts (they are all heading-relative), computed once.
@@ -69,17 +72,6 @@ struct Batch {
   at::Tensor gmp_in;    // [B, W, J * 3 + 6]
   at::Tensor vel, height, contacts;
 };
-
-// Frames [start, start + length) of x [T, ...] padded to W by repeating the last frame.
-at::Tensor padded_slice(const at::Tensor& x, int start, int length, int W) {
-  at::Tensor s = x.narrow(0, start, length);
-  if (length < W) {
-    std::vector<int64_t> shape(s.sizes().begin(), s.sizes().end());
-    shape[0] = W - length;
-    s = at::cat({s, s.narrow(0, length - 1, 1).expand(shape)}, 0);
-  }
-  return s.unsqueeze(0);
-}
 
 Batch make_batch(const std::vector<Clip>& clips, const std::vector<ClipTensors>& pre,
                  const std::vector<Window>& windows, size_t begin, size_t end, const RigInfo& rig, int W) {
@@ -133,12 +125,6 @@ std::vector<Window> epoch_windows(const std::vector<Clip>& clips, int W, int str
   }
   std::shuffle(out.begin(), out.end(), rng);
   return out;
-}
-
-at::Tensor masked_mean(const at::Tensor& value, const at::Tensor& mask) {
-  // value [B, S, ...], mask [B, S]
-  at::Tensor v = value.flatten(2).mean(-1);
-  return (v * mask).sum() / mask.sum().clamp_min(1.0);
 }
 
 struct Losses {
@@ -224,34 +210,6 @@ void compute_stats(NemfModel& model, const std::vector<Clip>& clips, const std::
   mean_std(gout, s.gmp_out_mean, s.gmp_out_std);
 }
 
-struct State {
-  int epoch = 0;
-  int64_t step = 0;
-  double minutes = 0.0;
-  double best = 1e30;
-};
-
-void save_state(const std::string& path, const State& s) {
-  std::ofstream out(path + ".tmp");
-  out.precision(17);
-  out << "epoch " << s.epoch << "\nstep " << s.step << "\nminutes " << s.minutes << "\nbest " << s.best << "\n";
-  out.close();
-  fs::rename(path + ".tmp", path);
-}
-
-State load_state(const std::string& path) {
-  State s;
-  std::ifstream in(path);
-  std::string key;
-  while (in >> key) {
-    if (key == "epoch") in >> s.epoch;
-    else if (key == "step") in >> s.step;
-    else if (key == "minutes") in >> s.minutes;
-    else if (key == "best") in >> s.best;
-  }
-  return s;
-}
-
 double item(const at::Tensor& t) { return t.item<double>(); }
 
 }  // namespace
@@ -267,29 +225,14 @@ PriorTrainingResult train_prior(const PriorTrainingOptions& o) {
   fs::create_directories(o.out_dir);
   const auto t0 = std::chrono::steady_clock::now();
 
-  DatasetOptions dopt;
-  dopt.source = o.data;
-  dopt.cache_dir = o.cache_dir;
-  dopt.verbose = o.verbose;
-  Dataset data = load_dataset(dopt);
+  Dataset data = training::load_training_data(o.data, o.cache_dir, o.max_train_clips, o.config.fps, o.verbose);
   std::vector<Clip>& train = data.train;
-  if (o.max_train_clips > 0 && static_cast<int>(train.size()) > o.max_train_clips) train.resize(o.max_train_clips);
-  if (train.empty()) throw InputError("train: no training clips");
-  for (const Clip& c : train) {
-    if (std::abs(c.motion.fps - o.config.fps) > 1e-3) {
-      throw InputError("train: clip " + c.name + " is at " + std::to_string(c.motion.fps) + " fps, the model at " +
-                       std::to_string(o.config.fps) + " fps");
-    }
-  }
-  std::vector<const Motion*> motions;
-  for (const Clip& c : train) motions.push_back(&c.motion);
-
   const std::string last_model = o.out_dir + "/last.mfm", last_optim = o.out_dir + "/last.optim",
                     last_state = o.out_dir + "/last.state", best_model = o.out_dir + "/best.mfm",
                     log_path = o.out_dir + "/log.csv";
   const bool resuming = o.resume && fs::exists(last_model) && fs::exists(last_state) && fs::exists(last_optim);
   at::manual_seed(o.seed);
-  NemfModel model = resuming ? load_nemf(last_model) : NemfModel(o.config, measure_rig(data.skeleton, motions));
+  NemfModel model = resuming ? load_nemf(last_model) : NemfModel(o.config, training::measure_training_rig(data));
   if (resuming && model.config().to_map() != o.config.to_map()) {
     throw InputError("train: --resume with different sizes than the checkpoint (" + model.config().describe() + ")");
   }
@@ -305,10 +248,10 @@ PriorTrainingResult train_prior(const PriorTrainingOptions& o) {
   model.train(true);
 
   torch::optim::Adam optimizer(model.parameters(), torch::optim::AdamOptions(o.lr));
-  State state;
+  training::TrainerState state;
   if (resuming) {
     torch::load(optimizer, last_optim);
-    state = load_state(last_state);
+    state = training::load_trainer_state(last_state);
   }
   if (!resuming) {
     std::ofstream log(log_path);
@@ -351,9 +294,9 @@ PriorTrainingResult train_prior(const PriorTrainingOptions& o) {
         out_of_time = true;
         break;
       }
-      lr = o.lr_final + 0.5 * (o.lr - o.lr_final) * (1.0 + std::cos(M_PI * progress));
+      lr = training::scheduled_lr(o.lr, o.lr_final, progress);
       beta = o.kl_weight * std::min(1.0, progress / std::max(1e-9, o.kl_warmup));
-      for (auto& group : optimizer.param_groups()) static_cast<torch::optim::AdamOptions&>(group.options()).lr(lr);
+      training::set_learning_rate(optimizer, lr);
       auto c0 = std::chrono::steady_clock::now();
       Batch b = make_batch(train, train_pre, windows, i, std::min(windows.size(), i + o.batch), model.rig(), W);
       auto c1 = std::chrono::steady_clock::now();
@@ -407,7 +350,7 @@ PriorTrainingResult train_prior(const PriorTrainingOptions& o) {
     }
     save_nemf(model, last_model);
     torch::save(optimizer, last_optim);
-    save_state(last_state, state);
+    training::save_trainer_state(last_state, state);
     {
       std::ofstream log(log_path, std::ios::app);
       log.precision(6);

@@ -172,10 +172,13 @@ std::string method_list(uint32_t flag) {
 
 // The model the jobs run with: --model PATH (loaded once, up front), else the
 // default model (loaded on first need, when a job names no method, since the
-// default method depends on it, or names one that needs the model).
+// default method depends on it, or names one that needs the model). The C API
+// loads the transformer files next to it; --twostage/--citl PATH add or
+// replace them.
 class Models {
  public:
-  explicit Models(std::string explicit_path) : explicit_path_(std::move(explicit_path)) {}
+  Models(std::string explicit_path, std::vector<std::string> transformers)
+      : explicit_path_(std::move(explicit_path)), transformers_(std::move(transformers)) {}
 
   void load_explicit() {
     if (explicit_path_.empty() || model_) return;
@@ -183,6 +186,7 @@ class Models {
     check(mf_model_load(explicit_path_.c_str(), &m));
     model_.reset(m);
     path_ = explicit_path_;
+    add_transformers();
   }
 
   // The model for a job with `method` ("" = the default method): may be null.
@@ -222,9 +226,19 @@ class Models {
     }
     model_.reset(m);
     path_ = path;
+    add_transformers();
+  }
+
+  void add_transformers() {
+    for (const std::string& file : transformers_) {
+      mf_model* m = nullptr;
+      check(mf_model_with_inbetweener(model_.get(), file.c_str(), &m));
+      model_.reset(m);
+    }
   }
 
   std::string explicit_path_, path_, default_error_;
+  std::vector<std::string> transformers_;
   bool tried_default_ = false;
   ModelPtr model_;
 };
@@ -234,7 +248,8 @@ class Models {
 const char* kMainHelp =
     "motionfield " MF_VERSION_STRING ": motion in-betweening, gap filling, resampling and re-navigation of BVH clips\n"
     "\n"
-    "usage: motionfield [--threads N] [--model PATH] [--verbose] <command> [options]\n"
+    "usage: motionfield [--threads N] [--model PATH] [--twostage PATH] [--citl PATH] [--verbose]\n"
+    "                   <command> [options]\n"
     "\n"
     "commands:\n"
     "  inbetween  fill the frames between sparse keyframes\n"
@@ -248,6 +263,11 @@ const char* kMainHelp =
     "  --model PATH   the prior's model file (default: the installed model, $MF_MODEL\n"
     "                 or models/motionfield-prior.mfm, if any); needed only by\n"
     "                 methods that use the prior\n"
+    "  --twostage PATH, --citl PATH\n"
+    "                 transformer in-betweener files (methods context, detail,\n"
+    "                 nemf-context, nemf-detail; citl, nemf-citl); default:\n"
+    "                 motionfield-twostage.mfm and motionfield-citl.mfm next to\n"
+    "                 the model file, when present\n"
     "  --verbose, -v  print what runs and how long it takes (stderr)\n"
     "  --help, -h     this help; `motionfield <command> --help` for a command\n"
     "  --version      print the version\n"
@@ -451,6 +471,7 @@ struct Settings {
   int threads = 2;
   bool verbose = false;
   std::string model;
+  std::vector<std::string> transformers;  ///< --twostage, --citl
 };
 
 void check_output_path(const std::string& out) {
@@ -564,7 +585,7 @@ int command_single(const std::string& command, const std::vector<std::string>& a
   } else {
     job.fps = parse_double(task_value, "--fps");
   }
-  Models models(settings.model);
+  Models models(settings.model, settings.transformers);
   models.load_explicit();
   std::vector<std::string> warnings;
   run_job(job, settings, models, &warnings);
@@ -613,7 +634,7 @@ int command_renav(const std::vector<std::string>& args, const Settings& settings
   }
   check_output_path(out);
   const auto t0 = Clock::now();
-  Models models(settings.model);
+  Models models(settings.model, settings.transformers);
   const mf_model* model = models.for_method("nemf");  // re-navigation always needs the prior
   const MotionPtr reference = load_motion(in);
   const std::vector<float> xz = read_path(path_file);
@@ -667,7 +688,7 @@ int command_batch(const std::vector<std::string>& args, const Settings& settings
   if (file.bad()) throw InputError("cannot read " + path);
   if (!lines.empty() && lines[0].compare(0, 3, "\xEF\xBB\xBF") == 0) lines[0].erase(0, 3);  // UTF-8 BOM
 
-  Models models(settings.model);
+  Models models(settings.model, settings.transformers);
   models.load_explicit();
   int total = 0;
   for (const std::string& l : lines) total += blank(l) ? 0 : 1;
@@ -844,6 +865,9 @@ int run(int argc, char** argv) {
       if (value.empty()) throw InputError("--model needs a value");
       settings.model = value;
       have_model = true;
+    } else if (global_option(argc, argv, &i, "twostage", &value) || global_option(argc, argv, &i, "citl", &value)) {
+      if (value.empty()) throw InputError(a + " needs a value");
+      settings.transformers.push_back(value);
     } else if (a == "--verbose" || a == "-v") {
       settings.verbose = true;
     } else if (a == "--version") {

@@ -220,14 +220,35 @@ MF_API int mf_model_default_path(char *out, size_t capacity, size_t *needed);
 
 /** Loads a model file (.mfm). path == NULL loads the default model
  *  (MF_ERROR_IO if there is none). MF_ERROR_IO if the file cannot be read,
- *  MF_ERROR_MODEL if it is not a valid model. */
+ *  MF_ERROR_MODEL if it is not a valid model. The transformer files next to
+ *  it are loaded too (see below). */
 MF_API int mf_model_load(const char *path, mf_model **out);
 /** Loads a model from the bytes of a model file (copied; the buffer may be
- *  freed after the call). */
+ *  freed after the call). No transformer is loaded with it (see
+ *  mf_model_with_inbetweener). */
 MF_API int mf_model_load_from_memory(const void *data, size_t size, mf_model **out);
 /** Destroys a model (NULL is fine). Motions and tasks do not need it to stay
  *  alive once they have returned. */
 MF_API void mf_model_destroy(mf_model *model);
+
+/* The transformer in-betweeners (methods "context", "detail", "citl" and the
+ * solver methods "nemf-context", "nemf-detail", "nemf-citl") live in their own
+ * files: motionfield-twostage.mfm (kind "twostage") and motionfield-citl.mfm
+ * (kind "citl"). mf_model_load also loads whichever of the two exist in the
+ * prior file's directory (for the default model too); a model handle without
+ * them works for every other method, and a method that needs a missing one
+ * fails with MF_ERROR_MODEL naming the file (and, when the file was there,
+ * why it did not load). */
+
+/** A new model handle: `model`'s prior and transformers plus the transformer
+ *  file at `path` (its kind is read from the file and replaces the handle's
+ *  transformer of that kind). `model` is unchanged. MF_ERROR_IO if the file
+ *  cannot be read, MF_ERROR_MODEL if it is not a transformer model file or
+ *  its skeleton is not the prior's. */
+MF_API int mf_model_with_inbetweener(const mf_model *model, const char *path, mf_model **out);
+/** *out = 1 if `model` has the transformer of `kind` ("twostage" or "citl"),
+ *  else 0. MF_ERROR_INVALID_ARGUMENT for any other kind. */
+MF_API int mf_model_has_inbetweener(const mf_model *model, const char *kind, int32_t *out);
 
 /** The model's skeleton: joint count, names, parent indices (-1 for the root,
  *  joint 0) and rest offsets [joints][3] in metres. */

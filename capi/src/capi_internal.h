@@ -18,10 +18,21 @@
 
 namespace mf {
 class NemfModel;
+class InbetweenModel;
+struct TaskContext;
 }
 
 struct mf_model {
   std::shared_ptr<const mf::NemfModel> model;
+  /// The transformer in-betweeners (null when absent): loaded from
+  /// motionfield-twostage.mfm / motionfield-citl.mfm next to the prior's file
+  /// by mf_model_load, or by mf_model_with_inbetweener.
+  std::shared_ptr<const mf::InbetweenModel> twostage;
+  std::shared_ptr<const mf::InbetweenModel> citl;
+  /// Why a transformer file next to the prior did not load ("" when it did or
+  /// is absent): the missing-transformer error of a method quotes it.
+  std::string twostage_error;
+  std::string citl_error;
 };
 
 struct mf_motion {
@@ -131,6 +142,13 @@ void skeleton_offsets(const Skeleton& s, float* out, size_t capacity, size_t* ne
 
 /// A new motion handle carrying `motion` and the BVH layout of `like` (if any).
 mf_motion* derived_motion(Motion motion, const mf_motion& like);
+
+/// Copies the model handle's prior and transformers into `ctx` (model may be NULL).
+void set_models(const mf_model* model, TaskContext* ctx);
+
+/// Throws MF_ERROR_MODEL when `method` needs a transformer that `model` lacks,
+/// naming the file (and why it did not load, if it was there).
+void require_inbetweener(const mf_model* model, const std::string& method, const std::string& kind);
 
 /// Applies the thread count of mf_set_num_threads() to the calling thread.
 void apply_num_threads();

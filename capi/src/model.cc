@@ -1,4 +1,5 @@
-// mf_model: loading (file, memory, default model) and skeleton/config queries.
+// mf_model: loading (file, memory, default model, the transformer
+// in-betweeners next to the prior's file) and skeleton/config queries.
 #include <dlfcn.h>
 
 #include <cerrno>
@@ -8,9 +9,12 @@
 #include <iterator>
 
 #include "capi/src/capi_internal.h"
+#include "prior/inbetween/inbetweener.h"
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "tasks/method.h"
+#include "tasks/transformer_methods.h"
 
 namespace mf::capi {
 namespace {
@@ -44,18 +48,75 @@ std::string default_path() {
   return mf::default_model_path();
 }
 
-mf_model* make_model(NemfModel model) {
+std::unique_ptr<mf_model> make_model(NemfModel model) {
   model.set_requires_grad(false);
   auto handle = std::make_unique<mf_model>();
   handle->model = std::make_shared<const NemfModel>(std::move(model));
-  return handle.release();
+  return handle;
 }
 
-mf_model* load_bytes(const uint8_t* data, size_t size, const std::string& source) {
+std::unique_ptr<mf_model> load_bytes(const uint8_t* data, size_t size, const std::string& source) {
   try {
     return make_model(deserialize_nemf(data, size, source));
   } catch (const InputError& e) {
     throw ApiError(MF_ERROR_MODEL, e.what());
+  }
+}
+
+// The bytes of a file; MF_ERROR_IO when it cannot be read.
+std::vector<uint8_t> read_file(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw ApiError(MF_ERROR_IO, "cannot open model file " + file + ": " + std::strerror(errno));
+  std::error_code ec;
+  if (fs::is_directory(file, ec)) throw ApiError(MF_ERROR_IO, "cannot read model file " + file + ": it is a directory");
+  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw ApiError(MF_ERROR_IO, "cannot read model file " + file);
+  return bytes;
+}
+
+// A transformer file for `prior`: MF_ERROR_IO when unreadable, MF_ERROR_MODEL
+// when it is not a transformer model or its skeleton is not the prior's.
+std::shared_ptr<const InbetweenModel> load_transformer(const std::string& file, const NemfModel& prior) {
+  const std::vector<uint8_t> bytes = read_file(file);
+  std::unique_ptr<InbetweenModel> t;
+  try {
+    t = deserialize_inbetweener(bytes.data(), bytes.size(), file);
+  } catch (const InputError& e) {
+    throw ApiError(MF_ERROR_MODEL, e.what());
+  }
+  if (!t->rig().skeleton.same_as(prior.rig().skeleton))
+    throw ApiError(MF_ERROR_MODEL, file + ": the transformer's skeleton (" + std::to_string(t->rig().num_joints()) +
+                                       " joints) is not the prior's (" + std::to_string(prior.rig().num_joints()) +
+                                       " joints): train it on the prior's data");
+  t->set_requires_grad(false);
+  t->train(false);
+  return std::shared_ptr<const InbetweenModel>(std::move(t));
+}
+
+void set_transformer(mf_model* handle, std::shared_ptr<const InbetweenModel> t) {
+  if (t->kind() == kCitlKind) {
+    handle->citl = std::move(t);
+    handle->citl_error.clear();
+  } else {
+    handle->twostage = std::move(t);
+    handle->twostage_error.clear();
+  }
+}
+
+// The transformer files next to `prior_file` that exist; failures are kept
+// for the methods' error messages (the prior alone stays usable).
+void load_companions(mf_model* handle, const std::string& prior_file) {
+  for (const std::string kind : {kTwoStageKind, kCitlKind}) {
+    const std::string file = inbetweener_path_next_to(prior_file, kind);
+    std::error_code ec;
+    if (!fs::exists(file, ec)) continue;
+    try {
+      std::shared_ptr<const InbetweenModel> t = load_transformer(file, *handle->model);
+      if (t->kind() != kind) throw ApiError(MF_ERROR_MODEL, file + " holds a '" + t->kind() + "' model, not '" + kind + "'");
+      set_transformer(handle, std::move(t));
+    } catch (const std::exception& e) {
+      (kind == kCitlKind ? handle->citl_error : handle->twostage_error) = e.what();
+    }
   }
 }
 
@@ -65,6 +126,24 @@ const NemfModel& get(const mf_model* model) {
 }
 
 }  // namespace
+
+void set_models(const mf_model* model, TaskContext* ctx) {
+  if (!model) return;
+  ctx->model = model->model;
+  ctx->twostage = model->twostage;
+  ctx->citl = model->citl;
+}
+
+void require_inbetweener(const mf_model* model, const std::string& method, const std::string& kind) {
+  if (kind.empty()) return;
+  const bool citl = kind == kCitlKind;
+  if (model && (citl ? model->citl : model->twostage)) return;
+  std::string message = missing_inbetweener_message("method '" + method + "'", kind);
+  const std::string why = !model ? "" : citl ? model->citl_error : model->twostage_error;
+  if (!why.empty()) message += "; the file next to the prior did not load: " + why;
+  throw ApiError(MF_ERROR_MODEL, message);
+}
+
 }  // namespace mf::capi
 
 using mf::capi::ApiError;
@@ -90,13 +169,10 @@ int mf_model_load(const char* path, mf_model** out) {
         throw ApiError(MF_ERROR_IO,
                        "no default model: set MF_MODEL or install models/motionfield-prior.mfm (see README)");
     }
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw ApiError(MF_ERROR_IO, "cannot open model file " + file + ": " + std::strerror(errno));
-    std::error_code ec;
-    if (std::filesystem::is_directory(file, ec)) throw ApiError(MF_ERROR_IO, "cannot read model file " + file + ": it is a directory");
-    std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw ApiError(MF_ERROR_IO, "cannot read model file " + file);
-    *out = mf::capi::load_bytes(bytes.data(), bytes.size(), file);
+    const std::vector<uint8_t> bytes = mf::capi::read_file(file);
+    std::unique_ptr<mf_model> handle = mf::capi::load_bytes(bytes.data(), bytes.size(), file);
+    mf::capi::load_companions(handle.get(), file);
+    *out = handle.release();
   });
 }
 
@@ -105,11 +181,35 @@ int mf_model_load_from_memory(const void* data, size_t size, mf_model** out) {
     require(out, "out");
     if (!data && size != 0) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "data is NULL");
     static const uint8_t kEmpty = 0;
-    *out = mf::capi::load_bytes(data ? static_cast<const uint8_t*>(data) : &kEmpty, size, "<memory>");
+    *out = mf::capi::load_bytes(data ? static_cast<const uint8_t*>(data) : &kEmpty, size, "<memory>").release();
   });
 }
 
 void mf_model_destroy(mf_model* model) { delete model; }
+
+int mf_model_with_inbetweener(const mf_model* model, const char* path, mf_model** out) {
+  return guard([&] {
+    require(model, "model");
+    require(path, "path");
+    require(out, "out");
+    if (!*path) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the transformer model path is empty");
+    auto handle = std::make_unique<mf_model>(*model);
+    mf::capi::set_transformer(handle.get(), mf::capi::load_transformer(path, *model->model));
+    *out = handle.release();
+  });
+}
+
+int mf_model_has_inbetweener(const mf_model* model, const char* kind, int32_t* out) {
+  return guard([&] {
+    require(model, "model");
+    require(kind, "kind");
+    require(out, "out");
+    const std::string k = kind;
+    if (k != mf::kTwoStageKind && k != mf::kCitlKind)
+      throw ApiError(MF_ERROR_INVALID_ARGUMENT, "unknown transformer kind '" + k + "' (available: twostage, citl)");
+    *out = (k == mf::kCitlKind ? model->citl : model->twostage) ? 1 : 0;
+  });
+}
 
 int mf_model_get_joint_count(const mf_model* model, int32_t* out) {
   return guard([&] {

@@ -47,7 +47,7 @@ int mf_renav(const mf_model* model, const mf_motion* reference, const float* pat
       throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the path has more than " + std::to_string(mf::kMaxPathFrames) + " points");
 
     mf::TaskContext ctx;
-    if (model) ctx.model = model->model;
+    mf::capi::set_models(model, &ctx);
     ctx.seed = o.seed;
     if (o.progress) {
       const mf_progress_fn fn = o.progress;

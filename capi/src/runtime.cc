@@ -199,7 +199,7 @@ int mf_default_method(const mf_model* model, const char** name) {
   return guard([&] {
     require(name, "name");
     mf::TaskContext ctx;
-    if (model) ctx.model = model->model;
+    mf::capi::set_models(model, &ctx);
     const std::string d = mf::default_method(ctx);
     for (const mf::Method& m : mf::registered_methods()) {
       if (m.name == d) {

@@ -14,7 +14,7 @@ namespace {
 TaskContext make_context(const mf_model* model, const mf_motion& input, const mf_task_options& o,
                          std::string* method) {
   TaskContext ctx;
-  if (model) ctx.model = model->model;
+  set_models(model, &ctx);
   ctx.seed = o.seed;
   if (o.progress) {
     const mf_progress_fn fn = o.progress;
@@ -49,6 +49,7 @@ TaskContext make_context(const mf_model* model, const mf_motion& input, const mf
                                                     " joints but the model's skeleton has " +
                                                     std::to_string(model_joints) + " (method '" + name + "')");
   }
+  require_inbetweener(model, name, found->needs_inbetweener);
   return ctx;
 }
 

@@ -2,6 +2,7 @@
 
 #include <ATen/ATen.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <cstdlib>
@@ -39,15 +40,15 @@ std::string shape_string(at::IntArrayRef s) {
 
 }  // namespace
 
-std::vector<uint8_t> serialize_nemf(const NemfModel& model) {
+std::vector<uint8_t> serialize_model_file(const std::string& kind, const std::map<std::string, double>& hyperparameters,
+                                          const RigInfo& rig,
+                                          const std::vector<std::pair<std::string, at::Tensor>>& tensors) {
   ByteWriter p;
-  auto config = model.config().to_map();
-  p.u32(static_cast<uint32_t>(config.size()));
-  for (const auto& [k, v] : config) {
+  p.u32(static_cast<uint32_t>(hyperparameters.size()));
+  for (const auto& [k, v] : hyperparameters) {
     p.str(k);
     p.f64(v);
   }
-  const RigInfo& rig = model.rig();
   const Skeleton& sk = rig.skeleton;
   p.u32(static_cast<uint32_t>(sk.num_joints()));
   for (int j = 0; j < sk.num_joints(); ++j) {
@@ -63,23 +64,21 @@ std::vector<uint8_t> serialize_nemf(const NemfModel& model) {
     p.f64(rig.foot_thresholds[k]);
   }
   p.f64(rig.contact_speed);
-  auto stats = stats_tensors(model.stats());
-  auto weights = model.named_parameters();
-  p.u32(static_cast<uint32_t>(stats.size() + weights.size()));
-  for (const auto& [name, t] : stats) write_tensor(p, name, t);
-  for (const auto& [name, t] : weights) write_tensor(p, name, t);
+  p.u32(static_cast<uint32_t>(tensors.size()));
+  for (const auto& [name, t] : tensors) write_tensor(p, name, t);
 
   ByteWriter out;
   out.bytes(kMagic, sizeof(kMagic));
   out.u32(kModelFormatVersion);
-  out.str(kNemfKind);
+  out.str(kind);
   out.u64(p.buffer().size());
   out.bytes(p.buffer().data(), p.buffer().size());
   out.u64(fnv1a64_bytes(p.buffer().data(), p.buffer().size()));
   return std::move(out.buffer());
 }
 
-NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& source) {
+ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::string& source,
+                                   const std::vector<std::string>& expected_kinds) {
   ByteReader head(data, size, source);
   char magic[8];
   if (size < sizeof(magic) || std::memcmp(data, kMagic, sizeof(magic)) != 0) {
@@ -91,9 +90,14 @@ NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& 
     throw InputError(source + ": unsupported model format version " + std::to_string(version) +
                      " (this build reads version " + std::to_string(kModelFormatVersion) + ")");
   }
-  std::string kind = head.str(64);
-  if (kind != kNemfKind) {
-    throw InputError(source + ": wrong kind of model: the file holds a '" + kind + "' model, expected '" + kNemfKind +
+  ModelFileContents c;
+  c.kind = head.str(64);
+  if (std::find(expected_kinds.begin(), expected_kinds.end(), c.kind) == expected_kinds.end()) {
+    std::string expected;
+    for (size_t i = 0; i < expected_kinds.size(); ++i) {
+      expected += (i ? (i + 1 == expected_kinds.size() ? "' or '" : "', '") : "") + expected_kinds[i];
+    }
+    throw InputError(source + ": wrong kind of model: the file holds a '" + c.kind + "' model, expected '" + expected +
                      "'");
   }
   uint64_t payload_size = head.u64();
@@ -109,18 +113,14 @@ NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& 
   }
 
   ByteReader p(payload, payload_size, source);
-  std::map<std::string, double> values;
   uint32_t n = p.u32();
   if (n > 1000) p.fail("too many hyperparameters");
   for (uint32_t i = 0; i < n; ++i) {
     std::string k = p.str(256);
-    values[k] = p.f64();
+    c.hyperparameters[k] = p.f64();
   }
-  NemfConfig config = NemfConfig::from_map(values);
-  std::string problem = config.validate();
-  if (!problem.empty()) throw InputError(source + ": invalid hyperparameters: " + problem);
 
-  RigInfo rig;
+  RigInfo& rig = c.rig;
   uint32_t J = p.u32();
   if (J == 0 || J > 1024) p.fail("bad joint count " + std::to_string(J));
   for (uint32_t j = 0; j < J; ++j) {
@@ -147,8 +147,6 @@ NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& 
   }
   rig.contact_speed = p.f64();
 
-  NemfModel model(config, rig);
-  std::map<std::string, at::Tensor> tensors;
   uint32_t count = p.u32();
   if (count > 100000) p.fail("too many tensors");
   for (uint32_t i = 0; i < count; ++i) {
@@ -166,22 +164,47 @@ NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& 
     at::Tensor t = at::empty(dims, at::kFloat);
     p.bytes(t.data_ptr<float>(), numel * sizeof(float));
     if (!at::isfinite(t).all().item<bool>()) p.fail("tensor '" + name + "' holds non-finite values");
-    tensors[name] = t;
+    c.tensors[name] = t;
   }
   if (p.remaining() != 0) p.fail("unexpected trailing data");
+  return c;
+}
 
-  auto take = [&](const std::string& name, at::Tensor& target) {
-    auto it = tensors.find(name);
-    if (it == tensors.end()) throw InputError(source + ": model file lacks tensor '" + name + "'");
-    if (target.defined() && !target.sizes().equals(it->second.sizes())) {
-      throw InputError(source + ": tensor '" + name + "' has shape " + shape_string(it->second.sizes()) +
-                       ", expected " + shape_string(target.sizes()));
-    }
-    at::NoGradGuard guard;
-    target.copy_(it->second);
-    tensors.erase(it);
-  };
+void take_model_tensor(std::map<std::string, at::Tensor>& tensors, const std::string& name, at::Tensor& target,
+                       const std::string& source) {
+  auto it = tensors.find(name);
+  if (it == tensors.end()) throw InputError(source + ": model file lacks tensor '" + name + "'");
+  if (target.defined() && !target.sizes().equals(it->second.sizes())) {
+    throw InputError(source + ": tensor '" + name + "' has shape " + shape_string(it->second.sizes()) +
+                     ", expected " + shape_string(target.sizes()));
+  }
+  at::NoGradGuard guard;
+  if (target.defined()) target.copy_(it->second);
+  else target = it->second;
+  tensors.erase(it);
+}
+
+void check_no_extra_tensors(const std::map<std::string, at::Tensor>& tensors, const std::string& source) {
+  if (!tensors.empty()) {
+    throw InputError(source + ": model file has unexpected tensor '" + tensors.begin()->first +
+                     "' (trained with another architecture?)");
+  }
+}
+
+std::vector<uint8_t> serialize_nemf(const NemfModel& model) {
+  auto tensors = stats_tensors(model.stats());
+  for (auto& named : model.named_parameters()) tensors.push_back(named);
+  return serialize_model_file(kNemfKind, model.config().to_map(), model.rig(), tensors);
+}
+
+NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& source) {
+  ModelFileContents c = parse_model_file(data, size, source, {kNemfKind});
+  NemfConfig config = NemfConfig::from_map(c.hyperparameters);
+  std::string problem = config.validate();
+  if (!problem.empty()) throw InputError(source + ": invalid hyperparameters: " + problem);
+  NemfModel model(config, c.rig);
   NemfStats& s = model.stats();
+  auto take = [&](const std::string& name, at::Tensor& target) { take_model_tensor(c.tensors, name, target, source); };
   take("stats.feature_mean", s.feature_mean);
   take("stats.feature_std", s.feature_std);
   take("stats.root_mean", s.root_mean);
@@ -191,10 +214,7 @@ NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& 
   take("stats.gmp_out_mean", s.gmp_out_mean);
   take("stats.gmp_out_std", s.gmp_out_std);
   for (auto& [name, param] : model.named_parameters()) take(name, param);
-  if (!tensors.empty()) {
-    throw InputError(source + ": model file has unexpected tensor '" + tensors.begin()->first +
-                     "' (trained with another architecture?)");
-  }
+  check_no_extra_tensors(c.tensors, source);
   return model;
 }
 

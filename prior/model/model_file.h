@@ -20,7 +20,9 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "prior/model/nemf.h"
@@ -29,6 +31,33 @@ namespace mf {
 
 constexpr uint32_t kModelFormatVersion = 1;
 constexpr char kNemfKind[] = "nemf";
+
+/// The generic container, shared by every model kind (the NeMF prior here,
+/// the in-betweeners in prior/inbetween/inbetweener.cc).
+struct ModelFileContents {
+  std::string kind;
+  std::map<std::string, double> hyperparameters;
+  RigInfo rig;                                   ///< skeleton validated
+  std::map<std::string, at::Tensor> tensors;     ///< float32, finite
+};
+
+/// The bytes of a model file of `kind` (layout above); tensors are written in
+/// the given order.
+std::vector<uint8_t> serialize_model_file(const std::string& kind, const std::map<std::string, double>& hyperparameters,
+                                          const RigInfo& rig,
+                                          const std::vector<std::pair<std::string, at::Tensor>>& tensors);
+/// Parses and validates a model file (magic, version, size, checksum, rig,
+/// tensors). `expected_kinds` (non-empty) lists the kinds the caller accepts;
+/// any other throws "wrong kind of model". `source` names the file in errors.
+ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::string& source,
+                                   const std::vector<std::string>& expected_kinds);
+/// Copies tensor `name` of `tensors` into `target` (same shape required) and
+/// removes it from the map; throws InputError when missing or misshapen.
+void take_model_tensor(std::map<std::string, at::Tensor>& tensors, const std::string& name, at::Tensor& target,
+                       const std::string& source);
+/// Throws InputError naming the first tensor left in `tensors` (one the
+/// architecture does not have), if any.
+void check_no_extra_tensors(const std::map<std::string, at::Tensor>& tensors, const std::string& source);
 
 std::vector<uint8_t> serialize_nemf(const NemfModel& model);
 NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& source);

@@ -252,6 +252,24 @@ class Model(_Handle):
         _Handle.__init__(self, handle)
         return self
 
+    def with_inbetweener(self, path):
+        """A new Model: this one's prior and transformers plus the transformer
+        in-betweener file at `path` (kind "twostage" or "citl", read from the
+        file). Model(path) already loads motionfield-twostage.mfm and
+        motionfield-citl.mfm found next to the prior's file."""
+        handle = ctypes.POINTER(_c.MfModel)()
+        _check(_c.mf_model_with_inbetweener(self._live(), str(path).encode(), ctypes.byref(handle)))
+        model = type(self).__new__(type(self))
+        _Handle.__init__(model, handle)
+        return model
+
+    def has_inbetweener(self, kind):
+        """True when the transformer of `kind` ("twostage": methods context,
+        detail, nemf-context, nemf-detail; "citl": citl, nemf-citl) is loaded."""
+        v = ctypes.c_int32(0)
+        _check(_c.mf_model_has_inbetweener(self._live(), str(kind).encode(), ctypes.byref(v)))
+        return v.value != 0
+
     def _i32(self, getter):
         v = ctypes.c_int32(0)
         _check(getter(self._live(), ctypes.byref(v)))

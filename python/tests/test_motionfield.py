@@ -260,6 +260,23 @@ class ModelTest(unittest.TestCase):
         same_code = code.with_latents(code.local_latents, code.global_latents)
         np.testing.assert_array_equal(same_code.decode(60.0).rotations, dec.rotations)
 
+    def test_transformers_are_optional_and_named_when_missing(self):
+        model = mf.Model(os.environ["MF_TEST_MODEL"])
+        self.assertFalse(model.has_inbetweener("twostage"))
+        self.assertFalse(model.has_inbetweener("citl"))
+        with self.assertRaises(mf.InvalidArgumentError):
+            model.has_inbetweener("lstm")
+        with self.assertRaises(mf.FileError):
+            model.with_inbetweener(os.path.join(os.path.dirname(os.environ["MF_TEST_MODEL"]), "absent.mfm"))
+        with self.assertRaisesRegex(mf.ModelError, "wrong kind"):
+            model.with_inbetweener(os.environ["MF_TEST_MODEL"])  # a prior, not a transformer
+        names = {m.name: m for m in mf.methods()}
+        for name in ("context", "detail", "citl", "nemf-context", "nemf-detail", "nemf-citl"):
+            self.assertTrue(names[name].needs_model and names[name].completes, name)
+        J = model.joint_count
+        m = mf.Motion.from_arrays(random_rotations(20, J, 4), np.zeros((20, 3), np.float32), 30.0, model=model)
+        with self.assertRaisesRegex(mf.ModelError, "motionfield-citl.mfm"):
+            mf.inbetween(m, [0, 19], method="citl", model=model)
 
 if __name__ == "__main__":
     unittest.main()

@@ -1,0 +1,326 @@
+#include "prior/inbetween/citl.h"
+
+#include <ATen/ATen.h>
+#include <torch/nn/module.h>
+#include <torch/nn/modules/conv.h>
+#include <torch/nn/modules/linear.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <tuple>
+
+#include "prior/motion/errors.h"
+
+namespace mf {
+
+namespace {
+
+// Additive attention mask: large but finite, so a row with every key masked
+// gives a uniform softmax instead of NaN.
+constexpr double kMasked = -1e9;
+
+struct CitlConfig {
+  int width = 128;
+  int layers = 3;
+  int heads = 4;
+  int ffn = 512;
+  int time_dim = 16;
+  int window = 128;
+  double fps = 30.0;
+
+  std::map<std::string, double> to_map() const {
+    return {{"width", width},   {"layers", layers}, {"heads", heads}, {"ffn", ffn},
+            {"time_dim", time_dim}, {"window", window}, {"fps", fps}};
+  }
+};
+
+CitlConfig parse_config(const std::map<std::string, double>& values) {
+  CitlConfig c;
+  std::ostringstream e;
+  auto integer = [&](const std::string& key, double v, int lo, int hi, int* out) {
+    if (!std::isfinite(v) || v != std::floor(v) || v < lo || v > hi) {
+      e << key << " must be an integer in [" << lo << ", " << hi << "] (got " << v << "); ";
+      return;
+    }
+    *out = static_cast<int>(v);
+  };
+  for (const auto& [key, v] : values) {
+    if (key == "width") {
+      integer(key, v, 8, 2048, &c.width);
+    } else if (key == "layers") {
+      integer(key, v, 1, 32, &c.layers);
+    } else if (key == "heads") {
+      integer(key, v, 1, 64, &c.heads);
+    } else if (key == "ffn") {
+      integer(key, v, 1, 16384, &c.ffn);
+    } else if (key == "time_dim") {
+      integer(key, v, 2, 256, &c.time_dim);
+    } else if (key == "window") {
+      integer(key, v, 2, 4096, &c.window);
+    } else if (key == "fps") {
+      if (!std::isfinite(v) || !(v > 0) || v > 1000) e << "fps must be in (0, 1000] (got " << v << "); ";
+      c.fps = v;
+    } else {
+      e << "unknown hyperparameter '" << key
+        << "' (CITL takes width, layers, heads, ffn, time_dim, window, fps); ";
+    }
+  }
+  if (c.width % c.heads != 0) e << "heads (" << c.heads << ") must divide width (" << c.width << "); ";
+  if (c.time_dim % 2 != 0) e << "time_dim must be even (got " << c.time_dim << "); ";
+  if (c.time_dim >= c.width) e << "time_dim must be smaller than width; ";
+  std::string message = e.str();
+  if (!message.empty()) throw InputError("invalid CITL hyperparameters: " + message.substr(0, message.size() - 2));
+  return c;
+}
+
+struct RmsNormImpl : torch::nn::Module {
+  explicit RmsNormImpl(int width) { weight = register_parameter("weight", at::ones({width})); }
+  at::Tensor forward(const at::Tensor& x) { return x * at::rsqrt(x.pow(2).mean(-1, true) + 1e-6) * weight; }
+  at::Tensor weight;
+};
+TORCH_MODULE(RmsNorm);
+
+struct FeedForwardImpl : torch::nn::Module {
+  FeedForwardImpl(int width, int hidden) {
+    up = register_module("up", torch::nn::Linear(width, hidden));
+    down = register_module("down", torch::nn::Linear(hidden, width));
+  }
+  at::Tensor forward(const at::Tensor& x) { return down->forward(at::gelu(up->forward(x))); }
+  torch::nn::Linear up{nullptr}, down{nullptr};
+};
+TORCH_MODULE(FeedForward);
+
+// Multi-head attention. Self-attention when `cross` is false (memory == x).
+// bias [B, 1, 1, Tk] is added to the scores (0 or kMasked per key).
+struct AttentionImpl : torch::nn::Module {
+  AttentionImpl(int width, int heads, bool cross) : heads_(heads), cross_(cross) {
+    if (cross) {
+      q = register_module("q", torch::nn::Linear(width, width));
+      kv = register_module("kv", torch::nn::Linear(width, 2 * width));
+    } else {
+      qkv = register_module("qkv", torch::nn::Linear(width, 3 * width));
+    }
+    out = register_module("out", torch::nn::Linear(width, width));
+  }
+  // x [B or 1, Tq, W], memory [B, Tk, W] -> [B, Tq, W]
+  at::Tensor forward(const at::Tensor& x, const at::Tensor& memory, const at::Tensor& bias) {
+    const int64_t W = x.size(-1), dh = W / heads_;
+    auto split_heads = [&](const at::Tensor& t) {  // [b, n, W] -> [b, H, n, dh]
+      return t.unflatten(-1, {heads_, dh}).transpose(1, 2);
+    };
+    at::Tensor qh, kh, vh;
+    if (cross_) {
+      qh = split_heads(q->forward(x));
+      std::vector<at::Tensor> parts = kv->forward(memory).chunk(2, -1);
+      kh = split_heads(parts[0]);
+      vh = split_heads(parts[1]);
+    } else {
+      std::vector<at::Tensor> parts = qkv->forward(x).chunk(3, -1);
+      qh = split_heads(parts[0]);
+      kh = split_heads(parts[1]);
+      vh = split_heads(parts[2]);
+    }
+    at::Tensor scores = at::matmul(qh * (1.0 / std::sqrt(static_cast<double>(dh))), kh.transpose(-1, -2)) + bias;
+    at::Tensor o = at::matmul(at::softmax(scores, -1), vh);  // [B, H, Tq, dh]
+    return out->forward(o.transpose(1, 2).flatten(2));
+  }
+  int64_t heads_;
+  bool cross_;
+  torch::nn::Linear q{nullptr}, kv{nullptr}, qkv{nullptr}, out{nullptr};
+};
+TORCH_MODULE(Attention);
+
+// Pre-norm transformer layer (RMSNorm, attention, RMSNorm, GELU feed-forward).
+struct LayerImpl : torch::nn::Module {
+  LayerImpl(const CitlConfig& c, bool cross) {
+    norm1 = register_module("norm1", RmsNorm(c.width));
+    attn = register_module("attn", Attention(c.width, c.heads, cross));
+    norm2 = register_module("norm2", RmsNorm(c.width));
+    ffn = register_module("ffn", FeedForward(c.width, c.ffn));
+  }
+  // Self-attention: memory undefined. Cross-attention: memory already normalised.
+  at::Tensor forward(at::Tensor x, const at::Tensor& memory, const at::Tensor& bias) {
+    at::Tensor n = norm1->forward(x);
+    x = x + attn->forward(n, memory.defined() ? memory : n, bias);
+    return x + ffn->forward(norm2->forward(x));
+  }
+  RmsNorm norm1{nullptr}, norm2{nullptr};
+  Attention attn{nullptr};
+  FeedForward ffn{nullptr};
+};
+TORCH_MODULE(Layer);
+
+struct CitlNetImpl : torch::nn::Module {
+  CitlNetImpl(const CitlConfig& c, int joints) : config(c), joints(joints), pose_size(joints * 6 + 3) {
+    const int W = c.width;
+    input = register_module("input", torch::nn::Linear(pose_size + joints + 1, W - c.time_dim));
+    for (int l = 0; l < c.layers; ++l) {
+      encoder.push_back(register_module("encoder" + std::to_string(l), Layer(c, false)));
+    }
+    encoder_norm = register_module("encoder_norm", RmsNorm(W));
+    query = register_module("query", torch::nn::Linear(c.time_dim, W));
+    for (int l = 0; l < c.layers; ++l) {
+      interpolator.push_back(register_module("interpolator" + std::to_string(l), Layer(c, true)));
+    }
+    interpolator_norm = register_module("interpolator_norm", RmsNorm(W));
+    key_ffn = register_module("key_ffn", FeedForward(W, c.ffn));
+    conv_in = register_module("conv_in", torch::nn::Conv1d(torch::nn::Conv1dOptions(W, W, 3).padding(1)));
+    for (int l = 0; l < c.layers; ++l) {
+      synthesis.push_back(register_module("synthesis" + std::to_string(l), Layer(c, false)));
+    }
+    synthesis_norm = register_module("synthesis_norm", RmsNorm(W));
+    conv_out = register_module("conv_out", torch::nn::Conv1d(torch::nn::Conv1dOptions(W, pose_size, 3).padding(1)));
+    torch::NoGradGuard no_grad;
+    conv_out->weight.mul_(0.1);  // start close to the mean pose
+    conv_out->bias.zero_();
+  }
+
+  // Sinusoids of the frame index [T, time_dim]; periods geometric from 4 frames
+  // to 4 windows so every channel varies over a window.
+  at::Tensor time_embedding(int64_t frames) const {
+    const int n = config.time_dim / 2;
+    at::Tensor i = at::arange(n, at::kFloat);
+    double ratio = n > 1 ? std::log(static_cast<double>(config.window)) / (n - 1) : 0.0;
+    at::Tensor omega = (2.0 * M_PI / 4.0) * at::exp(i * -ratio);
+    at::Tensor angle = at::arange(frames, at::kFloat).unsqueeze(1) * omega;
+    return at::cat({at::sin(angle), at::cos(angle)}, -1);
+  }
+
+  // x [B, T, C] -> Conv1d over time -> [B, T, C']
+  static at::Tensor conv_time(torch::nn::Conv1d& conv, const at::Tensor& x) {
+    return conv->forward(x.transpose(1, 2)).transpose(1, 2);
+  }
+
+  // pose [B, T, D] raw; known [B, T, J + 1]; valid [B, T]; mean/std [D].
+  at::Tensor forward(const at::Tensor& pose_in, const at::Tensor& known_in, const at::Tensor& valid,
+                     const at::Tensor& mean, const at::Tensor& scale) {
+    const int64_t B = pose_in.size(0), T = pose_in.size(1), J = joints;
+    at::Tensor valid3 = valid.unsqueeze(-1);
+    at::Tensor known = known_in * valid3;
+    at::Tensor channel_known = known_channel_mask(known, joints) > 0.5;  // [B, T, D]
+    at::Tensor pose = at::where(channel_known, pose_in, at::zeros_like(pose_in));
+
+    // Seq-RC: mean known root position over the window.
+    at::Tensor root_known = known.narrow(-1, J, 1);
+    at::Tensor center = (pose.narrow(-1, 6 * J, 3) * root_known).sum(1) / root_known.sum(1).clamp_min(1.0);
+    at::Tensor shift = at::constant_pad_nd(center, {6 * J, 0}).unsqueeze(1);  // [B, 1, D]
+    at::Tensor rotation_channels = (at::arange(pose_size, at::kLong) < 6 * J).to(at::kFloat);
+    at::Tensor offset = mean * rotation_channels + shift;
+
+    at::Tensor x = at::where(channel_known, (pose - offset) / scale, at::zeros_like(pose));
+    at::Tensor is_key = known.amax(-1);  // [B, T] in {0, 1}
+    at::Tensor valid_bias = ((1.0 - valid) * kMasked).view({B, 1, 1, T});
+    at::Tensor pe = time_embedding(T);
+
+    // The keyframes of each window first, in time order: index [B, K] with
+    // K = the largest key count in the batch; slots past a window's own count
+    // hold non-key frames and are masked out of every attention.
+    const int64_t K = std::max<int64_t>(1, is_key.sum(1).max().item<int64_t>());
+    at::Tensor rank = is_key * (2.0 * T) - at::arange(T, is_key.options());
+    at::Tensor index = std::get<1>(rank.sort(-1, /*descending=*/true)).narrow(1, 0, K);  // [B, K]
+    at::Tensor key_valid = is_key.gather(1, index);
+    at::Tensor key_bias = ((1.0 - key_valid) * kMasked).view({B, 1, 1, K});
+    auto take_keys = [&](const at::Tensor& t) {  // [B, T, C] -> [B, K, C]
+      return t.gather(1, index.unsqueeze(-1).expand({B, K, t.size(-1)}));
+    };
+
+    // Stage I: keyframe encoder over the keyframe tokens only.
+    at::Tensor h = at::cat({input->forward(take_keys(at::cat({x, known}, -1))),
+                            pe.index_select(0, index.flatten()).view({B, K, config.time_dim})},
+                           -1);
+    for (auto& layer : encoder) h = layer->forward(h, at::Tensor(), key_bias);
+    h = encoder_norm->forward(h);
+
+    // Stage II: time queries cross-attend to the keyframe tokens.
+    at::Tensor q = query->forward(pe).unsqueeze(0);
+    for (auto& layer : interpolator) q = layer->forward(q, h, key_bias);
+    q = interpolator_norm->forward(q).expand({B, T, config.width});
+
+    // Stage III: synthesis over all frames in time order. Padding tokens are
+    // zeroed before each convolution so they act like the convolution's own
+    // zero padding.
+    at::Tensor keys = at::zeros({B, T, config.width}, h.options())
+                          .scatter(1, index.unsqueeze(-1).expand({B, K, config.width}), h + key_ffn->forward(h));
+    at::Tensor s = at::where(is_key.unsqueeze(-1) > 0.5, keys, q) * valid3;
+    s = conv_time(conv_in, s);
+    for (auto& layer : synthesis) s = layer->forward(s, at::Tensor(), valid_bias);
+    s = synthesis_norm->forward(s) * valid3;
+    at::Tensor y = conv_time(conv_out, s) * scale + offset;
+    return at::where(channel_known, pose, y);
+  }
+
+  CitlConfig config;
+  int joints, pose_size;
+  torch::nn::Linear input{nullptr}, query{nullptr};
+  std::vector<Layer> encoder, interpolator, synthesis;
+  RmsNorm encoder_norm{nullptr}, interpolator_norm{nullptr}, synthesis_norm{nullptr};
+  FeedForward key_ffn{nullptr};
+  torch::nn::Conv1d conv_in{nullptr}, conv_out{nullptr};
+};
+TORCH_MODULE(CitlNet);
+
+class CitlModel final : public InbetweenModel {
+ public:
+  CitlModel(const CitlConfig& config, const RigInfo& rig)
+      : InbetweenModel(rig), config_(config), net_(config, rig.num_joints()) {}
+
+  std::string kind() const override { return kCitlKind; }
+  std::vector<std::string> stage_names() const override { return {"citl"}; }
+  std::map<std::string, double> hyperparameters() const override { return config_.to_map(); }
+  std::string describe() const override {
+    std::ostringstream s;
+    s << "citl: keyframe encoder " << config_.layers << "x" << config_.width << ", interpolator "
+      << config_.layers << "x" << config_.width << ", synthesis " << config_.layers << "x" << config_.width
+      << ", " << config_.heads << " heads, ffn " << config_.ffn << ", time embedding " << config_.time_dim
+      << ", window " << config_.window << " frames at " << config_.fps << " fps";
+    return s.str();
+  }
+
+  InbetweenOutput forward(const InbetweenBatch& batch) const override {
+    const int64_t J = rig().num_joints(), D = pose_size();
+    const at::Tensor& pose = batch.pose;
+    if (!pose.defined() || pose.dim() != 3 || pose.size(2) != D) {
+      throw InputError("CITL: pose must be [B, T, " + std::to_string(D) + "]");
+    }
+    const int64_t B = pose.size(0), T = pose.size(1);
+    if (B < 1 || T < 1 || T > config_.window) {
+      throw InputError("CITL: windows must have 1 to " + std::to_string(config_.window) + " frames (got " +
+                       std::to_string(T) + ")");
+    }
+    if (!batch.known.defined() || batch.known.sizes() != at::IntArrayRef{B, T, J + 1}) {
+      throw InputError("CITL: known must be [B, T, " + std::to_string(J + 1) + "] matching pose");
+    }
+    if (!batch.valid.defined() || batch.valid.sizes() != at::IntArrayRef{B, T}) {
+      throw InputError("CITL: valid must be [B, T] matching pose");
+    }
+    const at::TensorOptions options = pose.options().dtype(at::kFloat);
+    at::Tensor mean = stats().pose_mean.defined() ? stats().pose_mean.to(options) : at::zeros({D}, options);
+    at::Tensor scale = stats().pose_std.defined() ? stats().pose_std.to(options) : at::ones({D}, options);
+    if (mean.numel() != D || scale.numel() != D) throw InputError("CITL: statistics do not match the pose size");
+    InbetweenOutput out;
+    out.stages.push_back(net_->forward(pose.to(at::kFloat), batch.known.to(options), batch.valid.to(options),
+                                       mean.reshape({D}), scale.reshape({D})));
+    return out;
+  }
+
+  std::vector<std::pair<std::string, at::Tensor>> named_parameters() const override {
+    std::vector<std::pair<std::string, at::Tensor>> out;
+    for (const auto& item : net_->named_parameters(true)) out.emplace_back(item.key(), item.value());
+    return out;
+  }
+  void train(bool on) override { net_->train(on); }
+
+ private:
+  CitlConfig config_;
+  mutable CitlNet net_;
+};
+
+}  // namespace
+
+std::unique_ptr<InbetweenModel> make_citl(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {
+  if (rig.num_joints() < 1) throw InputError("CITL: the rig has no joints");
+  return std::make_unique<CitlModel>(parse_config(hyperparameters), rig);
+}
+
+}  // namespace mf

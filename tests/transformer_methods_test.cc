@@ -1,0 +1,373 @@
+// The transformer methods ("context", "detail", "citl"), their fill
+// (inbetweener_fill) and the transformer initialisers, with a stand-in model:
+// a test-only InbetweenModel that interpolates the known pose features
+// linearly per channel (stage 1 = stage 0 moved 1 cm along canonical x and
+// joint 1 turned a little at unknown values; optionally every output 5 cm
+// off), and
+// records what it was given. No trained file is needed.
+#include <ATen/ATen.h>
+#include <ATen/Parallel.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "prior/inbetween/inbetweener.h"
+#include "prior/model/nemf.h"
+#include "prior/motion/errors.h"
+#include "tasks/baselines.h"
+#include "tasks/initializers.h"
+#include "tasks/jobs.h"
+#include "tasks/transformer_methods.h"
+#include "tests/test_util.h"
+
+namespace mf {
+namespace {
+
+class LinearInbetweener : public InbetweenModel {
+ public:
+  LinearInbetweener(const RigInfo& rig, std::string kind, int window)
+      : InbetweenModel(rig), kind_(std::move(kind)), window_(window) {}
+
+  std::string kind() const override { return kind_; }
+  std::vector<std::string> stage_names() const override {
+    return kind_ == kTwoStageKind ? std::vector<std::string>{"context", "detail"} : std::vector<std::string>{"citl"};
+  }
+  std::map<std::string, double> hyperparameters() const override { return {{"window", window_}, {"fps", 30.0}}; }
+  std::string describe() const override { return "linear stand-in"; }
+  std::vector<std::pair<std::string, at::Tensor>> named_parameters() const override { return {}; }
+  void train(bool) override {}
+
+  InbetweenOutput forward(const InbetweenBatch& batch) const override {
+    const int J = rig().num_joints(), D = pose_size();
+    const int64_t B = batch.pose.size(0), T = batch.pose.size(1);
+    EXPECT_EQ(batch.pose.size(2), D);
+    EXPECT_EQ(batch.known.sizes(), (std::vector<int64_t>{B, T, J + 1}));
+    EXPECT_EQ(batch.valid.sizes(), (std::vector<int64_t>{B, T}));
+    ++calls;
+    max_frames = std::max<int64_t>(max_frames, T);
+    last_known = batch.known.clone();
+    const at::Tensor mask = at::cat({batch.known.narrow(2, 0, J).repeat_interleave(6, 2),
+                                     batch.known.narrow(2, J, 1).expand({B, T, 3})},
+                                    2);
+    unknown_abs_sum += (batch.pose * (1 - mask)).abs().sum().item<double>();
+    const at::Tensor pose = batch.pose.contiguous(), m = mask.contiguous(), valid = batch.valid.contiguous();
+    at::Tensor out = at::zeros_like(pose);
+    auto p = pose.accessor<float, 3>();
+    auto k = m.accessor<float, 3>();
+    auto v = valid.accessor<float, 2>();
+    auto o = out.accessor<float, 3>();
+    for (int64_t b = 0; b < B; ++b) {
+      int64_t frames = 0;
+      while (frames < T && v[b][frames] > 0.5f) ++frames;
+      // The contract: windows are canonical at a known first frame and end at one.
+      for (int j = 0; j <= J; ++j) {
+        EXPECT_EQ(batch.known[b][0][j].item<float>(), 1.0f) << "window " << b << " does not start at a full key";
+      }
+      EXPECT_EQ(batch.known[b][frames - 1][J].item<float>(), 1.0f) << "window " << b << " does not end at a key";
+      for (int64_t d = 0; d < D; ++d) {
+        std::vector<int64_t> at_known;
+        for (int64_t t = 0; t < frames; ++t) {
+          if (k[b][t][d] > 0.5f) at_known.push_back(t);
+        }
+        for (int64_t t = 0; t < frames; ++t) {
+          auto it = std::lower_bound(at_known.begin(), at_known.end(), t);
+          if (it == at_known.end()) {
+            o[b][t][d] = p[b][at_known.back()][d];
+          } else if (*it == t || it == at_known.begin()) {
+            o[b][t][d] = p[b][*it][d];
+          } else {
+            const int64_t a = *(it - 1), c = *it;
+            const float w = static_cast<float>(t - a) / static_cast<float>(c - a);
+            o[b][t][d] = p[b][a][d] * (1 - w) + p[b][c][d] * w;
+          }
+        }
+      }
+    }
+    if (miss_keys) out.select(2, D - 3).add_(0.05);  // misses even the keys by 5 cm
+    InbetweenOutput result;
+    result.stages.push_back(out);
+    if (kind_ == kTwoStageKind) {
+      at::Tensor moved = out.clone();
+      moved.select(2, D - 3).add_(0.01 * (1 - batch.known.select(2, J)));
+      moved.select(2, 6).add_(0.05 * (1 - batch.known.select(2, 1)));  // joint 1's 6D
+      result.stages.push_back(moved);
+    }
+    return result;
+  }
+
+  mutable int calls = 0;
+  mutable int64_t max_frames = 0;
+  mutable double unknown_abs_sum = 0.0;
+  mutable at::Tensor last_known;
+  bool miss_keys = false;
+
+ private:
+  std::string kind_;
+  double window_;
+};
+
+struct Fixture {
+  std::shared_ptr<NemfModel> prior;
+  std::shared_ptr<LinearInbetweener> twostage, citl;
+  TaskContext ctx;
+
+  explicit Fixture(int window = 32) {
+    at::set_num_threads(1);
+    const RigInfo rig = test::tiny_rig();
+    prior = std::make_shared<NemfModel>(test::tiny_nemf_config(), rig);
+    prior->set_requires_grad(false);
+    twostage = std::make_shared<LinearInbetweener>(rig, kTwoStageKind, window);
+    citl = std::make_shared<LinearInbetweener>(rig, kCitlKind, window);
+    ctx.model = prior;
+    ctx.twostage = twostage;
+    ctx.citl = citl;
+  }
+  Motion motion(int frames, uint32_t seed = 3) const {
+    return test::random_motion(prior->rig().skeleton, frames, 30.0, seed);
+  }
+};
+
+bool same_motion(const Motion& a, const Motion& b) {
+  if (a.num_frames() != b.num_frames() || a.num_joints() != b.num_joints()) return false;
+  for (size_t i = 0; i < a.rotations.size(); ++i) {
+    if (a.rotations[i].coeffs() != b.rotations[i].coeffs()) return false;
+  }
+  for (size_t i = 0; i < a.root_positions.size(); ++i) {
+    if (a.root_positions[i] != b.root_positions[i]) return false;
+  }
+  return true;
+}
+
+void expect_known_exact(const Motion& in, const Motion& out, const std::vector<int>& known) {
+  for (int f : known) {
+    for (int j = 0; j < in.num_joints(); ++j) {
+      EXPECT_EQ(out.rotation(f, j).coeffs(), in.rotation(f, j).coeffs()) << "frame " << f << " joint " << j;
+    }
+    EXPECT_EQ(out.root_positions[f], in.root_positions[f]) << "frame " << f;
+  }
+}
+
+void expect_finite(const Motion& m) {
+  for (const auto& q : m.rotations) EXPECT_TRUE(q.coeffs().allFinite());
+  for (const auto& p : m.root_positions) EXPECT_TRUE(p.allFinite());
+}
+
+TEST(TransformerMethods, RegisteredWithTheirNeedsAndDefaultUnchanged) {
+  for (const char* name : {"context", "detail", "citl", "nemf-context", "nemf-detail", "nemf-citl"}) {
+    const auto& all = registered_methods();
+    auto it = std::find_if(all.begin(), all.end(), [&](const Method& m) { return m.name == name; });
+    ASSERT_NE(it, all.end()) << name;
+    EXPECT_TRUE(it->needs_model) << name;
+    EXPECT_TRUE(static_cast<bool>(it->complete)) << name;
+    EXPECT_FALSE(static_cast<bool>(it->resample)) << name;
+    EXPECT_EQ(it->needs_inbetweener, std::string(name).find("citl") != std::string::npos ? "citl" : "twostage");
+  }
+  Fixture fx;
+  EXPECT_EQ(default_method(fx.ctx), "interp");
+}
+
+TEST(TransformerMethods, MissingModelNamesTheFile) {
+  Fixture fx;
+  TaskContext no_transformers;
+  no_transformers.model = fx.prior;
+  const Motion m = fx.motion(20);
+  try {
+    run_inbetween(m, {0, 10, 19}, "citl", no_transformers);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("method 'citl' needs models/motionfield-citl.mfm"), std::string::npos)
+        << e.what();
+  }
+  for (const char* method : {"context", "detail", "nemf-detail"}) {
+    try {
+      run_fill(m, 5, 15, method, no_transformers);
+      FAIL() << "no error for " << method;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("motionfield-twostage.mfm"), std::string::npos) << e.what();
+    }
+  }
+  // The method itself checks too (callers that bypass jobs.h).
+  for (const Method& method : transformer_methods()) {
+    EXPECT_THROW(method.complete(m, {0, 19}, no_transformers), InputError) << method.name;
+  }
+  EXPECT_THROW(make_initializer("citl-encoder", no_transformers), InputError);
+  EXPECT_THROW(make_initializer("nope", fx.ctx), InputError);
+}
+
+TEST(TransformerMethods, DispatchToStagesKnownFramesExactAndGapsFilled) {
+  Fixture fx;
+  const Motion in = fx.motion(30);
+  const std::vector<int> keys = {0, 9, 21, 29};
+  const Motion context = run_inbetween(in, keys, "context", fx.ctx);
+  const Motion detail = run_inbetween(in, keys, "detail", fx.ctx);
+  const Motion citl = run_inbetween(in, keys, "citl", fx.ctx);
+  const Motion interp = interpolate_motion(in, keys);
+  EXPECT_EQ(fx.twostage->calls, 2);
+  EXPECT_EQ(fx.citl->calls, 1);
+  for (const Motion* out : {&context, &detail, &citl}) {
+    ASSERT_EQ(out->num_frames(), in.num_frames());
+    EXPECT_EQ(out->fps, in.fps);
+    expect_known_exact(in, *out, keys);
+    expect_finite(*out);
+  }
+  // The stand-in's stage 0 is linear interpolation in the canonical frame, so
+  // the root path is interpolation's; stage 1 is moved by 1 cm off the keys.
+  for (int f = 0; f < in.num_frames(); ++f) {
+    EXPECT_LT((context.root_positions[f] - interp.root_positions[f]).norm(), 1e-4) << f;
+    EXPECT_LT((citl.root_positions[f] - interp.root_positions[f]).norm(), 1e-4) << f;
+    const bool key = std::find(keys.begin(), keys.end(), f) != keys.end();
+    EXPECT_NEAR((detail.root_positions[f] - context.root_positions[f]).norm(), key ? 0.0 : 0.01, 1e-4) << f;
+  }
+  // Unknown pose values reach the model as zeros.
+  EXPECT_EQ(fx.twostage->unknown_abs_sum, 0.0);
+  // Deterministic.
+  EXPECT_TRUE(same_motion(detail, run_inbetween(in, keys, "detail", fx.ctx)));
+}
+
+TEST(TransformerMethods, UnknownFramesAreNeverRead) {
+  Fixture fx;
+  const Motion in = fx.motion(32, 5);
+  const std::vector<int> known = {0, 1, 2, 3, 4, 20, 31};
+  Motion poisoned = in;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int f = 0; f < in.num_frames(); ++f) {
+    if (std::find(known.begin(), known.end(), f) != known.end()) continue;
+    for (int j = 0; j < in.num_joints(); ++j) poisoned.rotation(f, j) = Eigen::Quaterniond(nan, 0.3, nan, 1.0);
+    poisoned.root_positions[f] = Eigen::Vector3d(nan, 7.0, -3.0);
+  }
+  for (const char* method : {"context", "detail", "citl"}) {
+    const Motion a = run_known_frames(in, known, method, fx.ctx);
+    const Motion b = run_known_frames(poisoned, known, method, fx.ctx);
+    EXPECT_TRUE(same_motion(a, b)) << method;
+    expect_finite(b);
+  }
+}
+
+TEST(TransformerMethods, LongInputsInWindowsThatStartAndEndAtKeys) {
+  Fixture fx(24);
+  const Motion in = fx.motion(200, 8);
+  std::vector<int> keys;
+  for (int f = 0; f < 200; f += 7) keys.push_back(f);
+  keys.push_back(199);
+  const Motion out = run_inbetween(in, keys, "citl", fx.ctx);
+  EXPECT_EQ(fx.citl->calls, 1);  // every window in one batch
+  EXPECT_LE(fx.citl->max_frames, 24);
+  EXPECT_GE(fx.citl->last_known.size(0), 200 / 24);
+  expect_known_exact(in, out, keys);
+  expect_finite(out);
+  const Motion interp = interpolate_motion(in, keys);
+  for (int f = 0; f < 200; ++f) EXPECT_LT((out.root_positions[f] - interp.root_positions[f]).norm(), 1e-4) << f;
+
+  // Gap filling on a long clip: frames before and after held like interp.
+  const Motion filled = run_fill(in, 120, 140, "detail", fx.ctx);
+  expect_known_exact(in, filled, known_frames_outside_gap(200, 120, 140));
+
+  // Keys further apart than the window: a clear error.
+  try {
+    run_inbetween(in, {0, 10, 60}, "context", fx.ctx);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("keys 10 and 60 are 50 frames apart"), std::string::npos) << e.what();
+  }
+}
+
+TEST(TransformerMethods, ResidualAtTheKeysIsSpreadOverTheGap) {
+  Fixture fx;
+  fx.citl->miss_keys = true;  // the model's output is 5 cm off everywhere, keys included
+  const Motion in = fx.motion(30, 10);
+  const std::vector<int> keys = {0, 9, 21, 29};
+  const Motion out = run_inbetween(in, keys, "citl", fx.ctx);
+  const Motion interp = interpolate_motion(in, keys);
+  expect_known_exact(in, out, keys);
+  // A constant miss is taken back completely: no jump next to the keys.
+  for (int f = 0; f < in.num_frames(); ++f)
+    EXPECT_LT((out.root_positions[f] - interp.root_positions[f]).norm(), 1e-4) << f;
+}
+
+TEST(TransformerMethods, EndsHeldLikeInterpolation) {
+  Fixture fx;
+  const Motion in = fx.motion(30, 9);
+  const std::vector<int> keys = {5, 12, 20};
+  const Motion out = run_inbetween(in, keys, "citl", fx.ctx);
+  const Motion interp = interpolate_motion(in, keys);
+  for (int f : {0, 1, 4, 21, 29}) {
+    EXPECT_TRUE(out.root_positions[f] == interp.root_positions[f]) << f;
+    for (int j = 0; j < in.num_joints(); ++j) EXPECT_EQ(out.rotation(f, j).coeffs(), interp.rotation(f, j).coeffs());
+  }
+}
+
+TEST(TransformerMethods, PartialKeysGiveTheirKnownMask) {
+  Fixture fx;
+  const Motion in = fx.motion(32, 11);
+  const int J = in.num_joints();
+  MotionConstraints c;
+  c.keys.push_back({0, {}, true});
+  c.keys.push_back({10, {0}, true});       // root only: fixes the root
+  c.keys.push_back({20, {3, 4}, false});   // two joints, no root position
+  c.keys.push_back({31, {}, true});
+  const Motion out = inbetweener_fill(*fx.citl, -1, in, c, LongGapPolicy::Throw);
+  ASSERT_TRUE(fx.citl->last_known.defined());
+  // One window [0, 31], canonical at 0.
+  ASSERT_EQ(fx.citl->last_known.size(0), 1);
+  const at::Tensor k = fx.citl->last_known[0];
+  for (int j = 0; j <= J; ++j) {
+    EXPECT_EQ(k[10][j].item<float>(), (j == 0 || j == J) ? 1.0f : 0.0f) << j;
+    EXPECT_EQ(k[20][j].item<float>(), (j == 3 || j == 4) ? 1.0f : 0.0f) << j;
+    EXPECT_EQ(k[15][j].item<float>(), 0.0f) << j;
+  }
+  EXPECT_EQ(out.rotation(10, 0).coeffs(), in.rotation(10, 0).coeffs());
+  EXPECT_EQ(out.root_positions[10], in.root_positions[10]);
+  EXPECT_EQ(out.rotation(20, 3).coeffs(), in.rotation(20, 3).coeffs());
+  EXPECT_EQ(out.rotation(20, 4).coeffs(), in.rotation(20, 4).coeffs());
+  expect_finite(out);
+  EXPECT_THROW(inbetweener_fill(*fx.twostage, 2, in, c, LongGapPolicy::Throw), InputError);  // no stage 2
+}
+
+TEST(TransformerInitializers, FiniteCodesOfThePriorsShapeFromEachTransformer) {
+  Fixture fx;
+  const Motion window = fx.motion(32, 13);
+  MotionConstraints c;
+  c.keys.push_back({0, {}, true});
+  c.keys.push_back({12, {1, 2, 5}, false});
+  c.keys.push_back({31, {}, true});
+  InitRequest r;
+  r.model = fx.prior.get();
+  r.window = &window;
+  r.constraints = &c;
+  r.anchor = 0;
+  r.context = &fx.ctx;
+  const std::vector<std::string> names = initializer_names();
+  for (const char* name : {"context-encoder", "detail-encoder", "citl-encoder"}) {
+    ASSERT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
+    const InitialGuess bound = make_initializer(name, fx.ctx)->initialize(r);
+    ASSERT_EQ(bound.z_l.sizes(), (std::vector<int64_t>{1, fx.prior->config().zl})) << name;
+    ASSERT_EQ(bound.z_g.sizes(), (std::vector<int64_t>{1, fx.prior->config().zg})) << name;
+    EXPECT_TRUE(at::isfinite(bound.z_l).all().item<bool>()) << name;
+    EXPECT_TRUE(at::isfinite(bound.z_g).all().item<bool>()) << name;
+    const InitialGuess from_context = make_initializer(name)->initialize(r);
+    EXPECT_TRUE(at::equal(bound.z_l, from_context.z_l)) << name;
+  }
+  // Detail differs from context (stage 1 vs stage 0).
+  EXPECT_FALSE(at::equal(make_initializer("context-encoder")->initialize(r).z_l,
+                         make_initializer("detail-encoder")->initialize(r).z_l));
+  // Without a transformer in the request's context: the missing-file error.
+  TaskContext bare;
+  r.context = &bare;
+  EXPECT_THROW(make_initializer("citl-encoder")->initialize(r), InputError);
+}
+
+TEST(TransformerInitializers, SolverMethodsStartFromTheTransformer) {
+  Fixture fx;
+  const Motion in = fx.motion(28, 17);
+  const std::vector<int> keys = {0, 10, 27};
+  const Motion out = run_inbetween(in, keys, "nemf-citl", fx.ctx);
+  EXPECT_GE(fx.citl->calls, 1);
+  expect_known_exact(in, out, keys);
+  expect_finite(out);
+}
+
+}  // namespace
+}  // namespace mf

@@ -1,0 +1,88 @@
+#include "training/trainer_util.h"
+
+#include <ATen/ATen.h>
+#include <torch/optim/adam.h>
+#include <torch/optim/optimizer.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "prior/motion/errors.h"
+
+namespace mf::training {
+
+Dataset load_training_data(const std::string& source, const std::string& cache_dir, int max_train_clips, double fps,
+                           bool verbose) {
+  DatasetOptions dopt;
+  dopt.source = source;
+  dopt.cache_dir = cache_dir;
+  dopt.verbose = verbose;
+  Dataset data = load_dataset(dopt);
+  if (max_train_clips > 0 && static_cast<int>(data.train.size()) > max_train_clips) data.train.resize(max_train_clips);
+  if (data.train.empty()) throw InputError("train: no training clips");
+  for (const Clip& c : data.train) {
+    if (fps > 0 && std::abs(c.motion.fps - fps) > 1e-3) {
+      throw InputError("train: clip " + c.name + " is at " + std::to_string(c.motion.fps) + " fps, the model at " +
+                       std::to_string(fps) + " fps");
+    }
+  }
+  return data;
+}
+
+RigInfo measure_training_rig(const Dataset& data) {
+  std::vector<const Motion*> motions;
+  for (const Clip& c : data.train) motions.push_back(&c.motion);
+  return measure_rig(data.skeleton, motions);
+}
+
+at::Tensor padded_slice(const at::Tensor& x, int start, int length, int W) {
+  at::Tensor s = x.narrow(0, start, length);
+  if (length < W) {
+    std::vector<int64_t> shape(s.sizes().begin(), s.sizes().end());
+    shape[0] = W - length;
+    s = at::cat({s, s.narrow(0, length - 1, 1).expand(shape)}, 0);
+  }
+  return s.unsqueeze(0);
+}
+
+at::Tensor masked_mean(const at::Tensor& value, const at::Tensor& mask) {
+  at::Tensor v = value.dim() > 2 ? value.flatten(2).mean(-1) : value;
+  return (v * mask).sum() / mask.sum().clamp_min(1.0);
+}
+
+void save_trainer_state(const std::string& path, const TrainerState& s) {
+  {
+    std::ofstream out(path + ".tmp");
+    out.precision(17);
+    out << "epoch " << s.epoch << "\nstep " << s.step << "\nminutes " << s.minutes << "\nbest " << s.best << "\n";
+  }
+  std::filesystem::rename(path + ".tmp", path);
+}
+
+TrainerState load_trainer_state(const std::string& path) {
+  TrainerState s;
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot read the trainer state");
+  std::string key;
+  while (in >> key) {
+    if (key == "epoch") in >> s.epoch;
+    else if (key == "step") in >> s.step;
+    else if (key == "minutes") in >> s.minutes;
+    else if (key == "best") in >> s.best;
+  }
+  return s;
+}
+
+double scheduled_lr(double lr, double lr_final, double progress, double warmup) {
+  progress = std::min(1.0, std::max(0.0, progress));
+  if (warmup > 0 && progress < warmup) return lr * std::max(0.01, progress / warmup);
+  const double p = warmup > 0 ? (progress - warmup) / (1.0 - warmup) : progress;
+  return lr_final + 0.5 * (lr - lr_final) * (1.0 + std::cos(M_PI * p));
+}
+
+void set_learning_rate(torch::optim::Optimizer& optimizer, double lr) {
+  for (auto& group : optimizer.param_groups()) static_cast<torch::optim::AdamOptions&>(group.options()).lr(lr);
+}
+
+}  // namespace mf::training

@@ -1,0 +1,51 @@
+// Pieces shared by the training programs (prior_trainer.cc,
+// inbetween_trainer.cc): data loading with the common checks, padding, the
+// trainer state file, learning-rate schedule.
+#pragma once
+
+#include <ATen/core/Tensor.h>
+#include <cstdint>
+#include <string>
+
+#include "prior/data/dataset.h"
+#include "prior/model/representation.h"
+
+namespace torch::optim {
+class Optimizer;
+}
+
+namespace mf::training {
+
+/// Loads `data` (folder or archive) through the cache, keeps at most
+/// `max_train_clips` training clips (0 = all) and checks that every training
+/// clip is at `fps` (when fps > 0). Throws InputError when there is no training clip.
+Dataset load_training_data(const std::string& data, const std::string& cache_dir, int max_train_clips, double fps,
+                           bool verbose);
+
+/// The rig measured from the training clips (as the prior's trainer does).
+RigInfo measure_training_rig(const Dataset& data);
+
+/// Frames [start, start + length) of x [T, ...] padded to W by repeating the
+/// last frame, with a leading batch dimension: [1, W, ...].
+at::Tensor padded_slice(const at::Tensor& x, int start, int length, int W);
+
+/// Mean over the trailing dimensions of value [B, S, ...], then over the
+/// frames where mask [B, S] is 1.
+at::Tensor masked_mean(const at::Tensor& value, const at::Tensor& mask);
+
+/// What a run needs to resume besides the model and optimiser (out_dir/last.state).
+struct TrainerState {
+  int epoch = 0;
+  int64_t step = 0;
+  double minutes = 0.0;  ///< wall time of all runs so far
+  double best = 1e30;    ///< best validation score
+};
+void save_trainer_state(const std::string& path, const TrainerState& s);
+TrainerState load_trainer_state(const std::string& path);
+
+/// Cosine decay from lr to lr_final as progress goes 0 -> 1, after a linear
+/// warm-up over the first `warmup` fraction of progress (0 = none).
+double scheduled_lr(double lr, double lr_final, double progress, double warmup = 0.0);
+void set_learning_rate(torch::optim::Optimizer& optimizer, double lr);
+
+}  // namespace mf::training
