@@ -2,10 +2,9 @@
 # The README's demo (`make demo`): in-betweening and resampling of the bundled,
 # hand-made sample clip samples/walk_keyframes.bvh with the motionfield CLI.
 #   usage: scripts/demo.sh BUILD_DIR OUT_DIR
-# Resampling uses the bundled prior (models/motionfield-prior.mfm, method
-# "prior": encode, decode at the new times, input frames kept exactly);
-# in-betweening uses the interpolation baseline until the latent solvers are
-# measured to beat it (docs/BENCHMARKS.md).
+# Both use the bundled prior (models/motionfield-prior.mfm) through the default
+# methods: in-betweening with the latent solver ("nemf"), resampling with
+# "prior"; input keyframes come out exactly (docs/BENCHMARKS.md).
 set -euo pipefail
 
 if [ $# -ne 2 ]; then
@@ -31,8 +30,10 @@ keyframes=$(seq -s, 0 10 $((frames - 1)))
 if [ $(((frames - 1) % 10)) -ne 0 ]; then keyframes="$keyframes,$((frames - 1))"; fi
 
 echo "demo: sample $SAMPLE ($frames frames at $fps fps)"
-"$MF" inbetween --in "$SAMPLE" --keyframes "$keyframes" --method interp --out "$OUT/walk_inbetween.bvh"
-echo "demo: in-betweened from keyframes $keyframes -> $OUT/walk_inbetween.bvh"
+inbetween_method=interp
+if [ -f "$MODEL" ]; then inbetween_method=nemf; fi
+"$MF" inbetween --in "$SAMPLE" --keyframes "$keyframes" --method "$inbetween_method" --out "$OUT/walk_inbetween.bvh"
+echo "demo: in-betweened from keyframes $keyframes with method '$inbetween_method' -> $OUT/walk_inbetween.bvh"
 resample_method=interp
 if [ -f "$MODEL" ]; then resample_method=prior; fi
 "$MF" resample --in "$SAMPLE" --fps 60 --method "$resample_method" --out "$OUT/walk_60fps.bvh"

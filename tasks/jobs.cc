@@ -59,7 +59,12 @@ std::vector<std::string> available_methods() {
   return names;
 }
 
-std::string default_method(const TaskContext& ctx) { return "interp"; }
+// Measured in docs/BENCHMARKS.md ("Latent solvers"): the L-BFGS solver beats
+// interpolation on L2P, L2Q, NPSS and foot skating at every gap and keyframe
+// spacing of the benchmark.
+std::string default_method(const TaskContext& ctx) { return ctx.model ? "nemf" : "interp"; }
+
+std::string default_resample_method(const TaskContext& ctx) { return ctx.model ? "prior" : "interp"; }
 
 void validate_keyframes(const std::vector<int>& keyframes, int frames) {
   if (keyframes.size() < 2)
@@ -132,7 +137,7 @@ Motion run_fill(const Motion& input, int a, int b, const std::string& method, co
 
 Motion run_resample(const Motion& input, double fps, const std::string& method, std::vector<std::string>* warnings,
                     const TaskContext& ctx) {
-  const Method& m = resolve_method(method, ctx);
+  const Method& m = resolve_method(method.empty() ? default_resample_method(ctx) : method, ctx);
   if (!m.resample) throw InputError("method '" + m.name + "' does not do resampling");
   check_motion(input);
   bool rounded = false;

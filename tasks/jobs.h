@@ -25,9 +25,12 @@ namespace mf {
 const std::vector<Method>& registered_methods();
 /// Names accepted by --method, e.g. {"interp", "zerovel", ...}.
 std::vector<std::string> available_methods();
-/// What runs when no method is given: the best measured method that can run
-/// in this context (methods that need a model fall back to "interp" without one).
+/// What runs when no method is given for in-betweening and gap filling: the
+/// best measured method that can run in this context ("nemf" with a model,
+/// "interp" without one).
 std::string default_method(const TaskContext& ctx = {});
+/// The same for resampling: "prior" with a model, "interp" without one.
+std::string default_resample_method(const TaskContext& ctx = {});
 
 /// Throws InputError unless: at least two keyframes, strictly increasing (so
 /// sorted and unique), every one in [0, frames). The message names the

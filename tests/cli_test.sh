@@ -85,11 +85,22 @@ for method in interp zerovel; do
   # ...and really changes the others (so the comparison above can fail).
   expect_rc 3 "inbetween $method changes unknown frames" -- "$MF" diff "$SAMPLE" "$TMP/kf-$method.bvh"
 done
-# --flag=value form, --threads anywhere, and the default method (interp).
-expect_rc 0 "inbetween --in=..." -- "$MF" --threads 1 inbetween --in="$SAMPLE" --keyframes="$KEYS" --out="$TMP/default.bvh"
-expect_frames "$TMP/default.bvh" "$N"
-expect_rc 0 "the default method is interp" -- "$MF" diff "$TMP/default.bvh" "$TMP/kf-interp.bvh"
-expect_rc 3 "...and not zerovel" -- "$MF" diff "$TMP/default.bvh" "$TMP/kf-zerovel.bvh"
+# --flag=value form, --threads anywhere, and the default method: with the
+# bundled model the measured best method (tasks/jobs.cc default_method(),
+# docs/BENCHMARKS.md), which keeps the keyframes and is not interpolation;
+# without a model interpolation (tests/jobs_test.cc).
+if [ -f "$SRC/models/motionfield-prior.mfm" ]; then
+  default_method=nemf
+  expect_rc 0 "inbetween --in=..." -- \
+    "$MF" --threads 1 inbetween --in="$SAMPLE" --keyframes="$KEYS" --out="$TMP/default.bvh"
+  expect_frames "$TMP/default.bvh" "$N"
+  expect_rc 0 "inbetween --method $default_method" -- \
+    "$MF" --threads 1 inbetween --in "$SAMPLE" --keyframes "$KEYS" --out "$TMP/named-default.bvh" --method "$default_method"
+  expect_rc 0 "the default method with the model is $default_method" -- \
+    "$MF" diff "$TMP/default.bvh" "$TMP/named-default.bvh" --tol 1e-9
+  expect_rc 0 "the default method keeps the keyframes" -- "$MF" diff "$SAMPLE" "$TMP/default.bvh" --frames "$KEYS"
+  expect_rc 3 "...and is not interp" -- "$MF" diff "$TMP/default.bvh" "$TMP/kf-interp.bvh"
+fi
 
 # ------------------------------------------------------------ fill
 for method in interp zerovel; do

@@ -45,7 +45,8 @@ TEST(JobsTest, Methods) {
   const auto methods = available_methods();
   EXPECT_NE(std::find(methods.begin(), methods.end(), "interp"), methods.end());
   EXPECT_NE(std::find(methods.begin(), methods.end(), "zerovel"), methods.end());
-  EXPECT_EQ(default_method(), "interp");
+  EXPECT_EQ(default_method(), "interp");  // without a model
+  EXPECT_EQ(default_resample_method(), "interp");
 }
 
 TEST(JobsTest, ValidateKeyframesAcceptsSortedUniqueInRange) {

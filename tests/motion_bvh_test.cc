@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
+#include "prior/data/dataset.h"
 #include "prior/motion/rotations.h"
 #include "tests/test_util.h"
 
@@ -361,10 +363,16 @@ TEST(MotionBvhTest, ReadsAndWritesFiles) {
   EXPECT_THROW(read_motion(dir + "/missing.bvh"), BvhError);
 }
 
-// The training data's own files (only where the extracted copy exists).
+// One of the training data's own files, extracted from the shared archive
+// (skipped only on a machine without ../shared/data).
 TEST(MotionBvhTest, ReadsTheDatasetRig) {
-  const std::string path = "/tmp/data/Bandai-Namco-Research-Motiondataset-1/data/dataset-1_walk_normal_001.bvh";
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " is not there";
+  const std::string archive = default_train_archive();
+  if (!std::filesystem::exists(archive)) GTEST_SKIP() << archive << " is not there";
+  const std::string member = "Bandai-Namco-Research-Motiondataset-1/data/dataset-1_walk_normal_001.bvh";
+  const std::string dir = test::scratch_dir("dataset_rig");
+  const std::string command = "tar -xf '" + archive + "' -C '" + dir + "' '" + member + "'";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  const std::string path = dir + "/" + member;
   BvhDocument layout;
   const Motion m = read_motion(path, &layout);
   EXPECT_EQ(layout.joints.size(), 22u);

@@ -540,7 +540,9 @@ void run_job(const mf::cli::BatchJob& job, const Settings& settings, Models& mod
 
   if (settings.verbose) {
     auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
-    const std::string method = job.method.empty() ? default_method_name(model) : job.method;
+    const std::string method = !job.method.empty()      ? job.method
+                               : job.task == "resample" ? std::string("default")
+                                                        : default_method_name(model);
     std::fprintf(stderr,
                  "motionfield: %s %s -> %s: %d -> %d frames, method %s, model %s, %d threads; read %.1f ms, "
                  "solve %.1f ms, write %.1f ms\n",
