@@ -20,19 +20,7 @@
 namespace mf {
 namespace {
 
-NemfConfig tiny_config() {
-  NemfConfig c;
-  c.window = 32;
-  c.decoder_width = 32;
-  c.decoder_layers = 3;
-  c.zl = 8;
-  c.zg = 4;
-  c.zg_layers = 2;
-  c.encoder_channels = 4;
-  c.gmp_width = 8;
-  c.gmp_blocks = 1;
-  return c;
-}
+NemfConfig tiny_config() { return test::tiny_nemf_config(); }
 
 NemfModel tiny_model() {
   Skeleton s = test::small_skeleton();

@@ -24,16 +24,7 @@ namespace mf {
 namespace {
 
 NemfConfig tiny_config() {
-  NemfConfig c;
-  c.window = 32;
-  c.decoder_width = 32;
-  c.decoder_layers = 3;
-  c.zl = 8;
-  c.zg = 4;
-  c.zg_layers = 2;
-  c.encoder_channels = 4;
-  c.gmp_width = 8;
-  c.gmp_blocks = 1;
+  NemfConfig c = test::tiny_nemf_config();
   c.pe_frequencies = 4;  // periods of 12+ frames: a random decoder that does not jitter from frame to frame
   return c;
 }

@@ -14,19 +14,7 @@
 namespace mf::capi_test {
 namespace {
 
-NemfConfig tiny_config() {
-  NemfConfig c;
-  c.window = 32;
-  c.decoder_width = 32;
-  c.decoder_layers = 3;
-  c.zl = 8;
-  c.zg = 4;
-  c.zg_layers = 2;
-  c.encoder_channels = 4;
-  c.gmp_width = 8;
-  c.gmp_blocks = 1;
-  return c;
-}
+NemfConfig tiny_config() { return test::tiny_nemf_config(); }
 
 // The model file, in a directory of this process removed at exit (ctest runs
 // every test in its own process, several at once).
