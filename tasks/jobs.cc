@@ -59,10 +59,15 @@ std::vector<std::string> available_methods() {
   return names;
 }
 
-// Measured in docs/BENCHMARKS.md ("Latent solvers"): the L-BFGS solver beats
-// interpolation on L2P, L2Q, NPSS and foot skating at every gap and keyframe
-// spacing of the benchmark.
-std::string default_method(const TaskContext& ctx) { return ctx.model ? "nemf" : "interp"; }
+// Measured in docs/BENCHMARKS.md ("Latent solvers" and "Transformer
+// in-betweeners"): L-BFGS started from the two-stage transformer beats the
+// solver from interpolation, which beats interpolation, on L2P, L2Q, NPSS and
+// foot skating at gaps of 15+ frames and keys 15+ frames apart (and ties it
+// below).
+std::string default_method(const TaskContext& ctx) {
+  if (ctx.model && ctx.twostage) return "nemf-detail";
+  return ctx.model ? "nemf" : "interp";
+}
 
 std::string default_resample_method(const TaskContext& ctx) { return ctx.model ? "prior" : "interp"; }
 

@@ -26,8 +26,9 @@ const std::vector<Method>& registered_methods();
 /// Names accepted by --method, e.g. {"interp", "zerovel", ...}.
 std::vector<std::string> available_methods();
 /// What runs when no method is given for in-betweening and gap filling: the
-/// best measured method that can run in this context ("nemf" with a model,
-/// "interp" without one).
+/// best measured method that can run in this context ("nemf-detail" with the
+/// prior and the two-stage transformer, "nemf" with the prior alone, "interp"
+/// without a model).
 std::string default_method(const TaskContext& ctx = {});
 /// The same for resampling: "prior" with a model, "interp" without one.
 std::string default_resample_method(const TaskContext& ctx = {});

@@ -91,6 +91,7 @@ done
 # without a model interpolation (tests/jobs_test.cc).
 if [ -f "$SRC/models/motionfield-prior.mfm" ]; then
   default_method=nemf
+  if [ -f "$SRC/models/motionfield-twostage.mfm" ]; then default_method=nemf-detail; fi
   expect_rc 0 "inbetween --in=..." -- \
     "$MF" --threads 1 inbetween --in="$SAMPLE" --keyframes="$KEYS" --out="$TMP/default.bvh"
   expect_frames "$TMP/default.bvh" "$N"
@@ -255,6 +256,17 @@ if [ -n "$TINY" ]; then
   bad "renav: --frames with --path" --model "$TINY" renav --in "$SMALL" --path "$TMP/path50.csv" --frames 10 --out "$TMP/bad.bvh"
   bad "renav: --path and --polyline" --model "$TINY" renav --in "$SMALL" --path "$TMP/path50.csv" --polyline "$TMP/poly.csv" --out "$TMP/bad.bvh"
   bad "renav: --fps 0" --model "$TINY" renav --in "$SMALL" --path "$TMP/path50.csv" --fps 0 --out "$TMP/bad.bvh"
+  # The same jobs in batch mode give the same files; a bad renav line fails alone.
+  {
+    echo "{\"task\": \"renav\", \"in\": \"$SMALL\", \"out\": \"$TMP/b-renav.bvh\", \"path\": \"$TMP/path50.csv\"}"
+    echo "{\"task\": \"renav\", \"in\": \"$SMALL\", \"out\": \"$TMP/b-renav-poly.bvh\", \"polyline\": \"$TMP/poly.csv\", \"frames\": 30, \"fps\": 60, \"method\": \"nemf-adam\"}"
+    echo "{\"task\": \"renav\", \"in\": \"$SMALL\", \"out\": \"$TMP/b-bad.bvh\", \"path\": \"$TMP/one-point.csv\"}"
+  } >"$TMP/renav.jsonl"
+  expect_rc 2 "batch renav with one bad line" -- "$MF" --model "$TINY" --threads 1 batch "$TMP/renav.jsonl"
+  expect_stderr "at least two points" "batch renav names the bad line's problem"
+  expect_rc 0 "batch renav = renav" -- "$MF" diff "$TMP/b-renav.bvh" "$TMP/renav.bvh" --tol 1e-9
+  expect_rc 0 "batch renav --polyline = renav --polyline" -- "$MF" diff "$TMP/b-renav-poly.bvh" "$TMP/renav-poly.bvh" --tol 1e-9
+  expect_absent "$TMP/b-bad.bvh"
 else
   echo "cli_test: no tiny model (mf_capi_tiny_model not built, MF_TEST_MODEL unset): renav runs skipped"
 fi

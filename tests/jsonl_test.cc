@@ -194,6 +194,29 @@ TEST(JsonlTest, ResampleJob) {
   EXPECT_FALSE(j.has_keyframes);
 }
 
+TEST(JsonlTest, RenavJobTakesAPathOrAPolyline) {
+  const BatchJob a = job(R"({"task": "renav", "in": "a.bvh", "out": "b.bvh", "path": "p.csv", "method": "nemf"})");
+  EXPECT_EQ(a.path_file, "p.csv");
+  EXPECT_FALSE(a.polyline);
+  EXPECT_EQ(a.fps, 0.0);
+  EXPECT_EQ(a.method, "nemf");
+  const BatchJob b = job(R"({"task": "renav", "in": "a.bvh", "out": "b.bvh", "polyline": "v.csv", "frames": 90, "fps": 60})");
+  EXPECT_EQ(b.path_file, "v.csv");
+  EXPECT_TRUE(b.polyline);
+  EXPECT_EQ(b.frames, 90);
+  EXPECT_EQ(b.fps, 60.0);
+  auto has = [](const std::string& m, const std::string& part) { return m.find(part) != std::string::npos; };
+  EXPECT_TRUE(has(job_error(R"({"task": "renav", "in": "a", "out": "b"})"), "exactly one of \"path\" and \"polyline\""));
+  EXPECT_TRUE(has(job_error(R"({"task": "renav", "in": "a", "out": "b", "path": "p", "polyline": "q"})"),
+                  "exactly one of"));
+  EXPECT_TRUE(has(job_error(R"({"task": "renav", "in": "a", "out": "b", "path": 3})"), "\"path\" must be a string"));
+  EXPECT_TRUE(has(job_error(R"({"task": "renav", "in": "a", "out": "b", "path": "p", "frames": 10})"),
+                  "\"frames\" goes with \"polyline\""));
+  EXPECT_TRUE(has(job_error(R"({"task": "renav", "in": "a", "out": "b", "polyline": "p", "frames": 1.5})"), "integer"));
+  EXPECT_TRUE(has(job_error(R"({"task": "renav", "in": "a", "out": "b", "path": "p", "fps": 0})"), "positive"));
+  EXPECT_TRUE(has(job_error(R"({"task": "renav", "in": "a", "out": "b", "path": "p", "fps": "30"})"), "a number"));
+}
+
 TEST(JsonlTest, BadJobsNameTheProblem) {
   auto has = [](const std::string& m, const std::string& part) { return m.find(part) != std::string::npos; };
   EXPECT_TRUE(has(job_error("[1, 2]"), "JSON object"));

@@ -390,6 +390,31 @@ TEST(LatentSolver, EndEffectorIkReachesTheTarget) {
   for (int f : {0, 23}) EXPECT_EQ(out.rotation(f, 3).coeffs(), m.rotation(f, 3).coeffs());  // keys untouched
 }
 
+TEST(LatentSolver, EndEffectorBeyondTheLegsReachMovesTheRoot) {
+  at::set_num_threads(1);
+  LeggedModel legged = legged_model(-10.0f);  // no contacts: no foot locking
+  const NemfModel& model = *legged.model;
+  Motion m = gentle_motion(legged.skeleton, 24, 15);
+  MotionConstraints c = MotionConstraints::full_pose({0, 23});
+  // 5 cm farther from the hip than the straight leg (0.84 m) reaches.
+  const GlobalPose pm = forward_kinematics(m);
+  const Eigen::Vector3d hip = pm.position(12, 2);
+  const Eigen::Vector3d target = hip + (pm.position(12, 4) - hip).normalized() * 0.89;
+  c.effectors.push_back({12, 4, target, 1.0});
+  CompletionReport report;
+  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  Motion out = complete_motion(model, m, c, o, {}, &report);
+  EXPECT_LT((forward_kinematics(out).position(12, 4) - target).norm(), 1e-3);
+  EXPECT_LT(report.effectors.max_cm, 0.1);
+  for (int f : {0, 23}) {  // keys untouched
+    EXPECT_EQ(out.root_positions[f], m.root_positions[f]);
+    EXPECT_EQ(out.rotation(f, 3).coeffs(), m.rotation(f, 3).coeffs());
+  }
+  o.effector_falloff = -1;  // without the IK the target is missed
+  Motion pulled = complete_motion(model, m, c, o);
+  EXPECT_GT((forward_kinematics(pulled).position(12, 4) - target).norm(), 0.01);
+}
+
 TEST(LatentSolver, BadInputIsAnInputError) {
   NemfModel model = tiny_model();
   Motion m = test::random_motion(model.rig().skeleton, 20, 30.0, 1);

@@ -524,8 +524,9 @@ BatchJob batch_job_from_json(const JsonValue& line) {
   BatchJob job;
   if (const JsonValue* id = line.find("id")) job.id = id->is_string() ? id->as_string() : id->dump();
   job.task = string_value(required(line, "task", ""), "task", false);
-  if (job.task != "inbetween" && job.task != "fill" && job.task != "resample")
-    throw InputError("unknown task \"" + job.task + "\" (expected \"inbetween\", \"fill\" or \"resample\")");
+  if (job.task != "inbetween" && job.task != "fill" && job.task != "resample" && job.task != "renav")
+    throw InputError("unknown task \"" + job.task +
+                     "\" (expected \"inbetween\", \"fill\", \"resample\" or \"renav\")");
   job.in = string_value(required(line, "in", job.task), "in", false);
   job.out = string_value(required(line, "out", job.task), "out", false);
   if (const JsonValue* m = line.find("method")) job.method = string_value(*m, "method", false);
@@ -546,10 +547,26 @@ BatchJob batch_job_from_json(const JsonValue& line) {
       job.gap_end = int_value(g.as_array()[1], "\"gap\" item 1");
       job.has_gap = true;
     }
-  } else {
+  } else if (job.task == "resample") {
     const JsonValue& f = required(line, "fps", job.task);
     if (!f.is_number()) throw InputError(std::string("\"fps\" must be a number, not ") + json_type_name(f.type()));
     job.fps = f.as_number();
+  } else {  // renav
+    const JsonValue* path = line.find("path");
+    const JsonValue* polyline = line.find("polyline");
+    if ((path != nullptr) == (polyline != nullptr))
+      throw InputError("task \"renav\" needs exactly one of \"path\" and \"polyline\"");
+    job.polyline = polyline != nullptr;
+    job.path_file = string_value(job.polyline ? *polyline : *path, job.polyline ? "polyline" : "path", false);
+    if (const JsonValue* f = line.find("fps")) {
+      if (!f->is_number()) throw InputError(std::string("\"fps\" must be a number, not ") + json_type_name(f->type()));
+      job.fps = f->as_number();
+      if (!(job.fps > 0)) throw InputError("\"fps\" must be positive, not " + f->dump());
+    }
+    if (const JsonValue* n = line.find("frames")) {
+      if (!job.polyline) throw InputError("\"frames\" goes with \"polyline\" (a \"path\" has one point per frame)");
+      job.frames = int_value(*n, "\"frames\"");
+    }
   }
   return job;
 }

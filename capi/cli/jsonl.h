@@ -82,13 +82,15 @@ JsonValue parse_json(const std::string& text);
 /// Name of a JSON type for messages: "null", "a boolean", "a number", ...
 const char* json_type_name(JsonValue::Type type);
 
-/// One job of `motionfield batch`: {"task": "inbetween" | "fill" | "resample",
-/// "in": path, "out": path, "keyframes": [int...], "gap": [A, B], "fps": F,
-/// "method": name}. Only the keys the task needs are read and type-checked; any
-/// other key ("id", a frame count, the input's fps, ...) is ignored, so callers
-/// can annotate jobs.
+/// One job of `motionfield batch`: {"task": "inbetween" | "fill" | "resample" |
+/// "renav", "in": path, "out": path, "keyframes": [int...], "gap": [A, B],
+/// "fps": F, "method": name}; re-navigation takes exactly one of "path" (a CSV
+/// of x,z per output frame) and "polyline" (a CSV of vertices, with an
+/// optional "frames": N), and an optional "fps". Only the keys the task needs
+/// are read and type-checked; any other key ("id", a frame count, the input's
+/// fps, ...) is ignored, so callers can annotate jobs.
 struct BatchJob {
-  std::string task;    ///< "inbetween", "fill" or "resample"
+  std::string task;    ///< "inbetween", "fill", "resample" or "renav"
   std::string in, out; ///< paths as given (relative to the current directory)
   std::string method;  ///< empty: the default method
   std::string id;      ///< the job's "id" for messages (JSON text; strings unquoted), empty if none
@@ -96,14 +98,18 @@ struct BatchJob {
   std::vector<int> keyframes;  ///< inbetween: required; fill: optional and then authoritative
   bool has_gap = false;
   int gap_begin = 0, gap_end = 0;  ///< fill: frames gap_begin..gap_end-1 are unknown
-  double fps = 0.0;                ///< resample: the target fps
+  double fps = 0.0;                ///< resample: the target fps; renav: the output's (0 = the reference's)
+  std::string path_file;           ///< renav: the CSV of the path or of the polyline's vertices
+  bool polyline = false;           ///< renav: path_file holds a polyline's vertices
+  int frames = 0;                  ///< renav with a polyline: the output's frame count (0 = from the speed)
 };
 
 /// Reads a job from one parsed line. Throws mf::InputError with a message naming
 /// the key when the value is not an object, "task" is missing or unknown, or a
 /// key the task needs is missing or has the wrong type ("in" and "out" non-empty
 /// strings; "keyframes" an array of integers; "gap" an array of two integers;
-/// "fps" a number; "method" a string). Range checks (keyframes within the clip,
+/// "fps" a number; "method", "path" and "polyline" strings; "frames" an
+/// integer). Range checks (keyframes within the clip,
 /// fps positive, ...) happen later, in tasks/jobs.h, once the input is read.
 BatchJob batch_job_from_json(const JsonValue& line);
 

@@ -346,7 +346,11 @@ const char* kBatchHelp =
     "  {\"task\": \"inbetween\", \"in\": \"a.bvh\", \"out\": \"b.bvh\", \"keyframes\": [0, 10, 20]}\n"
     "  {\"task\": \"fill\", \"in\": \"a.bvh\", \"out\": \"c.bvh\", \"gap\": [10, 20]}\n"
     "  {\"task\": \"resample\", \"in\": \"a.bvh\", \"out\": \"d.bvh\", \"fps\": 60, \"method\": \"interp\"}\n"
-    "For fill, a \"keyframes\" list, if given, is authoritative over \"gap\". Keys a\n"
+    "  {\"task\": \"renav\", \"in\": \"a.bvh\", \"out\": \"e.bvh\", \"path\": \"path.csv\"}\n"
+    "  {\"task\": \"renav\", \"in\": \"a.bvh\", \"out\": \"f.bvh\", \"polyline\": \"p.csv\", \"frames\": 90}\n"
+    "For fill, a \"keyframes\" list, if given, is authoritative over \"gap\". For\n"
+    "renav, \"path\" or \"polyline\" and the optional \"fps\" and \"frames\" mean what\n"
+    "the flags of `motionfield renav` mean. Keys a\n"
     "job does not need (\"id\", frame counts, ...) are ignored; blank lines are\n"
     "skipped; relative paths are relative to the current directory. The model\n"
     "(--model) is loaded once for all jobs.\n"
@@ -495,18 +499,34 @@ std::string rounding_warning(int frames, double fps_in, double fps_out, int out_
   return msg.str();
 }
 
+std::vector<float> read_path(const std::string& path) {
+  size_t n = 0;
+  check(mf_path_load_csv(path.c_str(), nullptr, 0, &n));
+  std::vector<float> xz(n);
+  check(mf_path_load_csv(path.c_str(), xz.data(), xz.size(), &n));
+  return xz;
+}
+
 // Runs one job (from the command line or a batch line) end to end: read, solve,
 // write. Warnings are appended to *warnings.
 void run_job(const mf::cli::BatchJob& job, const Settings& settings, Models& models,
              std::vector<std::string>* warnings) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  if (!job.method.empty()) method_flags(job.method);  // unknown methods fail before any reading
+  const bool renav = job.task == "renav";
+  // Unknown methods fail before any reading (re-navigation has methods of its own, checked by mf_renav).
+  if (!job.method.empty() && !renav) method_flags(job.method);
+  if (renav) {
+    if (job.fps < 0 || !std::isfinite(job.fps)) throw InputError("renav: the fps must be positive");
+    if (job.polyline && job.frames != 0 && job.frames < 2) throw InputError("renav: the frame count must be at least 2");
+  }
   check_output_path(job.out);
-  const mf_model* model = models.for_method(job.method);
+  // Re-navigation always needs the prior, whatever the method.
+  const mf_model* model = models.for_method(renav && job.method.empty() ? "nemf" : job.method);
 
   const MotionPtr input = load_motion(job.in);
   const int frames_in = frame_count(input.get());
+  const std::vector<float> xz = renav ? read_path(job.path_file) : std::vector<float>();
   const auto t1 = Clock::now();
 
   mf_task_options options;
@@ -525,6 +545,14 @@ void run_job(const mf::cli::BatchJob& job, const Settings& settings, Models& mod
     check(mf_resample_frame_count(frames_in, fps_in, job.fps, &expected_frames, &rounded));
     if (rounded && warnings) warnings->push_back(rounding_warning(frames_in, fps_in, job.fps, expected_frames));
     check(mf_resample(model, input.get(), job.fps, &options, &raw));
+  } else if (renav) {
+    mf_renav_options renav_options;
+    check(mf_renav_options_init(&renav_options));
+    renav_options.path_kind = job.polyline ? MF_PATH_POLYLINE : MF_PATH_PER_FRAME;
+    if (job.fps > 0) renav_options.fps = job.fps;
+    if (job.polyline) renav_options.frame_count = job.frames;
+    check(mf_renav(model, input.get(), xz.data(), xz.size() / 2, &renav_options, &options, &raw));
+    expected_frames = job.polyline ? renav_options.frame_count : static_cast<int32_t>(xz.size() / 2);
   } else {
     throw InputError("unknown task '" + job.task + "'");
   }
@@ -532,7 +560,7 @@ void run_job(const mf::cli::BatchJob& job, const Settings& settings, Models& mod
   const auto t2 = Clock::now();
 
   const int32_t frames_out = frame_count(result.get());
-  if (frames_out != expected_frames)
+  if (expected_frames > 0 && frames_out != expected_frames)
     throw std::logic_error("the result has " + std::to_string(frames_out) + " frames, expected " +
                            std::to_string(expected_frames));
   check(mf_motion_save_bvh(result.get(), job.out.c_str(), nullptr));
@@ -542,6 +570,7 @@ void run_job(const mf::cli::BatchJob& job, const Settings& settings, Models& mod
     auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
     const std::string method = !job.method.empty()      ? job.method
                                : job.task == "resample" ? std::string("default")
+                               : renav                  ? std::string("nemf")
                                                         : default_method_name(model);
     std::fprintf(stderr,
                  "motionfield: %s %s -> %s: %d -> %d frames, method %s, model %s, %d threads; read %.1f ms, "
@@ -595,16 +624,7 @@ int command_single(const std::string& command, const std::vector<std::string>& a
   return kExitOk;
 }
 
-std::vector<float> read_path(const std::string& path) {
-  size_t n = 0;
-  check(mf_path_load_csv(path.c_str(), nullptr, 0, &n));
-  std::vector<float> xz(n);
-  check(mf_path_load_csv(path.c_str(), xz.data(), xz.size(), &n));
-  return xz;
-}
-
 int command_renav(const std::vector<std::string>& args, const Settings& settings) {
-  using Clock = std::chrono::steady_clock;
   const CommandArgs a = parse_command_args("renav", args, {"in", "out", "method", "path", "polyline", "fps", "frames"});
   if (a.help) {
     std::fputs(kRenavHelp, stdout);
@@ -612,59 +632,32 @@ int command_renav(const std::vector<std::string>& args, const Settings& settings
   }
   if (!a.positional.empty())
     throw InputError("renav: unexpected argument '" + a.positional.front() + "' (see motionfield renav --help)");
-  const std::string in = a.required("in", "renav"), out = a.required("out", "renav");
+  mf::cli::BatchJob job;
+  job.task = "renav";
+  job.in = a.required("in", "renav");
+  job.out = a.required("out", "renav");
   if (a.has("path") == a.has("polyline"))
     throw InputError("renav: give exactly one of --path and --polyline (see motionfield renav --help)");
-  const bool polyline = a.has("polyline");
-  const std::string path_file = a.get(polyline ? "polyline" : "path");
-  std::string method;
+  job.polyline = a.has("polyline");
+  job.path_file = a.get(job.polyline ? "polyline" : "path");
   if (a.has("method")) {
-    method = a.get("method");
-    if (method.empty()) throw InputError("renav: --method needs a value");
+    job.method = a.get("method");
+    if (job.method.empty()) throw InputError("renav: --method needs a value");
   }
-  mf_renav_options renav;
-  check(mf_renav_options_init(&renav));
-  renav.path_kind = polyline ? MF_PATH_POLYLINE : MF_PATH_PER_FRAME;
   if (a.has("fps")) {
-    renav.fps = parse_double(a.get("fps"), "--fps");
-    if (!(renav.fps > 0)) throw InputError("renav: --fps must be positive");
+    job.fps = parse_double(a.get("fps"), "--fps");
+    if (!(job.fps > 0)) throw InputError("renav: --fps must be positive");
   }
   if (a.has("frames")) {
-    if (!polyline) throw InputError("renav: --frames goes with --polyline (a --path has one point per frame)");
-    renav.frame_count = parse_int(a.get("frames"), "--frames");
-    if (renav.frame_count < 2) throw InputError("renav: --frames must be at least 2");
+    if (!job.polyline) throw InputError("renav: --frames goes with --polyline (a --path has one point per frame)");
+    job.frames = parse_int(a.get("frames"), "--frames");
+    if (job.frames < 2) throw InputError("renav: --frames must be at least 2");
   }
-  check_output_path(out);
-  const auto t0 = Clock::now();
   Models models(settings.model, settings.transformers);
-  const mf_model* model = models.for_method("nemf");  // re-navigation always needs the prior
-  const MotionPtr reference = load_motion(in);
-  const std::vector<float> xz = read_path(path_file);
-  const auto t1 = Clock::now();
-
-  mf_task_options options;
-  check(mf_task_options_init(&options));
-  options.method = method.empty() ? nullptr : method.c_str();
-  mf_motion* raw = nullptr;
-  check(mf_renav(model, reference.get(), xz.data(), xz.size() / 2, &renav, &options, &raw));
-  const MotionPtr result(raw);
-  const auto t2 = Clock::now();
-  const int32_t frames_out = frame_count(result.get());
-  const int32_t expected = polyline ? renav.frame_count : static_cast<int32_t>(xz.size() / 2);
-  if (expected > 0 && frames_out != expected)
-    throw std::logic_error("the result has " + std::to_string(frames_out) + " frames, expected " +
-                           std::to_string(expected));
-  check(mf_motion_save_bvh(result.get(), out.c_str(), nullptr));
-  const auto t3 = Clock::now();
-  if (settings.verbose) {
-    auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
-    std::fprintf(stderr,
-                 "motionfield: renav %s along %s (%zu %s) -> %s: %d frames, method %s, model %s, %d threads; "
-                 "read %.1f ms, solve %.1f ms, write %.1f ms\n",
-                 in.c_str(), path_file.c_str(), xz.size() / 2, polyline ? "vertices" : "points", out.c_str(),
-                 frames_out, method.empty() ? "nemf" : method.c_str(), models.path().c_str(), settings.threads,
-                 ms(t1 - t0), ms(t2 - t1), ms(t3 - t2));
-  }
+  models.load_explicit();
+  std::vector<std::string> warnings;
+  run_job(job, settings, models, &warnings);
+  print_warnings(warnings, "");
   return kExitOk;
 }
 

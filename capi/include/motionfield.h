@@ -207,8 +207,10 @@ MF_API int mf_method_get(int32_t index, const char **name, const char **descript
 MF_API int mf_method_find(const char *name, int32_t *index);
 /** The method used for in-betweening and gap filling when an options struct
  *  gives none: the best measured method that can run with `model` (which may
- *  be NULL: then a method that does not need one). Resampling without a method
- *  uses "prior" with a model and "interp" without. The string is static. */
+ *  be NULL: then a method that does not need one): "nemf-detail" when the
+ *  model has the two-stage transformer, "nemf" with the prior alone, "interp"
+ *  without a model. Resampling without a method uses "prior" with a model and
+ *  "interp" without. The string is static. */
 MF_API int mf_default_method(const mf_model *model, const char **name);
 
 /* ================================================================ model */
