@@ -313,13 +313,15 @@ void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector
 
 // Out of the reach of a two-bone chain (top, mid, joint) at `frame`: the
 // change that brings the target within reach, applied at `frame` and, with the
-// weights w, at its neighbours. When the chain hangs from the root (a leg),
-// the root moves by the shortfall along the top-to-target direction (the hips
-// dip or lean); otherwise the chain's parent (a shoulder) swings the joint
-// toward the target. A tenth of a millimetre inside the reach is kept as
-// margin. Returns false when the target is already within reach.
+// weights w, at its neighbours. With `swing` and a chain that does not hang
+// from the root, the chain's parent (a shoulder) swings the joint toward the
+// target; otherwise (a leg, or a target still beyond the swung arm) the root
+// moves by the shortfall along the top-to-target direction (the hips dip or
+// lean). A tenth of a millimetre inside the reach is kept as margin. Returns
+// false when the target is already within reach.
 bool extend_reach(const Motion& m, const GlobalPose& pose, int frame, int top, int mid, int joint,
-                  const Eigen::Vector3d& target, Eigen::Vector3d* root_shift, Eigen::Quaterniond* parent_swing) {
+                  const Eigen::Vector3d& target, bool swing, Eigen::Vector3d* root_shift,
+                  Eigen::Quaterniond* parent_swing) {
   const double reach = (pose.position(frame, mid) - pose.position(frame, top)).norm() +
                        (pose.position(frame, joint) - pose.position(frame, mid)).norm() - 2e-4;
   const Eigen::Vector3d to_target = target - pose.position(frame, top);
@@ -328,7 +330,7 @@ bool extend_reach(const Motion& m, const GlobalPose& pose, int frame, int top, i
   *parent_swing = Eigen::Quaterniond::Identity();
   if (distance <= reach || distance < 1e-9) return false;
   const int parent = m.skeleton.parents[top];
-  if (parent <= 0) {
+  if (parent <= 0 || !swing) {
     *root_shift = to_target * ((distance - reach) / distance);
   } else {
     const Eigen::Vector3d P = pose.position(frame, parent);
@@ -360,13 +362,14 @@ void reach_effector(const MotionConstraints& c, const EffectorTarget& e, int fal
   for (int attempt = 0; attempt < 3; ++attempt) {
     Eigen::Vector3d shift;
     Eigen::Quaterniond swing;
-    if (!extend_reach(*out, pose, e.frame, top, mid, j, e.position, &shift, &swing)) break;
+    if (!extend_reach(*out, pose, e.frame, top, mid, j, e.position, attempt == 0, &shift, &swing)) break;
+    const bool swung = shift.isZero();
     const int parent = skel.parents[top], grand = parent > 0 ? skel.parents[parent] : -1;
     // Frames whose keys fix what the extension changes: the chain, and the
     // root position (a shift) or the chain's parent (a swing).
     std::vector<char> kept = fixed;
     for (size_t i = 0; i < c.keys.size(); ++i) {
-      if (parent <= 0 ? c.keys[i].root_position : c.key_has_joint(i, parent)) kept[c.keys[i].frame] = 1;
+      if (swung ? c.key_has_joint(i, parent) : c.keys[i].root_position) kept[c.keys[i].frame] = 1;
     }
     if (kept[e.frame]) break;
     for (int f = std::max(0, e.frame - falloff); f <= std::min(N - 1, e.frame + falloff); ++f) {
@@ -375,7 +378,7 @@ void reach_effector(const MotionConstraints& c, const EffectorTarget& e, int fal
       for (int g = std::min(f, e.frame); g <= std::max(f, e.frame); ++g) blocked = blocked || kept[g];
       if (blocked) continue;
       const double w = falloff_weight(d);
-      if (parent <= 0) {
+      if (!swung) {
         out->root_positions[f] += w * shift;
       } else {
         const Eigen::Quaterniond global = pose.rotation(f, parent);
