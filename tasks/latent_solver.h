@@ -37,9 +37,12 @@
 //  * End-effector targets: the energy pulls the motion toward them (measured on
 //    the blended motion, EnergyWeights::on_output, so that the overwrite does
 //    not undo it), and a final two-bone IK on the target joint's chain (the
-//    joint, its parent and grandparent) places the joint exactly when the
-//    target is within reach, spreading the same displacement over
-//    `effector_falloff` frames on each side with raised-cosine weights. The
+//    joint, its parent and grandparent) places the joint exactly, spreading
+//    the same displacement over `effector_falloff` frames on each side with
+//    raised-cosine weights. A target beyond the chain's reach is first brought
+//    within it by swinging the chain's parent (a shoulder) and, if that is
+//    not enough or the chain hangs from the root (a leg), by moving the root,
+//    with the same falloff and never at keys that fix those values. The
 //    error of the raw solution and of the output are reported.
 //  * Foot locking (foot_lock_ramp >= 0, on by default): where the global
 //    motion predictor reports an ankle in contact and the output's ankle is
