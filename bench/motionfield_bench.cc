@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/text.h"
 #include "bench/prior_eval.h"
 #include "bench/protocol.h"
 #include "prior/data/dataset.h"
@@ -28,6 +29,9 @@
 #include "tasks/transformer_methods.h"
 
 namespace {
+
+using mf::bench::fixed;
+using mf::bench::split_list;
 
 const char* kUsage =
     "usage: motionfield-bench [options]\n"
@@ -51,17 +55,6 @@ const char* kUsage =
     "  --l2p-axes        add columns splitting L2P into horizontal (x, z) and vertical (y) parts\n"
     "  --print-stats     add the table of training statistics (position mean / std, standing heights)\n"
     "  --help            this text\n";
-
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    if (!item.empty()) out.push_back(item);
-  }
-  if (out.empty()) throw mf::InputError("empty list '" + s + "'");
-  return out;
-}
 
 int parse_int(const std::string& flag, const std::string& value, int min_value) {
   char* end = nullptr;
@@ -187,12 +180,6 @@ Args parse_args(int argc, char** argv) {
   if (args.source.empty()) args.source = mf::default_train_archive();
   if (args.cache_dir.empty()) args.cache_dir = mf::default_cache_dir();
   return args;
-}
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "bench/protocol.h"
+#include "bench/text.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
@@ -24,16 +25,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr double kRadToDeg = 57.29577951308232;
-
-double elapsed_ms(Clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
-}
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
 
 // Full windows of `length` frames (non-overlapping) and, separately, clips shorter than `length`.
 void recon_windows(const std::vector<Clip>& clips, int length, int max_windows, std::vector<Window>* full,
@@ -209,7 +200,7 @@ ReconResult run_recon(const NemfModel& model, const std::vector<Clip>& clips, co
       const Motion truth = window_motion(clips, w);
       const auto t0 = Clock::now();
       const Motion pred = decode_motion(model, encode_motion(model, truth), truth.fps, truth.num_frames());
-      ms += elapsed_ms(t0);
+      ms += ms_since(t0);
       acc.add(truth, pred);
       if (pass == 0) {
         at::NoGradGuard no_grad;
@@ -258,7 +249,7 @@ FpsResult run_fps(const NemfModel& model, const std::vector<Clip>& clips, const 
       const int frames = static_cast<int>(std::floor(span * row.fps + 1e-6)) + 1;
       const auto t0 = Clock::now();
       const Motion d = decode_motion(model, code, row.fps, frames);
-      row.ms += elapsed_ms(t0);
+      row.ms += ms_since(t0);
       row.accel += mean_joint_acceleration(d);
       row.accel_30 += acc30;
       row.truth_30 += truth_acc;
@@ -302,7 +293,7 @@ SeamResult run_seams(const NemfModel& model, const std::vector<Clip>& clips, con
     const auto t0 = Clock::now();
     const EncodedMotion code = encode_motion(model, truth);
     const Motion pred = decode_motion(model, code, truth.fps, N);
-    ms += elapsed_ms(t0);
+    ms += ms_since(t0);
     ++r.clips;
     r.windows += static_cast<int>(code.windows.size());
     // Window boundaries in the clip's frames (the clips run at the model's rate here).
@@ -379,7 +370,7 @@ SampleResult run_sample(const NemfModel& model, const std::vector<Clip>& clips, 
     at::Tensor rot = model.decode(at::arange(W, at::kFloat), zl, zg);
     at::Tensor root = model.root_positions(rot, model.predict_global(rot)).to(at::kDouble).contiguous();
     at::Tensor quat = torch_rot::matrix_to_quat(rot).to(at::kDouble).contiguous();
-    ms += elapsed_ms(t0);
+    ms += ms_since(t0);
     const double* q = quat.data_ptr<double>();
     const double* p = root.data_ptr<double>();
     for (int b = 0; b < B; ++b) {

@@ -8,16 +8,13 @@
 #include <sstream>
 
 #include "prior/motion/errors.h"
+#include "bench/text.h"
 #include "tasks/jobs.h"
 
 namespace mf::bench {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double elapsed_ms(Clock::time_point since) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
-}
 
 void check_prediction(const Motion& pred, const Motion& truth, const std::string& method) {
   if (pred.num_frames() != truth.num_frames() || pred.num_joints() != truth.num_joints()) {
@@ -34,12 +31,6 @@ TaskResult start_result(Task task, const std::string& method) {
   result.method = method;
   result.threads = at::get_num_threads();
   return result;
-}
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
 }
 
 }  // namespace
@@ -130,7 +121,7 @@ TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stat
       const Motion input = hide_unknown_frames(truth, known);
       const auto t0 = Clock::now();
       const Motion pred = run_fill(input, a, b, method, ctx);
-      ms += elapsed_ms(t0);
+      ms += ms_since(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, known);
     }
@@ -167,7 +158,7 @@ TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats&
       const Motion input = hide_unknown_frames(truth, keys);
       const auto t0 = Clock::now();
       const Motion pred = run_inbetween(input, keys, method, ctx);
-      ms += elapsed_ms(t0);
+      ms += ms_since(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, keys);
       ++used;
@@ -202,7 +193,7 @@ TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats
     }
     const auto t0 = Clock::now();
     const Motion pred = run_resample(input, truth.fps, method, nullptr, ctx);
-    ms += elapsed_ms(t0);
+    ms += ms_since(t0);
     check_prediction(pred, truth, method);
     acc.add(truth, pred, evaluated, known);
   }

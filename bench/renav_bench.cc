@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/text.h"
 #include "prior/data/dataset.h"
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
@@ -57,28 +58,13 @@
 
 namespace {
 
+using mf::bench::fixed;
+using mf::bench::split_list;
+using mf::bench::ms_since;
+
 using Clock = std::chrono::steady_clock;
 constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxReference = 600;  // frames of a clip used as the reference
-
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    if (!item.empty()) out.push_back(item);
-  }
-  if (out.empty()) throw mf::InputError("empty list '" + s + "'");
-  return out;
-}
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
 
 struct Args {
   std::string model;

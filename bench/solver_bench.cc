@@ -7,8 +7,8 @@
 // "Latent solvers").
 //
 //   solver-bench --model FILE [--split validation|train] [--threads N] [--max-windows N]
-//                [--tasks gap,sparse,effector,partial,long,none] [--methods interp,nemf,nemf-adam]
-//                [--lengths 5,15] [--spacings 5,10] [--speed N] [--out FILE]
+//                [--tasks gap,sparse,caps,effector,partial,long,none] [--methods interp,nemf,nemf-adam]
+//                [--lengths 5,15] [--spacings 5,10] [--caps 5,10,20,40] [--speed N] [--out FILE]
 //                [--iterations N] [--ftol X] [--ptol X] [--rank N] [--eigen-scaling 0|1]
 //                [--keyed-iterations N] [--adam-iterations N] [--adam-tol X] [--lock-ramp N] [--effector-falloff N] [--overwrite 0|1]
 //                [--penalty squared|absolute] [--init NAME] [--twostage FILE] [--citl FILE]
@@ -19,7 +19,10 @@
 // (hands, feet) or partial keys (root only, legs only) at frames 15, 45, 75,
 // 105 of 128-frame windows with full keys every 30 frames; long solves
 // 300-frame clips (several overlapping windows) and compares the acceleration
-// at the window joins with elsewhere; none runs only --speed.
+// at the window joins with elsewhere; caps solves every gap length and every
+// spacing once per L-BFGS iteration cap in --caps (one table per length or
+// spacing and method: how many iterations each start needs for a quality);
+// none runs only --speed.
 // --speed N adds the speed table: N sparse windows (a key every 15th frame),
 // each solved by every solver method; wall time, iterations, evaluations and
 // the floor (one decoder forward + backward over 128 frames, times the
@@ -48,6 +51,7 @@
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/text.h"
 #include "bench/protocol.h"
 #include "prior/data/dataset.h"
 #include "prior/model/model_file.h"
@@ -62,32 +66,12 @@
 
 namespace {
 
+using mf::bench::fixed;
+using mf::bench::split_list;
+using mf::bench::int_list;
+using mf::bench::ms_since;
+
 using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-std::vector<std::string> split_list(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) {
-    if (!item.empty()) out.push_back(item);
-  }
-  if (out.empty()) throw mf::InputError("empty list '" + s + "'");
-  return out;
-}
-
-std::vector<int> int_list(const std::string& s) {
-  std::vector<int> out;
-  for (const std::string& x : split_list(s)) out.push_back(std::atoi(x.c_str()));
-  return out;
-}
-
-std::string fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
-  return buf;
-}
 
 struct Args {
   std::string model;
@@ -98,6 +82,7 @@ struct Args {
   std::vector<std::string> methods{"interp", "nemf", "nemf-adam"};
   std::vector<int> lengths{5, 15, 30, 45, 90};
   std::vector<int> spacings{5, 10, 15, 20, 30};
+  std::vector<int> caps{5, 10, 20, 40};  // task "caps": L-BFGS iteration caps
   int speed = 0;
   std::string out;
   std::map<std::string, double> numbers;  // solver overrides
@@ -138,6 +123,7 @@ Args parse_args(int argc, char** argv) {
     else if (flag == "--methods") a.methods = split_list(v);
     else if (flag == "--lengths") a.lengths = int_list(v);
     else if (flag == "--spacings") a.spacings = int_list(v);
+    else if (flag == "--caps") a.caps = int_list(v);
     else if (flag == "--speed") a.speed = std::atoi(v.c_str());
     else if (flag == "--out") a.out = v;
     else if (flag == "--penalty") a.penalty = v;
@@ -502,6 +488,53 @@ double decoder_step_ms(const mf::NemfModel& model) {
   return t[t.size() / 2];
 }
 
+// One gap-filling row of the protocol (context frames, a gap of T, one
+// target frame) for `method`.
+Row gap_row(const Runner& runner, const std::string& method, const std::vector<mf::Clip>& clips,
+            const mf::bench::EvalStats& stats, const Eigen::Vector3d& forward, int T) {
+  const mf::bench::ProtocolOptions protocol;
+  const int length = protocol.context + T + 1, a = protocol.context, b = protocol.context + T;
+  const auto windows =
+      mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, protocol.stride), runner.args.max_windows);
+  std::vector<int> evaluated, known;
+  for (int f = 0; f < length; ++f) (f >= a && f < b ? evaluated : known).push_back(f);
+  mf::bench::MetricAccumulator acc(stats);
+  Row row;
+  row.parameter = T;
+  for (const mf::Window& w : windows) {
+    const mf::Motion truth =
+        mf::bench::canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), protocol.context - 1, forward);
+    const mf::Motion input = mf::bench::hide_unknown_frames(truth, known);
+    acc.add(truth, runner.solve(method, input, known, &row), evaluated, known);
+  }
+  row.metrics = acc.summary();
+  return row;
+}
+
+// One sparse-keyframe row (128-frame windows, a key every k frames).
+Row sparse_row(const Runner& runner, const std::string& method, const std::vector<mf::Clip>& clips,
+               const mf::bench::EvalStats& stats, const Eigen::Vector3d& forward, int k) {
+  const mf::bench::ProtocolOptions protocol;
+  const int length = protocol.sparse_window;
+  const auto windows =
+      mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, protocol.stride), runner.args.max_windows);
+  const std::vector<int> keys = mf::bench::sparse_keyframes(length, k);
+  std::vector<int> evaluated;
+  for (int f = 0; f < length; ++f) {
+    if (!std::binary_search(keys.begin(), keys.end(), f)) evaluated.push_back(f);
+  }
+  mf::bench::MetricAccumulator acc(stats);
+  Row row;
+  row.parameter = k;
+  for (const mf::Window& w : windows) {
+    const mf::Motion truth = mf::bench::canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, forward);
+    const mf::Motion input = mf::bench::hide_unknown_frames(truth, keys);
+    acc.add(truth, runner.solve(method, input, keys, &row), evaluated, keys);
+  }
+  row.metrics = acc.summary();
+  return row;
+}
+
 int run(int argc, char** argv) {
   Args args = parse_args(argc, argv);
   at::set_num_threads(args.threads);
@@ -542,7 +575,6 @@ int run(int argc, char** argv) {
   emit("\n");
 
   const Runner runner{model, args};
-  mf::bench::ProtocolOptions protocol;
   const Eigen::Vector3d forward = model.rig().root_forward;
   for (const std::string& task : args.tasks) {
     if (task == "none") continue;
@@ -550,49 +582,36 @@ int run(int argc, char** argv) {
       std::vector<Row> rows;
       if (task == "gap") {
         for (int T : args.lengths) {
-          const int length = protocol.context + T + 1, a = protocol.context, b = protocol.context + T;
-          const auto windows =
-              mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, protocol.stride), args.max_windows);
-          std::vector<int> evaluated, known;
-          for (int f = 0; f < length; ++f) (f >= a && f < b ? evaluated : known).push_back(f);
-          mf::bench::MetricAccumulator acc(stats);
-          Row row;
-          row.parameter = T;
-          for (const mf::Window& w : windows) {
-            const mf::Motion truth = mf::bench::canonicalise(
-                clips[w.clip].motion.slice(w.start, w.start + length), protocol.context - 1, forward);
-            const mf::Motion input = mf::bench::hide_unknown_frames(truth, known);
-            acc.add(truth, runner.solve(method, input, known, &row), evaluated, known);
-          }
-          row.metrics = acc.summary();
-          rows.push_back(row);
+          rows.push_back(gap_row(runner, method, clips, stats, forward, T));
           std::cerr << "gap " << T << " " << method << " done\n";
         }
         emit(table("#### Gap filling, `" + method + "`", "T", rows) + "\n");
       } else if (task == "sparse") {
-        const int length = protocol.sparse_window;
-        const auto windows =
-            mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, protocol.stride), args.max_windows);
         for (int k : args.spacings) {
-          const std::vector<int> keys = mf::bench::sparse_keyframes(length, k);
-          std::vector<int> evaluated;
-          for (int f = 0; f < length; ++f) {
-            if (!std::binary_search(keys.begin(), keys.end(), f)) evaluated.push_back(f);
-          }
-          mf::bench::MetricAccumulator acc(stats);
-          Row row;
-          row.parameter = k;
-          for (const mf::Window& w : windows) {
-            const mf::Motion truth =
-                mf::bench::canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, forward);
-            const mf::Motion input = mf::bench::hide_unknown_frames(truth, keys);
-            acc.add(truth, runner.solve(method, input, keys, &row), evaluated, keys);
-          }
-          row.metrics = acc.summary();
-          rows.push_back(row);
+          rows.push_back(sparse_row(runner, method, clips, stats, forward, k));
           std::cerr << "sparse " << k << " " << method << " done\n";
         }
         emit(table("#### Sparse keyframes (128 frames), `" + method + "`", "k", rows) + "\n");
+      } else if (task == "caps") {
+        if (method == "interp" || is_transformer_method(method) || method == "nemf-adam") continue;
+        for (const bool gap : {true, false}) {
+          for (int p : gap ? args.lengths : args.spacings) {
+            std::vector<Row> cap_rows;
+            for (int cap : args.caps) {
+              Args capped = args;
+              capped.numbers["iterations"] = cap;
+              const Runner r{model, capped};
+              cap_rows.push_back(gap ? gap_row(r, method, clips, stats, forward, p)
+                                     : sparse_row(r, method, clips, stats, forward, p));
+              cap_rows.back().parameter = cap;
+              std::cerr << (gap ? "gap " : "sparse ") << p << " " << method << " cap " << cap << " done\n";
+            }
+            emit(table(std::string("#### Iteration cap, ") + (gap ? "gap T = " : "keys every k = ") +
+                           std::to_string(p) + ", `" + method + "`",
+                       "cap", cap_rows) +
+                 "\n");
+          }
+        }
       } else if (task == "long") {
         if (method == "interp") continue;
         emit(long_table(method, runner, clips, stats, args, forward) + "\n");

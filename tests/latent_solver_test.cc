@@ -306,13 +306,20 @@ struct LeggedModel {
   Skeleton skeleton;
   std::unique_ptr<NemfModel> model;
 };
-LeggedModel legged_model(float contact_logit) {
+// With `arm`, a left arm hangs from the spine: Shoulder_L (8), UpperArm_L (9),
+// LowerArm_L (10), Hand_L (11); the upper and lower arm reach 0.53 m.
+LeggedModel legged_model(float contact_logit, bool arm = false) {
   LeggedModel out;
   Skeleton& s = out.skeleton;
   s.names = {"Hips", "Spine", "UpperLeg_L", "LowerLeg_L", "Foot_L", "UpperLeg_R", "LowerLeg_R", "Foot_R"};
   s.parents = {-1, 0, 0, 2, 3, 0, 5, 6};
   s.offsets = {{0, 0, 0}, {0, 0.2, 0}, {0.1, -0.05, 0}, {0, -0.42, 0.02}, {0, -0.42, -0.02},
                {-0.1, -0.05, 0}, {0, -0.42, 0.02}, {0, -0.42, -0.02}};
+  if (arm) {
+    s.names.insert(s.names.end(), {"Shoulder_L", "UpperArm_L", "LowerArm_L", "Hand_L"});
+    s.parents.insert(s.parents.end(), {1, 8, 9, 10});
+    s.offsets.insert(s.offsets.end(), {{0.05, 0.15, 0}, {0.12, 0, 0}, {0.28, 0, 0}, {0.25, 0, 0}});
+  }
   Motion m = gentle_motion(s, 24, 14);
   RigInfo rig = measure_rig(s, {&m});
   rig.root_forward = Eigen::Vector3d::UnitZ();
@@ -413,6 +420,50 @@ TEST(LatentSolver, EndEffectorBeyondTheLegsReachMovesTheRoot) {
   o.effector_falloff = -1;  // without the IK the target is missed
   Motion pulled = complete_motion(model, m, c, o);
   EXPECT_GT((forward_kinematics(pulled).position(12, 4) - target).norm(), 0.01);
+}
+
+TEST(LatentSolver, HandTargetBeyondTheArmsReachSwingsTheShoulderThenMovesTheRoot) {
+  at::set_num_threads(1);
+  LeggedModel armed = legged_model(-10.0f, true);
+  const NemfModel& model = *armed.model;
+  const int shoulder = 8, upper = 9, hand = 11, f = 12;
+  Motion m = gentle_motion(armed.skeleton, 24, 16);
+  const MotionConstraints keys = MotionConstraints::full_pose({0, 23});
+  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  o.effector_falloff = -1;  // the solve alone: what the IK starts from
+  const Motion solved = complete_motion(model, m, keys, o);
+  o.effector_falloff = quick(SolverMethod::Lbfgs).effector_falloff;
+  const GlobalPose ps = forward_kinematics(solved);
+  const Eigen::Vector3d P = ps.position(f, shoulder), hand_now = ps.position(f, hand);
+  const double reach = 0.53;
+
+  // (1) The whole arm turned about the shoulder: out of the chain's reach from
+  // where the upper arm is now, but exactly where a shoulder swing puts the hand.
+  Eigen::Vector3d turned = hand_now;
+  for (double deg = 30; deg <= 180 && (turned - ps.position(f, upper)).norm() <= reach + 0.01; deg += 10) {
+    turned = P + Eigen::AngleAxisd(deg * M_PI / 180.0, Eigen::Vector3d::UnitY()) * (hand_now - P);
+  }
+  ASSERT_GT((turned - ps.position(f, upper)).norm(), reach + 0.01);
+  MotionConstraints c = keys;
+  c.effectors.push_back({f, hand, turned, 1.0});
+  CompletionReport report;
+  Motion out = complete_motion(model, m, c, o, {}, &report);
+  EXPECT_LT((forward_kinematics(out).position(f, hand) - turned).norm(), 1e-3);
+  EXPECT_LT(report.effectors.max_cm, 0.1);
+  EXPECT_LT((out.root_positions[f] - solved.root_positions[f]).norm(), 1e-9);  // the swing was enough
+  EXPECT_GT(out.rotation(f, shoulder).angularDistance(solved.rotation(f, shoulder)), 0.1);
+
+  // (2) Beyond even the swung arm: the root moves by the rest.
+  const Eigen::Vector3d far = P + (hand_now - P).normalized() * 1.2;
+  c.effectors.back().position = far;
+  out = complete_motion(model, m, c, o, {}, &report);
+  EXPECT_LT((forward_kinematics(out).position(f, hand) - far).norm(), 1e-3);
+  EXPECT_LT(report.effectors.max_cm, 0.1);
+  EXPECT_GT((out.root_positions[f] - solved.root_positions[f]).norm(), 0.05);
+  for (int k : {0, 23}) {  // keys untouched
+    EXPECT_EQ(out.root_positions[k], m.root_positions[k]);
+    for (int j : {shoulder, upper, hand}) EXPECT_EQ(out.rotation(k, j).coeffs(), m.rotation(k, j).coeffs());
+  }
 }
 
 TEST(LatentSolver, BadInputIsAnInputError) {
