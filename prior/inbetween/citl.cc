@@ -37,40 +37,19 @@ struct CitlConfig {
 
 CitlConfig parse_config(const std::map<std::string, double>& values) {
   CitlConfig c;
-  std::ostringstream e;
-  auto integer = [&](const std::string& key, double v, int lo, int hi, int* out) {
-    if (!std::isfinite(v) || v != std::floor(v) || v < lo || v > hi) {
-      e << key << " must be an integer in [" << lo << ", " << hi << "] (got " << v << "); ";
-      return;
-    }
-    *out = static_cast<int>(v);
-  };
-  for (const auto& [key, v] : values) {
-    if (key == "width") {
-      integer(key, v, 8, 2048, &c.width);
-    } else if (key == "layers") {
-      integer(key, v, 1, 32, &c.layers);
-    } else if (key == "heads") {
-      integer(key, v, 1, 64, &c.heads);
-    } else if (key == "ffn") {
-      integer(key, v, 1, 16384, &c.ffn);
-    } else if (key == "time_dim") {
-      integer(key, v, 2, 256, &c.time_dim);
-    } else if (key == "window") {
-      integer(key, v, 2, 4096, &c.window);
-    } else if (key == "fps") {
-      if (!std::isfinite(v) || !(v > 0) || v > 1000) e << "fps must be in (0, 1000] (got " << v << "); ";
-      c.fps = v;
-    } else {
-      e << "unknown hyperparameter '" << key
-        << "' (CITL takes width, layers, heads, ffn, time_dim, window, fps); ";
-    }
-  }
-  if (c.width % c.heads != 0) e << "heads (" << c.heads << ") must divide width (" << c.width << "); ";
-  if (c.time_dim % 2 != 0) e << "time_dim must be even (got " << c.time_dim << "); ";
-  if (c.time_dim >= c.width) e << "time_dim must be smaller than width; ";
-  std::string message = e.str();
-  if (!message.empty()) throw InputError("invalid CITL hyperparameters: " + message.substr(0, message.size() - 2));
+  HyperparameterReader r("CITL", values);
+  r.integer("width", 8, 2048, &c.width);
+  r.integer("layers", 1, 32, &c.layers);
+  r.integer("heads", 1, 64, &c.heads);
+  r.integer("ffn", 1, 16384, &c.ffn);
+  r.integer("time_dim", 2, 256, &c.time_dim);
+  r.integer("window", 2, 4096, &c.window);
+  r.positive("fps", 1000, &c.fps);
+  r.check(c.width % c.heads == 0,
+          "heads (" + std::to_string(c.heads) + ") must divide width (" + std::to_string(c.width) + ")");
+  r.check(c.time_dim % 2 == 0, "time_dim must be even (got " + std::to_string(c.time_dim) + ")");
+  r.check(c.time_dim < c.width, "time_dim must be smaller than width");
+  r.finish();
   return c;
 }
 

@@ -46,37 +46,16 @@ struct TwoStageConfig {
 
 TwoStageConfig parse_config(const std::map<std::string, double>& values) {
   TwoStageConfig c;
-  std::ostringstream e;
-  auto integer = [&](const std::string& key, double v, int lo, int hi, int* out) {
-    if (!std::isfinite(v) || v != std::floor(v) || v < lo || v > hi) {
-      e << key << " must be an integer in [" << lo << ", " << hi << "] (got " << v << "); ";
-      return;
-    }
-    *out = static_cast<int>(v);
-  };
-  for (const auto& [key, v] : values) {
-    if (key == "width") {
-      integer(key, v, 4, 4096, &c.width);
-    } else if (key == "layers") {
-      integer(key, v, 1, 64, &c.layers);
-    } else if (key == "heads") {
-      integer(key, v, 1, 64, &c.heads);
-    } else if (key == "ffn") {
-      integer(key, v, 1, 16384, &c.ffn);
-    } else if (key == "window") {
-      integer(key, v, 2, 4096, &c.window);
-    } else if (key == "fps") {
-      if (!std::isfinite(v) || !(v > 0) || v > 1000) e << "fps must be in (0, 1000] (got " << v << "); ";
-      c.fps = v;
-    } else {
-      e << "unknown hyperparameter '" << key << "' (twostage takes width, layers, heads, ffn, window, fps); ";
-    }
-  }
-  if (c.width % c.heads != 0) e << "heads (" << c.heads << ") must divide width (" << c.width << "); ";
-  std::string message = e.str();
-  if (!message.empty()) {
-    throw InputError("invalid twostage hyperparameters: " + message.substr(0, message.size() - 2));
-  }
+  HyperparameterReader r("twostage", values);
+  r.integer("width", 4, 4096, &c.width);
+  r.integer("layers", 1, 64, &c.layers);
+  r.integer("heads", 1, 64, &c.heads);
+  r.integer("ffn", 1, 16384, &c.ffn);
+  r.integer("window", 2, 4096, &c.window);
+  r.positive("fps", 1000, &c.fps);
+  r.check(c.width % c.heads == 0,
+          "heads (" + std::to_string(c.heads) + ") must divide width (" + std::to_string(c.width) + ")");
+  r.finish();
   return c;
 }
 
