@@ -13,6 +13,8 @@
 #include <vector>
 #include <string>
 
+#include "prior/util/threads.h"
+
 namespace {
 
 template <class F>
@@ -33,9 +35,9 @@ double median_ms(F&& f, int reps) {
 
 int main(int argc, char** argv) {
   int threads = argc > 1 ? std::atoi(argv[1]) : 2;
-  at::set_num_threads(threads);
+  mf::set_compute_threads(threads);
   Eigen::setNbThreads(threads);
-  std::printf("threads: %d\n\n| m x k x n | torch mm (ms) | torch GFLOP/s | Eigen (ms) | Eigen GFLOP/s |\n|---|---|---|---|---|\n", threads);
+  std::printf("threads: %d; BLAS: %s\n\n| m x k x n | torch mm (ms) | torch GFLOP/s | Eigen (ms) | Eigen GFLOP/s |\n|---|---|---|---|---|\n", threads, mf::blas_library().c_str());
   const int shapes[][3] = {{2048, 782, 512}, {2048, 512, 512}, {128, 526, 256}, {4096, 1024, 1024}};
   for (auto& s : shapes) {
     int m = s[0], k = s[1], n = s[2];

@@ -27,6 +27,7 @@
 #include "prior/inbetween/inbetweener.h"
 #include "tasks/jobs.h"
 #include "tasks/transformer_methods.h"
+#include "prior/util/threads.h"
 
 namespace {
 
@@ -188,7 +189,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
 
 int run(int argc, char** argv) {
   const Args args = parse_args(argc, argv);
-  at::set_num_threads(args.threads);
+  mf::set_compute_threads(args.threads);
   const auto run_start = std::chrono::steady_clock::now();
   std::string command = "motionfield-bench";
   for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];

@@ -19,6 +19,7 @@
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/util/threads.h"
 
 namespace {
 
@@ -89,7 +90,7 @@ int main(int argc, char** argv) {
       else throw mf::InputError("unknown option " + a);
     }
     if (models.empty() && sizes.empty()) sizes = {"256x6:256:64", "384x8:384:96", "512x8:512:128", "1024x11:1024:256"};
-    at::set_num_threads(threads);
+    mf::set_compute_threads(threads);
     at::manual_seed(0);
     std::vector<Row> rows;
     for (const std::string& s : sizes) {

@@ -55,6 +55,7 @@
 #include "prior/motion/motion_bvh.h"
 #include "tasks/renav.h"
 #include "tasks/soft_dtw.h"
+#include "prior/util/threads.h"
 
 namespace {
 
@@ -320,7 +321,7 @@ std::string profile(const mf::NemfModel& model, const mf::Motion& ref, int n) {
 
 int run(int argc, char** argv) {
   const Args args = parse_args(argc, argv);
-  at::set_num_threads(args.threads);
+  mf::set_compute_threads(args.threads);
   std::string command = "renav-bench";
   for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "tasks/soft_dtw.h"
+#include "prior/util/threads.h"
 
 namespace {
 
@@ -67,7 +68,7 @@ int main(int argc, char** argv) {
     at::Tensor D = at::rand({len, len}, f64);
     const int reps = len <= 256 ? 51 : len <= 1024 ? 7 : 3;
     for (int t : threads) {
-      at::set_num_threads(t);
+      mf::set_compute_threads(t);
       const Timing fwd = median_ms([&] { (void)mf::soft_dtw(D, gamma); }, reps);
       const Timing fb = median_ms(
           [&] {
@@ -87,7 +88,7 @@ int main(int argc, char** argv) {
   for (int64_t B : {1, 4}) {
     at::Tensor x = at::randn({B, 128, 66}), ref = at::randn({1, 128, 66});
     for (int t : threads) {
-      at::set_num_threads(t);
+      mf::set_compute_threads(t);
       const Timing ms = median_ms(
           [&] {
             at::Tensor xg = x.detach().requires_grad_(true);

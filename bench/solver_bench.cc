@@ -63,6 +63,7 @@
 #include "tasks/initializers.h"
 #include "tasks/latent_solver.h"
 #include "tasks/transformer_methods.h"
+#include "prior/util/threads.h"
 
 namespace {
 
@@ -537,7 +538,7 @@ Row sparse_row(const Runner& runner, const std::string& method, const std::vecto
 
 int run(int argc, char** argv) {
   Args args = parse_args(argc, argv);
-  at::set_num_threads(args.threads);
+  mf::set_compute_threads(args.threads);
   std::string command = "solver-bench";
   for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
 
@@ -563,7 +564,7 @@ int run(int argc, char** argv) {
   };
   emit("## solver-bench\n\n- command: `" + command + "`\n- model: " + args.model + " (" + model.config().describe() +
        ")\n- split: " + args.split + " (" + std::to_string(clips.size()) + " clips)\n- torch threads: " +
-       std::to_string(at::get_num_threads()) + "\n");
+       std::to_string(at::get_num_threads()) + "\n- BLAS: " + mf::blas_library() + "\n");
   for (const char* kind : {"twostage", "citl"}) {
     const mf::InbetweenModel* t = args.transformers.inbetweener(kind);
     emit(std::string("- ") + kind + " transformer: " + (t ? t->describe() : std::string("not loaded")) + "\n");

@@ -19,6 +19,7 @@
 #include "prior/inbetween/inbetweener.h"
 #include "prior/motion/errors.h"
 #include "training/trainer_util.h"
+#include "prior/util/threads.h"
 
 namespace mf {
 
@@ -227,7 +228,7 @@ InbetweenTrainingResult train_inbetweener(const InbetweenTrainingOptions& o) {
     throw InputError(
         "train: batch, time budget and learning rate must be positive, min length at least 2, warm-up in [0, 1)");
   }
-  at::set_num_threads(std::max(1, o.threads));
+  mf::set_compute_threads(std::max(1, o.threads));
   fs::create_directories(o.out_dir);
   const auto t0 = std::chrono::steady_clock::now();
 

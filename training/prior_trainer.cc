@@ -22,6 +22,7 @@
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations_torch.h"
 #include "training/trainer_util.h"
+#include "prior/util/threads.h"
 
 namespace mf {
 
@@ -221,7 +222,7 @@ PriorTrainingResult train_prior(const PriorTrainingOptions& o) {
   }
   std::string problem = o.config.validate();
   if (!problem.empty()) throw InputError("train: " + problem);
-  at::set_num_threads(o.threads);
+  mf::set_compute_threads(o.threads);
   fs::create_directories(o.out_dir);
   const auto t0 = std::chrono::steady_clock::now();
 

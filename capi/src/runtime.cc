@@ -6,6 +6,7 @@
 #include "capi/src/capi_internal.h"
 #include "prior/motion/errors.h"
 #include "tasks/jobs.h"
+#include "prior/util/threads.h"
 
 namespace mf::capi {
 namespace {
@@ -75,7 +76,7 @@ void skeleton_offsets(const Skeleton& s, float* out, size_t capacity, size_t* ne
 
 void apply_num_threads() {
   const int n = g_num_threads.load();
-  if (n > 0 && at::get_num_threads() != n) at::set_num_threads(n);
+  if (n > 0 && at::get_num_threads() != n) mf::set_compute_threads(n);
 }
 
 }  // namespace mf::capi
@@ -113,7 +114,7 @@ int mf_set_num_threads(int32_t num_threads) {
       throw ApiError(MF_ERROR_INVALID_ARGUMENT,
                      "the thread count must be between 1 and 1024, not " + std::to_string(num_threads));
     mf::capi::g_num_threads.store(num_threads);
-    at::set_num_threads(num_threads);
+    mf::set_compute_threads(num_threads);
   });
 }
 

@@ -1,0 +1,43 @@
+#include "prior/util/threads.h"
+
+#include <ATen/Parallel.h>
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <system_error>
+
+namespace mf {
+
+namespace {
+
+// A symbol of the process: first the global scope, then libopenblas.so.0 if it
+// is loaded but not global (a library opened with RTLD_LOCAL, as ctypes does).
+void* find_symbol(const char* name, const char* library) {
+  if (void* s = dlsym(RTLD_DEFAULT, name)) return s;
+  void* handle = dlopen(library, RTLD_LAZY | RTLD_NOLOAD);
+  if (!handle) return nullptr;
+  void* s = dlsym(handle, name);
+  dlclose(handle);
+  return s;
+}
+
+}  // namespace
+
+void set_compute_threads(int n) {
+  n = std::max(1, n);
+  at::set_num_threads(n);
+  using SetThreads = void (*)(int);
+  if (auto set = reinterpret_cast<SetThreads>(find_symbol("openblas_set_num_threads", "libopenblas.so.0"))) set(n);
+}
+
+std::string blas_library() {
+  void* sgemm = find_symbol("sgemm_", "libblas.so.3");
+  Dl_info info;
+  if (!sgemm || !dladdr(sgemm, &info) || !info.dli_fname) return "unknown";
+  std::error_code ec;
+  const std::filesystem::path real = std::filesystem::canonical(info.dli_fname, ec);
+  return ec ? std::string(info.dli_fname) : real.string();
+}
+
+}  // namespace mf

@@ -1,0 +1,22 @@
+// The process's compute threads and the BLAS behind libtorch's matrix
+// products. libtorch's at::set_num_threads sizes its own intra-op pool only;
+// OpenBLAS (the libblas.so.3 that scripts/install-deps.sh selects) keeps a pool
+// of its own, one thread per core unless told otherwise, so a "1 thread" run
+// would still multiply matrices on every core. set_compute_threads sizes both.
+#pragma once
+
+#include <string>
+
+namespace mf {
+
+/// at::set_num_threads(n) and, when OpenBLAS is loaded, openblas_set_num_threads(n).
+/// n >= 1.
+void set_compute_threads(int n);
+
+/// The file (links resolved) of the library whose sgemm_ serves libtorch's
+/// float matrix products in this process, e.g.
+/// "/usr/lib/x86_64-linux-gnu/openblas-pthread/libblas.so.3", or "unknown".
+/// For benchmark headers and the BLAS test.
+std::string blas_library();
+
+}  // namespace mf
