@@ -24,11 +24,12 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-int default_iterations(SolverMethod m) { return m == SolverMethod::Adam ? 600 : 20; }
+int default_iterations(SolverMethod m) { return m == SolverMethod::Adam ? 600 : 40; }
 
-// L-BFGS cap for one window when the options leave it open: 20, or 60 when
+// L-BFGS cap for one window when the options leave it open: 40, or 60 when
 // the window has end-effector targets or 40+ frames in a row without a key
-// (long gaps keep improving with iterations; short ones and sparse keys do not).
+// (every task keeps improving up to 40 iterations, long gaps and effectors up to
+// 60; docs/BENCHMARKS.md, "Iteration caps").
 int window_iterations(const LatentSolverOptions& o, const MotionConstraints& wc, int T) {
   if (o.max_iterations > 0) return o.max_iterations;
   if (o.method == SolverMethod::Adam) return default_iterations(o.method);

@@ -16,7 +16,7 @@
 // step is random: the seed is handed to initialisers that sample).
 //
 // Defaults (docs/BENCHMARKS.md, "Latent solvers", has the measurements):
-// L-BFGS, at most 20 iterations (60 with long gaps or end-effector targets),
+// L-BFGS, at most 40 iterations (60 with long gaps or end-effector targets),
 // function tolerance 1e-3; weights rotation 1,
 // position 10, root orientation 1, root translation 10 (the GMP path), no
 // prior, skating or smoothness term (they bought nothing measurable with the
@@ -80,9 +80,9 @@ struct LatentSolverOptions {
   SolverMethod method = SolverMethod::Lbfgs;
   EnergyWeights weights;
   /// Iteration cap per window; 0 means the method's default: Adam 600; L-BFGS
-  /// 20, or 60 for a window with end-effector targets or with 40 or more
-  /// frames in a row without a key (measured: long gaps and effectors keep
-  /// improving with iterations, sparse keys do not).
+  /// 40, or 60 for a window with end-effector targets or with 40 or more
+  /// frames in a row without a key (measured: quality keeps improving up to
+  /// 40 iterations everywhere, to 60 on long gaps; docs/BENCHMARKS.md).
   int max_iterations = 0;
 
   // L-BFGS (Ceres GradientProblemSolver).
