@@ -29,8 +29,7 @@ bool upsample_by_solving(const Motion& in, double fps, int frames, const TaskCon
   std::vector<int> known;
   for (int i = 0; i < n; i += static_cast<int>(r)) known.push_back(i);
   // 20 iterations: the setting the blend below was chosen and measured with
-  // (the solver's default rose to 40 later; keys every other frame leave little
-  // to gain).
+  // (the solver's default rose to 40 later, not re-measured for resampling).
   LatentSolverOptions solver = default_solver_options(SolverMethod::Lbfgs);
   solver.max_iterations = 20;
   const Motion solved_raw = complete_motion(*ctx.model, dense, MotionConstraints::full_pose(known), solver, ctx);
