@@ -147,7 +147,7 @@ TEST(Citl, GradientsReachEveryParameter) {
 
 TEST(Citl, HyperparametersRoundTrip) {
   auto defaults = make_citl({}, test::tiny_rig());
-  std::map<std::string, double> expected = {{"width", 128}, {"layers", 3},  {"heads", 4}, {"ffn", 512},
+  std::map<std::string, double> expected = {{"width", 64}, {"layers", 2},  {"heads", 4}, {"ffn", 256},
                                             {"time_dim", 16}, {"window", 128}, {"fps", 30}};
   EXPECT_EQ(defaults->hyperparameters(), expected);
   auto model = tiny_citl();

@@ -159,8 +159,8 @@ TEST(TwoStage, GradientsReachEveryParameter) {
 
 TEST(TwoStage, HyperparametersRoundTrip) {
   auto defaults = make_two_stage({}, test::tiny_rig());
-  std::map<std::string, double> expected = {{"width", 128}, {"layers", 3},   {"heads", 4},
-                                            {"ffn", 256},   {"window", 128}, {"fps", 30}};
+  std::map<std::string, double> expected = {{"width", 64}, {"layers", 2},   {"heads", 4},
+                                            {"ffn", 128},  {"window", 128}, {"fps", 30}};
   EXPECT_EQ(defaults->hyperparameters(), expected);
   auto model = tiny_two_stage();
   auto copy = make_two_stage(model->hyperparameters(), model->rig());

@@ -21,10 +21,10 @@ namespace {
 constexpr double kMasked = -1e9;
 
 struct CitlConfig {
-  int width = 128;
-  int layers = 3;
+  int width = 64;
+  int layers = 2;
   int heads = 4;
-  int ffn = 512;
+  int ffn = 256;
   int time_dim = 16;
   int window = 128;
   double fps = 30.0;

@@ -26,10 +26,10 @@
 // full or partial poses; padding frames (valid = 0) never influence valid frames.
 // No contact head: InbetweenOutput::contact_logits is left undefined.
 //
-// Hyperparameters (defaults sized for about an hour of training at 1 CPU thread
-// and a few milliseconds per 128-frame window at inference):
-//   "width" 128, "layers" 3 (per stage), "heads" 4 (must divide width),
-//   "ffn" 512, "time_dim" 16 (even, < width), "window" 128, "fps" 30.
+// Hyperparameters (defaults: the size the pilots chose for two hours of training
+// at 1 CPU thread, docs/MODEL_CARD.md; a few milliseconds per 128-frame window):
+//   "width" 64, "layers" 2 (per stage), "heads" 4 (must divide width),
+//   "ffn" 256, "time_dim" 16 (even, < width), "window" 128, "fps" 30.
 #pragma once
 
 #include <map>

@@ -32,10 +32,10 @@ constexpr int kDistanceFeatures = 2 * kFrequencies + 1;
 constexpr int kKeyFeatures = 2 * kDistanceFeatures + 1;
 
 struct TwoStageConfig {
-  int width = 128;
-  int layers = 3;
+  int width = 64;
+  int layers = 2;
   int heads = 4;
-  int ffn = 256;
+  int ffn = 128;
   int window = 128;
   double fps = 30.0;
 

@@ -36,10 +36,10 @@
 // Parameter names are stable: "context.input.fc1.weight",
 // "context.layers.0.attn.q.weight", "detail.output.fc2.bias", ...
 //
-// Hyperparameters (defaults sized for about an hour of training at 1 CPU thread
-// and a few milliseconds per 128-frame window at inference):
-//   "width" 128 (d_model), "layers" 3 (per stage), "heads" 4 (must divide
-//   width), "ffn" 256, "window" 128 (maximum frames), "fps" 30.
+// Hyperparameters (defaults: the size the pilots chose for two hours of training
+// at 1 CPU thread, docs/MODEL_CARD.md; a few milliseconds per 128-frame window):
+//   "width" 64 (d_model), "layers" 2 (per stage), "heads" 4 (must divide
+//   width), "ffn" 128, "window" 128 (maximum frames), "fps" 30.
 #pragma once
 
 #include <map>
