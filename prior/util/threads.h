@@ -2,14 +2,16 @@
 // products. libtorch's at::set_num_threads sizes its own intra-op pool only;
 // OpenBLAS (the libblas.so.3 that scripts/install-deps.sh selects) keeps a pool
 // of its own, one thread per core unless told otherwise, so a "1 thread" run
-// would still multiply matrices on every core. set_compute_threads sizes both.
+// would still multiply matrices on every core, and a 2-thread run nests two
+// pools that thrash. set_compute_threads sizes libtorch's pool and keeps
+// OpenBLAS's at 1.
 #pragma once
 
 #include <string>
 
 namespace mf {
 
-/// at::set_num_threads(n) and, when OpenBLAS is loaded, openblas_set_num_threads(n).
+/// at::set_num_threads(n) and, when OpenBLAS is loaded, openblas_set_num_threads(1).
 /// n >= 1.
 void set_compute_threads(int n);
 
