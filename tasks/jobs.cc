@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "prior/motion/errors.h"
+#include "tasks/model_rig.h"
 #include "tasks/transformer_methods.h"
 
 namespace mf {
@@ -126,7 +127,10 @@ Motion run_known_frames(const Motion& input, const std::vector<int>& known, cons
   check_motion(input);
   validate_keyframes(known, input.num_frames());
   if (!m.complete) throw InputError("method '" + m.name + "' does not do in-betweening or gap filling");
-  return m.complete(input, known, ctx);
+  if (!m.needs_model) return m.complete(input, known, ctx);
+  return complete_on_model_rig(input, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
+    return m.complete(in, k, ctx);
+  });
 }
 
 Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method,
@@ -156,7 +160,10 @@ Motion run_resample(const Motion& input, double fps, const std::string& method, 
         << " s before the input's last frame";
     warnings->push_back(msg.str());
   }
-  return m.resample(input, fps, frames, ctx);
+  if (!m.needs_model) return m.resample(input, fps, frames, ctx);
+  return resample_on_model_rig(input, fps, frames, ctx, [&](const Motion& in, double f, int n) {
+    return m.resample(in, f, n, ctx);
+  });
 }
 
 }  // namespace mf

@@ -17,6 +17,7 @@ namespace mf {
 
 class NemfModel;
 class InbetweenModel;
+struct RigAnatomy;
 
 /// Progress of a long-running method (a solver's iterations).
 struct TaskProgress {
@@ -45,6 +46,13 @@ struct TaskContext {
   /// motionfield-twostage.mfm and motionfield-citl.mfm next to the prior's file.
   std::shared_ptr<const InbetweenModel> twostage;
   std::shared_ptr<const InbetweenModel> citl;
+  /// The anatomy of the prior's rig (prior/rig/retarget.h), needed to serve
+  /// motions on other rigs; the C API loads motionfield-rig.json next to the
+  /// prior's file. Null: only the model's own rig is served.
+  std::shared_ptr<const RigAnatomy> model_anatomy;
+  /// A rig map's JSON text ({"user joint": "model joint" or null}) that
+  /// overrides the automatic map of another rig onto the model's; empty: automatic.
+  std::string rig_map;
   uint64_t seed = 0;
   /// Called now and then by long methods; returning false cancels.
   std::function<bool(const TaskProgress&)> progress;

@@ -1,0 +1,440 @@
+#include "prior/rig/retarget.h"
+
+#include <cmath>
+#include <functional>
+#include <nlohmann/json.hpp>
+
+#include "prior/motion/errors.h"
+#include "prior/motion/rotations.h"
+
+namespace mf {
+namespace {
+
+using Eigen::Quaterniond;
+using Eigen::Vector3d;
+
+Vector3d unit(const Vector3d& v) {
+  const double n = v.norm();
+  return n > 1e-12 ? Vector3d(v / n) : Vector3d::Zero();
+}
+
+// What defines one joint's anatomical frame: its first axis runs from `from`
+// to `to`; its second is one of the directions below, measured per frame.
+enum class Second { HipLateral, ArmLateral, TorsoLateral, Up, Knee, Elbow };
+
+struct Rule {
+  int from = -1, to = -1;
+  Second second = Second::HipLateral;
+  int side = 0;
+};
+
+// The rule of every part joint; toe_rules: the feet measured along the toes.
+std::vector<Rule> part_rules(const RigParts& p, int joints, bool along_toes) {
+  std::vector<Rule> r(joints);
+  auto set = [&](int j, int from, int to, Second s, int side = 0) {
+    if (j >= 0 && from >= 0 && to >= 0) r[j] = {from, to, s, side};
+  };
+  set(p.hips, p.hips, p.chest, Second::HipLateral);
+  for (int s : p.spine) set(s, s, p.chest, Second::TorsoLateral);
+  set(p.chest, p.chest, p.head, Second::ArmLateral);
+  set(p.neck, p.neck, p.head, Second::ArmLateral);
+  set(p.head, p.chest, p.head, Second::ArmLateral);
+  for (int s = 0; s < 2; ++s) {
+    const ArmParts& a = p.arms[s];
+    set(a.shoulder, a.shoulder, a.upper, Second::Up);
+    set(a.upper, a.upper, a.fore, Second::Elbow, s);
+    set(a.fore, a.fore, a.hand, Second::Elbow, s);
+    set(a.hand, a.fore, a.hand, Second::Elbow, s);
+    const LegParts& l = p.legs[s];
+    set(l.thigh, l.thigh, l.shin, Second::Knee, s);
+    set(l.shin, l.shin, l.foot, Second::Knee, s);
+    if (along_toes && l.toe >= 0) set(l.foot, l.foot, l.toe, Second::Knee, s);
+    else set(l.foot, l.shin, l.foot, Second::Knee, s);
+    set(l.toe, l.foot, l.toe, Second::Knee, s);
+  }
+  return r;
+}
+
+// Joints that play no part but sit between a part joint above and one below
+// (extra spine or neck joints, twist bones, clavicles the map leaves out) take
+// their first axis toward the part below and the second of the part above.
+void add_between_rules(const Skeleton& s, const RigParts& p, std::vector<Rule>* rules) {
+  const int J = s.num_joints();
+  std::vector<bool> is_part(J, false);
+  for (const auto& [name, j] : p.list()) is_part[j] = true;
+  const auto kids = s.children();
+  for (int j = 0; j < J; ++j) {
+    if (is_part[j]) continue;
+    int above = s.parents[j];
+    while (above >= 0 && !is_part[above]) above = s.parents[above];
+    if (above < 0 || (*rules)[above].from < 0) continue;
+    // nearest part joint below (breadth first)
+    int below = -1;
+    std::vector<int> queue = kids[j];
+    for (size_t q = 0; q < queue.size() && below < 0; ++q) {
+      if (is_part[queue[q]]) below = queue[q];
+      else queue.insert(queue.end(), kids[queue[q]].begin(), kids[queue[q]].end());
+    }
+    if (below < 0) continue;
+    Rule r = (*rules)[above];
+    r.from = j, r.to = below;
+    (*rules)[j] = r;
+  }
+}
+
+struct Pose {
+  const GlobalPose& g;
+  int f;
+  Vector3d p(int j) const { return g.position(f, j); }
+};
+
+Vector3d second_axis(const Rule& r, const RigParts& parts, const Pose& pose) {
+  const Vector3d hip_lat = unit(pose.p(parts.legs[0].thigh) - pose.p(parts.legs[1].thigh));
+  const Vector3d arm_lat = unit(pose.p(parts.arms[0].upper) - pose.p(parts.arms[1].upper));
+  switch (r.second) {
+    case Second::HipLateral: return hip_lat;
+    case Second::ArmLateral: return arm_lat;
+    case Second::TorsoLateral: return hip_lat + arm_lat;
+    case Second::Up: return unit(pose.p(parts.head) - pose.p(parts.chest));
+    case Second::Knee: {
+      const LegParts& l = parts.legs[r.side];
+      const Vector3d a = unit(pose.p(l.shin) - pose.p(l.thigh)), b = unit(pose.p(l.foot) - pose.p(l.shin));
+      return a.cross(b) + 0.02 * hip_lat;  // knees bend backwards: the hinge points left; the small term decides a straight leg
+    }
+    case Second::Elbow: {
+      const ArmParts& a = parts.arms[r.side];
+      const Vector3d u = unit(pose.p(a.fore) - pose.p(a.upper)), v = unit(pose.p(a.hand) - pose.p(a.fore));
+      return u.cross(v) - 0.02 * arm_lat;  // elbows bend forwards: the hinge points right
+    }
+  }
+  return Vector3d::Zero();
+}
+
+// A rotation whose x axis is `first` and whose z axis is `second` made
+// orthogonal to it (any perpendicular when `second` is degenerate).
+Quaterniond frame_from(Vector3d first, Vector3d second) {
+  first = unit(first);
+  if (first.isZero()) first = Vector3d::UnitX();
+  Vector3d z = second - second.dot(first) * first;
+  if (z.norm() < 1e-9 * std::max(1.0, second.norm())) {
+    Eigen::Index k;
+    first.cwiseAbs().minCoeff(&k);
+    Vector3d e = Vector3d::Zero();
+    e[k] = 1;
+    z = e - e.dot(first) * first;
+  }
+  z.normalize();
+  Eigen::Matrix3d m;
+  m.col(0) = first;
+  m.col(1) = z.cross(first);
+  m.col(2) = z;
+  return Quaterniond(m).normalized();
+}
+
+std::vector<Quaterniond> estimate_frames(const Motion& motion, const GlobalPose& g, const RigParts& parts,
+                                         const std::vector<int>& frames, bool along_toes) {
+  const int J = motion.num_joints();
+  std::vector<Rule> rules = part_rules(parts, J, along_toes);
+  add_between_rules(motion.skeleton, parts, &rules);
+  std::vector<Vector3d> first(J, Vector3d::Zero()), second(J, Vector3d::Zero());
+  for (int f : frames) {
+    const Pose pose{g, f};
+    for (int j = 0; j < J; ++j) {
+      const Rule& r = rules[j];
+      if (r.from < 0) continue;
+      const Quaterniond inv = g.rotation(f, j).conjugate();
+      first[j] += inv * unit(pose.p(r.to) - pose.p(r.from));
+      second[j] += inv * second_axis(r, parts, pose);
+    }
+  }
+  std::vector<Quaterniond> out(J, Quaterniond::Identity());
+  for (int j = 0; j < J; ++j)
+    if (rules[j].from >= 0) out[j] = frame_from(first[j], second[j]);
+  return out;
+}
+
+// Rest-pose position of every joint (identity rotations, root at the origin).
+std::vector<Vector3d> rest_positions(const Skeleton& s) {
+  std::vector<Vector3d> p(s.num_joints(), Vector3d::Zero());
+  for (int j = 1; j < s.num_joints(); ++j) p[j] = p[s.parents[j]] + s.offsets[j];
+  return p;
+}
+
+Quaterniond json_quat(const nlohmann::json& v, const std::string& what) {
+  if (!v.is_array() || v.size() != 4) throw InputError(what + " must be an array of 4 numbers (w, x, y, z)");
+  Quaterniond q;
+  for (int i = 0; i < 4; ++i)
+    if (!v[i].is_number()) throw InputError(what + " must be an array of 4 numbers (w, x, y, z)");
+  q = Quaterniond(v[0].get<double>(), v[1].get<double>(), v[2].get<double>(), v[3].get<double>());
+  if (!q.coeffs().allFinite() || q.norm() < 1e-6) throw InputError(what + " is not a rotation");
+  return q.normalized();
+}
+
+nlohmann::json quat_json(const Quaterniond& q) { return {q.w(), q.x(), q.y(), q.z()}; }
+
+}  // namespace
+
+double leg_length(const Skeleton& s, const RigParts& p) {
+  const std::vector<Vector3d> rest = rest_positions(s);
+  double sum = 0;
+  int n = 0;
+  for (const LegParts& l : p.legs) {
+    if (l.thigh < 0 || l.shin < 0 || l.foot < 0) continue;
+    sum += (rest[l.shin] - rest[l.thigh]).norm() + (rest[l.foot] - rest[l.shin]).norm();
+    ++n;
+  }
+  return n ? sum / n : 0.0;
+}
+
+RigAnatomy estimate_anatomy(const Motion& motion, const RigParts& parts, const std::vector<int>& frames_in) {
+  const std::vector<std::string> missing = parts.missing();
+  if (!missing.empty()) throw InputError("cannot measure the rig's anatomy: no " + missing.front());
+  std::vector<int> frames = frames_in;
+  if (frames.empty())
+    for (int f = 0; f < motion.num_frames(); ++f) frames.push_back(f);
+  for (int f : frames)
+    if (f < 0 || f >= motion.num_frames()) throw InputError("estimate_anatomy: frame " + std::to_string(f) + " is out of range");
+  const GlobalPose g = forward_kinematics(motion);
+  RigAnatomy a;
+  a.frames = estimate_frames(motion, g, parts, frames, false);
+  a.toe_frames = estimate_frames(motion, g, parts, frames, true);
+  const int J = motion.num_joints();
+  a.mean_local.assign(J, Quaterniond::Identity());
+  for (int j = 0; j < J; ++j) {
+    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+    const Quaterniond first = motion.rotation(frames.front(), j).normalized();
+    for (int f : frames) {
+      Quaterniond q = motion.rotation(f, j).normalized();
+      if (q.dot(first) < 0) q.coeffs() = -q.coeffs();
+      sum += q.coeffs();
+    }
+    if (sum.norm() > 1e-12) a.mean_local[j] = Quaterniond(sum.normalized());
+  }
+  a.leg_length = leg_length(motion.skeleton, parts);
+  return a;
+}
+
+std::string RigAnatomy::to_json(const Skeleton& s) const {
+  nlohmann::ordered_json j;
+  j["format"] = "motionfield-rig-anatomy";
+  j["version"] = 1;
+  j["leg_length"] = leg_length;
+  nlohmann::ordered_json joints = nlohmann::ordered_json::object();
+  for (int i = 0; i < s.num_joints(); ++i)
+    joints[s.names[i]] = {{"frame", quat_json(frames[i])}, {"toe_frame", quat_json(toe_frames[i])},
+                          {"mean_local", quat_json(mean_local[i])}};
+  j["joints"] = joints;
+  return j.dump(1);
+}
+
+RigAnatomy RigAnatomy::from_json(const std::string& text, const Skeleton& s, const std::string& source) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(source + ": not valid JSON (" + e.what() + ")");
+  }
+  if (!j.is_object() || j.value("format", "") != "motionfield-rig-anatomy" || !j.contains("joints") ||
+      !j["joints"].is_object() || !j.contains("leg_length") || !j["leg_length"].is_number())
+    throw InputError(source + ": not a motionfield rig anatomy file");
+  RigAnatomy a;
+  a.leg_length = j["leg_length"].get<double>();
+  if (!(std::isfinite(a.leg_length) && a.leg_length > 0)) throw InputError(source + ": leg_length must be positive");
+  for (const std::string& name : s.names) {
+    if (!j["joints"].contains(name)) throw InputError(source + ": no entry for joint '" + name + "'");
+    const nlohmann::json& e = j["joints"][name];
+    if (!e.is_object() || !e.contains("frame") || !e.contains("toe_frame") || !e.contains("mean_local"))
+      throw InputError(source + ": joint '" + name + "' needs frame, toe_frame and mean_local");
+    a.frames.push_back(json_quat(e["frame"], source + ": " + name + ".frame"));
+    a.toe_frames.push_back(json_quat(e["toe_frame"], source + ": " + name + ".toe_frame"));
+    a.mean_local.push_back(json_quat(e["mean_local"], source + ": " + name + ".mean_local"));
+  }
+  return a;
+}
+
+std::vector<Quaterniond> reference_pose(const Skeleton& s, const RigParts& p, const RigAnatomy& a,
+                                        double arm_down_degrees) {
+  const int J = s.num_joints();
+  std::vector<Quaterniond> world(J, Quaterniond::Identity());
+  std::vector<bool> set(J, false);
+  // Canonical world frames (first axis, second axis) of each part's anatomy.
+  auto put = [&](int j, const Vector3d& first, const Vector3d& second, bool toe_frame = false) {
+    if (j < 0) return;
+    world[j] = frame_from(first, second) * (toe_frame ? a.toe_frames[j] : a.frames[j]).conjugate();
+    set[j] = true;
+  };
+  const Vector3d X = Vector3d::UnitX(), Y = Vector3d::UnitY(), Z = Vector3d::UnitZ();
+  put(p.hips, Y, X);
+  for (int j : p.spine) put(j, Y, X);
+  put(p.chest, Y, X);
+  put(p.neck, Y, X);
+  put(p.head, Y, X);
+  const double down = arm_down_degrees * M_PI / 180.0;
+  for (int side = 0; side < 2; ++side) {
+    const double sx = side == 0 ? 1.0 : -1.0;  // the character's left is +X
+    const ArmParts& arm = p.arms[side];
+    put(arm.shoulder, sx * X, Y);
+    const Vector3d dir = sx * std::cos(down) * X - std::sin(down) * Y;
+    const Vector3d hinge = dir.cross(Z);
+    put(arm.upper, dir, hinge);
+    put(arm.fore, dir, hinge);
+    put(arm.hand, dir, hinge);
+    const LegParts& leg = p.legs[side];
+    put(leg.thigh, -Y, X);
+    put(leg.shin, -Y, X);
+    if (leg.toe >= 0) put(leg.foot, Z, X, true);
+    else put(leg.foot, -Y, X);
+    put(leg.toe, Z, X);
+  }
+  for (int j = 0; j < J; ++j)
+    if (!set[j]) world[j] = (j == 0 ? Quaterniond::Identity() : world[s.parents[j]]) * a.mean_local[j];
+  return world;
+}
+
+Retargeter::Retargeter(Skeleton user, Skeleton model, RigMap map, RigAnatomy user_anatomy, RigAnatomy model_anatomy)
+    : user_(std::move(user)),
+      model_(std::move(model)),
+      map_(std::move(map)),
+      user_anatomy_(std::move(user_anatomy)),
+      model_anatomy_(std::move(model_anatomy)) {
+  if (map_.user_of_model.size() != static_cast<size_t>(model_.num_joints()) ||
+      user_anatomy_.frames.size() != static_cast<size_t>(user_.num_joints()) ||
+      model_anatomy_.frames.size() != static_cast<size_t>(model_.num_joints()))
+    throw InputError("retargeter: the map or an anatomy does not match its skeleton");
+  toes_ = true;
+  for (int s = 0; s < 2; ++s)
+    toes_ = toes_ && map_.model_parts.legs[s].toe >= 0 && map_.user_of_model[map_.model_parts.legs[s].toe] >= 0;
+  const double user_leg = leg_length(user_, map_.user_parts), model_leg = leg_length(model_, map_.model_parts);
+  if (!(user_leg > 1e-6 && model_leg > 1e-6)) throw InputError("retargeter: a rig has legs of zero length");
+  scale_ = model_leg / user_leg;
+}
+
+Motion Retargeter::transfer(const Motion& src, bool to_model, const Motion* reference) const {
+  const Skeleton& D = to_model ? model_ : user_;
+  const RigAnatomy& AS = to_model ? user_anatomy_ : model_anatomy_;
+  const RigAnatomy& AD = to_model ? model_anatomy_ : user_anatomy_;
+  const RigParts& PS = to_model ? map_.user_parts : map_.model_parts;
+  const RigParts& PD = to_model ? map_.model_parts : map_.user_parts;
+  const int JD = D.num_joints(), F = src.num_frames();
+  std::vector<int> corr(JD, -1);  // destination joint -> source joint
+  for (int m = 0; m < model_.num_joints(); ++m) {
+    const int u = map_.user_of_model[m];
+    if (u < 0) continue;
+    if (to_model) corr[m] = u;
+    else corr[u] = m;
+  }
+  const auto frame_of = [&](const RigAnatomy& a, const RigParts& p, int j) {
+    const bool foot = j == p.legs[0].foot || j == p.legs[1].foot;
+    return toes_ && foot ? a.toe_frames[j] : a.frames[j];
+  };
+
+  // Destination joints between two corresponding ones: the nearest mapped
+  // joint above and below, and the arc-length fraction.
+  struct Between {
+    int above = -1, below = -1;
+    double s = 0;
+  };
+  std::vector<Between> between(JD);
+  const auto kids = D.children();
+  for (int j = 0; j < JD; ++j) {
+    if (corr[j] >= 0) continue;
+    int above = D.parents[j];
+    double up = D.offsets[j].norm();
+    while (above >= 0 && corr[above] < 0) up += D.offsets[above].norm(), above = D.parents[above];
+    if (above < 0) continue;
+    int below = -1;
+    double down = 0;
+    std::vector<std::pair<int, double>> queue;
+    for (int c : kids[j]) queue.emplace_back(c, D.offsets[c].norm());
+    for (size_t q = 0; q < queue.size() && below < 0; ++q) {
+      if (corr[queue[q].first] >= 0) below = queue[q].first, down = queue[q].second;
+      else
+        for (int c : kids[queue[q].first]) queue.emplace_back(c, queue[q].second + D.offsets[c].norm());
+    }
+    if (below < 0) continue;
+    between[j] = {above, below, up + down > 1e-12 ? up / (up + down) : 0.5};
+  }
+
+  const GlobalPose g = forward_kinematics(src);
+  Motion out = Motion::identity(D, F, src.fps);
+  std::vector<Quaterniond> world(JD), target(JD);
+  std::vector<bool> has_target(JD);
+  const int hips_src = to_model ? map_.user_parts.hips : map_.model_parts.hips;
+  const int hips_dst = PD.hips;
+  const double scale = to_model ? scale_ : 1.0 / scale_;
+  for (int f = 0; f < F; ++f) {
+    // World targets of corresponding joints, then of the joints between them.
+    for (int j = 0; j < JD; ++j) {
+      has_target[j] = corr[j] >= 0;
+      if (has_target[j])
+        target[j] = g.rotation(f, corr[j]) * frame_of(AS, PS, corr[j]) * frame_of(AD, PD, j).conjugate();
+    }
+    for (int j = 0; j < JD; ++j) {
+      const Between& b = between[j];
+      if (b.above < 0) continue;
+      const Quaterniond fa = target[b.above] * frame_of(AD, PD, b.above);
+      const Quaterniond fb = target[b.below] * frame_of(AD, PD, b.below);
+      target[j] = slerp(fa, fb, b.s) * AD.frames[j].conjugate();
+      has_target[j] = true;
+    }
+    // Local rotations top-down; joints without a target keep the reference's
+    // (user side) or their mean (model side).
+    for (int j = 0; j < JD; ++j) {
+      const int p = D.parents[j];
+      Quaterniond local;
+      if (has_target[j]) {
+        local = p < 0 ? target[j] : world[p].conjugate() * target[j];
+      } else {
+        local = reference ? reference->rotation(f, j) : AD.mean_local[j];
+      }
+      local.normalize();
+      out.rotation(f, j) = local;
+      world[j] = p < 0 ? local : (world[p] * local).normalized();
+    }
+    // Root: the hips land where the source's hips are, scaled.
+    const Vector3d hips_target = g.position(f, hips_src) * scale;
+    if (hips_dst == 0) {
+      out.root_positions[f] = hips_target;
+    } else {
+      Vector3d root = reference ? reference->root_positions[f] : Vector3d(0, 0, 0);
+      Vector3d pos = root;
+      std::vector<int> chain;
+      for (int j = hips_dst; j > 0; j = D.parents[j]) chain.push_back(j);
+      Quaterniond rot = out.rotation(f, 0);
+      for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+        pos += rot * D.offsets[*it];
+        rot = rot * out.rotation(f, *it);
+      }
+      out.root_positions[f] = root + (hips_target - pos);
+    }
+  }
+  return out;
+}
+
+Motion Retargeter::to_model(const Motion& user) const {
+  if (!user.skeleton.same_as(user_)) throw InputError("retargeter: the motion is not on the user's rig");
+  return transfer(user, true, nullptr);
+}
+
+Motion Retargeter::to_user(const Motion& model, const Motion& reference) const {
+  if (!reference.skeleton.same_as(user_)) throw InputError("retargeter: the reference is not on the user's rig");
+  if (reference.num_frames() != model.num_frames())
+    throw InputError("retargeter: the reference has " + std::to_string(reference.num_frames()) +
+                     " frames, the motion " + std::to_string(model.num_frames()));
+  const Motion raw = transfer(model, false, &reference);
+  const Motion raw_ref = transfer(to_model(reference), false, &reference);
+  Motion out = raw;
+  const int J = user_.num_joints();
+  for (int f = 0; f < out.num_frames(); ++f) {
+    for (int j = 0; j < J; ++j) {
+      Quaterniond q = (reference.rotation(f, j).normalized() * raw_ref.rotation(f, j).conjugate() * raw.rotation(f, j))
+                          .normalized();
+      if (f > 0 && q.dot(out.rotation(f - 1, j)) < 0) q.coeffs() = -q.coeffs();
+      out.rotation(f, j) = q;
+    }
+    out.root_positions[f] = raw.root_positions[f] + (reference.root_positions[f] - raw_ref.root_positions[f]);
+  }
+  return out;
+}
+
+}  // namespace mf

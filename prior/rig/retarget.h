@@ -1,0 +1,98 @@
+// Retargeting between a user's humanoid rig and the model's, both ways, without
+// assuming the rigs share rest poses, local axes, bone lengths or units.
+//
+// Every mapped joint gets an *anatomical frame*: a rotation fixed in the joint's
+// own local frame whose first axis follows the body part (hips -> chest, upper
+// arm -> forearm, shin -> foot, ...) and whose second axis is an anatomical
+// direction measured from joint positions (the knee's or elbow's hinge axis,
+// the line between the thighs or the shoulders). Both are averaged over the
+// frames of a motion on that rig (estimate_anatomy), so T-pose, A-pose and
+// "collapsed" rests (every bone along local X, as in the training data and in
+// LaFAN1) and arbitrarily rotated local frames all give the same anatomy.
+// Transfer keeps the world anatomical frames equal:
+//   G_model(t) * A_model = G_user(t) * A_user,
+// so directions and twist of every mapped part follow exactly, relative to each
+// rig's own anatomy. Joints of one rig that lie between mapped joints of the
+// other (spine chains of other lengths, twist bones, clavicles) get the
+// interpolation of their neighbours' world anatomical frames by arc length.
+// The root path is scaled by the ratio of leg lengths.
+#pragma once
+
+#include <Eigen/Geometry>
+#include <string>
+#include <vector>
+
+#include "prior/motion/motion.h"
+#include "prior/rig/rig_map.h"
+
+namespace mf {
+
+/// The anatomical frames of one rig, estimated from motion on it.
+struct RigAnatomy {
+  /// Per joint: the anatomical frame in the joint's local frame (identity for
+  /// joints that play no part). `toe_frames`: the feet's frames measured along
+  /// the toes (used when both rigs have toes; identity elsewhere).
+  std::vector<Eigen::Quaterniond> frames;
+  std::vector<Eigen::Quaterniond> toe_frames;
+  /// Per joint: the mean local rotation over the frames read (a natural pose for
+  /// joints the other rig lacks, e.g. the toes).
+  std::vector<Eigen::Quaterniond> mean_local;
+  /// Thigh to ankle, averaged over both legs, metres.
+  double leg_length = 0.0;
+
+  /// JSON with per-joint quaternions (w, x, y, z) keyed by joint name.
+  std::string to_json(const Skeleton& skeleton) const;
+  /// Inverse of to_json; throws InputError if a joint of `skeleton` is missing
+  /// or a value is malformed.
+  static RigAnatomy from_json(const std::string& text, const Skeleton& skeleton, const std::string& source);
+};
+
+/// Estimates the anatomy of `motion`'s rig from the frames listed in `frames`
+/// (all frames when empty; no other frame is read). `parts` from
+/// find_rig_parts() or RigMap. Throws InputError if a required part is missing.
+RigAnatomy estimate_anatomy(const Motion& motion, const RigParts& parts, const std::vector<int>& frames = {});
+
+/// Leg length (thigh to ankle, mean of both legs) of a skeleton's rest offsets,
+/// in the skeleton's units; 0 when the legs are not found.
+double leg_length(const Skeleton& skeleton, const RigParts& parts);
+
+/// World rotations of every joint in a T-pose (arm_down_degrees = 0) or an
+/// A-pose (arms lowered by that angle) of a rig facing +Z with Y up, built from
+/// its anatomy: spine, neck and head up, legs down, feet and toes forward, arms
+/// out to the sides with the elbows' hinges vertical. Joints that play no part
+/// take their mean local rotation under their parent.
+std::vector<Eigen::Quaterniond> reference_pose(const Skeleton& skeleton, const RigParts& parts,
+                                               const RigAnatomy& anatomy, double arm_down_degrees = 0.0);
+
+class Retargeter {
+ public:
+  /// `map` from map_rig(user, model); anatomies of both rigs.
+  Retargeter(Skeleton user, Skeleton model, RigMap map, RigAnatomy user_anatomy, RigAnatomy model_anatomy);
+
+  /// The user's motion on the model's rig: same frames and fps.
+  Motion to_model(const Motion& user) const;
+  /// A model-rig motion back on the user's rig. `reference`, on the user's rig
+  /// with the same frame count and fps, supplies what the model does not have
+  /// (joints the map leaves out: fingers, props, helpers above the hips) and
+  /// the part of each pose the round trip does not carry: the result is
+  ///   reference_local * raw(to_model(reference))_local^-1 * raw(model)_local
+  /// per joint (the root position likewise by differences), so with
+  /// model == to_model(reference) the result equals `reference`.
+  Motion to_user(const Motion& model, const Motion& reference) const;
+
+  /// Model metres per user metre (leg length ratio).
+  double scale() const { return scale_; }
+  const RigMap& map() const { return map_; }
+
+ private:
+  // World anatomical frames -> local rotations on a rig, for the joints `set`.
+  Motion transfer(const Motion& src, bool to_model, const Motion* reference) const;
+
+  Skeleton user_, model_;
+  RigMap map_;
+  RigAnatomy user_anatomy_, model_anatomy_;
+  bool toes_ = false;
+  double scale_ = 1.0;
+};
+
+}  // namespace mf

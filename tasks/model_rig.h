@@ -1,0 +1,52 @@
+// Methods that use the learned models run on the model's rig at the model's
+// frame rate. These adapters let them serve a motion on any humanoid rig, in any
+// unit (the motion is in metres already) and at any frame rate: the input is
+// retargeted to the model's rig (prior/rig/retarget.h) and resampled to the
+// model's rate, the method runs, and its result comes back on the user's rig at
+// the input's rate. Joints the model lacks (fingers, twist bones, props) come
+// back interpolated between the known frames; known frames are returned exactly
+// as given; unknown input frames are never read.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "prior/motion/motion.h"
+#include "prior/rig/retarget.h"
+#include "tasks/method.h"
+
+namespace mf {
+
+/// True when `input` cannot go to a model method as it is: another skeleton
+/// than the prior's, or another frame rate than the model's.
+bool needs_model_rig(const Motion& input, const TaskContext& ctx);
+
+/// The map of `user` onto the prior's skeleton with ctx.rig_map applied
+/// (map_rig). Throws InputError without a model.
+RigMap model_rig_map(const Skeleton& user, const TaskContext& ctx);
+
+/// A retargeter from `input`'s rig to the model's, its anatomy measured on the
+/// frames `known` of `input` (all when empty). Throws InputError when the rig
+/// cannot be mapped or the context has no model anatomy.
+Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, const TaskContext& ctx);
+
+using CompleteFn = std::function<Motion(const Motion& input, const std::vector<int>& known)>;
+using ResampleFn = std::function<Motion(const Motion& input, double fps, int frames)>;
+
+/// Runs `complete` (a method on the model's rig and rate) for `input` with
+/// known frames `known` (validated by the caller).
+Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
+                             const CompleteFn& complete);
+
+/// Runs `resample` (a method on the model's rig; any input rate) for `input`.
+Motion resample_on_model_rig(const Motion& input, double fps, int frames, const TaskContext& ctx,
+                             const ResampleFn& resample);
+
+/// Corrects `out` so that its known frames equal `input`'s: the difference at
+/// each known frame (per joint rotation, root position) is interpolated over
+/// the frames between known ones (held before the first and after the last),
+/// then the known frames are copied exactly. Same skeleton, frames and fps.
+Motion match_known_frames(const Motion& out, const Motion& input, const std::vector<int>& known);
+
+}  // namespace mf

@@ -1,0 +1,211 @@
+// Rig maps, unit detection and retargeting (prior/rig/), the synthetic rigs of
+// the benchmark (bench/synthetic_rigs.h) and the model-rig adapter of the tasks
+// (tasks/model_rig.h). Motion on the model's rig: the hand-made sample walk.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "bench/synthetic_rigs.h"
+#include "prior/motion/errors.h"
+#include "prior/motion/motion_bvh.h"
+#include "prior/motion/rotations.h"
+#include "prior/rig/retarget.h"
+#include "prior/rig/rig_map.h"
+#include "prior/rig/units.h"
+#include "tasks/baselines.h"
+#include "tasks/model_rig.h"
+
+namespace mf {
+namespace {
+
+const Motion& sample() {
+  static const Motion m = read_motion(std::string(MF_SOURCE_DIR) + "/samples/walk_keyframes.bvh");
+  return m;
+}
+const RigAnatomy& sample_anatomy() {
+  static const RigAnatomy a = estimate_anatomy(sample(), find_rig_parts(sample().skeleton));
+  return a;
+}
+
+double max_angle_deg(const Motion& a, const Motion& b, int* where = nullptr) {
+  double worst = 0;
+  for (int f = 0; f < a.num_frames(); ++f)
+    for (int j = 0; j < a.num_joints(); ++j) {
+      const double d = geodesic_angle(a.rotation(f, j).normalized(), b.rotation(f, j).normalized()) * 180 / M_PI;
+      if (d > worst) worst = d, where ? *where = j : 0;
+    }
+  return worst;
+}
+double max_root_diff(const Motion& a, const Motion& b) {
+  double worst = 0;
+  for (int f = 0; f < a.num_frames(); ++f) worst = std::max(worst, (a.root_positions[f] - b.root_positions[f]).norm());
+  return worst;
+}
+
+TEST(RigMap, SampleRigFindsEveryPart) {
+  const RigParts p = find_rig_parts(sample().skeleton);
+  EXPECT_TRUE(p.missing().empty());
+  const Skeleton& s = sample().skeleton;
+  EXPECT_EQ(s.names[p.hips], "Hips");
+  EXPECT_EQ(s.names[p.chest], "Chest");
+  ASSERT_EQ(p.spine.size(), 1u);
+  EXPECT_EQ(s.names[p.spine[0]], "Spine");
+  EXPECT_EQ(s.names[p.head], "Head");
+  EXPECT_EQ(s.names[p.neck], "Neck");
+  EXPECT_EQ(s.names[p.arms[0].upper], "UpperArm_L");
+  EXPECT_EQ(s.names[p.arms[1].hand], "Hand_R");
+  EXPECT_EQ(s.names[p.arms[0].shoulder], "Shoulder_L");
+  EXPECT_EQ(s.names[p.legs[1].shin], "LowerLeg_R");
+  EXPECT_EQ(s.names[p.legs[0].toe], "Toes_L");
+}
+
+TEST(RigMap, NameSides) {
+  EXPECT_EQ(name_side("mixamorig:LeftForeArm"), 0);
+  EXPECT_EQ(name_side("RightHand"), 1);
+  EXPECT_EQ(name_side("upperarm_l"), 0);
+  EXPECT_EQ(name_side("DEF-upper_arm.R"), 1);
+  EXPECT_EQ(name_side("L_Elbow"), 0);
+  EXPECT_EQ(name_side("LHipJoint"), 0);
+  EXPECT_EQ(name_side("Bip01 R Thigh"), 1);
+  EXPECT_EQ(name_side("Spine1"), -1);
+  EXPECT_EQ(name_side("Head"), -1);
+}
+
+// Every convention maps the model's joints to the variant's renamed ones.
+TEST(RigMap, EveryConventionMapsToTheModel) {
+  for (const bench::RigVariant& v : bench::standard_rig_variants()) {
+    SCOPED_TRACE(v.name);
+    const bench::VariantMotion vm = bench::make_variant(sample(), sample_anatomy(), v);
+    const RigMap map = map_rig(vm.motion.skeleton, sample().skeleton);
+    const Skeleton& user = vm.motion.skeleton;
+    const Skeleton& model = sample().skeleton;
+    for (int m = 0; m < model.num_joints(); ++m) {
+      ASSERT_GE(map.user_of_model[m], 0) << model.names[m];
+      // Side and kind agree: the user joint's name side is the model joint's.
+      EXPECT_EQ(name_side(user.names[map.user_of_model[m]]), name_side(model.names[m]))
+          << model.names[m] << " -> " << user.names[map.user_of_model[m]];
+    }
+    EXPECT_EQ(user.names[map.user_of_model[model.find("Hand_L")]].find("orearm"), std::string::npos);
+  }
+}
+
+TEST(RigMap, MapFileOverridesAndErrors) {
+  const bench::VariantMotion vm = bench::make_variant(sample(), sample_anatomy(), bench::rig_variant("mixamo"));
+  const Skeleton& user = vm.motion.skeleton;
+  const Skeleton& model = sample().skeleton;
+  // Unmapping the neck and giving the spine to the extra joint.
+  const RigMap m = map_rig(user, model, R"({"mixamorig:Neck": null, "mixamorig:Spine1": "Spine"})");
+  EXPECT_EQ(m.user_of_model[model.find("Neck")], -1);
+  EXPECT_EQ(user.names[m.user_of_model[model.find("Spine")]], "mixamorig:Spine1");
+  EXPECT_EQ(m.how[model.find("Spine")], "map file");
+  auto message = [&](const std::string& json) {
+    try {
+      map_rig(user, model, json);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(R"({"NoSuchJoint": "Hips"})").find("no joint named 'NoSuchJoint'"), std::string::npos);
+  EXPECT_NE(message(R"({"mixamorig:Hips": "Pelvis"})").find("model has no joint named 'Pelvis'"), std::string::npos);
+  EXPECT_NE(message(R"({"mixamorig:Hips": "Hips", "mixamorig:Hips": "Spine"})").find("mapped twice"), std::string::npos);
+  EXPECT_NE(message(R"({"mixamorig:Spine": "Hips", "mixamorig:Spine1": "Hips"})").find("two user joints"),
+            std::string::npos);
+  EXPECT_NE(message("{\"a\": ").find("not valid JSON"), std::string::npos);
+  EXPECT_NE(message("[1, 2]").find("expected a JSON object"), std::string::npos);
+  EXPECT_NE(message(R"({"mixamorig:LeftHand": null})").find("missing left hand"), std::string::npos);
+  // The map must nest like the model: a hand above the forearm is refused.
+  EXPECT_NE(message(R"({"mixamorig:LeftArm": "Hand_L", "mixamorig:LeftHand": "UpperArm_L"})").find("not above it"),
+            std::string::npos);
+}
+
+TEST(RigMap, UnmappableRigListsWhatWasFound) {
+  Skeleton s;
+  s.names = {"a", "b"};
+  s.parents = {-1, 0};
+  s.offsets = {Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 1, 0)};
+  try {
+    map_rig(s, sample().skeleton);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("missing hips"), std::string::npos) << m;
+    EXPECT_NE(m.find("--rig-map"), std::string::npos) << m;
+  }
+}
+
+TEST(RigMap, ShapeFindsLimbJointsWithoutPartNames) {
+  // Sides named, parts not: "L_bone1".."L_bone4" along each leg and arm.
+  Skeleton s = sample().skeleton;
+  int count = 0;
+  for (std::string& n : s.names) {
+    for (const char* part : {"UpperArm", "LowerArm", "Hand", "UpperLeg", "LowerLeg", "Foot", "Toes"}) {
+      const std::string p = part;
+      if (n.rfind(p + "_", 0) == 0) n = n.substr(p.size() + 1) + "_seg" + std::to_string(++count);
+    }
+  }
+  s.validate();
+  const RigMap map = map_rig(s, sample().skeleton);
+  const Skeleton& model = sample().skeleton;
+  for (const char* j : {"UpperArm_L", "LowerArm_L", "Hand_L", "UpperLeg_R", "LowerLeg_R", "Foot_R", "Toes_R"}) {
+    ASSERT_GE(map.user_of_model[model.find(j)], 0) << j;
+    EXPECT_EQ(map.user_of_model[model.find(j)], model.find(j)) << j;
+    EXPECT_EQ(map.how[model.find(j)], "shape") << j;
+  }
+}
+
+TEST(Units, DetectsTheFileUnit) {
+  for (const auto& [name, metres] : std::vector<std::pair<std::string, double>>{
+           {"cm", 0.01}, {"m", 1.0}, {"in", 0.0254}, {"mm", 0.001}, {"asf", 0.0254 / 0.45}}) {
+    Skeleton s = sample().skeleton;
+    for (auto& o : s.offsets) o /= metres;  // metres -> file units
+    bool detected = false;
+    const LengthUnit u = detect_length_unit(s, &detected);
+    EXPECT_TRUE(detected);
+    EXPECT_EQ(u.name, name);
+  }
+  bool detected = true;
+  Skeleton tiny;
+  tiny.names = {"root"};
+  tiny.parents = {-1};
+  tiny.offsets = {Eigen::Vector3d::Zero()};
+  EXPECT_EQ(detect_length_unit(tiny, &detected).name, "cm");
+  EXPECT_FALSE(detected);
+  EXPECT_DOUBLE_EQ(length_unit_from_name("in").metres, 0.0254);
+  EXPECT_THROW(length_unit_from_name("furlong"), InputError);
+}
+
+// The variant is the sample rewritten onto another rig; retargeting it to the
+// model's rig gives the sample back (exactly, up to the BVH text's digits).
+TEST(Retarget, VariantsRetargetToTheOriginal) {
+  for (const bench::RigVariant& v0 : bench::standard_rig_variants()) {
+    bench::RigVariant v = v0;
+    v.fps = 0;  // same frames as the sample
+    SCOPED_TRACE(v.name);
+    const bench::VariantMotion vm = bench::make_variant(sample(), sample_anatomy(), v);
+    RigMap map = map_rig(vm.motion.skeleton, sample().skeleton);
+    RigAnatomy ua = estimate_anatomy(vm.motion, map.user_parts);
+    const Retargeter r(vm.motion.skeleton, sample().skeleton, map, ua, sample_anatomy());
+    EXPECT_NEAR(r.scale(), 1.0 / v.scale, 1e-6);
+    const Motion back = r.to_model(vm.motion);
+    int joint = -1;
+    EXPECT_LT(max_angle_deg(back, sample(), &joint), 1e-3) << sample().skeleton.names[std::max(joint, 0)];
+    EXPECT_LT(max_root_diff(back, sample()), 1e-5);
+    // Nothing solved: back on the user's rig is the identity on every joint.
+    const Motion again = r.to_user(back, vm.motion);
+    EXPECT_LT(max_angle_deg(again, vm.motion), 1e-5);
+    EXPECT_LT(max_root_diff(again, vm.motion), 1e-5 * v.length_unit);
+  }
+}
+
+TEST(Retarget, AnatomyJsonRoundTrip) {
+  const std::string text = sample_anatomy().to_json(sample().skeleton);
+  const RigAnatomy a = RigAnatomy::from_json(text, sample().skeleton, "x.json");
+  ASSERT_EQ(a.frames.size(), sample_anatomy().frames.size());
+  for (size_t j = 0; j < a.frames.size(); ++j) EXPECT_LT(geodesic_angle(a.frames[j], sample_anatomy().frames[j]), 1e-9);
+  EXPECT_THROW(RigAnatomy::from_json("{}", sample().skeleton, "x.json"), InputError);
+  EXPECT_THROW(RigAnatomy::from_json("nope", sample().skeleton, "x.json"), InputError);
+}
+
+}  // namespace
+}  // namespace mf
