@@ -9,6 +9,7 @@ packages=(
   libceres-dev          # Ceres solver (L-BFGS driver for the latent solvers)
   libeigen3-dev
   libgtest-dev
+  nlohmann-json3-dev    # JSON: rig map and rig anatomy files
   libopenblas0-pthread  # BLAS for libtorch and Eigen: ~3x faster than ATLAS here (docs/BLAS.md)
   python3 python3-numpy # the Python binding's tests
 )
