@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <optional>
 
 #include "prior/model/nemf.h"
@@ -57,6 +60,17 @@ std::vector<int> model_rate_known(const std::vector<int>& known, double fps, dou
 }
 
 }  // namespace
+
+std::shared_ptr<const RigAnatomy> load_rig_anatomy_next_to(const std::string& prior_file, const Skeleton& model) {
+  const std::filesystem::path path = std::filesystem::path(prior_file).parent_path() / kRigAnatomyFileName;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return nullptr;
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (!in) throw InputError(path.string() + ": cannot read the rig anatomy file");
+  return std::make_shared<const RigAnatomy>(RigAnatomy::from_json(text.str(), model, path.string()));
+}
 
 bool needs_model_rig(const Motion& input, const TaskContext& ctx) {
   if (!ctx.model) return false;

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -17,6 +18,14 @@
 #include "tasks/method.h"
 
 namespace mf {
+
+/// File name of the prior's rig anatomy, next to the prior's model file.
+inline constexpr char kRigAnatomyFileName[] = "motionfield-rig.json";
+
+/// The rig anatomy in `kRigAnatomyFileName` next to `prior_file` for the
+/// skeleton `model`; null when there is no such file. Throws InputError (naming
+/// the file) when it exists but cannot be read or does not fit the skeleton.
+std::shared_ptr<const RigAnatomy> load_rig_anatomy_next_to(const std::string& prior_file, const Skeleton& model);
 
 /// True when `input` cannot go to a model method as it is: another skeleton
 /// than the prior's, or another frame rate than the model's.

@@ -18,6 +18,7 @@
 #include "prior/inbetween/inbetweener.h"
 #include "prior/model/model_file.h"
 #include "prior/motion/errors.h"
+#include "prior/rig/retarget.h"
 #include "training/inbetween_trainer.h"
 #include "training/prior_trainer.h"
 
@@ -27,6 +28,9 @@ const char* kUsage =
     "usage: motionfield-train prior --out DIR [options]\n"
     "       motionfield-train twostage --out DIR [in-betweener options]\n"
     "       motionfield-train citl --out DIR [in-betweener options]\n"
+    "       motionfield-train rig --out FILE.json [--data PATH] [--cache-dir DIR] [--stride N]\n"
+    "                 measures the anatomy of the training data's rig (prior/rig/retarget.h) from the\n"
+    "                 training split, every N-th frame (default 2): models/motionfield-rig.json\n"
     "\n"
     "prior options:\n"
     "  --data PATH          folder or .tar/.tar.xz/.tar.gz of BVH files (default: the shared training archive)\n"
@@ -215,6 +219,42 @@ int train_inbetweener_main(const std::string& kind, int argc, char** argv) {
 
 }  // namespace
 
+// motionfield-train rig: the rig anatomy of the training split, as JSON.
+int measure_rig_main(int argc, char** argv) {
+  mf::DatasetOptions d;
+  d.source = mf::default_train_archive();
+  d.cache_dir = mf::default_cache_dir();
+  std::string out;
+  int stride = 2;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a.rfind("--", 0) != 0 || i + 1 >= argc) throw mf::InputError("unexpected argument '" + a + "'");
+    const std::string key = a.substr(2), value = argv[++i];
+    if (key == "out") out = value;
+    else if (key == "data") d.source = value;
+    else if (key == "cache-dir") d.cache_dir = value;
+    else if (key == "stride") stride = static_cast<int>(number(key, value));
+    else throw mf::InputError("unknown option --" + key + " for rig");
+  }
+  if (out.empty()) throw mf::InputError("rig: --out FILE is required");
+  if (stride < 1) throw mf::InputError("rig: --stride must be at least 1");
+  const mf::Dataset data = mf::load_dataset(d);
+  mf::Motion all = mf::Motion::identity(data.skeleton, 0, 30.0);
+  for (const mf::Clip& c : data.train) {
+    for (int f = 0; f < c.motion.num_frames(); f += stride) {
+      for (int j = 0; j < c.motion.num_joints(); ++j) all.rotations.push_back(c.motion.rotation(f, j));
+      all.root_positions.push_back(c.motion.root_positions[f]);
+    }
+  }
+  const mf::RigAnatomy a = mf::estimate_anatomy(all, mf::find_rig_parts(data.skeleton));
+  std::ofstream file(out);
+  file << a.to_json(data.skeleton) << "\n";
+  if (!file) throw std::runtime_error("cannot write " + out);
+  std::printf("measured the rig anatomy on %d frames of %zu training clips: %s\n", all.num_frames(),
+              data.train.size(), out.c_str());
+  return 0;
+}
+
 int main(int argc, char** argv) {
   try {
     if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
@@ -222,6 +262,7 @@ int main(int argc, char** argv) {
       return argc < 2 ? 2 : 0;
     }
     const std::string kind = argv[1];
+    if (kind == "rig") return measure_rig_main(argc, argv);
     if (kind == mf::kTwoStageKind || kind == mf::kCitlKind) return train_inbetweener_main(kind, argc, argv);
     if (kind != "prior") {
       throw mf::InputError("unknown model kind '" + kind + "' (expected prior, twostage or citl)");
