@@ -25,7 +25,9 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/inbetween/inbetweener.h"
+#include "bench/synthetic_rigs.h"
 #include "tasks/jobs.h"
+#include "tasks/model_rig.h"
 #include "tasks/transformer_methods.h"
 #include "prior/util/threads.h"
 
@@ -52,6 +54,9 @@ const char* kUsage =
     "  --cache-dir DIR   extraction and parse cache (default: <project>/.cache)\n"
     "  --max-windows N   at most N windows per table row, spread evenly (default: all)\n"
     "  --split NAME      validation (default) or train: the clips the tables are measured on (tune on train)\n"
+    "  --rig NAME        gap and sparse tables on a synthetic rig (mixamo, cmu, lafan1, unreal, rigify, smpl;\n"
+    "                    bench/synthetic_rigs.h): each window rewritten onto it, solved there, brought back;\n"
+    "                    needs motionfield-rig.json next to the model (default: native)\n"
     "  --out FILE        also write the markdown to FILE\n"
     "  --l2p-axes        add columns splitting L2P into horizontal (x, z) and vertical (y) parts\n"
     "  --print-stats     add the table of training statistics (position mean / std, standing heights)\n"
@@ -92,6 +97,7 @@ struct Args {
   std::string cache_dir;
   int max_windows = 0;
   std::string split = "validation";
+  std::string rig;
   std::string out;
   bool l2p_axes = false;
   bool print_stats = false;
@@ -149,6 +155,9 @@ Args parse_args(int argc, char** argv) {
       args.source = value;
     } else if (flag == "--cache-dir") {
       args.cache_dir = value;
+    } else if (flag == "--rig") {
+      if (value != "native") mf::bench::rig_variant(value);  // validates the name
+      args.rig = value == "native" ? "" : value;
     } else if (flag == "--split") {
       if (value != "validation" && value != "train") throw mf::InputError("--split: validation or train, not '" + value + "'");
       args.split = value;
@@ -209,6 +218,7 @@ int run(int argc, char** argv) {
       std::cerr << "loading transformer " << path << "\n";
       (kind == mf::kCitlKind ? ctx.citl : ctx.twostage) = mf::load_frozen_inbetweener(path, kind);
     }
+    ctx.model_anatomy = mf::load_rig_anatomy_next_to(args.model, model->rig().skeleton);
   }
 
   mf::DatasetOptions data_options;
@@ -257,6 +267,9 @@ int run(int argc, char** argv) {
   };
   mf::bench::ProtocolOptions options;
   options.max_windows = args.max_windows;
+  options.rig = args.rig;
+  options.rig_anatomy = ctx.model_anatomy;
+  if (!args.rig.empty()) emit("- rig: " + args.rig + " (bench/synthetic_rigs.h)\n\n");
   for (mf::bench::Task task : args.tasks) {
     for (const std::string& method : args.methods) {
       if (!mf::bench::method_supports(method, task)) {

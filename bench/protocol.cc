@@ -2,6 +2,7 @@
 
 #include <ATen/Parallel.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -9,6 +10,7 @@
 
 #include "prior/motion/errors.h"
 #include "bench/text.h"
+#include "bench/synthetic_rigs.h"
 #include "tasks/jobs.h"
 
 namespace mf::bench {
@@ -31,6 +33,39 @@ TaskResult start_result(Task task, const std::string& method) {
   result.method = method;
   result.threads = at::get_num_threads();
   return result;
+}
+
+// The method's prediction for `input` (native rig, frames outside `known`
+// hidden) through `run(input, known)`; with options.rig, on that rig and back.
+Motion predict(const Motion& truth, const std::vector<int>& known, const ProtocolOptions& options,
+               const std::function<Motion(const Motion&, const std::vector<int>&)>& run) {
+  if (options.rig.empty()) return run(hide_unknown_frames(truth, known), known);
+  if (!options.rig_anatomy) throw InputError("--rig needs the model's rig anatomy (" + options.rig + ")");
+  const RigVariant v = rig_variant(options.rig);
+  const VariantMotion on_rig = make_variant(truth, *options.rig_anatomy, v);
+  const int ratio = static_cast<int>(std::lround(on_rig.motion.fps / truth.fps));
+  if (ratio < 1 || std::abs(on_rig.motion.fps - ratio * truth.fps) > 1e-6 * truth.fps)
+    throw InputError("rig '" + v.name + "' runs at " + std::to_string(on_rig.motion.fps) +
+                     " fps, not a whole multiple of the benchmark's");
+  // Known frames at the rig's rate: runs of consecutive known frames stay runs.
+  std::vector<int> known_on_rig;
+  for (size_t i = 0; i < known.size(); ++i) {
+    const bool run_continues = i + 1 < known.size() && known[i + 1] == known[i] + 1;
+    for (int r = 0; r < (run_continues ? ratio : 1); ++r) known_on_rig.push_back(known[i] * ratio + r);
+  }
+  const Motion pred = run(hide_unknown_frames(on_rig.motion, known_on_rig), known_on_rig);
+  // Back to the native rig, exactly: both anatomies from the whole truth.
+  RigMap map = map_rig(on_rig.motion.skeleton, truth.skeleton);
+  RigAnatomy rig_anatomy = estimate_anatomy(on_rig.motion, map.user_parts);
+  const Retargeter back(on_rig.motion.skeleton, truth.skeleton, map, std::move(rig_anatomy),
+                        estimate_anatomy(truth, find_rig_parts(truth.skeleton)));
+  const Motion native = back.to_model(pred);
+  Motion out = Motion::identity(truth.skeleton, truth.num_frames(), truth.fps);
+  for (int f = 0; f < truth.num_frames(); ++f) {
+    out.root_positions[f] = native.root_positions[f * ratio];
+    for (int j = 0; j < truth.num_joints(); ++j) out.rotation(f, j) = native.rotation(f * ratio, j);
+  }
+  return out;
 }
 
 }  // namespace
@@ -118,9 +153,11 @@ TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stat
     for (const Window& w : windows) {
       const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), options.context - 1,
                                         options.root_forward);
-      const Motion input = hide_unknown_frames(truth, known);
       const auto t0 = Clock::now();
-      const Motion pred = run_fill(input, a, b, method, ctx);
+      const Motion pred = predict(truth, known, options, [&](const Motion& input, const std::vector<int>& k) {
+        const auto gap = std::adjacent_find(k.begin(), k.end(), [](int x, int y) { return y != x + 1; });
+        return run_fill(input, *gap + 1, *(gap + 1), method, ctx);
+      });
       ms += ms_since(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, known);
@@ -155,9 +192,10 @@ TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats&
     for (const Window& w : windows) {
       if (evaluated.empty()) break;  // spacing 1: nothing to evaluate
       const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, options.root_forward);
-      const Motion input = hide_unknown_frames(truth, keys);
       const auto t0 = Clock::now();
-      const Motion pred = run_inbetween(input, keys, method, ctx);
+      const Motion pred = predict(truth, keys, options, [&](const Motion& input, const std::vector<int>& k) {
+        return run_inbetween(input, k, method, ctx);
+      });
       ms += ms_since(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, keys);

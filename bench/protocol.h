@@ -30,11 +30,14 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "bench/metrics.h"
 #include "prior/data/dataset.h"
+#include "prior/rig/retarget.h"
 #include "tasks/method.h"
 
 namespace mf::bench {
@@ -57,6 +60,14 @@ struct ProtocolOptions {
   int resample_window = 65;    ///< odd, so that both ends are input frames
   int max_windows = 0;         ///< cap per table row (spread evenly over the windows); 0 = all
   Eigen::Vector3d root_forward = Eigen::Vector3d::UnitZ();
+  /// Gap filling and sparse keyframes on a synthetic rig (bench/synthetic_rigs.h,
+  /// by name; empty: the native rig): each window is rewritten onto it, the
+  /// method sees it there (at the rig's frame rate, indices scaled; only rates
+  /// that are whole multiples of the native one), and its result is brought back
+  /// to the native rig exactly (anatomies measured on the whole truth window)
+  /// for the metrics. `rig_anatomy`: the native rig's, for the rig's rest pose.
+  std::string rig;
+  std::shared_ptr<const RigAnatomy> rig_anatomy;
 };
 
 /// Windows of `length` frames starting at 0, stride, 2 stride, ... in each
