@@ -169,10 +169,12 @@ VariantMotion make_variant(const Motion& motion, const RigAnatomy& anatomy, cons
   std::vector<Node> nodes(J);
   for (int j = 0; j < J; ++j) {
     const int p = s.parents[j];
-    nodes[j] = {s.names[j], p, (p < 0 ? s.offsets[j] : Vector3d(Q[p].conjugate() * s.offsets[j])) * v.scale, {}};
+    // New world rotations G' = G Q^-1: at the new rest (identity locals) the
+    // rig stands in the pose whose world rotations are Q.
+    nodes[j] = {s.names[j], p, (p < 0 ? s.offsets[j] : Vector3d(Q[p] * s.offsets[j])) * v.scale, {}};
     nodes[j].rot.resize(F);
     for (int f = 0; f < F; ++f)
-      nodes[j].rot[f] = ((p < 0 ? Quaterniond::Identity() : Q[p].conjugate()) * motion.rotation(f, j) * Q[j]).normalized();
+      nodes[j].rot[f] = ((p < 0 ? Quaterniond::Identity() : Q[p]) * motion.rotation(f, j) * Q[j].conjugate()).normalized();
   }
   auto find = [&](const std::string& key) {
     for (size_t i = 0; i < nodes.size(); ++i)
@@ -202,7 +204,7 @@ VariantMotion make_variant(const Motion& motion, const RigAnatomy& anatomy, cons
     if (v.fingers) {
       // Along the forearm's direction, in the hand's (new) frame.
       const int hand = s.find("Hand" + S);
-      const Vector3d hand_dir = Q[hand].conjugate() * s.offsets[hand].normalized();
+      const Vector3d hand_dir = Q[s.parents[hand]] * s.offsets[hand].normalized();
       add_leaf("Hand" + S, "+finger1" + S, hand_dir * 0.09 * v.scale, 0.5);
       add_leaf("+finger1" + S, "+finger2" + S, hand_dir * 0.04 * v.scale, 0.7);
       add_leaf("Hand" + S, "+thumb" + S, hand_dir * 0.03 * v.scale + Vector3d(0, 0, 0.02) * v.scale, 0.3);

@@ -21,6 +21,7 @@
 #include "tasks/baselines.h"
 #include "tasks/initializers.h"
 #include "tasks/latent_optimizer.h"
+#include "tasks/model_rig.h"
 
 namespace mf {
 namespace {
@@ -691,6 +692,40 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
 
 std::vector<std::string> renav_methods() { return {"nemf", "nemf-adam"}; }
 
+namespace {
+
+// A motion of `frames` frames at `fps` that holds `motion`'s first frame.
+Motion hold_first_frame(const Motion& motion, int frames, double fps) {
+  Motion out = Motion::identity(motion.skeleton, frames, fps);
+  for (int f = 0; f < frames; ++f) {
+    for (int j = 0; j < motion.num_joints(); ++j) out.rotation(f, j) = motion.rotation(0, j);
+    out.root_positions[f] = motion.root_positions[0];
+  }
+  return out;
+}
+
+// Re-navigation of a reference on another rig than the model's: the
+// reference is retargeted to the model's rig, the path scaled to the model's
+// size (it is in the reference's metres), and the result brought back onto
+// the reference's rig; joints the model lacks hold the reference's first pose.
+Motion renavigate_on_model_rig(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double fps,
+                               const RenavOptions& options, const TaskContext& ctx, RenavReport* report) {
+  const Retargeter rig = model_retargeter(reference, {}, ctx);
+  std::vector<Eigen::Vector2d> scaled = path;
+  for (Eigen::Vector2d& p : scaled) p *= rig.scale();
+  const Motion result = renavigate(*ctx.model, rig.to_model(reference), scaled, fps, options, ctx, report);
+  if (report) {
+    report->path_error_mean_cm /= rig.scale();
+    report->path_error_max_cm /= rig.scale();
+  }
+  Motion back = rig.to_user(result, hold_first_frame(reference, result.num_frames(), fps));
+  back.skeleton = reference.skeleton;
+  back.fps = fps;
+  return back;
+}
+
+}  // namespace
+
 Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double path_fps,
                  const std::string& method, const TaskContext& ctx, RenavReport* report) {
   const std::string m = method.empty() ? renav_methods().front() : method;
@@ -710,6 +745,9 @@ Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& pa
     throw InputError("the reference's fps must be finite and positive");
   if (!std::isfinite(path_fps) || path_fps < 0) throw InputError("the path's frame rate must be finite and positive");
   const double fps = path_fps > 0 ? path_fps : reference.fps;
+  // renavigate() takes any frame rate itself; only another rig needs the adapter.
+  if (!reference.skeleton.same_as(ctx.model->rig().skeleton))
+    return renavigate_on_model_rig(reference, path, fps, default_renav_options(solver), ctx, report);
   return renavigate(*ctx.model, reference, path, fps, default_renav_options(solver), ctx, report);
 }
 

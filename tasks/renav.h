@@ -289,6 +289,12 @@ std::vector<std::string> renav_methods();
 /// The task entry point (the CLI, the C API, the benchmark): `method` empty =
 /// "nemf"; an unknown name throws InputError listing renav_methods(); no model
 /// in `ctx` throws InputError. path_fps <= 0 means the reference's fps.
+/// A reference on another humanoid rig than the model's is retargeted to it
+/// (tasks/model_rig.h: needs ctx.model_anatomy; ctx.rig_map applies), the
+/// path (the reference's metres) scaled by the rigs' size ratio, and the
+/// result brought back onto the reference's rig, joints the model lacks
+/// holding the reference's first pose; the report's path errors are then in
+/// the reference's centimetres.
 Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double path_fps,
                  const std::string& method, const TaskContext& ctx, RenavReport* report = nullptr);
 

@@ -224,11 +224,15 @@ MF_API int mf_model_default_path(char *out, size_t capacity, size_t *needed);
 /** Loads a model file (.mfm). path == NULL loads the default model
  *  (MF_ERROR_IO if there is none). MF_ERROR_IO if the file cannot be read,
  *  MF_ERROR_MODEL if it is not a valid model. The transformer files next to
- *  it are loaded too (see below). */
+ *  it are loaded too (see below), and so is the anatomy of the prior's rig,
+ *  motionfield-rig.json, which lets the prior's methods serve motions on other
+ *  humanoid rigs (see "Other rigs" below; a broken anatomy file does not stop
+ *  the load: tasks on other rigs then fail with MF_ERROR_MODEL saying why). */
 MF_API int mf_model_load(const char *path, mf_model **out);
 /** Loads a model from the bytes of a model file (copied; the buffer may be
  *  freed after the call). No transformer is loaded with it (see
- *  mf_model_with_inbetweener). */
+ *  mf_model_with_inbetweener), and no rig anatomy: such a handle serves only
+ *  motions on the model's own skeleton. */
 MF_API int mf_model_load_from_memory(const void *data, size_t size, mf_model **out);
 /** Destroys a model (NULL is fine). Motions and tasks do not need it to stay
  *  alive once they have returned. */
@@ -271,7 +275,10 @@ MF_API int mf_model_get_latent_sizes(const mf_model *model, int32_t *local_size,
 /** BVH reading and writing options. */
 typedef struct mf_bvh_options {
   uint32_t struct_size;
-  /** Metres per file length unit; 0 = 0.01 (centimetres, as most mocap BVH). */
+  /** Metres per file length unit. 0 when reading: detected from the
+   *  skeleton's leg length (cm, m, mm, in, ft or CMU's ASF unit; centimetres
+   *  when no humanoid legs are found), see mf_motion_get_length_scale. 0 when
+   *  writing: the scale the motion (or its task input) was read with. */
   double length_scale;
 } mf_bvh_options;
 
@@ -347,6 +354,15 @@ typedef struct mf_task_options {
   void *user_data;
   /** Optional cancel token (may be cancelled from another thread). */
   mf_cancel_token *cancel;
+  /** A rig map as JSON text, {"user joint": "model joint" or null, ...}, that
+   *  overrides the automatic map of an input on another rig onto the model's
+   *  (only the joints it names; null leaves a user joint unmapped). NULL or ""
+   *  = automatic. Used only by methods that need the model. */
+  const char *rig_map;
+  /** The same from a JSON file (MF_ERROR_IO if it cannot be read; errors in it
+   *  are prefixed with the path). Giving both rig_map and rig_map_path is
+   *  MF_ERROR_INVALID_ARGUMENT. */
+  const char *rig_map_path;
 } mf_task_options;
 
 MF_API int mf_task_options_init(mf_task_options *options);
@@ -355,9 +371,23 @@ MF_API int mf_task_options_init(mf_task_options *options);
  * MF_METHOD_NEEDS_MODEL; a method that needs one fails with MF_ERROR_MODEL
  * without), an input motion that is not modified, optional options, and
  * returns a new motion through `out` on the input's skeleton (and BVH layout).
- * When the method needs the model, the input must have the model's joint count
- * (MF_ERROR_INVALID_ARGUMENT otherwise). Unknown frames of the input are never
- * read (they must still be finite); known frames are copied exactly. */
+ * When the method needs the model, the input may be on any humanoid rig (see
+ * "Other rigs" above). Unknown frames of the input are never read (they must
+ * still be finite); known frames are copied exactly. */
+
+/* Other rigs. Methods that need the model run on the model's skeleton at the
+ * model's frame rate. An input on another humanoid skeleton (other joint
+ * names, counts, rest pose, bone lengths or units) or at another frame rate is
+ * retargeted to the model's rig, solved there, and brought back: the result is
+ * on the input's skeleton and frame rate; joints the model lacks (fingers,
+ * twist bones, props) are interpolated between the known frames. This needs
+ * the model's rig anatomy (motionfield-rig.json next to the model file, loaded
+ * by mf_model_load); without it, or when the skeleton is not a humanoid the
+ * rig map understands, the task fails with MF_ERROR_INVALID_ARGUMENT saying
+ * why (MF_ERROR_MODEL when the anatomy file is there but broken). Which user
+ * joint plays which model joint is found from the joint names and the
+ * hierarchy's shape; mf_task_options.rig_map / rig_map_path override it, and
+ * mf_rig_describe shows it. */
 
 /** Keyframe in-betweening: keyframes (0-based frame indices, strictly
  *  increasing, at least two, each in [0, frames)) are kept; every other frame
@@ -443,8 +473,8 @@ MF_API int mf_decode_times(const mf_encoding *encoding, const double *times, siz
 
 /* ================================================================ re-navigation */
 
-/* Re-navigation: a reference motion (on the model's skeleton: same joint names
- * and parents, at least 2 frames, any frame rate) and a new ground path give
+/* Re-navigation: a reference motion (on any humanoid rig, see "Other rigs"
+ * above; at least 2 frames, any frame rate) and a new ground path give
  * a motion that follows the path in the reference's style, by optimising the
  * prior's latent codes (NeMF's energy: path L1 + soft-DTW divergence of the
  * joint positions in the heading frame + soft-DTW divergence of the
@@ -460,7 +490,9 @@ MF_API int mf_decode_times(const mf_encoding *encoding, const double *times, siz
  * longer than the model's window are solved in overlapping windows that agree
  * where they overlap. The output has the reference's skeleton and BVH layout,
  * starts exactly at the path's first point, and has as many frames as the
- * (resampled) path at mf_renav_options.fps.
+ * (resampled) path at mf_renav_options.fps. On another rig than the model's,
+ * the path stays in the reference's metres and joints the model lacks hold
+ * their pose of the reference's first frame.
  *
  * Methods (mf_task_options.method): "nemf" (L-BFGS, the default; NULL or "")
  * and "nemf-adam" (NeMF's Adam reference, slower). The progress callback
@@ -486,7 +518,7 @@ MF_API int mf_renav_options_init(mf_renav_options *options);
 /** Re-navigates `reference` along `path_xz` ([point_count][2] floats, see
  *  above). `renav` and `options` may be NULL (defaults). MF_ERROR_MODEL
  *  without a model; MF_ERROR_INVALID_ARGUMENT for a bad path, a skeleton
- *  that does not match the model or an unknown method. */
+ *  that cannot be retargeted to the model's or an unknown method. */
 MF_API int mf_renav(const mf_model *model, const mf_motion *reference, const float *path_xz, size_t point_count,
                     const mf_renav_options *renav, const mf_task_options *options, mf_motion **out);
 
@@ -497,6 +529,37 @@ MF_API int mf_renav(const mf_model *model, const mf_motion *reference, const flo
  *  read, MF_ERROR_INVALID_ARGUMENT "<path>:<line>: ..." on a malformed line
  *  or a non-finite value, or when fewer than two points remain. */
 MF_API int mf_path_load_csv(const char *path, float *out, size_t capacity, size_t *needed);
+
+/* ================================================================ units and rigs */
+
+/** Metres per file unit of a motion read from BVH (the length_scale it was
+ *  read with, given or detected); 0.01 for motions made from arrays. Tasks
+ *  pass it on to their results, so files are written back in the input's
+ *  unit. */
+MF_API int mf_motion_get_length_scale(const mf_motion *motion, double *out);
+/** Metres per unit of a length unit name: "cm", "m", "mm", "in", "ft" or "asf"
+ *  (CMU's ASF/AMC unit, 1/0.45 inch). MF_ERROR_INVALID_ARGUMENT for any other
+ *  name, listing these. */
+MF_API int mf_length_unit_scale(const char *unit, double *out);
+/** How `motion`'s rig is read and mapped onto `model`'s, as JSON text (a
+ *  string getter, UTF-8):
+ *    {"unit": "cm", "length_scale": 0.01, "unit_detected": true,
+ *     "joints": 65,
+ *     "map": {"user joint": "model joint", ...},       (model joint order)
+ *     "how": {"model joint": "name" | "shape" | "map file", ...},
+ *     "unmapped_user_joints": ["user joint", ...],
+ *     "model_joints": ["model joint", ...],            (every model joint)
+ *     "retargeting": true}
+ *  "unit" is the unit's name ("custom" for a length_scale that is none of
+ *  mf_length_unit_scale's), "unit_detected" false when it was given or could
+ *  not be detected (no humanoid legs found: centimetres), "joints" the
+ *  motion's joint count, "retargeting" whether the model has the rig anatomy
+ *  that tasks on another rig need. `rig_map_json` (NULL or "" = automatic) as
+ *  mf_task_options.rig_map. MF_ERROR_MODEL without a model;
+ *  MF_ERROR_INVALID_ARGUMENT with the rig map's message when the skeleton
+ *  cannot be mapped or the map is malformed. */
+MF_API int mf_rig_describe(const mf_model *model, const mf_motion *motion, const char *rig_map_json, char *out,
+                           size_t capacity, size_t *needed);
 
 #ifdef __cplusplus
 }

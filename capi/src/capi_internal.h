@@ -19,6 +19,7 @@
 namespace mf {
 class NemfModel;
 class InbetweenModel;
+struct RigAnatomy;
 struct TaskContext;
 }
 
@@ -33,6 +34,12 @@ struct mf_model {
   /// is absent): the missing-transformer error of a method quotes it.
   std::string twostage_error;
   std::string citl_error;
+  /// The anatomy of the prior's rig (motionfield-rig.json next to the prior's
+  /// file, loaded by mf_model_load; null for models from memory or when absent
+  /// or broken): tasks on other rigs need it. Why it did not load ("" when it
+  /// did or is absent).
+  std::shared_ptr<const mf::RigAnatomy> anatomy;
+  std::string anatomy_error;
 };
 
 struct mf_motion {
@@ -45,6 +52,10 @@ struct mf_motion {
   double layout_fps = 0.0;
   /// Metres per BVH unit the motion was read with: the default for writing.
   double length_scale = 0.01;
+  /// That unit's name ("cm", "m", ..., "custom") and whether it was detected
+  /// from the skeleton (mf_bvh_options.length_scale 0 and humanoid legs found).
+  std::string unit = "cm";
+  bool unit_detected = false;
 };
 
 struct mf_cancel_token {
@@ -143,8 +154,21 @@ void skeleton_offsets(const Skeleton& s, float* out, size_t capacity, size_t* ne
 /// A new motion handle carrying `motion` and the BVH layout of `like` (if any).
 mf_motion* derived_motion(Motion motion, const mf_motion& like);
 
-/// Copies the model handle's prior and transformers into `ctx` (model may be NULL).
+/// Copies the model handle's prior, transformers and rig anatomy into `ctx`
+/// (model may be NULL).
 void set_models(const mf_model* model, TaskContext* ctx);
+
+/// The context of a task call from its options: models, seed, progress
+/// callback, cancel token and rig map (read from rig_map_path if given).
+TaskContext task_context(const mf_model* model, const mf_task_options& options);
+
+/// For a method that needs the model and an input on another skeleton than
+/// the model's: throws unless it can be retargeted (the model has a rig
+/// anatomy: MF_ERROR_MODEL when its file is broken; the rig maps:
+/// MF_ERROR_INVALID_ARGUMENT with the map's message, prefixed with the map
+/// file's path when it came from one). Nothing for the model's own skeleton.
+void check_model_rig(const mf_model* model, const Skeleton& input, const mf_task_options& options,
+                     const TaskContext& ctx);
 
 /// Throws MF_ERROR_MODEL when `method` needs a transformer that `model` lacks,
 /// naming the file (and why it did not load, if it was there).

@@ -1,5 +1,6 @@
 // mf_model: loading (file, memory, default model, the transformer
-// in-betweeners next to the prior's file) and skeleton/config queries.
+// in-betweeners and the rig anatomy next to the prior's file) and
+// skeleton/config queries.
 #include <dlfcn.h>
 
 #include <cerrno>
@@ -13,7 +14,9 @@
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/rig/retarget.h"
 #include "tasks/method.h"
+#include "tasks/model_rig.h"
 #include "tasks/transformer_methods.h"
 
 namespace mf::capi {
@@ -120,6 +123,16 @@ void load_companions(mf_model* handle, const std::string& prior_file) {
   }
 }
 
+// The rig anatomy next to `prior_file`, if any; a broken file is kept as the
+// error tasks on other rigs report (the prior stays usable on its own rig).
+void load_anatomy(mf_model* handle, const std::string& prior_file) {
+  try {
+    handle->anatomy = load_rig_anatomy_next_to(prior_file, handle->model->rig().skeleton);
+  } catch (const std::exception& e) {
+    handle->anatomy_error = e.what();
+  }
+}
+
 const NemfModel& get(const mf_model* model) {
   require(model, "model");
   return *model->model;
@@ -132,6 +145,7 @@ void set_models(const mf_model* model, TaskContext* ctx) {
   ctx->model = model->model;
   ctx->twostage = model->twostage;
   ctx->citl = model->citl;
+  ctx->model_anatomy = model->anatomy;
 }
 
 void require_inbetweener(const mf_model* model, const std::string& method, const std::string& kind) {
@@ -172,6 +186,7 @@ int mf_model_load(const char* path, mf_model** out) {
     const std::vector<uint8_t> bytes = mf::capi::read_file(file);
     std::unique_ptr<mf_model> handle = mf::capi::load_bytes(bytes.data(), bytes.size(), file);
     mf::capi::load_companions(handle.get(), file);
+    mf::capi::load_anatomy(handle.get(), file);
     *out = handle.release();
   });
 }

@@ -1,4 +1,5 @@
 // mf_motion: creation from arrays and BVH, BVH output, queries.
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <filesystem>
@@ -10,6 +11,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/motion_bvh.h"
+#include "prior/rig/units.h"
 
 namespace mf::capi {
 namespace {
@@ -59,23 +61,72 @@ Motion motion_from_arrays(const Skeleton& skeleton, int32_t frame_count, double 
   return m;
 }
 
-BvhUnits units_of(const mf_bvh_options* options, double fallback) {
+// The names mf_length_unit_scale knows (prior/rig/units.h).
+constexpr const char* kUnitNames[] = {"cm", "m", "mm", "in", "ft", "asf"};
+
+// The options' length_scale: 0 (the default) or finite and positive.
+double length_scale_of(const mf_bvh_options* options) {
   const mf_bvh_options o = read_options(options, "mf_bvh_options");
-  BvhUnits u;
-  u.length_scale = o.length_scale == 0.0 ? fallback : o.length_scale;
-  if (!(std::isfinite(u.length_scale) && u.length_scale > 0))
+  if (!(std::isfinite(o.length_scale) && o.length_scale >= 0))
     throw ApiError(MF_ERROR_INVALID_ARGUMENT, "mf_bvh_options.length_scale must be finite and positive (or 0)");
+  return o.length_scale;
+}
+
+BvhUnits units_of(const mf_bvh_options* options, double fallback) {
+  const double scale = length_scale_of(options);
+  BvhUnits u;
+  u.length_scale = scale == 0.0 ? fallback : scale;
   return u;
 }
 
-mf_motion* motion_from_document(BvhDocument doc, const BvhUnits& units, const std::string& source) {
+// The name of the unit of `metres` per unit, or "custom".
+std::string unit_name(double metres) {
+  for (const char* name : kUnitNames)
+    if (length_unit_from_name(name).metres == metres) return name;
+  return "custom";
+}
+
+// The document's skeleton in file units (from its first frame: position
+// channels on non-root joints replace offsets), for unit detection.
+Skeleton skeleton_in_file_units(const BvhDocument& doc) {
+  BvhDocument first;
+  first.joints = doc.joints;
+  first.num_frames = 1;
+  first.frame_time = doc.frame_time;
+  const size_t row = std::min(doc.values.size(), static_cast<size_t>(doc.num_channels()));
+  first.values.assign(doc.values.begin(), doc.values.begin() + static_cast<std::ptrdiff_t>(row));
+  BvhUnits file_units;
+  file_units.length_scale = 1.0;
+  return motion_from_bvh(first, file_units).skeleton;
+}
+
+// Sets the handle's unit: `given` metres per unit, or (0) the one detected
+// from the document's skeleton.
+void set_unit(mf_motion* handle, const BvhDocument& doc, double given) {
+  if (given > 0) {
+    handle->length_scale = given;
+    handle->unit = unit_name(given);
+    handle->unit_detected = false;
+    return;
+  }
+  bool detected = false;
+  const LengthUnit unit = detect_length_unit(skeleton_in_file_units(doc), &detected);
+  handle->length_scale = unit.metres;
+  handle->unit = unit.name;
+  handle->unit_detected = detected;
+}
+
+mf_motion* motion_from_document(BvhDocument doc, const mf_bvh_options* options, const std::string& source) {
+  const double given = length_scale_of(options);
   auto handle = std::make_unique<mf_motion>();
   try {
+    set_unit(handle.get(), doc, given);
+    BvhUnits units;
+    units.length_scale = handle->length_scale;
     handle->motion = motion_from_bvh(doc, units);
   } catch (const InputError& e) {
     throw InputError(source + ": " + e.what());
   }
-  handle->length_scale = units.length_scale;
   handle->layout_fps = handle->motion.fps;
   doc.values.clear();
   doc.values.shrink_to_fit();
@@ -104,6 +155,8 @@ mf_motion* derived_motion(Motion motion, const mf_motion& like) {
   handle->layout = like.layout;
   handle->layout_fps = like.layout_fps;
   handle->length_scale = like.length_scale;
+  handle->unit = like.unit;
+  handle->unit_detected = like.unit_detected;
   return handle.release();
 }
 
@@ -174,7 +227,7 @@ int mf_motion_load_bvh(const char* path, const mf_bvh_options* options, mf_motio
   return guard([&] {
     require(path, "path");
     require(out, "out");
-    const mf::BvhUnits units = mf::capi::units_of(options, 0.01);
+    mf::capi::length_scale_of(options);
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec))
       throw ApiError(MF_ERROR_IO, std::string(path) + ": cannot read: it is a directory");
@@ -182,7 +235,7 @@ int mf_motion_load_bvh(const char* path, const mf_bvh_options* options, mf_motio
     if (!in) throw ApiError(MF_ERROR_IO, std::string(path) + ": cannot open: " + std::strerror(errno));
     const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) throw ApiError(MF_ERROR_IO, std::string(path) + ": read error");
-    *out = mf::capi::motion_from_document(mf::parse_bvh(text, path), units, path);
+    *out = mf::capi::motion_from_document(mf::parse_bvh(text, path), options, path);
   });
 }
 
@@ -190,9 +243,9 @@ int mf_motion_load_bvh_from_memory(const char* data, size_t size, const mf_bvh_o
   return guard([&] {
     if (!data && size != 0) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "data is NULL");
     require(out, "out");
-    const mf::BvhUnits units = mf::capi::units_of(options, 0.01);
+    mf::capi::length_scale_of(options);
     const std::string text = data ? std::string(data, size) : std::string();
-    *out = mf::capi::motion_from_document(mf::parse_bvh(text, "<memory>"), units, "<memory>");
+    *out = mf::capi::motion_from_document(mf::parse_bvh(text, "<memory>"), options, "<memory>");
   });
 }
 
@@ -244,6 +297,22 @@ int mf_motion_get_fps(const mf_motion* motion, double* out) {
     const mf_motion& m = mf::capi::get(motion);
     require(out, "out");
     *out = m.motion.fps;
+  });
+}
+
+int mf_motion_get_length_scale(const mf_motion* motion, double* out) {
+  return guard([&] {
+    const mf_motion& m = mf::capi::get(motion);
+    require(out, "out");
+    *out = m.length_scale;
+  });
+}
+
+int mf_length_unit_scale(const char* unit, double* out) {
+  return guard([&] {
+    require(unit, "unit");
+    require(out, "out");
+    *out = mf::length_unit_from_name(unit).metres;
   });
 }
 

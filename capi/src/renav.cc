@@ -46,23 +46,7 @@ int mf_renav(const mf_model* model, const mf_motion* reference, const float* pat
     if (point_count > static_cast<size_t>(mf::kMaxPathFrames))
       throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the path has more than " + std::to_string(mf::kMaxPathFrames) + " points");
 
-    mf::TaskContext ctx;
-    mf::capi::set_models(model, &ctx);
-    ctx.seed = o.seed;
-    if (o.progress) {
-      const mf_progress_fn fn = o.progress;
-      void* const user_data = o.user_data;
-      ctx.progress = [fn, user_data](const mf::TaskProgress& p) {
-        mf_progress cp;
-        std::memset(&cp, 0, sizeof cp);
-        cp.struct_size = sizeof cp;
-        cp.iteration = p.iteration;
-        cp.max_iterations = p.max_iterations;
-        cp.energy = p.energy;
-        return fn(user_data, &cp) == 0;
-      };
-    }
-    if (o.cancel) ctx.cancel = &o.cancel->flag;
+    const mf::TaskContext ctx = mf::capi::task_context(model, o);
     const std::string method = o.method ? o.method : "";
     if (!method.empty()) {
       bool known = false;
@@ -77,11 +61,7 @@ int mf_renav(const mf_model* model, const mf_motion* reference, const float* pat
     }
     if (!ctx.model) throw ApiError(MF_ERROR_MODEL, "re-navigation needs a model (the prior), and none was given");
     const mf::Motion& ref = reference->motion;
-    const int model_joints = ctx.model->rig().num_joints();
-    if (ref.num_joints() != model_joints)
-      throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the reference has " + std::to_string(ref.num_joints()) +
-                                                    " joints but the model's skeleton has " +
-                                                    std::to_string(model_joints));
+    mf::capi::check_model_rig(model, ref.skeleton, o, ctx);
 
     std::vector<Eigen::Vector2d> path(point_count);
     for (size_t i = 0; i < point_count; ++i) path[i] = Eigen::Vector2d(path_xz[2 * i], path_xz[2 * i + 1]);

@@ -1,18 +1,40 @@
-// The tasks: in-betweening, gap filling, resampling (tasks/jobs.h by method name).
+// The tasks: in-betweening, gap filling, resampling (tasks/jobs.h by method
+// name), and the task context every task (re-navigation too) runs in.
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 #include "capi/src/capi_internal.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/rig/rig_map.h"
 #include "tasks/jobs.h"
+#include "tasks/model_rig.h"
 
 namespace mf::capi {
 namespace {
 
-// The context of one task call from its options; checks what the C boundary
-// can check before the method runs.
-TaskContext make_context(const mf_model* model, const mf_motion& input, const mf_task_options& o,
-                         std::string* method) {
+// The rig map file of the options, or "" when none.
+std::string rig_map_file(const mf_task_options& o) { return o.rig_map_path ? o.rig_map_path : ""; }
+
+// The rig map text of the options (read from the file if one is named); ""
+// for the automatic map.
+std::string rig_map_of(const mf_task_options& o) {
+  const std::string file = rig_map_file(o);
+  const bool text = o.rig_map && *o.rig_map;
+  if (text && !file.empty())
+    throw ApiError(MF_ERROR_INVALID_ARGUMENT, "mf_task_options: give rig_map or rig_map_path, not both");
+  if (text) return o.rig_map;
+  if (file.empty()) return "";
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec) || !std::ifstream(file, std::ios::binary))
+    throw ApiError(MF_ERROR_IO, file + ": cannot open the rig map file");
+  return read_rig_map_file(file);
+}
+
+}  // namespace
+
+TaskContext task_context(const mf_model* model, const mf_task_options& o) {
   TaskContext ctx;
   set_models(model, &ctx);
   ctx.seed = o.seed;
@@ -30,7 +52,36 @@ TaskContext make_context(const mf_model* model, const mf_motion& input, const mf
     };
   }
   if (o.cancel) ctx.cancel = &o.cancel->flag;
+  ctx.rig_map = rig_map_of(o);
+  return ctx;
+}
 
+void check_model_rig(const mf_model* model, const Skeleton& input, const mf_task_options& o, const TaskContext& ctx) {
+  if (!ctx.model || input.same_as(ctx.model->rig().skeleton)) return;
+  if (!ctx.model_anatomy) {
+    const std::string why = model && !model->anatomy_error.empty()
+                                ? "its rig anatomy file did not load: " + model->anatomy_error
+                                : std::string("it has no rig anatomy to retarget with (") + kRigAnatomyFileName +
+                                      " next to the model file)";
+    throw ApiError(model && !model->anatomy_error.empty() ? MF_ERROR_MODEL : MF_ERROR_INVALID_ARGUMENT,
+                   "the motion has " + std::to_string(input.num_joints()) + " joints on another rig than the model's (" +
+                       std::to_string(ctx.model->rig().num_joints()) + " joints), and " + why);
+  }
+  try {
+    model_rig_map(input, ctx);
+  } catch (const InputError& e) {
+    const std::string file = rig_map_file(o);
+    throw ApiError(MF_ERROR_INVALID_ARGUMENT, (file.empty() ? "" : file + ": ") + e.what());
+  }
+}
+
+namespace {
+
+// The context of one task call from its options; checks what the C boundary
+// can check before the method runs.
+TaskContext make_context(const mf_model* model, const mf_motion& input, const mf_task_options& o,
+                         std::string* method) {
+  const TaskContext ctx = task_context(model, o);
   *method = o.method ? o.method : "";
   const std::string name = method->empty() ? default_method(ctx) : *method;
   const Method* found = nullptr;
@@ -43,11 +94,7 @@ TaskContext make_context(const mf_model* model, const mf_motion& input, const mf
   if (found->needs_model) {
     if (!ctx.model)
       throw ApiError(MF_ERROR_MODEL, "method '" + name + "' needs a model (the prior), and none was given");
-    const int model_joints = ctx.model->rig().num_joints();
-    if (input.motion.num_joints() != model_joints)
-      throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the motion has " + std::to_string(input.motion.num_joints()) +
-                                                    " joints but the model's skeleton has " +
-                                                    std::to_string(model_joints) + " (method '" + name + "')");
+    check_model_rig(model, input.motion.skeleton, o, ctx);
   }
   require_inbetweener(model, name, found->needs_inbetweener);
   return ctx;

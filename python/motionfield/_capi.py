@@ -79,6 +79,8 @@ class MfTaskOptions(ctypes.Structure):
         ("progress", PROGRESS_FN),
         ("user_data", ctypes.c_void_p),
         ("cancel", ctypes.POINTER(MfCancelToken)),
+        ("rig_map", ctypes.c_char_p),
+        ("rig_map_path", ctypes.c_char_p),
     ]
 
 
@@ -238,6 +240,10 @@ _declare("mf_decode_times", _int, _encoding, _P(_f64), _size, _f64, _P(MfCodecOp
 _declare("mf_renav_options_init", _int, _P(MfRenavOptions))
 _declare("mf_renav", _int, _model, _motion, _P(_f32), _size, _P(MfRenavOptions), _P(MfTaskOptions), _P(_motion))
 _declare("mf_path_load_csv", _int, _str, _P(_f32), _size, _P(_size))
+
+_declare("mf_motion_get_length_scale", _int, _motion, _P(_f64))
+_declare("mf_length_unit_scale", _int, _str, _P(_f64))
+_declare("mf_rig_describe", _int, _model, _motion, _str, ctypes.c_char_p, _size, _P(_size))
 
 if mf_abi_version() != ABI_VERSION:  # noqa: F821 (declared above)
     raise ImportError("%s has ABI version %d; this package needs %d" %
