@@ -14,6 +14,7 @@
 #include "prior/rig/units.h"
 #include "tasks/baselines.h"
 #include "tasks/model_rig.h"
+#include "tests/test_util.h"
 
 namespace mf {
 namespace {
@@ -205,6 +206,116 @@ TEST(Retarget, AnatomyJsonRoundTrip) {
   for (size_t j = 0; j < a.frames.size(); ++j) EXPECT_LT(geodesic_angle(a.frames[j], sample_anatomy().frames[j]), 1e-9);
   EXPECT_THROW(RigAnatomy::from_json("{}", sample().skeleton, "x.json"), InputError);
   EXPECT_THROW(RigAnatomy::from_json("nope", sample().skeleton, "x.json"), InputError);
+}
+
+// A context whose prior is a tiny untrained model on the sample's rig: the
+// adapter needs its skeleton, frame rate and the rig anatomy, not its weights.
+TaskContext sample_rig_context() {
+  TaskContext ctx;
+  ctx.model = std::make_shared<const NemfModel>(test::tiny_nemf_config(), measure_rig(sample().skeleton, {&sample()}));
+  ctx.model_anatomy = std::make_shared<const RigAnatomy>(sample_anatomy());
+  return ctx;
+}
+
+double mean_angle_deg(const Motion& a, const Motion& b, const std::vector<int>& joints, const std::vector<int>& frames) {
+  double sum = 0;
+  for (int f : frames)
+    for (int j : joints) sum += geodesic_angle(a.rotation(f, j).normalized(), b.rotation(f, j).normalized());
+  return sum / (frames.size() * joints.size()) * 180 / M_PI;
+}
+
+// An oracle on the model's rig (it returns the sample, the truth) seen
+// through the adapter: the user gets the truth on their rig, at their rate,
+// the known frames exactly, and the joints the model lacks interpolated.
+TEST(ModelRig, OracleThroughTheAdapterGivesTheTruthOnTheUsersRig) {
+  const TaskContext ctx = sample_rig_context();
+  for (const char* name : {"mixamo", "lafan1", "unreal", "cmu", "rigify"}) {
+    SCOPED_TRACE(name);
+    const bench::RigVariant v = bench::rig_variant(name);
+    const bench::VariantMotion vm = bench::make_variant(sample(), sample_anatomy(), v);
+    const Motion& truth = vm.motion;
+    const int N = truth.num_frames();
+    std::vector<int> known;  // keys every half second and the last frame
+    const int step = static_cast<int>(std::lround(truth.fps / 2));
+    for (int f = 0; f < N - 1; f += step) known.push_back(f);
+    known.push_back(N - 1);
+    int calls = 0;
+    const Motion out = complete_on_model_rig(truth, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
+      ++calls;
+      EXPECT_TRUE(in.skeleton.same_as(sample().skeleton));
+      EXPECT_DOUBLE_EQ(in.fps, 30.0);
+      EXPECT_EQ(in.num_frames(), sample().num_frames());
+      EXPECT_GE(k.size(), 2u);
+      return sample();
+    });
+    EXPECT_EQ(calls, 1);
+    ASSERT_TRUE(out.skeleton.same_as(truth.skeleton));
+    ASSERT_EQ(out.num_frames(), N);
+    EXPECT_EQ(out.fps, truth.fps);
+    for (int f : known)
+      for (int j = 0; j < truth.num_joints(); ++j) {
+        ASSERT_EQ(out.rotation(f, j).coeffs(), truth.rotation(f, j).coeffs());
+        ASSERT_EQ(out.root_positions[f], truth.root_positions[f]);
+      }
+    const RigMap map = map_rig(truth.skeleton, sample().skeleton);
+    std::vector<int> mapped, unknown;
+    for (int u : map.user_of_model)
+      if (u >= 0) mapped.push_back(u);
+    for (int f = 0, i = 0; f < N; ++f)
+      if (i < static_cast<int>(known.size()) && known[i] == f) ++i;
+      else unknown.push_back(f);
+    const double err = mean_angle_deg(out, truth, mapped, unknown);
+    // Near exact at the model's rate (twist bones and extra spine joints are
+    // placed by interpolation); other rates add the interpolation between 30 fps frames.
+    EXPECT_LT(err, v.fps > 0 ? 1.5 : 0.1) << "mean rotation error of the mapped joints, degrees";
+    const Motion interp = interpolate_motion(truth, known);
+    EXPECT_LT(err, 0.5 * mean_angle_deg(interp, truth, mapped, unknown));
+    for (int j = 0; j < truth.num_joints(); ++j) {
+      if (std::find(mapped.begin(), mapped.end(), j) != mapped.end() || map.user_parts.part_of(j) != "") continue;
+      if (truth.skeleton.names[j].find("Index2") == std::string::npos) continue;  // a finger: interpolated
+      for (int f : unknown) EXPECT_LT(geodesic_angle(out.rotation(f, j), interp.rotation(f, j)), 1e-6);
+    }
+  }
+}
+
+TEST(ModelRig, NativeRigAtOtherRatesIsResampledAroundTheModel) {
+  const TaskContext ctx = sample_rig_context();
+  bench::RigVariant v = bench::rig_variant("mixamo");
+  v.convention = "native", v.rest = "native", v.fingers = false, v.extra_spine = false, v.length_unit = 0.01;
+  v.fps = 60;
+  const Motion at60 = bench::make_variant(sample(), sample_anatomy(), v).motion;
+  ASSERT_TRUE(at60.skeleton.same_as(sample().skeleton, 1e-6));
+  EXPECT_TRUE(needs_model_rig(at60, ctx));
+  const std::vector<int> known{0, 7, 30, 61, 90, at60.num_frames() - 1};  // 7 and 61 fall between 30 fps frames
+  const Motion out = complete_on_model_rig(at60, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
+    EXPECT_EQ(in.num_frames(), sample().num_frames());
+    EXPECT_TRUE(std::is_sorted(k.begin(), k.end()));
+    return sample();
+  });
+  EXPECT_EQ(out.num_frames(), at60.num_frames());
+  for (int f : known) EXPECT_EQ(out.rotation(f, 3).coeffs(), at60.rotation(f, 3).coeffs());
+  std::vector<int> all(at60.num_joints());
+  for (int j = 0; j < at60.num_joints(); ++j) all[j] = j;
+  std::vector<int> frames;
+  for (int f = 0; f < at60.num_frames(); ++f) frames.push_back(f);
+  EXPECT_LT(mean_angle_deg(out, at60, all, frames), 1.0);
+}
+
+TEST(ModelRig, UnmappableRigAndMissingAnatomyAreClearErrors) {
+  TaskContext ctx = sample_rig_context();
+  const Motion other = bench::make_variant(sample(), sample_anatomy(), bench::rig_variant("mixamo")).motion;
+  ctx.model_anatomy = nullptr;
+  try {
+    complete_on_model_rig(other, {0, 30, 60}, ctx, [](const Motion& m, const std::vector<int>&) { return m; });
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("motionfield-rig.json"), std::string::npos) << e.what();
+  }
+  ctx = sample_rig_context();
+  ctx.rig_map = R"({"mixamorig:LeftHand": null})";
+  EXPECT_THROW(
+      complete_on_model_rig(other, {0, 30, 60}, ctx, [](const Motion& m, const std::vector<int>&) { return m; }),
+      InputError);
 }
 
 }  // namespace

@@ -27,13 +27,15 @@ TEST(CApiLayout, BvhOptions) {
 }
 
 TEST(CApiLayout, TaskOptions) {
-  EXPECT_EQ(sizeof(mf_task_options), 48u);
+  EXPECT_EQ(sizeof(mf_task_options), 64u);
   EXPECT_EQ(offsetof(mf_task_options, struct_size), 0u);
   EXPECT_EQ(offsetof(mf_task_options, method), 8u);
   EXPECT_EQ(offsetof(mf_task_options, seed), 16u);
   EXPECT_EQ(offsetof(mf_task_options, progress), 24u);
   EXPECT_EQ(offsetof(mf_task_options, user_data), 32u);
   EXPECT_EQ(offsetof(mf_task_options, cancel), 40u);
+  EXPECT_EQ(offsetof(mf_task_options, rig_map), 48u);
+  EXPECT_EQ(offsetof(mf_task_options, rig_map_path), 56u);
 }
 
 TEST(CApiLayout, CodecOptions) {
@@ -75,6 +77,8 @@ TEST(CApiLayout, InitGivesZeroDefaults) {
   EXPECT_EQ(t.progress, nullptr);
   EXPECT_EQ(t.user_data, nullptr);
   EXPECT_EQ(t.cancel, nullptr);
+  EXPECT_EQ(t.rig_map, nullptr);
+  EXPECT_EQ(t.rig_map_path, nullptr);
   EXPECT_EQ(b.struct_size, sizeof b);
   EXPECT_EQ(b.length_scale, 0.0);
   EXPECT_EQ(c.struct_size, sizeof c);

@@ -1,0 +1,321 @@
+// Motions on other rigs through the C API: length units (detected or given),
+// rig maps (automatic, as JSON text or a file, and their errors), and the
+// learned methods and re-navigation served on a rig that is not the model's,
+// with the bundled default model (skipped when it is absent).
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "tests/capi/capi_test_util.h"
+#include "tests/test_util.h"
+
+namespace mf::capi_test {
+namespace {
+
+mf_motion* const kMotionSentinel = reinterpret_cast<mf_motion*>(0x5eed);
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_text(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
+
+std::string scratch() { return test::scratch_dir("capi-rig-" + std::to_string(::getpid())); }
+
+// The sample with Mixamo's joint names (everything else unchanged).
+std::string mixamo_sample_text() {
+  std::string text = read_text(sample_bvh());
+  std::vector<std::pair<std::string, std::string>> names = {
+      {"Hips", "Hips"}, {"Spine", "Spine"}, {"Chest", "Spine2"}, {"Neck", "Neck"}, {"Head", "Head"}};
+  for (const auto& [side, word] : {std::pair<std::string, std::string>{"L", "Left"}, {"R", "Right"}}) {
+    for (const auto& [ours, theirs] : std::vector<std::pair<std::string, std::string>>{
+             {"Shoulder", "Shoulder"}, {"UpperArm", "Arm"}, {"LowerArm", "ForeArm"}, {"Hand", "Hand"},
+             {"UpperLeg", "UpLeg"}, {"LowerLeg", "Leg"}, {"Foot", "Foot"}, {"Toes", "ToeBase"}})
+      names.emplace_back(ours + "_" + side, word + theirs);
+  }
+  for (const auto& [from, to] : names) {
+    const std::string key = "JOINT " + from + "\n";
+    const size_t at = text.find(key);
+    EXPECT_NE(at, std::string::npos) << from;
+    if (at != std::string::npos) text.replace(at, key.size(), "JOINT mixamorig:" + to + "\n");
+  }
+  return text;
+}
+
+MotionPtr motion_from_text(const std::string& text, double length_scale = 0.0) {
+  mf_bvh_options o;
+  mf_bvh_options_init(&o);
+  o.length_scale = length_scale;
+  mf_motion* m = nullptr;
+  const int status = mf_motion_load_bvh_from_memory(text.data(), text.size(), &o, &m);
+  EXPECT_EQ(status, MF_OK) << describe(status);
+  return MotionPtr(m);
+}
+
+std::string bvh_text(const mf_motion* m, double length_scale = 0.0) {
+  mf_bvh_options o;
+  mf_bvh_options_init(&o);
+  o.length_scale = length_scale;
+  size_t n = 0;
+  EXPECT_EQ(mf_motion_save_bvh_to_memory(m, &o, nullptr, 0, &n), MF_OK);
+  std::string text(n, '\0');
+  EXPECT_EQ(mf_motion_save_bvh_to_memory(m, &o, text.data(), text.size(), &n), MF_OK);
+  text.resize(n - 1);
+  return text;
+}
+
+double length_scale(const mf_motion* m) {
+  double s = 0;
+  EXPECT_EQ(mf_motion_get_length_scale(m, &s), MF_OK);
+  return s;
+}
+
+std::vector<std::string> joint_names(const mf_motion* m) {
+  int32_t J = 0;
+  EXPECT_EQ(mf_motion_get_joint_count(m, &J), MF_OK);
+  std::vector<std::string> out;
+  for (int32_t j = 0; j < J; ++j) {
+    char name[256];
+    EXPECT_EQ(mf_motion_get_joint_name(m, j, name, sizeof name, nullptr), MF_OK);
+    out.emplace_back(name);
+  }
+  return out;
+}
+
+// The sample on Mixamo names, in metres.
+MotionPtr mixamo_metres() {
+  const MotionPtr cm = motion_from_text(mixamo_sample_text());
+  return motion_from_text(bvh_text(cm.get(), 1.0));
+}
+
+std::string default_model_file() { return std::string(MF_SOURCE_DIR) + "/models/motionfield-prior.mfm"; }
+
+// The bundled model, loaded once (null when it is absent).
+const mf_model* default_model() {
+  static const ModelPtr model = [] {
+    mf_model* m = nullptr;
+    if (!std::filesystem::exists(default_model_file())) return ModelPtr();
+    EXPECT_EQ(mf_model_load(default_model_file().c_str(), &m), MF_OK) << describe(MF_OK);
+    return ModelPtr(m);
+  }();
+  return model.get();
+}
+
+#define REQUIRE_DEFAULT_MODEL()                                                   \
+  if (!default_model()) GTEST_SKIP() << "no bundled model at " << default_model_file()
+
+// A fast learned method: the two-stage transformer if the model has it, else the solver.
+const char* fast_method(const mf_model* model) {
+  int32_t has = 0;
+  EXPECT_EQ(mf_model_has_inbetweener(model, "twostage", &has), MF_OK);
+  return has ? "detail" : "nemf";
+}
+
+nlohmann::json describe_rig(const mf_model* model, const mf_motion* motion, const char* map = nullptr) {
+  size_t n = 0;
+  EXPECT_EQ(mf_rig_describe(model, motion, map, nullptr, 0, &n), MF_OK) << describe(MF_OK);
+  std::string text(n, '\0');
+  EXPECT_EQ(mf_rig_describe(model, motion, map, text.data(), text.size(), &n), MF_OK);
+  text.resize(n - 1);
+  return nlohmann::json::parse(text);
+}
+
+::testing::AssertionResult Fails(int got, int status, const std::string& text) {
+  if (got != status) return ::testing::AssertionFailure() << "status " << got << ", expected " << status << ": " << mf_last_error_message();
+  if (std::string(mf_last_error_message()).find(text) == std::string::npos)
+    return ::testing::AssertionFailure() << "message '" << mf_last_error_message() << "' lacks '" << text << "'";
+  return ::testing::AssertionSuccess();
+}
+
+TEST(CApiRig, LengthUnitIsDetectedFromTheSkeletonOrGiven) {
+  mf_motion* raw = nullptr;
+  ASSERT_EQ(mf_motion_load_bvh(sample_bvh().c_str(), nullptr, &raw), MF_OK);
+  const MotionPtr cm(raw);
+  EXPECT_EQ(length_scale(cm.get()), 0.01);
+  // The same motion written in metres reads back as metres, same positions.
+  const std::string metres_text = bvh_text(cm.get(), 1.0);
+  const MotionPtr metres = motion_from_text(metres_text);
+  EXPECT_EQ(length_scale(metres.get()), 1.0);
+  EXPECT_EQ(bvh_text(metres.get()), metres_text);  // written back in its own unit
+  const std::vector<float> a = root_positions(cm.get()), b = root_positions(metres.get());
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-5f);
+  // A given scale wins; motions from arrays are in centimetres.
+  EXPECT_EQ(length_scale(motion_from_text(metres_text, 0.01).get()), 0.01);
+  EXPECT_EQ(length_scale(random_capi_motion(3, 30.0, 1).get()), 0.01);
+
+  double s = 0;
+  ASSERT_EQ(mf_length_unit_scale("in", &s), MF_OK);
+  EXPECT_DOUBLE_EQ(s, 0.0254);
+  ASSERT_EQ(mf_length_unit_scale("m", &s), MF_OK);
+  EXPECT_EQ(s, 1.0);
+  EXPECT_TRUE(Fails(mf_length_unit_scale("furlong", &s), MF_ERROR_INVALID_ARGUMENT, "cm, m, mm, in, ft or asf"));
+  EXPECT_EQ(s, 1.0);
+  EXPECT_TRUE(Fails(mf_motion_get_length_scale(nullptr, &s), MF_ERROR_INVALID_ARGUMENT, "NULL"));
+}
+
+TEST(CApiRig, DescribeShowsTheUnitAndTheMap) {
+  REQUIRE_DEFAULT_MODEL();
+  const MotionPtr user = mixamo_metres();
+  const nlohmann::json d = describe_rig(default_model(), user.get());
+  EXPECT_EQ(d["unit"], "m");
+  EXPECT_EQ(d["length_scale"], 1.0);
+  EXPECT_EQ(d["unit_detected"], true);
+  EXPECT_EQ(d["joints"], 21);
+  EXPECT_EQ(d["map"]["mixamorig:LeftArm"], "UpperArm_L");
+  EXPECT_EQ(d["map"]["mixamorig:RightToeBase"], "Toes_R");
+  EXPECT_EQ(d["how"]["UpperArm_L"], "name");
+  EXPECT_TRUE(d["unmapped_user_joints"].empty());
+  EXPECT_EQ(d["model_joints"].size(), 21u);
+  EXPECT_EQ(d["retargeting"], true);
+  // A map's entries say so.
+  const nlohmann::json m = describe_rig(default_model(), user.get(), R"({"mixamorig:Spine2": "Chest"})");
+  EXPECT_EQ(m["how"]["Chest"], "map file");
+
+  char small[4];
+  size_t needed = 0;
+  EXPECT_TRUE(Fails(mf_rig_describe(default_model(), user.get(), nullptr, small, sizeof small, &needed),
+                    MF_ERROR_BUFFER_TOO_SMALL, ""));
+  EXPECT_GT(needed, sizeof small);
+  EXPECT_TRUE(Fails(mf_rig_describe(nullptr, user.get(), nullptr, nullptr, 0, &needed), MF_ERROR_MODEL, "model"));
+  EXPECT_TRUE(Fails(mf_rig_describe(default_model(), user.get(), "{not json", nullptr, 0, &needed),
+                    MF_ERROR_INVALID_ARGUMENT, "rig map: not valid JSON"));
+}
+
+TEST(CApiRig, LearnedMethodsServeAnotherRig) {
+  REQUIRE_DEFAULT_MODEL();
+  const MotionPtr user = mixamo_metres();
+  const int32_t keys[] = {0, 20, 40, 60};
+  mf_task_options o;
+  mf_task_options_init(&o);
+  o.method = fast_method(default_model());
+  mf_motion* raw = nullptr;
+  ASSERT_EQ(mf_inbetween(default_model(), user.get(), keys, 4, &o, &raw), MF_OK) << describe(MF_OK);
+  const MotionPtr out(raw);
+  EXPECT_EQ(joint_names(out.get()), joint_names(user.get()));
+  EXPECT_EQ(frame_count(out.get()), 61);
+  const std::vector<float> rin = rotations(user.get()), rout = rotations(out.get());
+  const std::vector<float> pin = root_positions(user.get()), pout = root_positions(out.get());
+  for (float v : rout) ASSERT_TRUE(std::isfinite(v));
+  const size_t per_frame = rin.size() / 61;
+  for (int32_t k : keys) {
+    for (size_t i = 0; i < per_frame; ++i) EXPECT_EQ(rout[k * per_frame + i], rin[k * per_frame + i]) << k;
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(pout[3 * k + c], pin[3 * k + c]) << k;
+  }
+  // Written back in the input's unit (metres) with its joint names.
+  EXPECT_EQ(length_scale(out.get()), 1.0);
+  EXPECT_NE(bvh_text(out.get()).find("JOINT mixamorig:LeftForeArm"), std::string::npos);
+
+  // Gap filling at another frame rate (25 fps), with a rig map as text.
+  std::string text = bvh_text(user.get());
+  const size_t at = text.find("Frame Time:");
+  text.replace(at, text.find('\n', at) - at, "Frame Time: 0.04");
+  const MotionPtr slow = motion_from_text(text);
+  o.rig_map = R"({"mixamorig:Spine2": "Chest"})";
+  ASSERT_EQ(mf_fill(default_model(), slow.get(), 10, 40, &o, &raw), MF_OK) << describe(MF_OK);
+  const MotionPtr filled(raw);
+  EXPECT_EQ(frame_count(filled.get()), 61);
+  double fps = 0;
+  ASSERT_EQ(mf_motion_get_fps(filled.get(), &fps), MF_OK);
+  EXPECT_EQ(fps, 25.0);
+  EXPECT_EQ(rotations(filled.get())[9 * per_frame], rotations(slow.get())[9 * per_frame]);
+}
+
+TEST(CApiRig, BadRigMapsFailWithTheirMessage) {
+  REQUIRE_DEFAULT_MODEL();
+  const MotionPtr user = mixamo_metres();
+  const int32_t keys[] = {0, 60};
+  const std::string dir = scratch();
+  mf_task_options o;
+  mf_task_options_init(&o);
+  o.method = fast_method(default_model());
+  mf_motion* out = kMotionSentinel;
+
+  o.rig_map = "[1, 2";
+  EXPECT_TRUE(Fails(mf_inbetween(default_model(), user.get(), keys, 2, &o, &out), MF_ERROR_INVALID_ARGUMENT,
+                    "rig map: not valid JSON"));
+  o.rig_map = R"({"Nobody": "Hips"})";
+  EXPECT_TRUE(Fails(mf_inbetween(default_model(), user.get(), keys, 2, &o, &out), MF_ERROR_INVALID_ARGUMENT,
+                    "the motion has no joint named 'Nobody'"));
+  // Both a text and a file.
+  const std::string file = dir + "/map.json";
+  write_text(file, R"({"mixamorig:Hips": "NoSuchJoint"})");
+  o.rig_map = R"({"mixamorig:Spine2": "Chest"})";
+  o.rig_map_path = file.c_str();
+  EXPECT_TRUE(Fails(mf_inbetween(default_model(), user.get(), keys, 2, &o, &out), MF_ERROR_INVALID_ARGUMENT,
+                    "not both"));
+  // Errors in a file name it.
+  o.rig_map = nullptr;
+  EXPECT_TRUE(Fails(mf_inbetween(default_model(), user.get(), keys, 2, &o, &out), MF_ERROR_INVALID_ARGUMENT,
+                    file + ": rig map: the model has no joint named 'NoSuchJoint'"));
+  const std::string missing = dir + "/missing.json";
+  o.rig_map_path = missing.c_str();
+  EXPECT_TRUE(Fails(mf_inbetween(default_model(), user.get(), keys, 2, &o, &out), MF_ERROR_IO, missing));
+  EXPECT_EQ(out, kMotionSentinel);
+  // Re-navigation reads the same options.
+  const float path[] = {0, 0, 1, 0};
+  EXPECT_TRUE(Fails(mf_renav(default_model(), user.get(), path, 2, nullptr, &o, &out), MF_ERROR_IO, missing));
+  EXPECT_EQ(out, kMotionSentinel);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(CApiRig, RenavigatesAReferenceOnAnotherRig) {
+  REQUIRE_DEFAULT_MODEL();
+  const MotionPtr user = mixamo_metres();
+  std::vector<float> path;
+  for (int i = 0; i < 40; ++i) path.insert(path.end(), {0.04f * i, 0.01f * i});
+  mf_motion* raw = nullptr;
+  ASSERT_EQ(mf_renav(default_model(), user.get(), path.data(), 40, nullptr, nullptr, &raw), MF_OK)
+      << describe(MF_OK);
+  const MotionPtr out(raw);
+  EXPECT_EQ(joint_names(out.get()), joint_names(user.get()));
+  EXPECT_EQ(frame_count(out.get()), 40);
+  const std::vector<float> root = root_positions(out.get());
+  for (float v : root) ASSERT_TRUE(std::isfinite(v));
+  EXPECT_NEAR(root[0], 0.0f, 1e-4f);  // starts at the path's first point
+  EXPECT_NEAR(root[2], 0.0f, 1e-4f);
+  EXPECT_GT(root[3 * 39], 0.5f);  // and travels along +x
+}
+
+TEST(CApiRig, WithoutARigAnatomyOnlyTheModelsRigIsServed) {
+  REQUIRE_DEFAULT_MODEL();
+  // From memory: no anatomy.
+  const std::string bytes = read_text(default_model_file());
+  mf_model* raw = nullptr;
+  ASSERT_EQ(mf_model_load_from_memory(bytes.data(), bytes.size(), &raw), MF_OK);
+  const ModelPtr from_memory(raw);
+  const MotionPtr user = mixamo_metres();
+  const int32_t keys[] = {0, 60};
+  mf_task_options o;
+  mf_task_options_init(&o);
+  o.method = "nemf";
+  mf_motion* out = kMotionSentinel;
+  EXPECT_TRUE(Fails(mf_inbetween(from_memory.get(), user.get(), keys, 2, &o, &out), MF_ERROR_INVALID_ARGUMENT,
+                    "no rig anatomy"));
+  EXPECT_EQ(describe_rig(from_memory.get(), user.get())["retargeting"], false);
+
+  // A broken anatomy file next to the model: the model loads, other rigs fail naming it.
+  const std::string dir = scratch();
+  std::filesystem::copy_file(tiny_model_path(), dir + "/motionfield-prior.mfm");
+  write_text(dir + "/motionfield-rig.json", "{ broken");
+  ASSERT_EQ(mf_model_load((dir + "/motionfield-prior.mfm").c_str(), &raw), MF_OK) << describe(MF_OK);
+  const ModelPtr broken(raw);
+  mf_motion* sample = nullptr;
+  ASSERT_EQ(mf_motion_load_bvh(sample_bvh().c_str(), nullptr, &sample), MF_OK);
+  const MotionPtr walk(sample);
+  EXPECT_TRUE(Fails(mf_inbetween(broken.get(), walk.get(), keys, 2, &o, &out), MF_ERROR_MODEL,
+                    "motionfield-rig.json"));
+  EXPECT_EQ(out, kMotionSentinel);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace mf::capi_test
