@@ -144,7 +144,8 @@ TEST(CApiRig, LengthUnitIsDetectedFromTheSkeletonOrGiven) {
   const std::string metres_text = bvh_text(cm.get(), 1.0);
   const MotionPtr metres = motion_from_text(metres_text);
   EXPECT_EQ(length_scale(metres.get()), 1.0);
-  EXPECT_EQ(bvh_text(metres.get()), metres_text);  // written back in its own unit
+  // Written back in its own unit: the chest's 14 cm as 0.14.
+  EXPECT_NE(bvh_text(metres.get()).find("OFFSET 0.14 0 0"), std::string::npos);
   const std::vector<float> a = root_positions(cm.get()), b = root_positions(metres.get());
   ASSERT_EQ(a.size(), b.size());
   for (size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(a[i], b[i], 1e-5f);
