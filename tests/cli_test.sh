@@ -63,7 +63,7 @@ FT=$(frame_time_of "$SAMPLE")
 expect_rc 0 "--version" -- "$MF" --version
 grep -q "^motionfield [0-9]" "$TMP/out" && pass || fail "--version prints 'motionfield <version>'"
 expect_rc 0 "--help" -- "$MF" --help
-for cmd in inbetween fill resample renav batch; do
+for cmd in inbetween fill resample renav batch rig; do
   expect_rc 0 "$cmd --help" -- "$MF" "$cmd" --help
   grep -q "usage: motionfield $cmd" "$TMP/out" && pass || fail "$cmd --help prints its usage"
 done
@@ -307,6 +307,71 @@ if [ -x "$HELPER" ] && mkdir -p "$TMP/tr" "$TMP/notr" && "$HELPER" "$TMP/tr/prio
   expect_stderr "frames apart" "long-gap message"
 else
   echo "cli_test: mf_capi_tiny_model not built: transformer method runs skipped"
+fi
+
+# ------------------------------------------------------------ other rigs
+# The sample on Mixamo's joint names and in metres (offsets and root positions
+# scaled), with the bundled model: detected unit, the map, a task on that rig
+# written back in its names and unit, and rig map errors naming the file.
+if [ -f "$SRC/models/motionfield-prior.mfm" ]; then
+  MIX="$TMP/mixamo-m.bvh"
+  sed -e 's/JOINT Chest$/JOINT mixamorig:Spine2/' -e 's/JOINT \(Hips\|Spine\|Neck\|Head\)$/JOINT mixamorig:\1/' \
+    -e 's/JOINT UpperArm_\([LR]\)$/JOINT mixamorig:\1Arm/' -e 's/JOINT LowerArm_\([LR]\)$/JOINT mixamorig:\1ForeArm/' \
+    -e 's/JOINT Shoulder_\([LR]\)$/JOINT mixamorig:\1Shoulder/' -e 's/JOINT Hand_\([LR]\)$/JOINT mixamorig:\1Hand/' \
+    -e 's/JOINT UpperLeg_\([LR]\)$/JOINT mixamorig:\1UpLeg/' -e 's/JOINT LowerLeg_\([LR]\)$/JOINT mixamorig:\1Leg/' \
+    -e 's/JOINT Foot_\([LR]\)$/JOINT mixamorig:\1Foot/' -e 's/JOINT Toes_\([LR]\)$/JOINT mixamorig:\1ToeBase/' \
+    -e 's/mixamorig:L\([A-Z]\)/mixamorig:Left\1/' -e 's/mixamorig:R\([A-Z]\)/mixamorig:Right\1/' "$SAMPLE" |
+    awk 'motion && NF > 6 { for (i = 1; i <= 9; i++) if (i <= 3 || i >= 7) $i = $i * 0.01 }
+         $1 == "OFFSET" { $2 *= 0.01; $3 *= 0.01; $4 *= 0.01 }
+         /^Frame Time:/ { motion = 1 } { print }' >"$MIX"
+  grep -q "JOINT mixamorig:LeftForeArm" "$MIX" && pass || fail "the Mixamo-named sample has mixamorig:LeftForeArm"
+  rig_method=nemf
+  if [ -f "$SRC/models/motionfield-twostage.mfm" ]; then rig_method=detail; fi
+
+  expect_rc 0 "rig prints the unit and the map" -- "$MF" rig "$MIX"
+  grep -q "unit m (detected" "$TMP/out" && pass || fail "rig detects metres"
+  grep -Eq "mixamorig:LeftForeArm +-> LowerArm_L +name" "$TMP/out" && pass || fail "rig prints the map"
+  grep -q "user joints left out: none" "$TMP/out" && pass || fail "rig prints the joints left out"
+  expect_rc 0 "rig --json" -- "$MF" rig "$MIX" --json
+  grep -q '^{"unit":"m","length_scale":1' "$TMP/out" && pass || fail "rig --json prints the description"
+  expect_rc 0 "rig --units cm" -- "$MF" --units cm rig "$MIX"
+  grep -q "unit cm (given" "$TMP/out" && pass || fail "rig says a given unit"
+
+  expect_rc 0 "inbetween on another rig ($rig_method)" -- \
+    "$MF" --threads 1 inbetween --in "$MIX" --keyframes 0,20,40,60 --out "$TMP/mix-kf.bvh" --method "$rig_method"
+  expect_frames "$TMP/mix-kf.bvh" "$N"
+  grep -q "JOINT mixamorig:LeftForeArm" "$TMP/mix-kf.bvh" && pass || fail "the output has the user's joint names"
+  grep -q "OFFSET 0.14 0 0" "$TMP/mix-kf.bvh" && pass || fail "the output is in the input's unit (metres)"
+  expect_rc 0 "known frames kept on another rig" -- "$MF" diff "$MIX" "$TMP/mix-kf.bvh" --frames 0,20,40,60
+  expect_rc 3 "...and the others solved" -- "$MF" diff "$MIX" "$TMP/mix-kf.bvh" --frames 10
+
+  printf '{"mixamorig:Spine2": "Chest"}\n' >"$TMP/map.json"
+  printf '{"mixamorig:Hips": "NoSuchJoint"}\n' >"$TMP/badmap.json"
+  expect_rc 0 "fill with --rig-map" -- "$MF" --threads 1 fill --in "$MIX" --gap 10:30 --out "$TMP/mix-fill.bvh" \
+    --method "$rig_method" --rig-map "$TMP/map.json"
+  expect_rc 0 "rig --rig-map" -- "$MF" rig "$MIX" --rig-map "$TMP/map.json"
+  grep -Eq "mixamorig:Spine2 +-> Chest +map file" "$TMP/out" && pass || fail "rig says which joints the map file gave"
+  bad "a rig map naming a missing joint" --rig-map "$TMP/badmap.json" inbetween --in "$MIX" --keyframes 0,60 \
+    --out "$TMP/bad.bvh" --method "$rig_method"
+  expect_stderr "badmap.json: rig map: the model has no joint named 'NoSuchJoint'" "rig map errors name the file"
+  expect_rc 2 "rig with a bad map" -- "$MF" rig "$MIX" --rig-map "$TMP/badmap.json"
+  expect_stderr "badmap.json: rig map:" "rig names the bad map file"
+  bad "a missing rig map file" inbetween --in "$MIX" --keyframes 0,60 --out "$TMP/bad.bvh" --rig-map "$TMP/none.json"
+  expect_stderr "none.json: cannot open the rig map file" "missing map file message"
+  bad "an unknown unit" --units furlong inbetween --in "$MIX" --keyframes 0,60 --out "$TMP/bad.bvh"
+  expect_stderr "unknown length unit 'furlong'" "unknown unit message"
+
+  printf '%s\n' "{\"task\": \"fill\", \"in\": \"$MIX\", \"out\": \"$TMP/mix-b1.bvh\", \"gap\": [10, 30], \"method\": \"$rig_method\", \"rig_map\": \"$TMP/map.json\", \"units\": \"m\"}" \
+    "{\"task\": \"fill\", \"in\": \"$MIX\", \"out\": \"$TMP/mix-b2.bvh\", \"gap\": [10, 30], \"method\": \"$rig_method\", \"rig_map\": \"$TMP/badmap.json\"}" \
+    "{\"task\": \"inbetween\", \"in\": \"$MIX\", \"out\": \"$TMP/mix-b3.bvh\", \"keyframes\": [0, 60], \"method\": \"interp\", \"units\": 1}" \
+    >"$TMP/rig-jobs.jsonl"
+  expect_rc 2 "batch with rig_map and units" -- "$MF" --threads 1 batch "$TMP/rig-jobs.jsonl"
+  expect_frames "$TMP/mix-b1.bvh" "$N"
+  expect_frames "$TMP/mix-b3.bvh" "$N"
+  expect_absent "$TMP/mix-b2.bvh"
+  expect_stderr "line 2: error: .*badmap.json: rig map" "batch names the job's bad map file"
+else
+  echo "cli_test: no bundled model: other-rig runs skipped"
 fi
 
 # ------------------------------------------------------------ batch

@@ -530,6 +530,17 @@ BatchJob batch_job_from_json(const JsonValue& line) {
   job.in = string_value(required(line, "in", job.task), "in", false);
   job.out = string_value(required(line, "out", job.task), "out", false);
   if (const JsonValue* m = line.find("method")) job.method = string_value(*m, "method", false);
+  if (const JsonValue* r = line.find("rig_map")) job.rig_map = string_value(*r, "rig_map", false);
+  if (const JsonValue* u = line.find("units")) {
+    if (!u->is_number()) {
+      if (!u->is_string()) throw InputError(std::string("\"units\" must be a unit name or a number, not ") + json_type_name(u->type()));
+      job.units = string_value(*u, "units", false);
+    } else if (u->as_number() > 0) {
+      job.units = u->dump();
+    } else {
+      throw InputError("\"units\" must be positive, not " + u->dump());
+    }
+  }
 
   if (job.task == "inbetween") {
     job.keyframes = int_array(required(line, "keyframes", job.task), "keyframes");

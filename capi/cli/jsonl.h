@@ -86,7 +86,9 @@ const char* json_type_name(JsonValue::Type type);
 /// "renav", "in": path, "out": path, "keyframes": [int...], "gap": [A, B],
 /// "fps": F, "method": name}; re-navigation takes exactly one of "path" (a CSV
 /// of x,z per output frame) and "polyline" (a CSV of vertices, with an
-/// optional "frames": N), and an optional "fps". Only the keys the task needs
+/// optional "frames": N), and an optional "fps". Every task takes an optional
+/// "rig_map" (a JSON map file) and "units" (a unit name, "auto", or metres per
+/// unit as a number or a string). Only the keys the task needs
 /// are read and type-checked; any other key ("id", a frame count, the input's
 /// fps, ...) is ignored, so callers can annotate jobs.
 struct BatchJob {
@@ -102,14 +104,16 @@ struct BatchJob {
   std::string path_file;           ///< renav: the CSV of the path or of the polyline's vertices
   bool polyline = false;           ///< renav: path_file holds a polyline's vertices
   int frames = 0;                  ///< renav with a polyline: the output's frame count (0 = from the speed)
+  std::string rig_map;             ///< a rig map file; empty: the command line's (--rig-map)
+  std::string units;               ///< "auto", a unit name or metres per unit as text; empty: the command line's
 };
 
 /// Reads a job from one parsed line. Throws mf::InputError with a message naming
 /// the key when the value is not an object, "task" is missing or unknown, or a
 /// key the task needs is missing or has the wrong type ("in" and "out" non-empty
 /// strings; "keyframes" an array of integers; "gap" an array of two integers;
-/// "fps" a number; "method", "path" and "polyline" strings; "frames" an
-/// integer). Range checks (keyframes within the clip,
+/// "fps" a number; "method", "path", "polyline" and "rig_map" strings;
+/// "frames" an integer; "units" a string or a positive number). Range checks (keyframes within the clip,
 /// fps positive, ...) happen later, in tasks/jobs.h, once the input is read.
 BatchJob batch_job_from_json(const JsonValue& line);
 

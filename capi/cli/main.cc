@@ -1,5 +1,5 @@
 // motionfield: the command-line front end (in-betweening, gap filling,
-// resampling, re-navigation, batch runs). It is a client of the C API
+// resampling, re-navigation, batch runs, rig descriptions). It is a client of the C API
 // (motionfield.h) and calls nothing else of motionfield; the JSON Lines parser
 // (jsonl.h) is its own.
 // Exit codes: 0 ok, 2 bad input, 1 internal error; every message goes to
@@ -62,10 +62,35 @@ struct ModelDeleter {
 using MotionPtr = std::unique_ptr<mf_motion, MotionDeleter>;
 using ModelPtr = std::unique_ptr<mf_model, ModelDeleter>;
 
-MotionPtr load_motion(const std::string& path) {
+// Metres per file unit of --units / "units": "" or "auto" = 0 (detected), a
+// unit name (mf_length_unit_scale) or a positive number.
+double units_scale(const std::string& units, const std::string& what) {
+  if (units.empty() || units == "auto") return 0.0;
+  double v = 0;
+  const auto r = std::from_chars(units.data(), units.data() + units.size(), v);
+  if (r.ec == std::errc() && r.ptr == units.data() + units.size()) {
+    if (!(std::isfinite(v) && v > 0)) throw InputError(what + " must be positive, not " + units);
+    return v;
+  }
+  if (mf_length_unit_scale(units.c_str(), &v) != MF_OK)
+    throw InputError(what + ": " + mf_last_error_message() + "; auto (the default) detects it");
+  return v;
+}
+
+// Reads a BVH file; `units` as units_scale() takes it.
+MotionPtr load_motion(const std::string& path, const std::string& units = "") {
+  mf_bvh_options o;
+  check(mf_bvh_options_init(&o));
+  o.length_scale = units_scale(units, "--units");
   mf_motion* m = nullptr;
-  check(mf_motion_load_bvh(path.c_str(), nullptr, &m));
+  check(mf_motion_load_bvh(path.c_str(), &o, &m));
   return MotionPtr(m);
+}
+
+double length_scale_of(const mf_motion* m) {
+  double s = 0;
+  check(mf_motion_get_length_scale(m, &s));
+  return s;
 }
 
 int32_t frame_count(const mf_motion* m) {
@@ -203,6 +228,17 @@ class Models {
     return model_.get();
   }
 
+  // The model, explicit or default, for `what` that always needs it.
+  const mf_model* required(const std::string& what) {
+    if (!explicit_path_.empty()) {
+      load_explicit();
+      return model_.get();
+    }
+    load_default();
+    if (!model_) throw InputError(what + " needs the model, and none is installed (name one with --model)");
+    return model_.get();
+  }
+
   const std::string& path() const { return path_; }
 
  private:
@@ -249,7 +285,7 @@ const char* kMainHelp =
     "motionfield " MF_VERSION_STRING ": motion in-betweening, gap filling, resampling and re-navigation of BVH clips\n"
     "\n"
     "usage: motionfield [--threads N] [--model PATH] [--twostage PATH] [--citl PATH] [--verbose]\n"
-    "                   <command> [options]\n"
+    "                   [--rig-map FILE] [--units U] <command> [options]\n"
     "\n"
     "commands:\n"
     "  inbetween  fill the frames between sparse keyframes\n"
@@ -257,6 +293,7 @@ const char* kMainHelp =
     "  resample   change the frame rate, keeping the time span\n"
     "  renav      make a reference clip follow a new ground path (needs the model)\n"
     "  batch      run many jobs from a JSON Lines file in one process\n"
+    "  rig        show how a BVH's rig is read: its unit and its map onto the model's\n"
     "\n"
     "global options:\n"
     "  --threads N    intra-op threads for the solvers (default 2)\n"
@@ -268,11 +305,18 @@ const char* kMainHelp =
     "                 nemf-context, nemf-detail; citl, nemf-citl); default:\n"
     "                 motionfield-twostage.mfm and motionfield-citl.mfm next to\n"
     "                 the model file, when present\n"
+    "  --rig-map FILE a JSON map {\"your joint\": \"model joint\" or null} that\n"
+    "                 overrides the automatic map of your rig onto the model's\n"
+    "  --units U      the BVH length unit: auto (the default: detected from the leg\n"
+    "                 length), cm, m, mm, in, ft, asf or metres per unit\n"
     "  --verbose, -v  print what runs and how long it takes (stderr)\n"
     "  --help, -h     this help; `motionfield <command> --help` for a command\n"
     "  --version      print the version\n"
     "\n"
-    "Output BVH files keep the input's skeleton, channel layout and frame time.\n"
+    "Any humanoid rig works, in its own unit and frame rate: methods that need the\n"
+    "model retarget it to the model's rig and back (`motionfield rig IN.bvh` shows\n"
+    "the map). Output BVH files keep the input's skeleton, channel layout, unit and\n"
+    "frame time.\n"
     "Exit codes: 0 ok, 2 bad input (message on stderr), 1 internal error.\n";
 
 const char* kInbetweenHelp =
@@ -318,7 +362,7 @@ const char* kRenavHelp =
     "a new ground path (the prior's latent codes optimised against NeMF's energy: the\n"
     "root path, and soft-DTW divergences of the pose and of the facing relative to\n"
     "the path, against the reference). Needs the model (--model or the default one);\n"
-    "the reference must be on its skeleton.\n"
+    "the reference may be on any humanoid rig (--rig-map, --units: motionfield --help).\n"
     "\n"
     "The path CSV has one \"x,z\" pair per line, metres, in the BVH's world frame\n"
     "(Y up); an optional header line \"x,z\"; blank lines and lines starting with #\n"
@@ -350,7 +394,9 @@ const char* kBatchHelp =
     "  {\"task\": \"renav\", \"in\": \"a.bvh\", \"out\": \"f.bvh\", \"polyline\": \"p.csv\", \"frames\": 90}\n"
     "For fill, a \"keyframes\" list, if given, is authoritative over \"gap\". For\n"
     "renav, \"path\" or \"polyline\" and the optional \"fps\" and \"frames\" mean what\n"
-    "the flags of `motionfield renav` mean. Keys a\n"
+    "the flags of `motionfield renav` mean. Every task takes \"rig_map\" (a file) and\n"
+    "\"units\" (a name, auto, or metres per unit), which replace --rig-map and\n"
+    "--units for that job. Keys a\n"
     "job does not need (\"id\", frame counts, ...) are ignored; blank lines are\n"
     "skipped; relative paths are relative to the current directory. The model\n"
     "(--model) is loaded once for all jobs.\n"
@@ -358,6 +404,18 @@ const char* kBatchHelp =
     "still run. Exit code: 0 if every job succeeded, 1 if any job hit an internal\n"
     "error, otherwise 2 if any job had bad input. Progress is shown on stderr when\n"
     "it is a terminal.\n";
+
+const char* kRigHelp =
+    "usage: motionfield rig IN.bvh [--model PATH] [--rig-map FILE] [--units U] [--json]\n"
+    "\n"
+    "How the rig of IN.bvh is read and mapped onto the model's (--model or the\n"
+    "default one): its length unit (detected from the leg length unless --units\n"
+    "names it), which of its joints plays which joint of the model and how that was\n"
+    "found (name, shape or map file), and its joints left out (the learned methods\n"
+    "interpolate them between known frames). --rig-map FILE entries replace what\n"
+    "was found. A rig that cannot be mapped gives the reason (exit 2).\n"
+    "\n"
+    "  --json  the description as JSON (the C API's mf_rig_describe)\n";
 
 const char* kDiffHelp =
     "usage: motionfield diff A.bvh B.bvh [--tol T] [--frames LIST] [--step K]\n"
@@ -476,6 +534,8 @@ struct Settings {
   bool verbose = false;
   std::string model;
   std::vector<std::string> transformers;  ///< --twostage, --citl
+  std::string rig_map;                    ///< --rig-map FILE, "" for the automatic map
+  std::string units;                      ///< --units, "" = auto
 };
 
 void check_output_path(const std::string& out) {
@@ -524,7 +584,7 @@ void run_job(const mf::cli::BatchJob& job, const Settings& settings, Models& mod
   // Re-navigation always needs the prior, whatever the method.
   const mf_model* model = models.for_method(renav && job.method.empty() ? "nemf" : job.method);
 
-  const MotionPtr input = load_motion(job.in);
+  const MotionPtr input = load_motion(job.in, job.units.empty() ? settings.units : job.units);
   const int frames_in = frame_count(input.get());
   const std::vector<float> xz = renav ? read_path(job.path_file) : std::vector<float>();
   const auto t1 = Clock::now();
@@ -532,6 +592,8 @@ void run_job(const mf::cli::BatchJob& job, const Settings& settings, Models& mod
   mf_task_options options;
   check(mf_task_options_init(&options));
   options.method = job.method.empty() ? nullptr : job.method.c_str();
+  const std::string& rig_map = job.rig_map.empty() ? settings.rig_map : job.rig_map;
+  options.rig_map_path = rig_map.empty() ? nullptr : rig_map.c_str();
   mf_motion* raw = nullptr;
   int32_t expected_frames = frames_in;
   if (job.task == "inbetween" || (job.task == "fill" && job.has_keyframes)) {
@@ -735,6 +797,72 @@ int command_batch(const std::vector<std::string>& args, const Settings& settings
   return kExitOk;
 }
 
+std::string read_text_file(const std::string& path, const std::string& what) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open the " + what);
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw InputError(path + ": cannot read the " + what);
+  return text.str();
+}
+
+// The text form of mf_rig_describe's JSON.
+void print_rig(const std::string& in, const mf::cli::JsonValue& d, const std::string& model_path, bool units_given) {
+  const bool detected = d.find("unit_detected")->as_bool();
+  const char* unit_how = units_given ? "given" : detected ? "detected from the leg length" : "no legs found: assumed";
+  std::printf("%s: %d joints, unit %s (%s; %g m per file unit)\n", in.c_str(),
+              static_cast<int>(d.find("joints")->as_number()), d.find("unit")->as_string().c_str(), unit_how,
+              d.find("length_scale")->as_number());
+  std::printf("mapped onto %s (%zu joints): user joint -> model joint, found by\n", model_path.c_str(),
+              d.find("model_joints")->as_array().size());
+  const mf::cli::JsonValue& map = *d.find("map");
+  const mf::cli::JsonValue& how = *d.find("how");
+  size_t width = 0;
+  for (const std::string& user : map.keys()) width = std::max(width, user.size());
+  for (size_t i = 0; i < map.keys().size(); ++i) {
+    const std::string& model_joint = map.values()[i].as_string();
+    std::printf("  %-*s -> %-14s %s\n", static_cast<int>(width), map.keys()[i].c_str(), model_joint.c_str(),
+                how.find(model_joint)->as_string().c_str());
+  }
+  std::string left;
+  for (const mf::cli::JsonValue& j : d.find("unmapped_user_joints")->as_array())
+    left += (left.empty() ? "" : ", ") + j.as_string();
+  std::printf("user joints left out: %s\n", left.empty() ? "none" : left.c_str());
+  if (!d.find("retargeting")->as_bool())
+    std::printf("note: the model has no rig anatomy (motionfield-rig.json next to it): only its own rig can be solved\n");
+}
+
+int command_rig(std::vector<std::string> args, const Settings& settings) {
+  const auto json_flag = std::find(args.begin(), args.end(), "--json");
+  const bool json = json_flag != args.end();
+  if (json) args.erase(json_flag);
+  const CommandArgs a = parse_command_args("rig", args, {});
+  if (a.help) {
+    std::fputs(kRigHelp, stdout);
+    return kExitOk;
+  }
+  if (a.positional.size() != 1) throw InputError("rig: expected exactly one BVH file (see motionfield rig --help)");
+  const std::string& in = a.positional.front();
+  const std::string map = settings.rig_map.empty() ? "" : read_text_file(settings.rig_map, "rig map file");
+  Models models(settings.model, settings.transformers);
+  const mf_model* model = models.required("rig");
+  const MotionPtr motion = load_motion(in, settings.units);
+  size_t n = 0;
+  int status = mf_rig_describe(model, motion.get(), map.c_str(), nullptr, 0, &n);
+  std::string text(n, '\0');
+  if (status == MF_OK) status = mf_rig_describe(model, motion.get(), map.c_str(), text.data(), text.size(), &n);
+  if (status == MF_ERROR_INVALID_ARGUMENT && !settings.rig_map.empty())
+    throw InputError(settings.rig_map + ": " + mf_last_error_message());
+  check(status);
+  text.resize(n - 1);
+  if (json) {
+    std::printf("%s\n", text.c_str());
+  } else {
+    print_rig(in, mf::cli::parse_json(text), models.path(), units_scale(settings.units, "--units") > 0);
+  }
+  return kExitOk;
+}
+
 // Angle in degrees between two rotations given as (w, x, y, z) floats: the
 // angle of q_a^-1 q_b, computed from its vector part (accurate near zero).
 double rotation_difference_degrees(const float* a, const float* b) {
@@ -754,7 +882,7 @@ double rotation_difference_degrees(const float* a, const float* b) {
   return angle * (180.0 / 3.14159265358979323846);
 }
 
-int command_diff(const std::vector<std::string>& args) {
+int command_diff(const std::vector<std::string>& args, const Settings& settings) {
   const CommandArgs a = parse_command_args("diff", args, {"tol", "frames", "step"});
   if (a.help) {
     std::fputs(kDiffHelp, stdout);
@@ -764,9 +892,9 @@ int command_diff(const std::vector<std::string>& args) {
   const double tol = a.has("tol") ? parse_double(a.get("tol"), "--tol") : 1e-4;
   const int step = a.has("step") ? parse_int(a.get("step"), "--step") : 1;
   if (step < 1) throw InputError("diff: --step must be at least 1");
-  constexpr double kFileUnitsPerMetre = 100.0;  // BVH files are read as centimetres
-  const MotionPtr ma = load_motion(a.positional[0]);
-  const MotionPtr mb = load_motion(a.positional[1]);
+  const MotionPtr ma = load_motion(a.positional[0], settings.units);
+  const MotionPtr mb = load_motion(a.positional[1], settings.units);
+  const double file_units_per_metre = 1.0 / length_scale_of(ma.get());
   const int frames_a = frame_count(ma.get()), frames_b = frame_count(mb.get());
 
   std::vector<std::string> problems;
@@ -805,7 +933,7 @@ int command_diff(const std::vector<std::string>& args) {
         const double d = static_cast<double>(pos_a[3 * f + k]) - pos_b[3 * g + k];
         d2 += d * d;
       }
-      const double d = std::sqrt(d2) * kFileUnitsPerMetre;
+      const double d = std::sqrt(d2) * file_units_per_metre;
       if (d > max_pos) max_pos = d, worst_pos = f;
       for (int j = 0; j < J; ++j) {
         const double r = rotation_difference_degrees(&rot_a[4 * (static_cast<size_t>(f) * J + j)],
@@ -863,6 +991,12 @@ int run(int argc, char** argv) {
     } else if (global_option(argc, argv, &i, "twostage", &value) || global_option(argc, argv, &i, "citl", &value)) {
       if (value.empty()) throw InputError(a + " needs a value");
       settings.transformers.push_back(value);
+    } else if (global_option(argc, argv, &i, "rig-map", &value)) {
+      if (value.empty()) throw InputError("--rig-map needs a value");
+      settings.rig_map = value;
+    } else if (global_option(argc, argv, &i, "units", &value)) {
+      units_scale(value, "--units");
+      settings.units = value;
     } else if (a == "--verbose" || a == "-v") {
       settings.verbose = true;
     } else if (a == "--version") {
@@ -894,7 +1028,8 @@ int run(int argc, char** argv) {
     return command_single(command, args, settings);
   if (command == "renav") return command_renav(args, settings);
   if (command == "batch") return command_batch(args, settings);
-  if (command == "diff") return command_diff(args);
+  if (command == "diff") return command_diff(args, settings);
+  if (command == "rig") return command_rig(args, settings);
   throw InputError("unknown command '" + command + "' (see motionfield --help)");
 }
 

@@ -192,19 +192,28 @@ RigAnatomy estimate_anatomy(const Motion& motion, const RigParts& parts, const s
   std::vector<int> frames = frames_in;
   if (frames.empty())
     for (int f = 0; f < motion.num_frames(); ++f) frames.push_back(f);
+  if (frames.empty()) throw InputError("cannot measure the rig's anatomy of a motion without frames");
   for (int f : frames)
     if (f < 0 || f >= motion.num_frames()) throw InputError("estimate_anatomy: frame " + std::to_string(f) + " is out of range");
-  const GlobalPose g = forward_kinematics(motion);
+  // Only the listed frames are read (the others may be unknown).
+  Motion listed = Motion::identity(motion.skeleton, static_cast<int>(frames.size()), motion.fps);
+  for (size_t i = 0; i < frames.size(); ++i) {
+    listed.root_positions[i] = motion.root_positions[frames[i]];
+    for (int j = 0; j < motion.num_joints(); ++j) listed.rotation(static_cast<int>(i), j) = motion.rotation(frames[i], j);
+  }
+  std::vector<int> all(frames.size());
+  for (size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  const GlobalPose g = forward_kinematics(listed);
   RigAnatomy a;
-  a.frames = estimate_frames(motion, g, parts, frames, false);
-  a.toe_frames = estimate_frames(motion, g, parts, frames, true);
+  a.frames = estimate_frames(listed, g, parts, all, false);
+  a.toe_frames = estimate_frames(listed, g, parts, all, true);
   const int J = motion.num_joints();
   a.mean_local.assign(J, Quaterniond::Identity());
   for (int j = 0; j < J; ++j) {
     Eigen::Vector4d sum = Eigen::Vector4d::Zero();
-    const Quaterniond first = motion.rotation(frames.front(), j).normalized();
-    for (int f : frames) {
-      Quaterniond q = motion.rotation(f, j).normalized();
+    const Quaterniond first = listed.rotation(0, j).normalized();
+    for (int f : all) {
+      Quaterniond q = listed.rotation(f, j).normalized();
       if (q.dot(first) < 0) q.coeffs() = -q.coeffs();
       sum += q.coeffs();
     }
