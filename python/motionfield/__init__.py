@@ -18,6 +18,12 @@ Example::
     filled = mf.inbetween(walk, [0, 15, 30, 45, 60], method="interp")
     mf.resample(filled, 60.0).save_bvh("walk60.bvh")
 
+Any humanoid rig works with every task, in its own unit (detected from the leg
+length, or ``Motion.load_bvh(path, units="m")``) and frame rate: methods that
+need the model retarget it to the model's rig and back. ``describe_rig(motion,
+model)`` shows the map found; ``rig_map=`` (a dict, a JSON file or JSON text)
+on the tasks overrides it.
+
 The library is found through $MOTIONFIELD_LIBRARY, then next to this package,
 then a build tree of the source checkout, then the system's library path.
 Tasks release the GIL: several Python threads may run them at once on one
@@ -25,6 +31,8 @@ shared Model.
 """
 
 import ctypes
+import json
+import os
 from collections import namedtuple
 
 import numpy as np
@@ -38,7 +46,7 @@ __all__ = [
     "Method", "methods", "default_method", "default_model_path",
     "Model", "Motion", "CancelToken", "Progress", "Encoding",
     "inbetween", "fill", "resample", "resample_frame_count", "encode",
-    "renav", "load_path_csv",
+    "renav", "load_path_csv", "describe_rig",
 ]
 
 # ------------------------------------------------------------------ errors
@@ -139,6 +147,37 @@ def _bvh_options(length_scale):
     if length_scale is not None:
         o.length_scale = float(length_scale)
     return o
+
+
+def _units_scale(units, length_scale):
+    """Metres per file unit for reading: None or "auto" -> None (detected), a
+    unit name ("cm", "m", "mm", "in", "ft", "asf") or a number."""
+    if length_scale is not None:
+        if units is not None:
+            raise InvalidArgumentError("give units or length_scale, not both")
+        return length_scale
+    if units is None or units == "auto":
+        return None
+    if isinstance(units, str):
+        v = ctypes.c_double(0)
+        _check(_c.mf_length_unit_scale(units.encode(), ctypes.byref(v)))
+        return v.value
+    return float(units)
+
+
+def _rig_map_args(rig_map):
+    """(JSON text, file path) of a rig_map= argument: None, a dict {user joint:
+    model joint or None}, a path to a JSON file, or JSON text."""
+    if rig_map is None:
+        return None, None
+    if isinstance(rig_map, dict):
+        return json.dumps(rig_map), None
+    if isinstance(rig_map, str) and rig_map.lstrip().startswith("{"):
+        return rig_map, None
+    if isinstance(rig_map, (str, os.PathLike)):
+        return None, os.fspath(rig_map)
+    raise InvalidArgumentError("rig_map must be a dict, a JSON file's path or JSON text, not %s" %
+                               type(rig_map).__name__)
 
 
 # ------------------------------------------------------------------ library-wide
@@ -365,18 +404,21 @@ class Motion(_Handle):
         return cls._wrap(out)
 
     @classmethod
-    def load_bvh(cls, path, length_scale=None):
-        """Reads a BVH file; length_scale is metres per file unit (default 0.01: centimetres)."""
+    def load_bvh(cls, path, units=None, length_scale=None):
+        """Reads a BVH file. units: None or "auto" (detected from the leg
+        length; centimetres when no legs are found), "cm", "m", "mm", "in",
+        "ft", "asf" or metres per file unit (a number; length_scale= is the
+        same). The motion remembers it (length_scale) and writes in it."""
         out = ctypes.POINTER(_c.MfMotion)()
-        o = _bvh_options(length_scale)
+        o = _bvh_options(_units_scale(units, length_scale))
         _check(_c.mf_motion_load_bvh(str(path).encode(), ctypes.byref(o), ctypes.byref(out)))
         return cls._wrap(out)
 
     @classmethod
-    def from_bvh_text(cls, text, length_scale=None):
+    def from_bvh_text(cls, text, units=None, length_scale=None):
         data = text.encode() if isinstance(text, str) else bytes(text)
         out = ctypes.POINTER(_c.MfMotion)()
-        o = _bvh_options(length_scale)
+        o = _bvh_options(_units_scale(units, length_scale))
         _check(_c.mf_motion_load_bvh_from_memory(data, len(data), ctypes.byref(o), ctypes.byref(out)))
         return cls._wrap(out)
 
@@ -410,6 +452,12 @@ class Motion(_Handle):
     @property
     def fps(self):
         return self._f64(_c.mf_motion_get_fps)
+
+    @property
+    def length_scale(self):
+        """Metres per file unit the motion was read with (given or detected);
+        0.01 for motions from arrays. Task results keep their input's."""
+        return self._f64(_c.mf_motion_get_length_scale)
 
     @property
     def frame_time(self):
@@ -485,11 +533,14 @@ class _TaskCall:
     """The options struct of one task call, and its progress callback (kept
     alive for the call; exceptions it raises cancel the task and are re-raised)."""
 
-    def __init__(self, method, seed, progress, cancel):
+    def __init__(self, method, seed, progress, cancel, rig_map=None):
         self.options = _c.MfTaskOptions()
         _check(_c.mf_task_options_init(ctypes.byref(self.options)))
         self._method = method.encode() if method else None
         self.options.method = self._method
+        text, path = _rig_map_args(rig_map)
+        self._rig_map = (text.encode() if text else None, path.encode() if path else None)
+        self.options.rig_map, self.options.rig_map_path = self._rig_map
         self.options.seed = int(seed)
         self.error = None
         if progress is not None:
@@ -518,27 +569,30 @@ def _model_handle(model):
     return model._live() if model is not None else None
 
 
-def inbetween(motion, keyframes, method=None, model=None, seed=0, progress=None, cancel=None):
+def inbetween(motion, keyframes, method=None, model=None, seed=0, progress=None, cancel=None, rig_map=None):
     """Keyframe in-betweening: the frames in `keyframes` (0-based, strictly
     increasing, at least two) are kept, every other frame is produced.
 
     progress(Progress) is called now and then; returning True cancels (the
-    call then raises CancelledError). cancel: a CancelToken."""
+    call then raises CancelledError). cancel: a CancelToken. rig_map: for a
+    motion on another rig than the model's, a dict {user joint: model joint or
+    None}, a JSON file's path or JSON text overriding the automatic map (see
+    describe_rig)."""
     keys = np.ascontiguousarray(keyframes, dtype=np.int32).reshape(-1)
-    call = _TaskCall(method, seed, progress, cancel)
+    call = _TaskCall(method, seed, progress, cancel, rig_map)
     return call.run(_c.mf_inbetween, _model_handle(model), motion._live(),
                     keys.ctypes.data_as(ctypes.POINTER(ctypes.c_int32)), keys.size)
 
 
-def fill(motion, gap_begin, gap_end, method=None, model=None, seed=0, progress=None, cancel=None):
+def fill(motion, gap_begin, gap_end, method=None, model=None, seed=0, progress=None, cancel=None, rig_map=None):
     """Gap filling: frames gap_begin..gap_end-1 are produced, the others kept."""
-    call = _TaskCall(method, seed, progress, cancel)
+    call = _TaskCall(method, seed, progress, cancel, rig_map)
     return call.run(_c.mf_fill, _model_handle(model), motion._live(), int(gap_begin), int(gap_end))
 
 
-def resample(motion, fps, method=None, model=None, seed=0, progress=None, cancel=None):
+def resample(motion, fps, method=None, model=None, seed=0, progress=None, cancel=None, rig_map=None):
     """Resampling to `fps`, keeping the time span (see resample_frame_count)."""
-    call = _TaskCall(method, seed, progress, cancel)
+    call = _TaskCall(method, seed, progress, cancel, rig_map)
     return call.run(_c.mf_resample, _model_handle(model), motion._live(), float(fps))
 
 
@@ -564,10 +618,10 @@ def load_path_csv(path):
 
 
 def renav(reference, path, model, method=None, polyline=False, frames=0, fps=0.0, seed=0, progress=None,
-          cancel=None):
-    """Re-navigation: a motion in the style of `reference` (on the model's
-    skeleton) whose root follows `path`, an array [points, 2] of ground (x, z)
-    positions in metres. By default one point per output frame at `fps` (0:
+          cancel=None, rig_map=None):
+    """Re-navigation: a motion in the style of `reference` (on any humanoid
+    rig; rig_map as in inbetween()) whose root follows `path`, an array
+    [points, 2] of ground (x, z) positions in metres. By default one point per output frame at `fps` (0:
     the reference's frame rate); with polyline=True the points are the
     vertices of a polyline walked at constant speed, in `frames` frames (0:
     at the reference's mean ground speed). method: "nemf" (L-BFGS, the
@@ -580,9 +634,29 @@ def renav(reference, path, model, method=None, polyline=False, frames=0, fps=0.0
     o.path_kind = _c.PATH_POLYLINE if polyline else _c.PATH_PER_FRAME
     o.frame_count = int(frames)
     o.fps = float(fps)
-    call = _TaskCall(method, seed, progress, cancel)
+    call = _TaskCall(method, seed, progress, cancel, rig_map)
     return call.run(lambda *args: _c.mf_renav(*args[:4], ctypes.byref(o), *args[4:]), _model_handle(model),
                     reference._live(), _f32_ptr(xz), xz.shape[0])
+
+
+def describe_rig(motion, model, rig_map=None):
+    """How `motion`'s rig is read and mapped onto `model`'s, as a dict:
+    {"unit", "length_scale", "unit_detected", "joints", "map": {user joint:
+    model joint}, "how": {model joint: "name" | "shape" | "map file"},
+    "unmapped_user_joints", "model_joints", "retargeting"} (mf_rig_describe).
+    rig_map as in inbetween(). Raises InvalidArgumentError with the reason
+    when the rig cannot be mapped."""
+    text, path = _rig_map_args(rig_map)
+    if path is not None:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    try:
+        out = _read_string(_c.mf_rig_describe, model._live(), motion._live(), text.encode() if text else None)
+    except InvalidArgumentError as e:
+        if path is None:
+            raise
+        raise InvalidArgumentError("%s: %s" % (path, e), e.status) from None
+    return json.loads(out)
 
 
 # ------------------------------------------------------------------ encode, decode

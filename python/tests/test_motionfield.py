@@ -7,6 +7,7 @@ The model tests need a model file: $MF_TEST_MODEL (CTest writes a tiny random
 one with mf_capi_tiny_model); they are skipped without it.
 """
 
+import json
 import os
 import sys
 import tempfile
@@ -277,6 +278,97 @@ class ModelTest(unittest.TestCase):
         m = mf.Motion.from_arrays(random_rotations(20, J, 4), np.zeros((20, 3), np.float32), 30.0, model=model)
         with self.assertRaisesRegex(mf.ModelError, "motionfield-citl.mfm"):
             mf.inbetween(m, [0, 19], method="citl", model=model)
+
+
+
+DEFAULT_MODEL = os.path.join(SOURCE, "models", "motionfield-prior.mfm")
+
+
+def mixamo_sample_text():
+    """The sample with Mixamo's joint names (everything else unchanged)."""
+    with open(SAMPLE) as f:
+        text = f.read()
+    names = {"Hips": "Hips", "Spine": "Spine", "Chest": "Spine2", "Neck": "Neck", "Head": "Head"}
+    for side, word in (("L", "Left"), ("R", "Right")):
+        for ours, theirs in (("Shoulder", "Shoulder"), ("UpperArm", "Arm"), ("LowerArm", "ForeArm"), ("Hand", "Hand"),
+                             ("UpperLeg", "UpLeg"), ("LowerLeg", "Leg"), ("Foot", "Foot"), ("Toes", "ToeBase")):
+            names["%s_%s" % (ours, side)] = word + theirs
+    for ours, theirs in names.items():
+        text = text.replace("JOINT %s\n" % ours, "JOINT mixamorig:%s\n" % theirs)
+    return text
+
+
+class UnitsTest(unittest.TestCase):
+    def test_units_are_detected_or_given(self):
+        cm = mf.Motion.load_bvh(SAMPLE)
+        self.assertEqual(cm.length_scale, 0.01)
+        metres = mf.Motion.from_bvh_text(cm.to_bvh_text(length_scale=1.0))
+        self.assertEqual(metres.length_scale, 1.0)
+        np.testing.assert_allclose(metres.global_positions, cm.global_positions, atol=1e-5)
+        self.assertIn("OFFSET 0.14 0 0", metres.to_bvh_text())  # written back in metres
+        self.assertEqual(mf.Motion.load_bvh(SAMPLE, units="in").length_scale, 0.0254)
+        self.assertEqual(mf.Motion.load_bvh(SAMPLE, units=0.02).length_scale, 0.02)
+        self.assertEqual(mf.Motion.load_bvh(SAMPLE, units="auto").length_scale, 0.01)
+        self.assertEqual(mf.Motion.load_bvh(SAMPLE, length_scale=0.01).length_scale, 0.01)
+        with self.assertRaisesRegex(mf.InvalidArgumentError, "unknown length unit 'furlong'"):
+            mf.Motion.load_bvh(SAMPLE, units="furlong")
+        with self.assertRaises(mf.InvalidArgumentError):
+            mf.Motion.load_bvh(SAMPLE, units="m", length_scale=1.0)
+
+
+@unittest.skipUnless(os.path.exists(DEFAULT_MODEL), "no bundled model")
+class OtherRigTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.model = mf.Model(DEFAULT_MODEL)
+        cls.method = "detail" if cls.model.has_inbetweener("twostage") else "nemf"
+        cm = mf.Motion.from_bvh_text(mixamo_sample_text())
+        cls.user = mf.Motion.from_bvh_text(cm.to_bvh_text(length_scale=1.0))  # in metres
+
+    def test_describe_rig(self):
+        d = mf.describe_rig(self.user, self.model)
+        self.assertEqual(d["unit"], "m")
+        self.assertTrue(d["unit_detected"])
+        self.assertEqual(d["joints"], 21)
+        self.assertEqual(d["map"]["mixamorig:LeftForeArm"], "LowerArm_L")
+        self.assertEqual(d["how"]["LowerArm_L"], "name")
+        self.assertEqual(d["unmapped_user_joints"], [])
+        self.assertEqual(d["model_joints"], self.model.joint_names)
+        self.assertTrue(d["retargeting"])
+        given = mf.describe_rig(self.user, self.model, rig_map={"mixamorig:Spine2": "Chest"})
+        self.assertEqual(given["how"]["Chest"], "map file")
+        with self.assertRaisesRegex(mf.InvalidArgumentError, "rig map: not valid JSON"):
+            mf.describe_rig(self.user, self.model, rig_map="{oops")
+
+    def test_tasks_on_another_rig(self):
+        keys = [0, 20, 40, 60]
+        out = mf.inbetween(self.user, keys, method=self.method, model=self.model)
+        self.assertEqual(out.joint_names, self.user.joint_names)
+        self.assertEqual(out.length_scale, 1.0)
+        self.assertTrue(np.isfinite(out.rotations).all())
+        np.testing.assert_array_equal(out.rotations[keys], self.user.rotations[keys])
+        np.testing.assert_array_equal(out.root_positions[keys], self.user.root_positions[keys])
+        # The three forms of rig_map= give the same result.
+        mapping = {"mixamorig:Spine2": "Chest"}
+        by_dict = mf.fill(self.user, 10, 30, method=self.method, model=self.model, rig_map=mapping)
+        by_text = mf.fill(self.user, 10, 30, method=self.method, model=self.model, rig_map=json.dumps(mapping))
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "map.json")
+            with open(path, "w") as f:
+                json.dump(mapping, f)
+            by_file = mf.fill(self.user, 10, 30, method=self.method, model=self.model, rig_map=path)
+            with open(path, "w") as f:
+                json.dump({"mixamorig:Hips": "NoSuchJoint"}, f)
+            with self.assertRaisesRegex(mf.InvalidArgumentError, "map.json: rig map: the model has no joint"):
+                mf.fill(self.user, 10, 30, method=self.method, model=self.model, rig_map=path)
+            with self.assertRaises(mf.FileError):
+                mf.fill(self.user, 10, 30, method=self.method, model=self.model, rig_map=os.path.join(d, "none.json"))
+        np.testing.assert_array_equal(by_dict.rotations, by_text.rotations)
+        np.testing.assert_array_equal(by_dict.rotations, by_file.rotations)
+        resampled = mf.resample(self.user, 60.0, method="prior", model=self.model, rig_map=mapping)
+        self.assertEqual(resampled.frame_count, 121)
+        self.assertEqual(resampled.joint_names, self.user.joint_names)
+
 
 if __name__ == "__main__":
     unittest.main()
