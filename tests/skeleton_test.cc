@@ -84,6 +84,10 @@ TEST(SkeletonTest, SameAs) {
   b.offsets[1].y() = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(a.same_as(b));
   EXPECT_FALSE(a.same_as(chain()));
+  // The root's offset (its rest position) is not part of the rig.
+  b = a;
+  b.offsets[0] = Eigen::Vector3d(0.3, 0.9, -4.5);
+  EXPECT_TRUE(a.same_as(b, 0.0));
 }
 
 TEST(MotionTest, Identity) {

@@ -33,7 +33,7 @@ void Skeleton::validate() const {
 
 bool Skeleton::same_as(const Skeleton& other, double tolerance) const {
   if (names != other.names || parents != other.parents || offsets.size() != other.offsets.size()) return false;
-  for (size_t j = 0; j < offsets.size(); ++j)
+  for (size_t j = 1; j < offsets.size(); ++j)
     for (int k = 0; k < 3; ++k)  // written so that NaN compares unequal
       if (!(std::abs(offsets[j][k] - other.offsets[j][k]) <= tolerance)) return false;
   return true;

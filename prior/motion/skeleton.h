@@ -33,7 +33,10 @@ struct Skeleton {
   void validate() const;
 
   /// True if both skeletons have the same joint names and parents in the same
-  /// order and offsets equal within `tolerance` metres.
+  /// order and offsets equal within `tolerance` metres. The root's offset (its
+  /// rest position, unused by forward kinematics: motions carry their own root
+  /// positions) is not compared, so clips of one rig recorded at different
+  /// places are on the same skeleton.
   bool same_as(const Skeleton& other, double tolerance = 1e-4) const;
 
   /// Children of every joint, in index order.
