@@ -1,7 +1,7 @@
-// Constraints and energies of the latent solvers: what the animator asks for
-// (pose keys, partial keys, end-effector targets), its canonical form for one
-// window of the prior, and the differentiable energy terms the solvers minimise
-// over the latent codes (z_l, z_g) with the network frozen.
+// Energies of the latent solvers: the constraints (tasks/motion_constraints.h)
+// in their canonical form for one window of the prior, and the differentiable
+// energy terms the solvers minimise over the latent codes (z_l, z_g) with the
+// network frozen.
 //
 // Frames and coordinates. A MotionConstraints refers to frames of a Motion and
 // to world coordinates (metres, Y up; prior/motion/skeleton.h). A WindowProblem
@@ -53,53 +53,11 @@
 
 #include "prior/model/representation.h"
 #include "prior/motion/motion.h"
+#include "tasks/motion_constraints.h"
 
 namespace mf {
 
 class NemfModel;
-
-/// A pose constraint at one frame: the local rotations of `joints` (joint 0's
-/// is the root's world rotation) and, if `root_position`, the root's world
-/// position, as the input motion holds them at that frame. Nothing else of the
-/// frame is read.
-struct PoseKey {
-  int frame = 0;
-  std::vector<int> joints;     ///< constrained joints, increasing; empty means every joint
-  bool root_position = true;   ///< the root translation is constrained too
-};
-
-/// An end-effector target: the world position (metres) of `joint` at `frame`,
-/// without a pose. Not enforced exactly (that would need IK): the solver pulls
-/// toward it with the effector weight times `weight`.
-struct EffectorTarget {
-  int frame = 0;
-  int joint = 0;
-  Eigen::Vector3d position = Eigen::Vector3d::Zero();
-  double weight = 1.0;
-};
-
-/// Everything known about a motion to complete.
-struct MotionConstraints {
-  std::vector<PoseKey> keys;              ///< strictly increasing frames
-  std::vector<EffectorTarget> effectors;  ///< any order, any frames in range
-
-  /// Full-pose keys (every joint and the root position) at `frames`.
-  static MotionConstraints full_pose(const std::vector<int>& frames);
-
-  /// Throws mf::InputError unless: keys are in range and strictly increasing,
-  /// key joints are in range, increasing and unique, effector frames and joints
-  /// are in range with finite positions and non-negative finite weights, and at
-  /// least one key fixes the root (rotation of joint 0 and root position), which
-  /// the canonical frame needs.
-  void validate(int frames, int joints) const;
-
-  /// True when key `k` constrains `joint`'s rotation.
-  bool key_has_joint(size_t k, int joint) const;
-  /// True when key `k` gives the root's rotation and position (it can anchor a window).
-  bool key_fixes_root(size_t k) const;
-  /// Constraints of frames [begin, begin + length), renumbered from 0.
-  MotionConstraints slice(int begin, int length) const;
-};
 
 /// The constraints of one window in its canonical frame, as tensors (float).
 struct WindowProblem {

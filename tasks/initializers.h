@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "prior/motion/motion.h"
-#include "tasks/energies.h"
-#include "tasks/method.h"
+#include "tasks/motion_constraints.h"
+#include "tasks/task_context.h"
 
 namespace mf {
 

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "tasks/method.h"
+#include "tasks/task_context.h"
 
 namespace mf {
 

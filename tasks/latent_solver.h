@@ -68,7 +68,7 @@
 #include "prior/motion/motion.h"
 #include "tasks/energies.h"
 #include "tasks/initializers.h"
-#include "tasks/method.h"
+#include "tasks/task_context.h"
 
 namespace mf {
 

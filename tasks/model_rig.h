@@ -15,7 +15,7 @@
 
 #include "prior/motion/motion.h"
 #include "prior/rig/retarget.h"
-#include "tasks/method.h"
+#include "tasks/task_context.h"
 
 namespace mf {
 

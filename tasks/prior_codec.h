@@ -71,7 +71,7 @@
 
 #include "prior/model/representation.h"
 #include "prior/motion/motion.h"
-#include "tasks/method.h"
+#include "tasks/task_context.h"
 
 namespace mf {
 

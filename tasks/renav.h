@@ -92,7 +92,7 @@
 
 #include "prior/model/representation.h"
 #include "prior/motion/motion.h"
-#include "tasks/method.h"
+#include "tasks/task_context.h"
 #include "tasks/soft_dtw.h"
 
 namespace mf {

@@ -44,7 +44,7 @@
 #include <vector>
 
 #include "prior/motion/motion.h"
-#include "tasks/energies.h"
+#include "tasks/motion_constraints.h"
 #include "tasks/method.h"
 
 namespace mf {

@@ -1,0 +1,57 @@
+// What the animator asks of a motion to complete: pose keys (full or
+// partial: some joints' rotations, with or without the root position) and
+// end-effector targets, in the frames and world coordinates of a Motion
+// (metres, Y up; prior/motion/skeleton.h).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstddef>
+#include <vector>
+
+namespace mf {
+
+/// A pose constraint at one frame: the local rotations of `joints` (joint 0's
+/// is the root's world rotation) and, if `root_position`, the root's world
+/// position, as the input motion holds them at that frame. Nothing else of the
+/// frame is read.
+struct PoseKey {
+  int frame = 0;
+  std::vector<int> joints;     ///< constrained joints, increasing; empty means every joint
+  bool root_position = true;   ///< the root translation is constrained too
+};
+
+/// An end-effector target: the world position (metres) of `joint` at `frame`,
+/// without a pose. The solver's energy pulls toward it with the effector
+/// weight times `weight`; complete_motion() then places the joint by IK
+/// (tasks/latent_solver.h).
+struct EffectorTarget {
+  int frame = 0;
+  int joint = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  double weight = 1.0;
+};
+
+/// Everything known about a motion to complete.
+struct MotionConstraints {
+  std::vector<PoseKey> keys;              ///< strictly increasing frames
+  std::vector<EffectorTarget> effectors;  ///< any order, any frames in range
+
+  /// Full-pose keys (every joint and the root position) at `frames`.
+  static MotionConstraints full_pose(const std::vector<int>& frames);
+
+  /// Throws mf::InputError unless: keys are in range and strictly increasing,
+  /// key joints are in range, increasing and unique, effector frames and joints
+  /// are in range with finite positions and non-negative finite weights, and at
+  /// least one key fixes the root (rotation of joint 0 and root position), which
+  /// the canonical frame needs.
+  void validate(int frames, int joints) const;
+
+  /// True when key `k` constrains `joint`'s rotation.
+  bool key_has_joint(size_t k, int joint) const;
+  /// True when key `k` gives the root's rotation and position (it can anchor a window).
+  bool key_fixes_root(size_t k) const;
+  /// Constraints of frames [begin, begin + length), renumbered from 0.
+  MotionConstraints slice(int begin, int length) const;
+};
+
+}  // namespace mf
