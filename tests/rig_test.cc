@@ -120,6 +120,61 @@ TEST(RigMap, MapFileOverridesAndErrors) {
             std::string::npos);
 }
 
+// A skeleton from a list of (name, parent name) with unit bones along -Y.
+Skeleton named_skeleton(const std::vector<std::pair<std::string, std::string>>& joints) {
+  Skeleton s;
+  for (const auto& [name, parent] : joints) {
+    s.names.push_back(name);
+    s.parents.push_back(parent.empty() ? -1 : s.find(parent));
+    s.offsets.emplace_back(0, parent.empty() ? 0.0 : -0.1, 0);
+  }
+  s.validate();
+  return s;
+}
+
+TEST(RigMap, CmuAndUnrealLayouts) {
+  // cgspeed's CMU conversion: hip joints between the hips and the thighs, two necks, fingers.
+  std::vector<std::pair<std::string, std::string>> cmu = {
+      {"Hips", ""}, {"LHipJoint", "Hips"}, {"LeftUpLeg", "LHipJoint"}, {"LeftLeg", "LeftUpLeg"},
+      {"LeftFoot", "LeftLeg"}, {"LeftToeBase", "LeftFoot"}, {"RHipJoint", "Hips"}, {"RightUpLeg", "RHipJoint"},
+      {"RightLeg", "RightUpLeg"}, {"RightFoot", "RightLeg"}, {"RightToeBase", "RightFoot"}, {"LowerBack", "Hips"},
+      {"Spine", "LowerBack"}, {"Spine1", "Spine"}, {"Neck", "Spine1"}, {"Neck1", "Neck"}, {"Head", "Neck1"},
+      {"LeftShoulder", "Spine1"}, {"LeftArm", "LeftShoulder"}, {"LeftForeArm", "LeftArm"}, {"LeftHand", "LeftForeArm"},
+      {"LeftFingerBase", "LeftHand"}, {"LeftHandIndex1", "LeftFingerBase"}, {"LThumb", "LeftHand"},
+      {"RightShoulder", "Spine1"}, {"RightArm", "RightShoulder"}, {"RightForeArm", "RightArm"},
+      {"RightHand", "RightForeArm"}, {"RightFingerBase", "RightHand"}, {"RThumb", "RightHand"}};
+  const Skeleton c = named_skeleton(cmu);
+  const RigParts p = find_rig_parts(c);
+  EXPECT_TRUE(p.missing().empty());
+  EXPECT_EQ(c.names[p.hips], "Hips");
+  EXPECT_EQ(c.names[p.legs[0].thigh], "LeftUpLeg");
+  EXPECT_EQ(c.names[p.legs[1].toe], "RightToeBase");
+  EXPECT_EQ(c.names[p.chest], "Spine1");
+  EXPECT_EQ(c.names[p.neck], "Neck");
+  EXPECT_EQ(c.names[p.arms[0].hand], "LeftHand");
+  EXPECT_EQ(c.names[p.arms[1].shoulder], "RightShoulder");
+  // The Unreal mannequin: a root with IK helpers beside the pelvis, twist bones.
+  std::vector<std::pair<std::string, std::string>> ue = {{"root", ""}, {"pelvis", "root"}, {"spine_01", "pelvis"},
+      {"spine_02", "spine_01"}, {"spine_03", "spine_02"}, {"clavicle_l", "spine_03"}, {"upperarm_l", "clavicle_l"},
+      {"lowerarm_l", "upperarm_l"}, {"hand_l", "lowerarm_l"}, {"index_01_l", "hand_l"}, {"lowerarm_twist_01_l", "lowerarm_l"},
+      {"clavicle_r", "spine_03"}, {"upperarm_r", "clavicle_r"}, {"lowerarm_r", "upperarm_r"}, {"hand_r", "lowerarm_r"},
+      {"neck_01", "spine_03"}, {"head", "neck_01"}, {"thigh_l", "pelvis"}, {"calf_l", "thigh_l"}, {"foot_l", "calf_l"},
+      {"ball_l", "foot_l"}, {"thigh_twist_01_l", "thigh_l"}, {"thigh_r", "pelvis"}, {"calf_r", "thigh_r"},
+      {"foot_r", "calf_r"}, {"ball_r", "foot_r"}, {"ik_foot_root", "root"}, {"ik_foot_l", "ik_foot_root"},
+      {"ik_hand_root", "root"}, {"ik_hand_gun", "ik_hand_root"}, {"ik_hand_l", "ik_hand_gun"}};
+  const Skeleton u = named_skeleton(ue);
+  const RigParts q = find_rig_parts(u);
+  EXPECT_TRUE(q.missing().empty());
+  EXPECT_EQ(u.names[q.hips], "pelvis");
+  EXPECT_EQ(u.names[q.chest], "spine_03");
+  ASSERT_EQ(q.spine.size(), 2u);
+  EXPECT_EQ(u.names[q.legs[0].foot], "foot_l");
+  EXPECT_EQ(u.names[q.arms[0].fore], "lowerarm_l");
+  EXPECT_EQ(u.names[q.arms[1].hand], "hand_r");
+  // SMPL's FBX names carry an "m_avg_" prefix.
+  EXPECT_EQ(name_side("m_avg_L_Hip"), 0);
+}
+
 TEST(RigMap, UnmappableRigListsWhatWasFound) {
   Skeleton s;
   s.names = {"a", "b"};

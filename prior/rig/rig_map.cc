@@ -44,7 +44,7 @@ std::vector<std::string> name_words(const std::string& raw) {
   flush();
   // Rig-tool prefixes that carry no meaning.
   static const std::set<std::string> noise = {"mixamorig", "bip", "def", "org", "mch", "jnt", "bn", "b", "j", "ctrl",
-                                              "sk", "joint"};
+                                              "sk", "m", "f", "avg"};
   std::vector<std::string> kept;
   for (const std::string& w : words)
     if (!noise.count(w)) kept.push_back(w);
@@ -86,10 +86,14 @@ Kind classify(const std::string& name, int* side) {
   *side = split_side(name, &w);
   std::string core;
   for (const std::string& s : w) core += s;
+  if (core.find("hipjoint") != std::string::npos) return Kind::Helper;  // CMU's LHipJoint: hips to thigh
+  w.erase(std::remove(w.begin(), w.end(), "joint"), w.end());
+  core.clear();
+  for (const std::string& s : w) core += s;
   for (const char* h : {"twist", "roll", "helper", "ik", "pole", "nub", "end", "dummy", "share", "bend", "corrective",
-                        "tip", "top", "prop", "weapon", "breast", "pelvisl", "hipjoint"})
+                        "tip", "top", "prop", "weapon", "breast"})
     if (has(w, h) || core == h) return Kind::Helper;
-  if (core.find("hipjoint") != std::string::npos || core.find("twist") != std::string::npos) return Kind::Helper;
+  if (core.find("twist") != std::string::npos) return Kind::Helper;
   for (const char* f : {"thumb", "index", "middle", "ring", "pinky", "little", "finger", "fingers", "carpal", "palm"})
     if (core.find(f) != std::string::npos) return Kind::Finger;
   const bool sided = *side >= 0;
