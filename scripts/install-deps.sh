@@ -10,6 +10,8 @@ packages=(
   libeigen3-dev
   libgtest-dev
   nlohmann-json3-dev    # JSON: rig map and rig anatomy files
+  libcli11-dev          # CLI11 (header-only): argument parsing of the trainer, the benchmarks and the tools
+  libarchive-dev        # libarchive: reads the training archives (.tar, .tar.xz, .tar.gz) without spawning tar
   libopenblas0-pthread  # BLAS for libtorch and Eigen: ~3x faster than ATLAS here (docs/BLAS.md)
   python3 python3-numpy # the Python binding's tests
 )

@@ -290,6 +290,54 @@ TEST(DatasetLoad, ArchivesGiveTheSameClipsAsTheFolder) {
   }
 }
 
+// Archives are read with libarchive (prior/data/tar_archive.h): only regular
+// files are extracted, and an entry that would land outside the extraction
+// folder (a ".." component, an absolute path) fails the load before anything of
+// it is written, leaving no extraction behind.
+TEST(DatasetLoad, ArchivesExtractRegularFilesAndRefuseUnsafePaths) {
+  const fs::path root = test::scratch_dir("dataset_archive_entries");
+  const Skeleton skel = test::small_skeleton();
+  write_clip(root / "src" / "clips" / "ok.bvh", test::random_motion(skel, 20, 30.0, 1));
+  write_clip(root / "src" / "evil.bvh", test::random_motion(skel, 20, 30.0, 2));
+  fs::create_symlink("ok.bvh", root / "src" / "clips" / "link.bvh");
+  auto make_tar = [&](const std::string& name, const std::string& members) {
+    // -P keeps "../" and "/" in member names, as a hostile archive would hold them.
+    const std::string cmd = "tar -cPf '" + (root / name).string() + "' -C '" + (root / "src" / "clips").string() +
+                            "' " + members + " 2>/dev/null";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    return (root / name).string();
+  };
+  DatasetOptions o;
+  o.cache_dir = (root / "cache").string();
+  o.use_cache = false;
+
+  o.source = make_tar("good.tar", ".");
+  const Dataset good = load_dataset(o);
+  EXPECT_EQ(names_of(good.train).size() + names_of(good.validation).size(), 1u);
+  const auto extracted = files_matching(root / "cache", "extract-");
+  ASSERT_EQ(extracted.size(), 1u);
+  EXPECT_TRUE(fs::is_regular_file(extracted[0] / "ok.bvh"));
+  EXPECT_FALSE(fs::exists(fs::symlink_status(extracted[0] / "link.bvh")));
+
+  const std::vector<std::pair<std::string, std::string>> unsafe = {
+      {"dotdot.tar", "ok.bvh ../evil.bvh"}, {"absolute.tar", "ok.bvh '" + (root / "src" / "evil.bvh").string() + "'"}};
+  for (const auto& [name, members] : unsafe) {
+    SCOPED_TRACE(name);
+    o.source = make_tar(name, members);
+    o.cache_dir = (root / ("cache-" + name)).string();
+    try {
+      load_dataset(o);
+      ADD_FAILURE() << "expected InputError";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("evil.bvh"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("cannot extract"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(files_matching(o.cache_dir, "extract-").empty());
+    EXPECT_FALSE(has_temp_files(o.cache_dir));
+    EXPECT_FALSE(fs::exists(fs::path(o.cache_dir) / "evil.bvh"));
+  }
+}
+
 TEST(DatasetLoad, StaleTemporariesOfDeadProcessesAreRemoved) {
   const fs::path root = test::scratch_dir("dataset_stale_temps");
   write_corpus(root / "src");

@@ -1,10 +1,7 @@
 #include "prior/data/dataset.h"
 
-#include <fcntl.h>
-#include <spawn.h>
 #include <signal.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -27,9 +24,8 @@
 #include <system_error>
 #include <thread>
 
+#include "prior/data/tar_archive.h"
 #include "prior/motion/errors.h"
-
-extern char** environ;
 
 #ifndef MF_DEFAULT_TRAIN_ARCHIVE
 #define MF_DEFAULT_TRAIN_ARCHIVE ""
@@ -246,21 +242,25 @@ void write_clips_file(const std::string& path, const std::vector<Clip>& clips, c
   }
 }
 
-std::vector<Clip> read_clips_file(const std::string& path, std::vector<std::string>* skipped_out) {
+// The whole file in memory. Not a std::string: zero-filling a few hundred
+// megabytes first costs time.
+std::unique_ptr<char[]> read_whole_file(const std::string& path, size_t* size) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path + ": cannot open clips file");
   in.seekg(0, std::ios::end);
   const std::streamoff file_size = in.tellg();
   in.seekg(0);
   if (file_size < 0) throw InputError(path + ": cannot read clips file");
-  // Not a std::string: zero-filling a few hundred megabytes first costs time.
-  const size_t data_size = static_cast<size_t>(file_size);
-  std::unique_ptr<char[]> buffer(new (std::nothrow) char[std::max<size_t>(data_size, 1)]);
-  if (!buffer) throw InputError(path + ": clips file too large to load (" + std::to_string(data_size) + " bytes)");
+  *size = static_cast<size_t>(file_size);
+  std::unique_ptr<char[]> buffer(new (std::nothrow) char[std::max<size_t>(*size, 1)]);
+  if (!buffer) throw InputError(path + ": clips file too large to load (" + std::to_string(*size) + " bytes)");
   in.read(buffer.get(), file_size);
   if (in.gcount() != file_size) throw InputError(path + ": cannot read clips file");
-  const std::string_view data(buffer.get(), data_size);
+  return buffer;
+}
 
+// Checks the header (magic, version, byte order, size, checksum); returns the payload.
+std::string_view checked_payload(std::string_view data, const std::string& path) {
   if (data.size() < 8 || std::memcmp(data.data(), kClipsMagic, 8) != 0)
     throw InputError(path + ": not a motionfield clips file");
   if (data.size() < kHeaderBytes) throw InputError(path + ": truncated clips file");
@@ -281,54 +281,64 @@ std::vector<Clip> read_clips_file(const std::string& path, std::vector<std::stri
   Checksum check;
   check.update(data.data() + kHeaderBytes, actual);
   if (check.h != sum) throw InputError(path + ": corrupted clips file (checksum mismatch)");
+  return data.substr(kHeaderBytes);
+}
 
-  PayloadReader r(data.data() + kHeaderBytes, actual, path);
+Clip read_clip(PayloadReader& r, uint64_t index) {
+  Clip clip;
+  clip.name = r.str();
+  Motion& m = clip.motion;
+  m.fps = r.pod<double>();
+  const uint32_t J = r.pod<uint32_t>(), F = r.pod<uint32_t>();
+  if (J < 1 || J > static_cast<uint32_t>(kBvhMaxJoints) || F < 1 || F > static_cast<uint64_t>(kBvhMaxFrames))
+    r.fail("corrupted clips file (clip " + std::to_string(index) + ": " + std::to_string(J) + " joints, " +
+           std::to_string(F) + " frames)");
+  m.skeleton.names.resize(J);
+  m.skeleton.parents.resize(J);
+  m.skeleton.offsets.resize(J);
+  for (uint32_t j = 0; j < J; ++j) {
+    m.skeleton.names[j] = r.str();
+    m.skeleton.parents[j] = r.pod<int32_t>();
+    double off[3];
+    r.bytes(off, sizeof off);
+    m.skeleton.offsets[j] = Eigen::Vector3d(off[0], off[1], off[2]);
+  }
+  const uint64_t nq = static_cast<uint64_t>(J) * F;
+  r.need(nq * 4 * sizeof(double) + static_cast<uint64_t>(F) * 3 * sizeof(double));
+  const char* q = r.take(static_cast<size_t>(nq * 4 * sizeof(double)));
+  m.rotations.resize(static_cast<size_t>(nq));
+  for (size_t i = 0; i < nq; ++i) {
+    double v[4];
+    std::memcpy(v, q + 32 * i, 32);
+    m.rotations[i] = Eigen::Quaterniond(v[0], v[1], v[2], v[3]);
+  }
+  const char* p = r.take(static_cast<size_t>(F) * 3 * sizeof(double));
+  m.root_positions.resize(F);
+  for (uint32_t f = 0; f < F; ++f) {
+    double v[3];
+    std::memcpy(v, p + 24 * static_cast<size_t>(f), 24);
+    m.root_positions[f] = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  try {
+    m.skeleton.validate();
+    m.validate();
+  } catch (const InputError& e) {
+    r.fail("corrupted clips file (clip " + clip.name + ": " + e.what() + ")");
+  }
+  return clip;
+}
+
+std::vector<Clip> read_clips_file(const std::string& path, std::vector<std::string>* skipped_out) {
+  size_t size = 0;
+  const std::unique_ptr<char[]> buffer = read_whole_file(path, &size);
+  const std::string_view payload = checked_payload(std::string_view(buffer.get(), size), path);
+  PayloadReader r(payload.data(), payload.size(), path);
   const uint64_t num_clips = r.pod<uint64_t>();
   // Every clip takes at least its name length, fps and two counts.
   if (num_clips > r.remaining() / 24) r.fail("corrupted clips file (clip count " + std::to_string(num_clips) + ")");
-  std::vector<Clip> clips(static_cast<size_t>(num_clips));
-  for (uint64_t c = 0; c < num_clips; ++c) {
-    Clip& clip = clips[c];
-    clip.name = r.str();
-    Motion& m = clip.motion;
-    m.fps = r.pod<double>();
-    const uint32_t J = r.pod<uint32_t>(), F = r.pod<uint32_t>();
-    if (J < 1 || J > static_cast<uint32_t>(kBvhMaxJoints) || F < 1 || F > static_cast<uint64_t>(kBvhMaxFrames))
-      r.fail("corrupted clips file (clip " + std::to_string(c) + ": " + std::to_string(J) + " joints, " +
-             std::to_string(F) + " frames)");
-    m.skeleton.names.resize(J);
-    m.skeleton.parents.resize(J);
-    m.skeleton.offsets.resize(J);
-    for (uint32_t j = 0; j < J; ++j) {
-      m.skeleton.names[j] = r.str();
-      m.skeleton.parents[j] = r.pod<int32_t>();
-      double off[3];
-      r.bytes(off, sizeof off);
-      m.skeleton.offsets[j] = Eigen::Vector3d(off[0], off[1], off[2]);
-    }
-    const uint64_t nq = static_cast<uint64_t>(J) * F;
-    r.need(nq * 4 * sizeof(double) + static_cast<uint64_t>(F) * 3 * sizeof(double));
-    const char* q = r.take(static_cast<size_t>(nq * 4 * sizeof(double)));
-    m.rotations.resize(static_cast<size_t>(nq));
-    for (size_t i = 0; i < nq; ++i) {
-      double v[4];
-      std::memcpy(v, q + 32 * i, 32);
-      m.rotations[i] = Eigen::Quaterniond(v[0], v[1], v[2], v[3]);
-    }
-    const char* p = r.take(static_cast<size_t>(F) * 3 * sizeof(double));
-    m.root_positions.resize(F);
-    for (uint32_t f = 0; f < F; ++f) {
-      double v[3];
-      std::memcpy(v, p + 24 * static_cast<size_t>(f), 24);
-      m.root_positions[f] = Eigen::Vector3d(v[0], v[1], v[2]);
-    }
-    try {
-      m.skeleton.validate();
-      m.validate();
-    } catch (const InputError& e) {
-      r.fail("corrupted clips file (clip " + clip.name + ": " + e.what() + ")");
-    }
-  }
+  std::vector<Clip> clips;
+  clips.reserve(static_cast<size_t>(num_clips));
+  for (uint64_t c = 0; c < num_clips; ++c) clips.push_back(read_clip(r, c));
   const uint64_t num_skipped = r.pod<uint64_t>();
   if (num_skipped > r.remaining() / 8) r.fail("corrupted clips file (skipped count)");
   std::vector<std::string> skipped(static_cast<size_t>(num_skipped));
@@ -340,23 +350,9 @@ std::vector<Clip> read_clips_file(const std::string& path, std::vector<std::stri
 
 // ---------------------------------------------------------------- sources
 
-enum class ArchiveKind { None, Tar, TarXz, TarGz };
-
 std::string lower(std::string s) {
   for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   return s;
-}
-
-bool ends_with(const std::string& s, const std::string& suffix) {
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-ArchiveKind archive_kind(const fs::path& p) {
-  const std::string n = lower(p.filename().string());
-  if (ends_with(n, ".tar.xz") || ends_with(n, ".txz")) return ArchiveKind::TarXz;
-  if (ends_with(n, ".tar.gz") || ends_with(n, ".tgz")) return ArchiveKind::TarGz;
-  if (ends_with(n, ".tar")) return ArchiveKind::Tar;
-  return ArchiveKind::None;
 }
 
 struct FileStamp {
@@ -412,45 +408,11 @@ uint64_t folder_key(const fs::path& folder, const std::vector<SourceFile>& files
   return fnv1a64(k.str());
 }
 
-std::string read_text_file(const fs::path& p, size_t max_bytes) {
-  std::ifstream in(p, std::ios::binary);
-  std::string s(max_bytes, '\0');
-  in.read(s.data(), static_cast<std::streamsize>(max_bytes));
-  s.resize(static_cast<size_t>(in.gcount()));
-  while (!s.empty() && (s.back() == '\n' || s.back() == '\r')) s.pop_back();
-  return s;
-}
-
-// Runs `args` (args[0] looked up in PATH) without a shell, stdin and stdout on
-// /dev/null, stderr into `stderr_path`. Returns the exit status (128 + signal
-// number if killed).
-int run_program(const std::vector<std::string>& args, const std::string& stderr_path) {
-  std::vector<char*> argv;
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, "/dev/null", O_WRONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 2, stderr_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  pid_t pid = 0;
-  const int rc = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0) throw InputError("cannot run " + args[0] + ": " + std::strerror(rc));
-  int status = 0;
-  while (::waitpid(pid, &status, 0) < 0) {
-    if (errno != EINTR) throw InputError("waiting for " + args[0] + " failed: " + std::strerror(errno));
-  }
-  if (WIFEXITED(status)) return WEXITSTATUS(status);
-  if (WIFSIGNALED(status)) return 128 + WTERMSIG(status);
-  return 255;
-}
-
 // Extracts `archive` into <cache_dir>/extract-<key>/ unless that folder exists.
-// tar writes into a private temporary folder that is renamed only after tar
-// succeeded, so the final folder always holds a complete extraction.
-fs::path ensure_extracted(const fs::path& archive, ArchiveKind kind, const fs::path& cache_dir, uint64_t key,
-                          bool verbose) {
+// libarchive writes into a private temporary folder that is renamed only after
+// the whole archive was read, so the final folder always holds a complete
+// extraction.
+fs::path ensure_extracted(const fs::path& archive, const fs::path& cache_dir, uint64_t key, bool verbose) {
   const fs::path final_dir = cache_dir / ("extract-" + hex64(key));
   std::error_code ec;
   if (fs::is_directory(final_dir, ec)) {
@@ -459,35 +421,20 @@ fs::path ensure_extracted(const fs::path& archive, ArchiveKind kind, const fs::p
   }
   remove_stale_temps(cache_dir, "extract-" + hex64(key));
   const fs::path tmp = cache_dir / ("extract-" + hex64(key) + temp_suffix());
-  const fs::path log = tmp.string() + ".log";
   auto cleanup = [&] {
     std::error_code e;
     fs::remove_all(tmp, e);
-    fs::remove(log, e);
   };
   fs::create_directories(tmp, ec);
   if (ec) throw InputError("cannot create " + tmp.string() + ": " + ec.message());
-
-  std::vector<std::string> args = {"tar", "-x"};
-  if (kind == ArchiveKind::TarXz) args.push_back("-J");
-  if (kind == ArchiveKind::TarGz) args.push_back("-z");
-  args.insert(args.end(), {"--no-same-owner", "-f", archive.string(), "-C", tmp.string()});
   if (verbose) std::fprintf(stderr, "mf dataset: extracting %s\n", archive.c_str());
   const auto t0 = Clock::now();
-  int status = 0;
   try {
-    status = run_program(args, log.string());
+    extract_tar_archive(archive.string(), tmp.string());
   } catch (...) {
     cleanup();
     throw;
   }
-  if (status != 0) {
-    const std::string message = read_text_file(log, 2000);
-    cleanup();
-    throw InputError("cannot extract " + archive.string() + ": tar exited with status " + std::to_string(status) +
-                     (message.empty() ? "" : ": " + message));
-  }
-  fs::remove(log, ec);
   fs::rename(tmp, final_dir, ec);
   if (ec) {
     // Another process may have completed the same extraction first.
@@ -591,6 +538,104 @@ void parse_clips(const std::vector<SourceFile>& files, const DatasetOptions& opt
   }
 }
 
+// ---------------------------------------------------------------- loading steps
+
+void check_options(const DatasetOptions& options) {
+  if (options.source.empty()) throw InputError("dataset source is empty");
+  if (options.validation_percent < 0 || options.validation_percent > 100)
+    throw InputError("validation_percent must be within 0..100, got " + std::to_string(options.validation_percent));
+  if (!(options.units.length_scale > 0) || !std::isfinite(options.units.length_scale))
+    throw InputError("BVH length scale must be positive and finite");
+}
+
+// The source and the cache folder of DatasetOptions, made absolute and checked.
+struct ResolvedSource {
+  fs::path path;
+  bool is_folder = false;
+  fs::path cache_dir;      // empty: none
+  bool use_cache = false;  // read and write the clips file
+};
+
+// Also creates the cache folder when it will be written to.
+ResolvedSource resolve_source(const DatasetOptions& options) {
+  ResolvedSource r;
+  std::error_code ec;
+  r.path = fs::absolute(options.source, ec).lexically_normal();
+  if (ec) throw InputError("bad dataset source " + options.source + ": " + ec.message());
+  const fs::file_status st = fs::status(r.path, ec);
+  if (!fs::exists(st)) throw InputError("dataset source does not exist: " + options.source);
+  r.is_folder = fs::is_directory(st);
+  if (!r.is_folder) {
+    if (!is_tar_archive_name(r.path.filename().string()) || !fs::is_regular_file(st))
+      throw InputError("dataset source is neither a folder nor a .tar, .tar.xz, .txz, .tar.gz or .tgz archive: " +
+                       options.source);
+    if (options.cache_dir.empty())
+      throw InputError("an archive source needs a cache_dir to extract into: " + options.source);
+  }
+  if (!options.cache_dir.empty()) {
+    r.cache_dir = fs::absolute(options.cache_dir, ec).lexically_normal();
+    if (ec) throw InputError("bad cache_dir " + options.cache_dir + ": " + ec.message());
+  }
+  r.use_cache = options.use_cache && !r.cache_dir.empty();
+  if (!r.cache_dir.empty() && (r.use_cache || !r.is_folder)) {
+    fs::create_directories(r.cache_dir, ec);
+    if (ec || !fs::is_directory(r.cache_dir))
+      throw InputError("cannot create cache_dir " + r.cache_dir.string() + (ec ? ": " + ec.message() : std::string()));
+  }
+  return r;
+}
+
+// The key of the clips file: the source's key and the length units.
+uint64_t clips_key(uint64_t source_key, const BvhUnits& units) {
+  char scale[40];
+  std::snprintf(scale, sizeof scale, "%.17g", units.length_scale);
+  return fnv1a64(hex64(source_key) + "\nlength_scale " + scale);
+}
+
+// True when the clips came from `cache_file`; a damaged file is reported and ignored.
+bool read_cached_clips(const fs::path& cache_file, std::vector<Clip>* clips, std::vector<std::string>* skipped) {
+  std::error_code ec;
+  if (!fs::exists(cache_file, ec)) return false;
+  try {
+    *clips = read_clips_file(cache_file.string(), skipped);
+    return true;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "mf dataset: ignoring the cache, parsing again: %s\n", e.what());
+    clips->clear();
+    skipped->clear();
+    return false;
+  }
+}
+
+// Failing to write the cache is only a warning.
+void write_cached_clips(const fs::path& cache_file, const std::vector<Clip>& clips,
+                        const std::vector<std::string>& skipped, bool verbose) {
+  try {
+    remove_stale_temps(cache_file.parent_path(), cache_file.filename().string());
+    write_clips_file(cache_file.string(), clips, skipped);
+    if (verbose) std::fprintf(stderr, "mf dataset: wrote cache %s\n", cache_file.c_str());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mf dataset: warning: cache not written: %s\n", e.what());
+  }
+}
+
+InputError no_usable_clip(const std::string& source, const std::vector<std::string>& skipped) {
+  std::string msg = "no usable clip in " + source + " (" + std::to_string(skipped.size()) + " skipped";
+  for (size_t i = 0; i < skipped.size() && i < 3; ++i) msg += (i ? "; " : ": ") + skipped[i];
+  return InputError(msg + ")");
+}
+
+// The reference skeleton (the first clip's) and the split by name.
+void split_clips(std::vector<Clip> clips, int validation_percent, Dataset* ds) {
+  ds->skeleton = clips.front().motion.skeleton;
+  for (Clip& c : clips) {
+    if (is_validation_clip(c.name, validation_percent))
+      ds->validation.push_back(std::move(c));
+    else
+      ds->train.push_back(std::move(c));
+  }
+}
+
 std::string env_or(const char* var, const char* fallback) {
   const char* v = std::getenv(var);
   if (v && *v) return v;
@@ -625,94 +670,33 @@ std::vector<Clip> load_clips(const std::string& path) { return read_clips_file(p
 
 Dataset load_dataset(const DatasetOptions& options) {
   const auto t0 = Clock::now();
-  if (options.source.empty()) throw InputError("dataset source is empty");
-  if (options.validation_percent < 0 || options.validation_percent > 100)
-    throw InputError("validation_percent must be within 0..100, got " + std::to_string(options.validation_percent));
-  if (!(options.units.length_scale > 0) || !std::isfinite(options.units.length_scale))
-    throw InputError("BVH length scale must be positive and finite");
-
-  std::error_code ec;
-  const fs::path source = fs::absolute(options.source, ec).lexically_normal();
-  if (ec) throw InputError("bad dataset source " + options.source + ": " + ec.message());
-  const fs::file_status st = fs::status(source, ec);
-  if (!fs::exists(st)) throw InputError("dataset source does not exist: " + options.source);
-  const bool is_folder = fs::is_directory(st);
-  ArchiveKind kind = ArchiveKind::None;
-  if (!is_folder) {
-    kind = archive_kind(source);
-    if (kind == ArchiveKind::None || !fs::is_regular_file(st))
-      throw InputError("dataset source is neither a folder nor a .tar, .tar.xz, .txz, .tar.gz or .tgz archive: " +
-                       options.source);
-    if (options.cache_dir.empty())
-      throw InputError("an archive source needs a cache_dir to extract into: " + options.source);
-  }
-  fs::path cache_dir;
-  if (!options.cache_dir.empty()) {
-    cache_dir = fs::absolute(options.cache_dir, ec).lexically_normal();
-    if (ec) throw InputError("bad cache_dir " + options.cache_dir + ": " + ec.message());
-  }
-  const bool use_cache = options.use_cache && !cache_dir.empty();
-  if (!cache_dir.empty() && (use_cache || !is_folder)) {
-    fs::create_directories(cache_dir, ec);
-    if (ec || !fs::is_directory(cache_dir)) throw InputError("cannot create cache_dir " + cache_dir.string() +
-                                                             (ec ? ": " + ec.message() : std::string()));
-  }
-
+  check_options(options);
+  const ResolvedSource source = resolve_source(options);
   std::vector<SourceFile> files;
   uint64_t source_key = 0;
-  if (is_folder) {
-    files = list_bvh_files(source);
-    if (use_cache) source_key = folder_key(source, files);
+  if (source.is_folder) {
+    files = list_bvh_files(source.path);
+    if (source.use_cache) source_key = folder_key(source.path, files);
   } else {
-    source_key = archive_key(source);
+    source_key = archive_key(source.path);
   }
-  char scale[40];
-  std::snprintf(scale, sizeof scale, "%.17g", options.units.length_scale);
-  const uint64_t clips_key = fnv1a64(hex64(source_key) + "\nlength_scale " + scale);
-  const fs::path cache_file = cache_dir / ("clips-" + hex64(clips_key) + ".bin");
+  const fs::path cache_file = source.cache_dir / ("clips-" + hex64(clips_key(source_key, options.units)) + ".bin");
 
   Dataset ds;
   std::vector<Clip> clips;
-  if (use_cache && fs::exists(cache_file, ec)) {
-    try {
-      clips = read_clips_file(cache_file.string(), &ds.skipped);
-      ds.from_cache = true;
-      if (options.verbose)
-        std::fprintf(stderr, "mf dataset: %zu clips from cache %s (%.2f s)\n", clips.size(), cache_file.c_str(),
-                     seconds_since(t0));
-    } catch (const InputError& e) {
-      std::fprintf(stderr, "mf dataset: ignoring the cache, parsing again: %s\n", e.what());
-      clips.clear();
-      ds.skipped.clear();
-    }
+  if (source.use_cache) ds.from_cache = read_cached_clips(cache_file, &clips, &ds.skipped);
+  if (ds.from_cache && options.verbose) {
+    std::fprintf(stderr, "mf dataset: %zu clips from cache %s (%.2f s)\n", clips.size(), cache_file.c_str(),
+                 seconds_since(t0));
   }
   if (!ds.from_cache) {
-    if (!is_folder) files = list_bvh_files(ensure_extracted(source, kind, cache_dir, source_key, options.verbose));
+    if (!source.is_folder) files = list_bvh_files(ensure_extracted(source.path, source.cache_dir, source_key, options.verbose));
     if (files.empty()) throw InputError("no .bvh file in " + options.source);
     parse_clips(files, options, &clips, &ds.skipped);
-    if (use_cache && !clips.empty()) {
-      try {
-        remove_stale_temps(cache_dir, cache_file.filename().string());
-        write_clips_file(cache_file.string(), clips, ds.skipped);
-        if (options.verbose) std::fprintf(stderr, "mf dataset: wrote cache %s\n", cache_file.c_str());
-      } catch (const std::exception& e) {
-        std::fprintf(stderr, "mf dataset: warning: cache not written: %s\n", e.what());
-      }
-    }
+    if (source.use_cache && !clips.empty()) write_cached_clips(cache_file, clips, ds.skipped, options.verbose);
   }
-  if (clips.empty()) {
-    std::string msg = "no usable clip in " + options.source + " (" + std::to_string(ds.skipped.size()) + " skipped";
-    for (size_t i = 0; i < ds.skipped.size() && i < 3; ++i) msg += (i ? "; " : ": ") + ds.skipped[i];
-    throw InputError(msg + ")");
-  }
-
-  ds.skeleton = clips.front().motion.skeleton;
-  for (Clip& c : clips) {
-    if (is_validation_clip(c.name, options.validation_percent))
-      ds.validation.push_back(std::move(c));
-    else
-      ds.train.push_back(std::move(c));
-  }
+  if (clips.empty()) throw no_usable_clip(options.source, ds.skipped);
+  split_clips(std::move(clips), options.validation_percent, &ds);
   if (options.verbose)
     std::fprintf(stderr, "mf dataset: %zu train, %zu validation, %zu skipped clips in %.2f s\n", ds.train.size(),
                  ds.validation.size(), ds.skipped.size(), seconds_since(t0));

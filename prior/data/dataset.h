@@ -4,10 +4,11 @@
 //
 // Sources. A folder is searched recursively for files ending in ".bvh" (any
 // case); an archive is a file ending in .tar, .tar.xz, .txz, .tar.gz or .tgz,
-// extracted with the system `tar`. Clips are always processed in the order of
-// their path (relative to the folder or archive root, compared bytewise), so
-// every result below is independent of the file system's listing order and of
-// the number of parsing threads.
+// extracted with libarchive (prior/data/tar_archive.h: regular files only; an
+// entry with an absolute path or a ".." component fails the load). Clips are
+// always processed in the order of their path (relative to the folder or
+// archive root, compared bytewise), so every result below is independent of
+// the file system's listing order and of the number of parsing threads.
 //
 // Split: a clip goes to validation when FNV-1a-64(file base name) % 100 <
 // validation_percent (default 10). It depends only on the file name, so it is
@@ -21,8 +22,8 @@
 //
 // Nothing extracted or cached is ever written inside the source tree: archives
 // are extracted into `<cache_dir>/extract-<key>/` (through a temporary folder
-// renamed when tar has succeeded, so an interrupted extraction is never taken
-// for a complete one) and the parsed clips are stored in
+// renamed once the whole archive was read, so an interrupted extraction is
+// never taken for a complete one) and the parsed clips are stored in
 // `<cache_dir>/clips-<key>.bin` (written to a temporary file and renamed).
 // For an archive, key = hex FNV-1a-64 of (absolute path, size, modification
 // time, cache format version); for a folder it covers the folder's absolute path
