@@ -1,0 +1,57 @@
+// The shared frame of motionfield's command-line tools (the trainer, the
+// benchmark programs, mf_inspect_dataset): CLI11 (header-only, Debian's
+// libcli11-dev) parses the arguments, and every tool ends the same way:
+//   0  success, and for --help (the help on stdout)
+//   2  bad input: an unknown, missing or malformed option, or an mf::InputError
+//      from the tool itself; "<tool>: <message>" on stderr
+//   1  any other error; "<tool>: internal error: <message>" on stderr
+// Only executables include this header (the libraries never parse arguments).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+
+#include "prior/motion/errors.h"
+
+namespace mf::cli {
+
+/// The conventions of every tool: a repeated option keeps its last value (as
+/// the hand-written parsers did), and --help shows each option's default.
+inline void use_tool_defaults(CLI::App& app) {
+  app.option_defaults()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast)->always_capture_default();
+  app.get_formatter()->column_width(28);
+}
+
+/// An option that may be given several times and keeps every value.
+inline CLI::Option* repeatable(CLI::Option* option) {
+  return option->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
+/// Parses argc/argv into `app`, then returns `body()`, mapping every outcome to
+/// the exit codes above. `body` may throw mf::InputError (exit code 2) or any
+/// other std::exception (exit code 1).
+template <class Body>
+int run(CLI::App& app, int argc, char** argv, Body&& body) {
+  const std::string tool = app.get_name();
+  try {
+    try {
+      app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+      if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);  // --help
+      std::fprintf(stderr, "%s: %s\n(%s --help lists the options)\n", tool.c_str(), e.what(), tool.c_str());
+      return 2;
+    }
+    return body();
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "%s: %s\n", tool.c_str(), e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: internal error: %s\n", tool.c_str(), e.what());
+    return 1;
+  }
+}
+
+}  // namespace mf::cli
