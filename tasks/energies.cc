@@ -10,6 +10,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations_torch.h"
+#include "tasks/residuals.h"
 
 namespace mf {
 namespace {
@@ -145,8 +146,6 @@ at::Tensor aligned_root_path(const NemfModel& model, const WindowProblem& proble
   return path - shift.unsqueeze(1);
 }
 
-double smoothstep(double t) { return t * t * (3.0 - 2.0 * t); }
-
 // Where each frame takes its residual from: the keys a and b around it that
 // constrain the joint (or the root position) and the smoothstep weight of b.
 struct Brackets {
@@ -155,7 +154,8 @@ struct Brackets {
   at::Tensor has;   // [n] float: 0 where no key constrains the joint
 };
 
-// frames_of[k] = frame of key k; on[k] = whether key k constrains the series.
+// key_frame[k] = frame of key k; on[k] = whether key k constrains the series
+// (residual_bracket() over the frames of those keys, as key indices).
 void bracket_series(const std::vector<int64_t>& key_frame, const std::vector<char>& on, int T, int64_t* a, int64_t* b,
                     float* s, float* has, int64_t stride) {
   std::vector<std::pair<int64_t, int64_t>> keys;  // (frame, key index)
@@ -163,7 +163,8 @@ void bracket_series(const std::vector<int64_t>& key_frame, const std::vector<cha
     if (on[k]) keys.emplace_back(key_frame[k], static_cast<int64_t>(k));
   }
   std::sort(keys.begin(), keys.end());
-  size_t next = 0;
+  std::vector<int> frames;
+  for (const auto& k : keys) frames.push_back(static_cast<int>(k.first));
   for (int f = 0; f < T; ++f) {
     const int64_t i = static_cast<int64_t>(f) * stride;
     if (keys.empty()) {
@@ -172,20 +173,11 @@ void bracket_series(const std::vector<int64_t>& key_frame, const std::vector<cha
       has[i] = 0.0f;
       continue;
     }
+    const ResidualBracket br = residual_bracket(f, frames, ResidualRamp::Smoothstep);
     has[i] = 1.0f;
-    while (next < keys.size() && keys[next].first < f) ++next;
-    if (next == keys.size()) {
-      a[i] = b[i] = keys.back().second;
-      s[i] = 0.0f;
-    } else if (keys[next].first == f || next == 0) {
-      a[i] = b[i] = keys[next].second;
-      s[i] = 0.0f;
-    } else {
-      a[i] = keys[next - 1].second;
-      b[i] = keys[next].second;
-      s[i] = static_cast<float>(
-          smoothstep(static_cast<double>(f - keys[next - 1].first) / (keys[next].first - keys[next - 1].first)));
-    }
+    a[i] = keys[br.a].second;
+    b[i] = keys[br.b].second;
+    s[i] = static_cast<float>(br.s);
   }
 }
 

@@ -14,6 +14,8 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "tasks/latent_optimizer.h"
+#include "tasks/residuals.h"
+#include "tasks/windows.h"
 
 namespace mf {
 namespace {
@@ -82,29 +84,6 @@ LatentOptimizerSettings optimizer_settings(const LatentSolverOptions& o, int cap
   return s;
 }
 
-// ---------------------------------------------------------------------------
-// Windows
-
-double smoothstep(double t) { return t * t * (3.0 - 2.0 * t); }
-
-Eigen::Quaterniond residual_rotation(const Eigen::Quaterniond& given, const Eigen::Quaterniond& raw) {
-  return (given.normalized() * raw.normalized().conjugate()).normalized();
-}
-
-// Blend weights of the residual of sorted `frames` at frame f: the residual is
-// r(a) * (1 - s) + r(b) * s with s = smoothstep, held outside. Returns (a, b, s).
-struct Bracket {
-  int a, b;
-  double s;
-};
-Bracket bracket(int f, const std::vector<int>& frames) {
-  auto it = std::lower_bound(frames.begin(), frames.end(), f);
-  if (it == frames.end()) return {frames.back(), frames.back(), 0.0};
-  if (*it == f || it == frames.begin()) return {*it, *it, 0.0};
-  const int b = *it, a = *(it - 1);
-  return {a, b, smoothstep(static_cast<double>(f - a) / (b - a))};
-}
-
 void measure_effectors(const Motion& motion, const MotionConstraints& c, EffectorError* e) {
   *e = EffectorError{};
   if (c.effectors.empty()) return;
@@ -119,68 +98,49 @@ void measure_effectors(const Motion& motion, const MotionConstraints& c, Effecto
   e->mean_cm = sum / e->count;
 }
 
-// Makes the constrained values of `out` exactly the input's, spreading the
-// residuals (see the header). Records the raw error first.
-void overwrite_known(const Motion& input, const MotionConstraints& c, Motion* out, ConstraintError* err) {
-  const int N = input.num_frames(), J = input.num_joints();
-  *err = ConstraintError{};
+// The error of the raw solution at the constrained values.
+ConstraintError known_value_error(const Motion& input, const MotionConstraints& c, const Motion& raw) {
+  ConstraintError err;
   double rot_sum = 0.0, root_sum = 0.0;
-  const Motion raw = *out;
-  for (int j = 0; j < J; ++j) {
-    std::vector<int> frames;
-    std::vector<Eigen::Quaterniond> residual;
+  for (int j = 0; j < input.num_joints(); ++j) {
     for (size_t k = 0; k < c.keys.size(); ++k) {
       if (!c.key_has_joint(k, j)) continue;
       const int f = c.keys[k].frame;
-      frames.push_back(f);
-      residual.push_back(residual_rotation(input.rotation(f, j), raw.rotation(f, j)));
       const double deg = geodesic_angle(input.rotation(f, j).normalized(), raw.rotation(f, j)) * 180.0 / M_PI;
-      err->rotation_max_deg = std::max(err->rotation_max_deg, deg);
+      err.rotation_max_deg = std::max(err.rotation_max_deg, deg);
       rot_sum += deg;
-      ++err->rotations;
-    }
-    if (frames.empty()) continue;
-    size_t next = 0;
-    for (int f = 0; f < N; ++f) {
-      if (next < frames.size() && frames[next] == f) {
-        out->rotation(f, j) = input.rotation(f, j);  // bit for bit
-        ++next;
-        continue;
-      }
-      const Bracket br = bracket(f, frames);
-      const size_t ia = std::lower_bound(frames.begin(), frames.end(), br.a) - frames.begin();
-      const size_t ib = std::lower_bound(frames.begin(), frames.end(), br.b) - frames.begin();
-      const Eigen::Quaterniond r = slerp(residual[ia], residual[ib], br.s);
-      out->rotation(f, j) = (r * raw.rotation(f, j).normalized()).normalized();
+      ++err.rotations;
     }
   }
-  std::vector<int> frames;
-  std::vector<Eigen::Vector3d> residual;
   for (const PoseKey& k : c.keys) {
     if (!k.root_position) continue;
-    frames.push_back(k.frame);
-    residual.push_back(input.root_positions[k.frame] - raw.root_positions[k.frame]);
-    const double cm = residual.back().norm() * 100.0;
-    err->root_max_cm = std::max(err->root_max_cm, cm);
+    const double cm = (input.root_positions[k.frame] - raw.root_positions[k.frame]).norm() * 100.0;
+    err.root_max_cm = std::max(err.root_max_cm, cm);
     root_sum += cm;
-    ++err->roots;
+    ++err.roots;
   }
-  if (!frames.empty()) {
-    size_t next = 0;
-    for (int f = 0; f < N; ++f) {
-      if (next < frames.size() && frames[next] == f) {
-        out->root_positions[f] = input.root_positions[f];
-        ++next;
-        continue;
-      }
-      const Bracket br = bracket(f, frames);
-      const size_t ia = std::lower_bound(frames.begin(), frames.end(), br.a) - frames.begin();
-      const size_t ib = std::lower_bound(frames.begin(), frames.end(), br.b) - frames.begin();
-      out->root_positions[f] = raw.root_positions[f] + residual[ia] * (1.0 - br.s) + residual[ib] * br.s;
+  if (err.rotations) err.rotation_mean_deg = rot_sum / err.rotations;
+  if (err.roots) err.root_mean_cm = root_sum / err.roots;
+  return err;
+}
+
+// Makes the constrained values of `out` exactly the input's, spreading the
+// residuals with smoothstep ramps (see the header). Records the raw error first.
+void overwrite_known(const Motion& input, const MotionConstraints& c, Motion* out, ConstraintError* err) {
+  const Motion raw = *out;
+  *err = known_value_error(input, c, raw);
+  for (int j = 0; j < input.num_joints(); ++j) {
+    std::vector<int> frames;
+    for (size_t k = 0; k < c.keys.size(); ++k) {
+      if (c.key_has_joint(k, j)) frames.push_back(c.keys[k].frame);
     }
+    spread_rotation_residual(input, raw, j, frames, ResidualRamp::Smoothstep, out);
   }
-  if (err->rotations) err->rotation_mean_deg = rot_sum / err->rotations;
-  if (err->roots) err->root_mean_cm = root_sum / err->roots;
+  std::vector<int> frames;
+  for (const PoseKey& k : c.keys) {
+    if (k.root_position) frames.push_back(k.frame);
+  }
+  spread_root_residual(input, raw, frames, ResidualRamp::Smoothstep, out);
 }
 
 // Moves the ankle at `frame` to `target` (world) by turning the hip and the
@@ -408,16 +368,6 @@ void reach_effectors(const MotionConstraints& c, int falloff, Motion* out) {
   }
 }
 
-// Window starts for N frames, windows of W frames overlapping by at least `overlap`.
-std::vector<int> window_starts(int N, int W, int overlap) {
-  if (N <= W) return {0};
-  std::vector<int> starts;
-  int s = 0;
-  for (; s + W < N; s += W - overlap) starts.push_back(s);
-  starts.push_back(N - W);
-  return starts;
-}
-
 }  // namespace
 
 std::string LatentSolverOptions::validate() const {
@@ -522,7 +472,7 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
   }
 
   const int W = model.config().window;
-  const std::vector<int> starts = window_starts(N, W, std::min(options.overlap, W / 2));
+  const std::vector<int> starts = window_starts(N, W, W - std::min(options.overlap, W / 2));
   const int windows = static_cast<int>(starts.size());
   auto length_of = [&](int k) { return std::min(W, N - starts[k]); };
 
@@ -621,11 +571,7 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
         const int pos = solved_before ? f - ov_a + 1 : ov_b - f;
         wn = static_cast<double>(pos) / (n_ov + 1);
       }
-      for (int j = 0; j < J; ++j) {
-        out.rotation(g, j) = wn >= 1.0 ? piece.rotation(f, j) : slerp(out.rotation(g, j), piece.rotation(f, j), wn);
-      }
-      out.root_positions[g] =
-          wn >= 1.0 ? piece.root_positions[f] : Eigen::Vector3d(out.root_positions[g] * (1.0 - wn) + piece.root_positions[f] * wn);
+      cross_fade_frame(piece, f, wn, &out, g);
       for (int k = 0; k < F; ++k) {
         float& c = contacts[static_cast<size_t>(g) * F + k];
         c = static_cast<float>(c * (1.0 - wn) + pc[f * F + k] * wn);

@@ -11,6 +11,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "tasks/baselines.h"
+#include "tasks/residuals.h"
 
 namespace mf {
 namespace {
@@ -94,30 +95,9 @@ Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, 
 
 Motion match_known_frames(const Motion& out_in, const Motion& input, const std::vector<int>& known) {
   Motion out = out_in;
-  const int J = out.num_joints(), N = out.num_frames();
-  if (known.empty()) return out;
-  auto rot_delta = [&](int k, int j) {
-    return (input.rotation(k, j).normalized() * out_in.rotation(k, j).normalized().conjugate()).normalized();
-  };
-  size_t next = 0;
-  for (int f = 0; f < N; ++f) {
-    while (next < known.size() && known[next] < f) ++next;
-    if (next < known.size() && known[next] == f) {
-      for (int j = 0; j < J; ++j) out.rotation(f, j) = input.rotation(f, j);
-      out.root_positions[f] = input.root_positions[f];
-      continue;
-    }
-    const int a = next > 0 ? known[next - 1] : known.front();
-    const int b = next < known.size() ? known[next] : known.back();
-    const double t = b == a ? 0.0 : static_cast<double>(f - a) / (b - a);
-    for (int j = 0; j < J; ++j) {
-      const Eigen::Quaterniond d = slerp(rot_delta(a, j), rot_delta(b, j), t);
-      out.rotation(f, j) = (d * out_in.rotation(f, j).normalized()).normalized();
-    }
-    const Eigen::Vector3d da = input.root_positions[a] - out_in.root_positions[a];
-    const Eigen::Vector3d db = input.root_positions[b] - out_in.root_positions[b];
-    out.root_positions[f] = out_in.root_positions[f] + (1 - t) * da + t * db;
-  }
+  for (int j = 0; j < out.num_joints(); ++j)
+    spread_rotation_residual(input, out_in, j, known, ResidualRamp::Linear, &out);
+  spread_root_residual(input, out_in, known, ResidualRamp::Linear, &out);
   return out;
 }
 

@@ -53,9 +53,10 @@ Motion resample_on_model_rig(const Motion& input, double fps, int frames, const 
                              const ResampleFn& resample);
 
 /// Corrects `out` so that its known frames equal `input`'s: the difference at
-/// each known frame (per joint rotation, root position) is interpolated over
-/// the frames between known ones (held before the first and after the last),
-/// then the known frames are copied exactly. Same skeleton, frames and fps.
+/// each known frame (per joint rotation, root position) is interpolated
+/// linearly over the frames between known ones (held before the first and
+/// after the last), then the known frames are copied exactly
+/// (tasks/residuals.h, ResidualRamp::Linear). Same skeleton, frames and fps.
 Motion match_known_frames(const Motion& out, const Motion& input, const std::vector<int>& known);
 
 }  // namespace mf

@@ -97,17 +97,6 @@ void check_code(const NemfModel& model, const EncodedMotion& code) {
 
 }  // namespace
 
-std::vector<int> window_starts(int frames, int window, int hop) {
-  if (frames < 1 || window < 2 || hop < 1 || hop >= window) {
-    throw InputError("window_starts: need frames >= 1, window >= 2 and 1 <= hop < window");
-  }
-  std::vector<int> starts{0};
-  if (frames <= window) return starts;
-  for (int s = hop; s + window < frames; s += hop) starts.push_back(s);
-  starts.push_back(frames - window);
-  return starts;
-}
-
 std::vector<double> blend_weights(const std::vector<WindowCode>& windows, double s) {
   std::vector<double> w(windows.size(), 0.0);
   if (windows.empty()) return w;

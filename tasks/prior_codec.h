@@ -13,7 +13,8 @@
 //      last model frame is the first at or past the input's last frame time
 //      (positions past the last input frame hold it). A motion already at the
 //      model's rate (within 1e-5 relative) is used as it is.
-//   2. The model-rate sequence of N frames is cut into windows (window_starts()):
+//   2. The model-rate sequence of N frames is cut into windows (window_starts()
+//      of tasks/windows.h):
 //      N <= window: one short window [0, N); the encoder masks the missing frames
 //      (see nemf.h, "Short clips"). Otherwise windows of exactly `window` frames
 //      start at 0, hop, 2 hop, ... while they end before the last frame, and one
@@ -72,6 +73,7 @@
 #include "prior/model/representation.h"
 #include "prior/motion/motion.h"
 #include "tasks/task_context.h"
+#include "tasks/windows.h"  // window_starts()
 
 namespace mf {
 
@@ -105,12 +107,6 @@ struct EncodedMotion {
   /// Seconds from the first to the last model frame.
   double duration() const { return frames > 1 ? (frames - 1) / fps : 0.0; }
 };
-
-/// Window starts for a sequence of `frames` model frames (see the header
-/// comment): {0} when frames <= window, else 0, hop, 2 hop, ... (while
-/// start + window < frames) and frames - window. Throws mf::InputError unless
-/// frames >= 1, window >= 2 and 1 <= hop < window.
-std::vector<int> window_starts(int frames, int window, int hop);
 
 /// Normalised blend weights of `windows` (only start and length are read) at
 /// model-frame position s: one weight per window, zero for windows that do not

@@ -22,6 +22,7 @@
 #include "tasks/initializers.h"
 #include "tasks/latent_optimizer.h"
 #include "tasks/model_rig.h"
+#include "tasks/windows.h"
 
 namespace mf {
 namespace {
@@ -68,16 +69,6 @@ std::string fmt(double v) {
   std::ostringstream s;
   s << v;
   return s.str();
-}
-
-// Window starts for N frames, windows of W frames overlapping by at least `overlap`.
-std::vector<int> window_starts(int N, int W, int overlap) {
-  if (N <= W) return {0};
-  std::vector<int> starts;
-  int s = 0;
-  for (; s + W < N; s += W - overlap) starts.push_back(s);
-  starts.push_back(N - W);
-  return starts;
 }
 
 int default_iterations(RenavSolver s) { return s == RenavSolver::Adam ? 600 : 100; }
@@ -592,7 +583,7 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
   const int R = ref_m.num_frames();
 
   const int overlap = options.overlap > 0 ? std::min(options.overlap, W / 2) : std::max(1, W / 4);
-  const std::vector<int> starts = window_starts(M, W, overlap);
+  const std::vector<int> starts = window_starts(M, W, W - overlap);
   const int windows = static_cast<int>(starts.size());
   const int cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.solver);
   const int zl = model.config().zl, zg = model.config().zg;
@@ -664,11 +655,7 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
     for (int f = 0; f < T; ++f) {
       const int g = s + f;
       const double wn = f < shared ? static_cast<double>(f + 1) / (shared + 1) : 1.0;
-      for (int j = 0; j < J; ++j) {
-        out.rotation(g, j) = wn >= 1.0 ? piece.rotation(f, j) : slerp(out.rotation(g, j), piece.rotation(f, j), wn);
-      }
-      out.root_positions[g] = wn >= 1.0 ? piece.root_positions[f]
-                                        : Eigen::Vector3d(out.root_positions[g] * (1.0 - wn) + piece.root_positions[f] * wn);
+      cross_fade_frame(piece, f, wn, &out, g);
     }
     sum.wall_ms = ms_since(tw);
     rep.windows.push_back(std::move(sum));

@@ -11,6 +11,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "tasks/initializers.h"
+#include "tasks/residuals.h"
 
 namespace mf {
 
@@ -26,8 +27,6 @@ struct FillWindow {
   int owned_from = 0;  // frames (owned_from, end] are this window's output
   int end = 0;         // a key fixing the root
 };
-
-double smoothstep(double t) { return t * t * (3.0 - 2.0 * t); }
 
 std::string kind_title(const std::string& kind) {
   return kind == kCitlKind ? "CITL transformer" : kind == kTwoStageKind ? "two-stage transformer" : kind;
