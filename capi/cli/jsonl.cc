@@ -533,7 +533,8 @@ BatchJob batch_job_from_json(const JsonValue& line) {
   if (const JsonValue* r = line.find("rig_map")) job.rig_map = string_value(*r, "rig_map", false);
   if (const JsonValue* u = line.find("units")) {
     if (!u->is_number()) {
-      if (!u->is_string()) throw InputError(std::string("\"units\" must be a unit name or a number, not ") + json_type_name(u->type()));
+      if (!u->is_string())
+        throw InputError(std::string("\"units\" must be a unit name or a number, not ") + json_type_name(u->type()));
       job.units = string_value(*u, "units", false);
     } else if (u->as_number() > 0) {
       job.units = u->dump();

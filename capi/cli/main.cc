@@ -829,7 +829,8 @@ void print_rig(const std::string& in, const mf::cli::JsonValue& d, const std::st
     left += (left.empty() ? "" : ", ") + j.as_string();
   std::printf("user joints left out: %s\n", left.empty() ? "none" : left.c_str());
   if (!d.find("retargeting")->as_bool())
-    std::printf("note: the model has no rig anatomy (motionfield-rig.json next to it): only its own rig can be solved\n");
+    std::printf("note: the model has no rig anatomy (motionfield-rig.json next to it): "
+                "only its own rig can be solved\n");
 }
 
 int command_rig(std::vector<std::string> args, const Settings& settings) {

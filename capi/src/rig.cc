@@ -50,7 +50,8 @@ extern "C" {
 int mf_rig_describe(const mf_model* model, const mf_motion* motion, const char* rig_map_json, char* out,
                     size_t capacity, size_t* needed) {
   return guard([&] {
-    if (!model) throw ApiError(MF_ERROR_MODEL, "describing a rig needs a model (the rig to map onto), and none was given");
+    if (!model)
+      throw ApiError(MF_ERROR_MODEL, "describing a rig needs a model (the rig to map onto), and none was given");
     require(motion, "motion");
     const std::string text = mf::capi::describe_rig(*model, *motion, rig_map_json ? rig_map_json : "");
     mf::capi::write_string(text, out, capacity, needed);

@@ -60,12 +60,13 @@ void check_model_rig(const mf_model* model, const Skeleton& input, const mf_task
   if (!ctx.model || input.same_as(ctx.model->rig().skeleton)) return;
   if (!ctx.model_anatomy) {
     const std::string why = model && !model->anatomy_error.empty()
-                                ? "its rig anatomy file did not load: " + model->anatomy_error
-                                : std::string("it has no rig anatomy to retarget with (") + kRigAnatomyFileName +
+                                ? "the model's rig anatomy file did not load: " + model->anatomy_error
+                                : std::string("the model has no rig anatomy to retarget with (") + kRigAnatomyFileName +
                                       " next to the model file)";
     throw ApiError(model && !model->anatomy_error.empty() ? MF_ERROR_MODEL : MF_ERROR_INVALID_ARGUMENT,
-                   "the motion has " + std::to_string(input.num_joints()) + " joints on another rig than the model's (" +
-                       std::to_string(ctx.model->rig().num_joints()) + " joints), and " + why);
+                   "the motion has " + std::to_string(input.num_joints()) +
+                       " joints on another rig than the model's (" + std::to_string(ctx.model->rig().num_joints()) +
+                       " joints), and " + why);
   }
   try {
     model_rig_map(input, ctx);

@@ -290,7 +290,8 @@ TEST(CApiBadInput, JointCountsThatDoNotMatch) {
     options.method = method.c_str();
     // Another rig than the model's: the tiny model has no rig anatomy to retarget with.
     EXPECT_TRUE(Fails(mf_resample(model.get(), walk.get(), 60.0, &options, &m), MF_ERROR_INVALID_ARGUMENT,
-                      "the motion has 21 joints on another rig than the model's (7 joints), and it has no rig anatomy"));
+                      "the motion has 21 joints on another rig than the model's (7 joints), "
+                      "and the model has no rig anatomy"));
   }
   EXPECT_EQ(m, kMotionSentinel);
 }

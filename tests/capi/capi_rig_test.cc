@@ -129,7 +129,9 @@ nlohmann::json describe_rig(const mf_model* model, const mf_motion* motion, cons
 }
 
 ::testing::AssertionResult Fails(int got, int status, const std::string& text) {
-  if (got != status) return ::testing::AssertionFailure() << "status " << got << ", expected " << status << ": " << mf_last_error_message();
+  if (got != status)
+    return ::testing::AssertionFailure() << "status " << got << ", expected " << status << ": "
+                                         << mf_last_error_message();
   if (std::string(mf_last_error_message()).find(text) == std::string::npos)
     return ::testing::AssertionFailure() << "message '" << mf_last_error_message() << "' lacks '" << text << "'";
   return ::testing::AssertionSuccess();
