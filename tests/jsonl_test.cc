@@ -217,6 +217,21 @@ TEST(JsonlTest, RenavJobTakesAPathOrAPolyline) {
   EXPECT_TRUE(has(job_error(R"({"task": "renav", "in": "a", "out": "b", "path": "p", "fps": "30"})"), "a number"));
 }
 
+TEST(JsonlTest, EveryJobTakesARigMapAndUnits) {
+  const BatchJob a = job(R"({"task": "inbetween", "in": "a.bvh", "out": "b.bvh", "keyframes": [0, 9], "rig_map": "m.json", "units": "in"})");
+  EXPECT_EQ(a.rig_map, "m.json");
+  EXPECT_EQ(a.units, "in");
+  const BatchJob b = job(R"({"task": "renav", "in": "a.bvh", "out": "b.bvh", "path": "p.csv", "units": 0.01})");
+  EXPECT_EQ(std::stod(b.units), 0.01);
+  EXPECT_EQ(b.rig_map, "");
+  auto has = [](const std::string& m, const std::string& part) { return m.find(part) != std::string::npos; };
+  EXPECT_TRUE(has(job_error(R"({"task": "fill", "in": "a", "out": "b", "gap": [1, 2], "rig_map": 3})"),
+                  "\"rig_map\" must be a string"));
+  EXPECT_TRUE(has(job_error(R"({"task": "fill", "in": "a", "out": "b", "gap": [1, 2], "units": -1})"), "positive"));
+  EXPECT_TRUE(has(job_error(R"({"task": "fill", "in": "a", "out": "b", "gap": [1, 2], "units": [1]})"),
+                  "a unit name or a number"));
+}
+
 TEST(JsonlTest, BadJobsNameTheProblem) {
   auto has = [](const std::string& m, const std::string& part) { return m.find(part) != std::string::npos; };
   EXPECT_TRUE(has(job_error("[1, 2]"), "JSON object"));
