@@ -53,6 +53,7 @@
 
 #include "prior/model/representation.h"
 #include "prior/motion/motion.h"
+#include "tasks/latent_energy.h"
 #include "tasks/motion_constraints.h"
 
 namespace mf {
@@ -115,13 +116,8 @@ struct EnergyWeights {
   bool on_output = true;
 };
 
-/// The energy of one latent code: the weighted terms and their sum.
-struct EnergyTerms {
-  at::Tensor total;                                      ///< scalar
-  std::vector<std::pair<std::string, at::Tensor>> terms;  ///< active terms, weighted, in the order above
-};
-
-/// Evaluates the energy of (z_l [1, zl], z_g [1, zg]) on `problem`.
+/// Evaluates the energy of (z_l [1, zl], z_g [1, zg]) on `problem`: the
+/// active terms, weighted, in the order above (EnergyTerms, tasks/latent_energy.h).
 /// Differentiable with respect to the latents (the caller freezes the network).
 EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& weights,
                             const at::Tensor& z_l, const at::Tensor& z_g);

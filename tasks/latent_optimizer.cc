@@ -11,6 +11,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <sstream>
 
 #include "prior/motion/errors.h"
 
@@ -164,12 +165,24 @@ at::Tensor adam(const LatentEnergy& energy, const at::Tensor& x0, const LatentOp
 
 }  // namespace
 
-at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
-                           const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset,
-                           int iteration_total) {
+std::string LatentOptimizerSettings::validate() const {
+  std::ostringstream e;
+  if (max_iterations < 0) e << "max_iterations must be >= 0; ";
+  if (lbfgs_rank < 1) e << "lbfgs_rank must be >= 1; ";
+  if (!(function_tolerance >= 0) || !(gradient_tolerance >= 0) || !(parameter_tolerance >= 0))
+    e << "tolerances must be >= 0; ";
+  if (!(adam_lr > 0) || !std::isfinite(adam_lr)) e << "adam_lr must be positive; ";
+  if (adam_decay_every < 1 || !(adam_decay > 0 && adam_decay <= 1)) e << "bad Adam decay; ";
+  if (!(adam_tolerance >= 0) || adam_patience < 1) e << "bad Adam convergence settings; ";
+  return e.str();
+}
+
+at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, LatentOptimizer method,
+                           const LatentOptimizerSettings& settings, const TaskContext& ctx, LatentOptimizerStats* stats,
+                           int iteration_offset, int iteration_total) {
   *stats = LatentOptimizerStats{};
   const int total = iteration_total > 0 ? iteration_total : settings.max_iterations;
-  return settings.method == LatentOptimizer::Lbfgs
+  return method == LatentOptimizer::Lbfgs
              ? lbfgs(energy, x0, settings, ctx, iteration_offset, total, stats)
              : adam(energy, x0, settings, ctx, iteration_offset, total, stats);
 }

@@ -44,44 +44,11 @@ int window_iterations(const LatentSolverOptions& o, const MotionConstraints& wc,
   return (!wc.effectors.empty() || longest >= 40) ? 60 : default_iterations(o.method);
 }
 
-// The energy of a flat latent vector x = [z_l, z_g] (float, [zl + zg]).
-struct FlatEnergy {
-  const NemfModel& model;
-  const WindowProblem& problem;
-  const EnergyWeights& weights;
-  int zl, zg;
-
-  EnergyTerms operator()(const at::Tensor& x) const {
-    return evaluate_energy(model, problem, weights, x.narrow(0, 0, zl).view({1, zl}), x.narrow(0, zl, zg).view({1, zg}));
-  }
-  LatentEnergy total() const {
-    return [this](const at::Tensor& x) { return (*this)(x).total; };
-  }
-  std::vector<std::pair<std::string, double>> terms(const at::Tensor& x, double* total) const {
-    at::NoGradGuard no_grad;
-    EnergyTerms e = (*this)(x);
-    std::vector<std::pair<std::string, double>> out;
-    for (const auto& t : e.terms) out.emplace_back(t.first, t.second.item<double>());
-    *total = e.total.item<double>();
-    return out;
-  }
-};
-
-LatentOptimizerSettings optimizer_settings(const LatentSolverOptions& o, int cap) {
-  LatentOptimizerSettings s;
-  s.method = o.method == SolverMethod::Adam ? LatentOptimizer::Adam : LatentOptimizer::Lbfgs;
-  s.max_iterations = cap;
-  s.lbfgs_rank = o.lbfgs_rank;
-  s.lbfgs_eigenvalue_scaling = o.lbfgs_eigenvalue_scaling;
-  s.function_tolerance = o.function_tolerance;
-  s.gradient_tolerance = o.gradient_tolerance;
-  s.parameter_tolerance = o.parameter_tolerance;
-  s.adam_lr = o.adam_lr;
-  s.adam_decay_every = o.adam_decay_every;
-  s.adam_decay = o.adam_decay;
-  s.adam_tolerance = o.adam_tolerance;
-  s.adam_patience = o.adam_patience;
-  return s;
+// The energy of a window's problem as a function of the codes.
+CodeEnergy window_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& weights) {
+  return [&model, &problem, &weights](const at::Tensor& z_l, const at::Tensor& z_g) {
+    return evaluate_energy(model, problem, weights, z_l, z_g);
+  };
 }
 
 void measure_effectors(const Motion& motion, const MotionConstraints& c, EffectorError* e) {
@@ -372,13 +339,7 @@ void reach_effectors(const MotionConstraints& c, int falloff, Motion* out) {
 
 std::string LatentSolverOptions::validate() const {
   std::ostringstream e;
-  if (max_iterations < 0) e << "max_iterations must be >= 0; ";
-  if (lbfgs_rank < 1) e << "lbfgs_rank must be >= 1; ";
-  if (!(function_tolerance >= 0) || !(gradient_tolerance >= 0) || !(parameter_tolerance >= 0))
-    e << "tolerances must be >= 0; ";
-  if (!(adam_lr > 0) || !std::isfinite(adam_lr)) e << "adam_lr must be positive; ";
-  if (adam_decay_every < 1 || !(adam_decay > 0 && adam_decay <= 1)) e << "bad Adam decay; ";
-  if (!(adam_tolerance >= 0) || adam_patience < 1) e << "bad Adam convergence settings; ";
+  e << LatentOptimizerSettings::validate();
   if (overlap < 1) e << "overlap must be >= 1; ";
   if (keyed_iterations < 0) e << "keyed_iterations must be >= 0; ";
   const EnergyWeights& w = weights;
@@ -407,8 +368,8 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
   if (!start.z_l.defined() || !start.z_g.defined() || start.z_l.numel() != zl || start.z_g.numel() != zg)
     throw InputError("initial codes must have " + std::to_string(zl) + " + " + std::to_string(zg) + " values");
   const auto t0 = Clock::now();
-  const FlatEnergy energy{model, problem, options.weights, zl, zg};
-  const at::Tensor x0 = at::cat({start.z_l.reshape({zl}), start.z_g.reshape({zg})}).to(at::kFloat).detach();
+  const FlatLatentEnergy energy(window_energy(model, problem, options.weights), zl, zg);
+  const at::Tensor x0 = energy.join(start.z_l, start.z_g);
   const int cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.method);
   const int total = iteration_total > 0 ? iteration_total : cap;
 
@@ -421,23 +382,23 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
   if (options.method == SolverMethod::Lbfgs && options.keyed_iterations > 0 && dense) {
     EnergyWeights keyed = w;
     keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
-    const FlatEnergy cheap{model, problem, keyed, zl, zg};
+    const FlatLatentEnergy cheap(window_energy(model, problem, keyed), zl, zg);
     LatentOptimizerStats first;
-    x = minimize_latent(cheap.total(), x, optimizer_settings(options, options.keyed_iterations), ctx, &first,
+    x = minimize_latent(cheap.total(), x, options.method, options.capped(options.keyed_iterations), ctx, &first,
                         iteration_offset, total);
     s.keyed_iterations = first.iterations;
     s.evaluations += first.evaluations;
   }
   LatentOptimizerStats main;
-  x = minimize_latent(energy.total(), x, optimizer_settings(options, cap), ctx, &main,
+  x = minimize_latent(energy.total(), x, options.method, options.capped(cap), ctx, &main,
                       iteration_offset + s.keyed_iterations, total);
   s.iterations = s.keyed_iterations + main.iterations;
   s.evaluations += main.evaluations;
   s.converged = main.converged;
   s.message = main.message;
   s.final_terms = energy.terms(x, &s.final_energy);
-  out.z_l = x.narrow(0, 0, zl).reshape({1, zl}).clone();
-  out.z_g = x.narrow(0, zl, zg).reshape({1, zg}).clone();
+  out.z_l = energy.z_l(x);
+  out.z_g = energy.z_g(x);
   s.wall_ms = ms_since(t0);
   return out;
 }

@@ -68,45 +68,34 @@
 #include "prior/motion/motion.h"
 #include "tasks/energies.h"
 #include "tasks/initializers.h"
+#include "tasks/latent_optimizer.h"
 #include "tasks/task_context.h"
 
 namespace mf {
 
 class NemfModel;
 
-enum class SolverMethod { Lbfgs, Adam };
+/// The optimiser of a latent solve (tasks/latent_optimizer.h).
+using SolverMethod = LatentOptimizer;
 
-struct LatentSolverOptions {
+/// The options of complete_motion() and solve_latents(). The optimiser's
+/// settings are embedded (LatentOptimizerSettings, with its defaults:
+/// function tolerance 1e-3, gradient tolerance 1e-8, parameter tolerance
+/// 1e-6, L-BFGS rank 20; Adam lr 0.1, x0.7 every 200 iterations, stopping when
+/// the best energy improves by less than 1e-4 over 100 iterations).
+/// max_iterations is the cap per window; 0 means the method's default: Adam
+/// 600; L-BFGS 40, or 60 for a window with end-effector targets or with 40 or
+/// more frames in a row without a key (measured: quality keeps improving up
+/// to 40 iterations everywhere, to 60 on long gaps; docs/BENCHMARKS.md).
+struct LatentSolverOptions : LatentOptimizerSettings {
   SolverMethod method = SolverMethod::Lbfgs;
   EnergyWeights weights;
-  /// Iteration cap per window; 0 means the method's default: Adam 600; L-BFGS
-  /// 40, or 60 for a window with end-effector targets or with 40 or more
-  /// frames in a row without a key (measured: quality keeps improving up to
-  /// 40 iterations everywhere, to 60 on long gaps; docs/BENCHMARKS.md).
-  int max_iterations = 0;
 
-  // L-BFGS (Ceres GradientProblemSolver).
-  int lbfgs_rank = 20;               ///< memory of the Hessian approximation
-  /// Ceres' use_approximate_eigenvalue_bfgs_scaling: scales the initial
-  /// inverse Hessian (helps when the energy's scale is far from 1).
-  bool lbfgs_eigenvalue_scaling = false;
   /// L-BFGS only: first up to this many iterations on the terms that need
   /// only the key frames decoded (rotation, position, root orientation, latent
   /// prior), which cost a fraction of a dense evaluation, then the full energy
   /// (max_iterations). 0 = a single stage.
   int keyed_iterations = 0;
-  double function_tolerance = 1e-3;  ///< stop when |delta f| / f falls below this
-  double gradient_tolerance = 1e-8;  ///< ... or max |gradient| relative to the initial one below this
-  double parameter_tolerance = 1e-6; ///< ... or the step relative to |z| below this
-
-  // Adam (NeMF's reference).
-  double adam_lr = 0.1;
-  int adam_decay_every = 200;
-  double adam_decay = 0.7;
-  /// Converged when the best energy improved by less than this fraction over
-  /// the last `adam_patience` iterations.
-  double adam_tolerance = 1e-4;
-  int adam_patience = 100;
 
   /// Null means InterpolationEncoderInitializer.
   std::shared_ptr<const LatentInitializer> initializer;

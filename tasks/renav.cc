@@ -449,48 +449,11 @@ RenavDecoded decode_renav_window(const NemfModel& model, const RenavWindow& wind
 
 namespace {
 
-// The energy of a flat latent vector x = [z_l, z_g] (float, [zl + zg]).
-struct FlatEnergy {
-  const NemfModel& model;
-  const RenavWindow& window;
-  const RenavWeights& weights;
-  int zl, zg;
-
-  RenavEnergy operator()(const at::Tensor& x) const {
-    return evaluate_renav_energy(model, window, weights, x.narrow(0, 0, zl).view({1, zl}),
-                                 x.narrow(0, zl, zg).view({1, zg}));
-  }
-  LatentEnergy total() const {
-    return [this](const at::Tensor& x) { return (*this)(x).total; };
-  }
-  double cost(const at::Tensor& x) const {
-    at::NoGradGuard no_grad;
-    return (*this)(x).total.item<double>();
-  }
-  std::vector<std::pair<std::string, double>> terms(const at::Tensor& x, double* total) const {
-    at::NoGradGuard no_grad;
-    RenavEnergy e = (*this)(x);
-    std::vector<std::pair<std::string, double>> out;
-    for (const auto& t : e.terms) out.emplace_back(t.first, t.second.item<double>());
-    *total = e.total.item<double>();
-    return out;
-  }
-};
-
-LatentOptimizerSettings optimizer_settings(const RenavOptions& o, int cap) {
-  LatentOptimizerSettings s;
-  s.method = o.solver == RenavSolver::Adam ? LatentOptimizer::Adam : LatentOptimizer::Lbfgs;
-  s.max_iterations = cap;
-  s.lbfgs_rank = o.lbfgs_rank;
-  s.function_tolerance = o.function_tolerance;
-  s.gradient_tolerance = o.gradient_tolerance;
-  s.parameter_tolerance = o.parameter_tolerance;
-  s.adam_lr = o.adam_lr;
-  s.adam_decay_every = o.adam_decay_every;
-  s.adam_decay = o.adam_decay;
-  s.adam_tolerance = o.adam_tolerance;
-  s.adam_patience = o.adam_patience;
-  return s;
+// The energy of a window as a function of the codes.
+CodeEnergy window_energy(const NemfModel& model, const RenavWindow& window, const RenavWeights& weights) {
+  return [&model, &window, &weights](const at::Tensor& z_l, const at::Tensor& z_g) {
+    return evaluate_renav_energy(model, window, weights, z_l, z_g);
+  };
 }
 
 const std::vector<std::string>& init_names() {
@@ -504,13 +467,7 @@ const std::vector<std::string>& init_names() {
 
 std::string RenavOptions::validate() const {
   std::ostringstream e;
-  if (max_iterations < 0) e << "max_iterations must be >= 0; ";
-  if (lbfgs_rank < 1) e << "lbfgs_rank must be >= 1; ";
-  if (!(function_tolerance >= 0) || !(gradient_tolerance >= 0) || !(parameter_tolerance >= 0))
-    e << "tolerances must be >= 0; ";
-  if (!(adam_lr > 0) || !std::isfinite(adam_lr)) e << "adam_lr must be positive; ";
-  if (adam_decay_every < 1 || !(adam_decay > 0 && adam_decay <= 1)) e << "bad Adam decay; ";
-  if (!(adam_tolerance >= 0) || adam_patience < 1) e << "bad Adam convergence settings; ";
+  e << LatentOptimizerSettings::validate();
   if (overlap < 0) e << "overlap must be >= 0; ";
   const RenavWeights& w = weights;
   for (double v : {w.path, w.joints, w.heading, w.foot_skating, w.continuity}) {
@@ -613,7 +570,7 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
     sum.begin = s;
     sum.length = T;
     const InitialGuess ref_code = encode_window(model, window.reference_segment, 0);
-    const FlatEnergy energy{model, window, options.weights, zl, zg};
+    const FlatLatentEnergy energy(window_energy(model, window, options.weights), zl, zg);
     at::Tensor x0;
     double best = std::numeric_limits<double>::infinity();
     for (const std::string& name : inits) {
@@ -628,7 +585,7 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
         z_g = at::empty({1, zg}, at::kFloat);
         for (int i = 0; i < zg; ++i) z_g.data_ptr<float>()[i] = normal(rng);
       }
-      const at::Tensor x = at::cat({ref_code.z_l.reshape({zl}), z_g.reshape({zg})}).to(at::kFloat).detach();
+      const at::Tensor x = energy.join(ref_code.z_l, z_g);
       const double e = energy.cost(x);
       sum.init_energies.emplace_back(name, e);
       if (e < best || !x0.defined()) {
@@ -639,8 +596,8 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
     }
     sum.initial_terms = energy.terms(x0, &sum.initial_energy);
     LatentOptimizerStats stats;
-    const at::Tensor x =
-        minimize_latent(energy.total(), x0, optimizer_settings(options, cap), ctx, &stats, iterations, cap * windows);
+    const at::Tensor x = minimize_latent(energy.total(), x0, options.solver, options.capped(cap), ctx, &stats,
+                                         iterations, cap * windows);
     sum.iterations = stats.iterations;
     sum.evaluations = stats.evaluations;
     sum.converged = stats.converged;
@@ -648,8 +605,7 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
     sum.final_terms = energy.terms(x, &sum.final_energy);
     iterations += sum.iterations;
 
-    const RenavDecoded dec =
-        decode_renav_window(model, window, x.narrow(0, 0, zl).reshape({1, zl}), x.narrow(0, zl, zg).reshape({1, zg}));
+    const RenavDecoded dec = decode_renav_window(model, window, energy.z_l(x), energy.z_g(x));
     Motion piece = Motion::identity(reference.skeleton, T, fm);
     write_window(dec.local_rotations, dec.root_positions, window.transform, &piece, 0);
     for (int f = 0; f < T; ++f) {

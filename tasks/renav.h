@@ -93,6 +93,8 @@
 #include "prior/model/representation.h"
 #include "prior/motion/motion.h"
 #include "tasks/task_context.h"
+#include "tasks/latent_energy.h"
+#include "tasks/latent_optimizer.h"
 #include "tasks/soft_dtw.h"
 
 namespace mf {
@@ -190,10 +192,7 @@ RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, i
 
 /// The energy and its weighted terms (names "path", "joints", "heading",
 /// "foot_skating", "continuity"; only the active ones, in that order).
-struct RenavEnergy {
-  at::Tensor total;  ///< scalar
-  std::vector<std::pair<std::string, at::Tensor>> terms;
-};
+using RenavEnergy = EnergyTerms;
 
 /// The energy of a given canonical window motion: local rotations
 /// [1, T, J, 3, 3] (root in the canonical frame), root positions [1, T, 3]
@@ -220,24 +219,23 @@ RenavDecoded decode_renav_window(const NemfModel& model, const RenavWindow& wind
 
 // ---------------------------------------------------------------- the solve
 
-enum class RenavSolver { Lbfgs, Adam };
+/// The optimiser of a re-navigation (tasks/latent_optimizer.h).
+using RenavSolver = LatentOptimizer;
 
-struct RenavOptions {
+/// The options of renavigate(). The optimiser's settings are embedded
+/// (LatentOptimizerSettings) with re-navigation's defaults: max_iterations
+/// is the cap per window, 0 = the solver's default (L-BFGS 100, Adam 600);
+/// function tolerance 1e-5, gradient tolerance 1e-8, parameter tolerance
+/// 1e-7, L-BFGS rank 20; Adam lr 0.1, x0.7 every 200 iterations, stopping when
+/// the best energy improves by less than 1e-4 over 100 iterations.
+struct RenavOptions : LatentOptimizerSettings {
+  RenavOptions() {
+    function_tolerance = 1e-5;
+    parameter_tolerance = 1e-7;
+  }
+
   RenavSolver solver = RenavSolver::Lbfgs;
   RenavWeights weights;
-  /// Iteration cap per window; 0 = the solver's default (L-BFGS 100, Adam 600).
-  int max_iterations = 0;
-  // L-BFGS.
-  int lbfgs_rank = 20;
-  double function_tolerance = 1e-5;   ///< stop when |delta f| / f falls below this
-  double gradient_tolerance = 1e-8;
-  double parameter_tolerance = 1e-7;
-  // Adam (NeMF's reference).
-  double adam_lr = 0.1;
-  int adam_decay_every = 200;
-  double adam_decay = 0.7;
-  double adam_tolerance = 1e-4;       ///< relative improvement of the best energy ...
-  int adam_patience = 100;            ///< ... over this many iterations, else stop
   /// Initial z_g candidates tried, among "turned", "reference", "random"
   /// (see the top of this file); the lowest energy is kept. Empty = all three.
   std::vector<std::string> inits;
