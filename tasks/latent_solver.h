@@ -33,23 +33,22 @@
 //    position) the residual is blended with smoothstep weights from one key's
 //    to the other's; before the first and after the last such key it is held.
 //    The error of the raw solution at the keys, before this overwrite, is
-//    reported (CompletionReport::raw_known).
+//    reported (CompletionReport::raw_known). (tasks/residuals.h, with
+//    smoothstep ramps.)
 //  * End-effector targets: the energy pulls the motion toward them (measured on
 //    the blended motion, EnergyWeights::on_output, so that the overwrite does
 //    not undo it), and a final two-bone IK on the target joint's chain (the
 //    joint, its parent and grandparent) places the joint exactly, spreading
 //    the same displacement over `effector_falloff` frames on each side with
-//    raised-cosine weights. A target beyond the chain's reach is first brought
-//    within it by swinging the chain's parent (a shoulder) and, if that is
-//    not enough or the chain hangs from the root (a leg), by moving the root,
-//    with the same falloff and never at keys that fix those values. The
-//    error of the raw solution and of the output are reported.
-//  * Foot locking (foot_lock_ramp >= 0, on by default): where the global
-//    motion predictor reports an ankle in contact and the output's ankle is
-//    low, the ankle's ground position is held by two-bone IK on thigh and
-//    shin (known frames, constrained legs and effector frames untouched).
-//    The overwrite spreads key residuals over whole gaps, which makes planted
-//    feet slide; this takes most of that back.
+//    raised-cosine weights (tasks/effector_ik.h: a target beyond the chain's
+//    reach swings the shoulder or moves the root). The error of the raw
+//    solution and of the output are reported.
+//  * Foot locking (foot_lock_ramp >= 0, on by default; tasks/foot_locking.h):
+//    where the global motion predictor reports an ankle in contact and the
+//    output's ankle is low, the ankle's ground position is held by two-bone
+//    IK on thigh and shin (known frames, constrained legs and effector frames
+//    untouched). The overwrite spreads key residuals over whole gaps, which
+//    makes planted feet slide; this takes most of that back.
 //  * Inputs longer than a window: windows of the model's length overlapping by
 //    `overlap` frames, solved one after the other starting from the first
 //    window that holds a key fixing the root; each later (or earlier) window

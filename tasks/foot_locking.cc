@@ -1,0 +1,132 @@
+#include "tasks/foot_locking.h"
+
+#include <algorithm>
+#include <cctype>
+#include <string>
+
+#include "tasks/two_bone_ik.h"
+
+namespace mf {
+namespace {
+
+struct Leg {
+  int hip = -1, knee = -1, ankle = -1;
+};
+
+// The leg above `ankle`; false for a toe joint or an ankle without a thigh and
+// a shin below the root.
+bool leg_above(const Skeleton& skel, int ankle, Leg* leg) {
+  std::string name = skel.names[ankle];
+  std::transform(name.begin(), name.end(), name.begin(), [](unsigned char ch) { return std::tolower(ch); });
+  if (name.find("toe") != std::string::npos) return false;
+  leg->ankle = ankle;
+  leg->knee = skel.parents[ankle];
+  leg->hip = leg->knee > 0 ? skel.parents[leg->knee] : -1;
+  return leg->hip > 0;
+}
+
+// Frames the IK may not change (`fixed`: a key constrains a joint of the leg,
+// or an effector target sits on the leg, below it or above its hip) and frames
+// whose ankle position is known (`known`: a key gives the whole leg and the root).
+void protected_frames(const MotionConstraints& c, const Skeleton& skel, const Leg& leg, int frames,
+                      std::vector<char>* fixed, std::vector<char>* known) {
+  fixed->assign(frames, 0);
+  known->assign(frames, 0);
+  for (size_t i = 0; i < c.keys.size(); ++i) {
+    const int f = c.keys[i].frame;
+    const bool hip = c.key_has_joint(i, leg.hip), knee = c.key_has_joint(i, leg.knee),
+               ankle = c.key_has_joint(i, leg.ankle);
+    if (hip || knee || ankle) (*fixed)[f] = 1;
+    if (hip && knee && ankle && c.key_fixes_root(i)) (*known)[f] = 1;
+  }
+  for (const EffectorTarget& e : c.effectors) {
+    for (int j = e.joint; j >= 0; j = skel.parents[j]) {
+      if (j == leg.ankle || j == leg.knee || j == leg.hip) (*fixed)[e.frame] = 1;
+    }
+    for (int j = leg.ankle; j >= 0; j = skel.parents[j]) {
+      if (j == e.joint) (*fixed)[e.frame] = 1;  // an effector on the root or the spine above the hip
+    }
+  }
+}
+
+// Where the ankle is held at frame f of the contact [s, e]: the known ankle
+// positions inside the contact (`inside`, sorted), interpolated between them
+// and held beyond the first and the last, else the contact's mean position.
+Eigen::Vector3d lock_point(const GlobalPose& pose, int ankle, const std::vector<int>& inside,
+                           const Eigen::Vector3d& mean, int f) {
+  if (inside.empty()) return mean;
+  if (f <= inside.front()) return pose.position(inside.front(), ankle);
+  if (f >= inside.back()) return pose.position(inside.back(), ankle);
+  const auto it = std::lower_bound(inside.begin(), inside.end(), f);
+  const int b = *it, a = *(it - 1);
+  const double t = static_cast<double>(f - a) / (b - a);
+  return pose.position(a, ankle) * (1.0 - t) + pose.position(b, ankle) * t;
+}
+
+// Per frame, where the ankle is held (`goal`) and how much (`weight`): 1
+// inside each contact [s, e] of two or more frames, a linear ramp over `ramp`
+// frames on each side; where ramps of two contacts meet, the larger weight.
+void contact_goals(const GlobalPose& pose, int ankle, const std::vector<char>& on, const std::vector<char>& known,
+                   int ramp, std::vector<Eigen::Vector3d>* goal, std::vector<double>* weight) {
+  const int N = static_cast<int>(on.size());
+  goal->assign(N, Eigen::Vector3d::Zero());
+  weight->assign(N, 0.0);
+  for (int s = 0; s < N;) {
+    if (!on[s]) {
+      ++s;
+      continue;
+    }
+    int e = s;
+    while (e + 1 < N && on[e + 1]) ++e;
+    if (e > s) {
+      std::vector<int> inside;
+      for (int f = s; f <= e; ++f) {
+        if (known[f]) inside.push_back(f);
+      }
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (int f = s; f <= e; ++f) mean += pose.position(f, ankle);
+      mean /= (e - s + 1);
+      for (int f = std::max(0, s - ramp); f <= std::min(N - 1, e + ramp); ++f) {
+        const double w = f < s ? 1.0 - static_cast<double>(s - f) / (ramp + 1)
+                               : f > e ? 1.0 - static_cast<double>(f - e) / (ramp + 1) : 1.0;
+        if (w > (*weight)[f]) {
+          (*weight)[f] = w;
+          (*goal)[f] = lock_point(pose, ankle, inside, mean, std::clamp(f, s, e));
+        }
+      }
+    }
+    s = e + 1;
+  }
+}
+
+}  // namespace
+
+void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector<float>& contacts, int ramp,
+               Motion* out) {
+  const int N = out->num_frames(), F = rig.num_feet();
+  for (int k = 0; k < F; ++k) {
+    Leg leg;
+    if (!leg_above(out->skeleton, rig.foot_joints[k], &leg)) continue;
+    std::vector<char> fixed, known;
+    protected_frames(c, out->skeleton, leg, N, &fixed, &known);
+    GlobalPose pose = forward_kinematics(*out);
+    // In contact: the predictor says so and the output's ankle is low enough.
+    const double low = rig.foot_heights[k] + rig.foot_thresholds[k];
+    std::vector<char> on(N);
+    for (int f = 0; f < N; ++f)
+      on[f] = contacts[static_cast<size_t>(f) * F + k] > 0.5f && pose.position(f, leg.ankle).y() < low;
+    std::vector<Eigen::Vector3d> goal;
+    std::vector<double> weight;
+    contact_goals(pose, leg.ankle, on, known, ramp, &goal, &weight);
+    for (int f = 0; f < N; ++f) {
+      if (weight[f] <= 0.0 || fixed[f]) continue;
+      const Eigen::Vector3d now = pose.position(f, leg.ankle);
+      Eigen::Vector3d target = now;
+      target.x() += weight[f] * (goal[f].x() - now.x());
+      target.z() += weight[f] * (goal[f].z() - now.z());
+      two_bone_ik(out, &pose, f, leg.hip, leg.knee, leg.ankle, target);
+    }
+  }
+}
+
+}  // namespace mf

@@ -1,0 +1,29 @@
+// Foot locking after a latent solve. Spreading the residuals of the known
+// frames over whole gaps (tasks/residuals.h) makes planted feet slide; this
+// takes most of that back: while the global motion predictor says an ankle is
+// in contact (probability > 0.5 for at least two frames in a row) and the
+// ankle is within its contact threshold of its standing height
+// (RigInfo::foot_heights, foot_thresholds), its ground position (x, z) is
+// held by two-bone IK on thigh and shin (tasks/two_bone_ik.h). It is held at
+// the ankle's positions at the known frames inside the contact, interpolated
+// between them (so that nothing jumps at a known frame), else at the
+// contact's mean position, with a linear ramp of `ramp` frames on each side.
+// Frames whose leg joints a key constrains, or that carry an end-effector
+// target on the leg or on the joints above its hip, are not touched; toe
+// joints and feet without a thigh and a shin below the root are skipped.
+#pragma once
+
+#include <vector>
+
+#include "prior/model/representation.h"
+#include "prior/motion/motion.h"
+#include "tasks/motion_constraints.h"
+
+namespace mf {
+
+/// Locks the feet of `out` (see the top of this file). `contacts` holds the
+/// predictor's contact probabilities [frames, rig.num_feet()] row-major.
+void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector<float>& contacts, int ramp,
+               Motion* out);
+
+}  // namespace mf
