@@ -9,10 +9,10 @@
 #include <chrono>
 #include <cstdio>
 #include <algorithm>
-#include <cstdlib>
 #include <vector>
 #include <string>
 
+#include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 
 namespace {
@@ -31,10 +31,7 @@ double median_ms(F&& f, int reps) {
   return t[t.size() / 2];
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  int threads = argc > 1 ? std::atoi(argv[1]) : 2;
+int run(int threads) {
   mf::set_compute_threads(threads);
   Eigen::setNbThreads(threads);
   std::printf("threads: %d; BLAS: %s\n\n| m x k x n | torch mm (ms) | torch GFLOP/s | Eigen (ms) | Eigen GFLOP/s |\n|---|---|---|---|---|\n", threads, mf::blas_library().c_str());
@@ -49,4 +46,16 @@ int main(int argc, char** argv) {
     std::printf("| %d x %d x %d | %.3f | %.1f | %.3f | %.1f |\n", m, k, n, tt, gf / (tt * 1e-3), te, gf / (te * 1e-3));
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int threads = 2;
+  CLI::App app{"Times the prior's matrix products through libtorch (the system's libblas.so.3) and Eigen "
+               "(docs/BLAS.md).",
+               "blas-bench"};
+  mf::cli::use_tool_defaults(app);
+  app.add_option("threads", threads, "torch and Eigen threads")->check(mf::cli::at_least(1));
+  return mf::cli::run(app, argc, argv, [&] { return run(threads); });
 }

@@ -5,10 +5,8 @@
 // seams, sample), and prints markdown tables.
 #include <ATen/Parallel.h>
 
-#include <cerrno>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -17,6 +15,7 @@
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/options.h"
 #include "bench/text.h"
 #include "bench/prior_eval.h"
 #include "bench/protocol.h"
@@ -29,48 +28,12 @@
 #include "tasks/jobs.h"
 #include "tasks/model_rig.h"
 #include "tasks/transformer_methods.h"
+#include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 
 namespace {
 
 using mf::bench::fixed;
-using mf::bench::split_list;
-
-const char* kUsage =
-    "usage: motionfield-bench [options]\n"
-    "  --methods a,b     methods to run (default: every available method)\n"
-    "  --tasks a,b       gap, sparse, resample, and with a model recon, fps, seams, sample\n"
-    "                    (default: gap, sparse, resample, plus the prior's four when a model is loaded)\n"
-    "  --model PATH      the prior (default: the default model, see mf::default_model_path())\n"
-    "  --no-model        run without a prior (methods that need one are skipped)\n"
-    "  --twostage PATH   the two-stage transformer (methods context, detail, nemf-context, nemf-detail;\n"
-    "                    default: motionfield-twostage.mfm next to the model, if present)\n"
-    "  --citl PATH       the CITL transformer (methods citl, nemf-citl; default: motionfield-citl.mfm\n"
-    "                    next to the model, if present)\n"
-    "  --samples N       windows drawn for the sample task (default 256)\n"
-    "  --seed N          seed of the sample task (default 1)\n"
-    "  --threads N       torch intra-op threads (default 2)\n"
-    "  --source PATH     BVH folder or archive (default: the shared training archive)\n"
-    "  --cache-dir DIR   extraction and parse cache (default: <project>/.cache)\n"
-    "  --max-windows N   at most N windows per table row, spread evenly (default: all)\n"
-    "  --split NAME      validation (default) or train: the clips the tables are measured on (tune on train)\n"
-    "  --rig NAME        gap and sparse tables on a synthetic rig (mixamo, cmu, lafan1, unreal, rigify, smpl;\n"
-    "                    bench/synthetic_rigs.h): each window rewritten onto it, solved there, brought back;\n"
-    "                    needs motionfield-rig.json next to the model (default: native)\n"
-    "  --out FILE        also write the markdown to FILE\n"
-    "  --l2p-axes        add columns splitting L2P into horizontal (x, z) and vertical (y) parts\n"
-    "  --print-stats     add the table of training statistics (position mean / std, standing heights)\n"
-    "  --help            this text\n";
-
-int parse_int(const std::string& flag, const std::string& value, int min_value) {
-  char* end = nullptr;
-  errno = 0;
-  const long v = std::strtol(value.c_str(), &end, 10);
-  if (value.empty() || *end != '\0' || errno != 0 || v < min_value || v > 1000000) {
-    throw mf::InputError(flag + " expects an integer >= " + std::to_string(min_value) + ", got '" + value + "'");
-  }
-  return static_cast<int>(v);
-}
 
 const std::vector<std::string> kPriorTasks = {"recon", "fps", "seams", "sample"};
 
@@ -84,92 +47,54 @@ bool is_prior_task(const std::string& name) {
 struct Args {
   std::vector<std::string> methods;
   bool methods_given = false;
+  std::vector<std::string> task_names;  // as given, split below into:
   std::vector<mf::bench::Task> tasks;
   std::vector<std::string> prior_tasks;
   bool tasks_given = false;
   std::string model;
-  std::string twostage, citl;  // transformer files (default: next to the model)
+  mf::bench::TransformerFiles transformers;
   bool no_model = false;
   int samples = 256;
   int seed = 1;
   int threads = 2;
-  std::string source;
-  std::string cache_dir;
-  int max_windows = 0;
-  std::string split = "validation";
-  std::string rig;
+  mf::bench::DataSource data;
+  mf::bench::SplitChoice split;
+  std::string rig = "native";
   std::string out;
   bool l2p_axes = false;
   bool print_stats = false;
 };
 
-Args parse_args(int argc, char** argv) {
-  Args args;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag == "--help" || flag == "-h") {
-      std::cout << kUsage;
-      std::exit(0);
-    }
-    if (flag == "--l2p-axes") {
-      args.l2p_axes = true;
-      continue;
-    }
-    if (flag == "--print-stats") {
-      args.print_stats = true;
-      continue;
-    }
-    if (flag == "--no-model") {
-      args.no_model = true;
-      continue;
-    }
-    if (i + 1 >= argc) throw mf::InputError("unknown flag or missing value: " + flag + "\n" + kUsage);
-    const std::string value = argv[++i];
-    if (flag == "--methods") {
-      args.methods = split_list(value);
-      args.methods_given = true;
-    } else if (flag == "--tasks") {
-      args.tasks.clear();
-      args.prior_tasks.clear();
-      args.tasks_given = true;
-      for (const std::string& t : split_list(value)) {
-        if (is_prior_task(t)) {
-          args.prior_tasks.push_back(t);
-        } else {
-          args.tasks.push_back(mf::bench::task_from_name(t));
-        }
-      }
-    } else if (flag == "--model") {
-      args.model = value;
-    } else if (flag == "--twostage") {
-      args.twostage = value;
-    } else if (flag == "--citl") {
-      args.citl = value;
-    } else if (flag == "--samples") {
-      args.samples = parse_int(flag, value, 1);
-    } else if (flag == "--seed") {
-      args.seed = parse_int(flag, value, 0);
-    } else if (flag == "--threads") {
-      args.threads = parse_int(flag, value, 1);
-    } else if (flag == "--source") {
-      args.source = value;
-    } else if (flag == "--cache-dir") {
-      args.cache_dir = value;
-    } else if (flag == "--rig") {
-      if (value != "native") mf::bench::rig_variant(value);  // validates the name
-      args.rig = value == "native" ? "" : value;
-    } else if (flag == "--split") {
-      if (value != "validation" && value != "train") throw mf::InputError("--split: validation or train, not '" + value + "'");
-      args.split = value;
-    } else if (flag == "--max-windows") {
-      args.max_windows = parse_int(flag, value, 0);
-    } else if (flag == "--out") {
-      args.out = value;
-    } else {
-      throw mf::InputError("unknown flag " + flag + "\n" + kUsage);
-    }
-  }
+void add_options(CLI::App& app, Args& args) {
+  mf::bench::add_list_option(app, "--methods", args.methods, "methods to run (default: every available method)");
+  mf::bench::add_list_option(app, "--tasks", args.task_names,
+                             "gap, sparse, resample, and with a model recon, fps, seams, sample (default: gap, sparse, "
+                             "resample, plus the prior's four when a model is loaded)");
+  app.add_option("--model", args.model, "the prior (default: the default model, see mf::default_model_path())");
+  app.add_flag("--no-model", args.no_model, "run without a prior (methods that need one are skipped)");
+  mf::bench::add_transformer_options(app, args.transformers);
+  app.add_option("--samples", args.samples, "windows drawn for the sample task")->check(mf::cli::at_least(1));
+  app.add_option("--seed", args.seed, "seed of the sample task")->check(mf::cli::at_least(0));
+  mf::bench::add_threads_option(app, args.threads);
+  mf::bench::add_data_options(app, args.data);
+  mf::bench::add_split_options(app, args.split);
+  app.add_option("--rig", args.rig,
+                 "gap and sparse tables on a synthetic rig (mixamo, cmu, lafan1, unreal, rigify, smpl; "
+                 "bench/synthetic_rigs.h): each window rewritten onto it, solved there, brought back; needs "
+                 "motionfield-rig.json next to the model")
+      ->each([](const std::string& name) {
+        if (name != "native") mf::bench::rig_variant(name);  // validates the name
+      });
+  app.add_option("--out", args.out, "also write the markdown to FILE");
+  app.add_flag("--l2p-axes", args.l2p_axes, "add columns splitting L2P into horizontal (x, z) and vertical (y) parts");
+  app.add_flag("--print-stats", args.print_stats,
+               "add the table of training statistics (position mean / std, standing heights)");
+}
+
+// The checks and defaults that depend on several options.
+void resolve(Args& args) {
   const std::vector<std::string> available = mf::available_methods();
+  args.methods_given = !args.methods.empty();
   if (args.methods.empty()) args.methods = available;
   for (const std::string& m : args.methods) {
     bool found = false;
@@ -180,6 +105,14 @@ Args parse_args(int argc, char** argv) {
       throw mf::InputError("unknown method '" + m + "' (available: " + list + ")");
     }
   }
+  args.tasks_given = !args.task_names.empty();
+  for (const std::string& t : args.task_names) {
+    if (is_prior_task(t)) {
+      args.prior_tasks.push_back(t);
+    } else {
+      args.tasks.push_back(mf::bench::task_from_name(t));
+    }
+  }
   if (!args.tasks_given) args.tasks = mf::bench::all_tasks();
   if (args.no_model && !args.model.empty()) throw mf::InputError("--model and --no-model exclude each other");
   if (!args.no_model && args.model.empty()) args.model = mf::default_model_path();
@@ -187,21 +120,17 @@ Args parse_args(int argc, char** argv) {
   if (!args.prior_tasks.empty() && args.model.empty()) {
     throw mf::InputError("the tasks recon, fps, seams and sample need a model (--model PATH)");
   }
-  if (args.source.empty()) args.source = mf::default_train_archive();
-  if (args.cache_dir.empty()) args.cache_dir = mf::default_cache_dir();
-  return args;
+  if (args.rig == "native") args.rig.clear();
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-int run(int argc, char** argv) {
-  const Args args = parse_args(argc, argv);
+int run(Args& args, const std::string& command) {
+  resolve(args);
   mf::set_compute_threads(args.threads);
   const auto run_start = std::chrono::steady_clock::now();
-  std::string command = "motionfield-bench";
-  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
 
   // The prior, loaded once, frozen, shared by every method and task.
   mf::TaskContext ctx;
@@ -212,7 +141,7 @@ int run(int argc, char** argv) {
     model->set_requires_grad(false);
     ctx.model = model;
     for (const std::string kind : {mf::kTwoStageKind, mf::kCitlKind}) {
-      const std::string given = kind == mf::kCitlKind ? args.citl : args.twostage;
+      const std::string given = kind == mf::kCitlKind ? args.transformers.citl : args.transformers.twostage;
       const std::string path = given.empty() ? mf::inbetweener_path_next_to(args.model, kind) : given;
       if (given.empty() && !std::ifstream(path)) continue;
       std::cerr << "loading transformer " << path << "\n";
@@ -221,18 +150,14 @@ int run(int argc, char** argv) {
     ctx.model_anatomy = mf::load_rig_anatomy_next_to(args.model, model->rig().skeleton);
   }
 
-  mf::DatasetOptions data_options;
-  data_options.source = args.source;
-  data_options.cache_dir = args.cache_dir;
-  data_options.verbose = true;
-  std::cerr << "loading " << args.source << "\n";
+  std::cerr << "loading " << args.data.source << "\n";
   const auto t0 = std::chrono::steady_clock::now();
-  const mf::Dataset data = mf::load_dataset(data_options);
+  const mf::Dataset data = mf::bench::load_data(args.data, true);
   std::cerr << "loaded " << data.train.size() << " training and " << data.validation.size()
             << " validation clips in "
             << std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() << " s\n";
-  if (data.validation.empty()) throw mf::InputError("the validation split of " + args.source + " is empty");
-  const std::vector<mf::Clip>& clips = args.split == "train" ? data.train : data.validation;
+  if (data.validation.empty()) throw mf::InputError("the validation split of " + args.data.source + " is empty");
+  const std::vector<mf::Clip>& clips = args.split.clips(data);
 
   const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);
   long validation_frames = 0;
@@ -248,7 +173,7 @@ int run(int argc, char** argv) {
   }
   md << "- validation clips: " << data.validation.size() << " (" << validation_frames << " frames)"
      << ", training clips: " << data.train.size() << "\n";
-  md << "- tables measured on the " << args.split << " split\n";
+  md << "- tables measured on the " << args.split.split << " split\n";
   md << "- L2P statistics: " << stats.windows << " training windows of 50 frames every 20, canonicalised at frame 9\n";
   md << "- standing heights (median of per-clip 5th percentiles, training split):";
   for (size_t i = 0; i < stats.feet.size(); ++i) {
@@ -256,7 +181,7 @@ int run(int argc, char** argv) {
        << " cm (threshold " << fixed(stats.feet[i].threshold_cm, 0) << " cm)";
   }
   md << "\n- torch threads: " << at::get_num_threads();
-  if (args.max_windows > 0) md << ", at most " << args.max_windows << " windows per row";
+  if (args.split.max_windows > 0) md << ", at most " << args.split.max_windows << " windows per row";
   md << "\n\n";
   if (args.print_stats) md << "### Training statistics\n\n" << mf::bench::format_eval_stats(stats) << "\n";
   std::cout << md.str() << std::flush;
@@ -266,7 +191,7 @@ int run(int argc, char** argv) {
     md << text;
   };
   mf::bench::ProtocolOptions options;
-  options.max_windows = args.max_windows;
+  options.max_windows = args.split.max_windows;
   options.rig = args.rig;
   options.rig_anatomy = ctx.model_anatomy;
   if (!args.rig.empty()) emit("- rig: " + args.rig + " (bench/synthetic_rigs.h)\n\n");
@@ -306,7 +231,7 @@ int run(int argc, char** argv) {
   }
 
   mf::bench::PriorEvalOptions prior_options;
-  prior_options.max_windows = args.max_windows;
+  prior_options.max_windows = args.split.max_windows;
   prior_options.samples = args.samples;
   prior_options.seed = static_cast<uint64_t>(args.seed);
   for (const std::string& task : args.prior_tasks) {
@@ -339,13 +264,11 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const mf::InputError& e) {
-    std::cerr << "motionfield-bench: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "motionfield-bench: error: " << e.what() << "\n";
-    return 1;
-  }
+  Args args;
+  CLI::App app{"The LaFAN1-style benchmark of docs/BENCHMARKS.md: markdown tables of every (task, method) pair.",
+               "motionfield-bench"};
+  mf::cli::use_tool_defaults(app);
+  add_options(app, args);
+  return mf::cli::run(app, argc, argv,
+                      [&] { return run(args, mf::bench::command_line("motionfield-bench", argc, argv)); });
 }

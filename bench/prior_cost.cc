@@ -16,9 +16,11 @@
 #include <string>
 #include <vector>
 
+#include "bench/options.h"
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 
 namespace {
@@ -74,50 +76,46 @@ Row measure(const std::string& name, const mf::NemfModel& model, int reps) {
   return {name, model.num_parameters(), decode, step};
 }
 
+// Measures every requested size and model and prints the table.
+int run(int threads, int reps, std::vector<std::string> sizes, const std::vector<std::string>& models) {
+  if (models.empty() && sizes.empty()) sizes = {"256x6:256:64", "384x8:384:96", "512x8:512:128", "1024x11:1024:256"};
+  mf::set_compute_threads(threads);
+  at::manual_seed(0);
+  std::vector<Row> rows;
+  for (const std::string& s : sizes) {
+    mf::NemfConfig c;
+    if (std::sscanf(s.c_str(), "%dx%d:%d:%d", &c.decoder_width, &c.decoder_layers, &c.zl, &c.zg) != 4) {
+      throw mf::InputError("--size expects WIDTHxLAYERS:ZL:ZG, got " + s);
+    }
+    mf::NemfModel m(c, placeholder_rig(21));
+    m.set_requires_grad(false);
+    rows.push_back(measure("decoder " + s, m, reps));
+  }
+  for (const std::string& path : models) {
+    mf::NemfModel m = mf::load_nemf(path);
+    m.set_requires_grad(false);
+    rows.push_back(measure(path + " (" + m.config().describe() + ")", m, reps));
+  }
+  std::printf("threads: %d, frames: 128, median of %d\n\n", threads, reps);
+  std::printf("| model | parameters | decode (ms) | decode + GMP, backward to z (ms) |\n|---|---|---|---|\n");
+  for (const Row& r : rows) {
+    std::printf("| %s | %.2f M | %.2f | %.2f |\n", r.name.c_str(), r.params / 1e6, r.decode_ms, r.step_ms);
+  }
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    int threads = 2, reps = 20;
-    std::vector<std::string> models, sizes;
-    for (int i = 1; i < argc; ++i) {
-      std::string a = argv[i];
-      if (i + 1 >= argc) throw mf::InputError("option " + a + " needs a value");
-      if (a == "--threads") threads = std::atoi(argv[++i]);
-      else if (a == "--reps") reps = std::max(1, std::atoi(argv[++i]));
-      else if (a == "--model") models.push_back(argv[++i]);
-      else if (a == "--size") sizes.push_back(argv[++i]);
-      else throw mf::InputError("unknown option " + a);
-    }
-    if (models.empty() && sizes.empty()) sizes = {"256x6:256:64", "384x8:384:96", "512x8:512:128", "1024x11:1024:256"};
-    mf::set_compute_threads(threads);
-    at::manual_seed(0);
-    std::vector<Row> rows;
-    for (const std::string& s : sizes) {
-      mf::NemfConfig c;
-      if (std::sscanf(s.c_str(), "%dx%d:%d:%d", &c.decoder_width, &c.decoder_layers, &c.zl, &c.zg) != 4) {
-        throw mf::InputError("--size expects WIDTHxLAYERS:ZL:ZG, got " + s);
-      }
-      mf::NemfModel m(c, placeholder_rig(21));
-      m.set_requires_grad(false);
-      rows.push_back(measure("decoder " + s, m, reps));
-    }
-    for (const std::string& path : models) {
-      mf::NemfModel m = mf::load_nemf(path);
-      m.set_requires_grad(false);
-      rows.push_back(measure(path + " (" + m.config().describe() + ")", m, reps));
-    }
-    std::printf("threads: %d, frames: 128, median of %d\n\n", threads, reps);
-    std::printf("| model | parameters | decode (ms) | decode + GMP, backward to z (ms) |\n|---|---|---|---|\n");
-    for (const Row& r : rows) {
-      std::printf("| %s | %.2f M | %.2f | %.2f |\n", r.name.c_str(), r.params / 1e6, r.decode_ms, r.step_ms);
-    }
-    return 0;
-  } catch (const mf::InputError& e) {
-    std::fprintf(stderr, "prior-cost: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "prior-cost: internal error: %s\n", e.what());
-    return 1;
-  }
+  int threads = 2, reps = 20;
+  std::vector<std::string> models, sizes;
+  CLI::App app{"The cost of one latent-solver iteration for prior sizes (docs/PRIOR_SIZES.md); without --model or "
+               "--size it measures the pilot sizes.",
+               "prior-cost"};
+  mf::cli::use_tool_defaults(app);
+  mf::bench::add_threads_option(app, threads);
+  app.add_option("--reps", reps, "repetitions (the median is reported)")->check(mf::cli::at_least(1));
+  mf::cli::repeatable(app.add_option("--model", models, "a model file to measure (repeatable)"));
+  mf::cli::repeatable(app.add_option("--size", sizes, "a decoder size WIDTHxLAYERS:ZL:ZG to measure (repeatable)"));
+  return mf::cli::run(app, argc, argv, [&] { return run(threads, reps, sizes, models); });
 }

@@ -6,7 +6,7 @@
 // clip. Prints a markdown table (docs/BENCHMARKS.md, "Re-navigation") and writes
 // a few results as BVH files, their path CSVs and SVG top views.
 //
-//   renav-bench [--model FILE] [--threads N] [--clips N] [--paths straight,circle0.5,circle1.5,sine]
+//   renav-bench [--model FILE] [--source PATH] [--cache-dir DIR] [--threads N] [--clips N] [--paths straight,circle0.5,circle1.5,sine]
 //               [--methods turned,nemf,nemf-adam] [--iterations N] [--adam-iterations N] [--ftol X]
 //               [--w-path X] [--w-joints X] [--w-heading X] [--w-skate X] [--w-continuity X]
 //               [--inits turned,reference,random] [--write N] [--out-dir DIR] [--out FILE]
@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/options.h"
 #include "bench/text.h"
 #include "prior/data/dataset.h"
 #include "prior/model/model_file.h"
@@ -55,12 +56,12 @@
 #include "prior/motion/motion_bvh.h"
 #include "tasks/renav.h"
 #include "tasks/soft_dtw.h"
+#include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 
 namespace {
 
 using mf::bench::fixed;
-using mf::bench::split_list;
 using mf::bench::ms_since;
 
 using Clock = std::chrono::steady_clock;
@@ -69,6 +70,7 @@ constexpr int kMaxReference = 600;  // frames of a clip used as the reference
 
 struct Args {
   std::string model;
+  mf::bench::DataSource data;
   int threads = 1;
   int clips = 6;
   std::vector<std::string> paths{"straight", "circle0.5", "circle1.5", "sine"};
@@ -82,33 +84,33 @@ struct Args {
   std::string out;
 };
 
-Args parse_args(int argc, char** argv) {
-  Args a;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag == "--help") {
-      std::printf("see the top of bench/renav_bench.cc\n");
-      std::exit(0);
-    }
-    if (i + 1 >= argc) throw mf::InputError("missing value for " + flag);
-    const std::string v = argv[++i];
-    if (flag == "--model") a.model = v;
-    else if (flag == "--threads") a.threads = std::max(1, std::atoi(v.c_str()));
-    else if (flag == "--clips") a.clips = std::max(1, std::atoi(v.c_str()));
-    else if (flag == "--paths") a.paths = split_list(v);
-    else if (flag == "--methods") a.methods = split_list(v);
-    else if (flag == "--inits") a.inits = split_list(v);
-    else if (flag == "--write") a.write = std::atoi(v.c_str());
-    else if (flag == "--profile") a.profile = std::atoi(v.c_str());
-    else if (flag == "--verbose") a.verbose = std::atoi(v.c_str());
-    else if (flag == "--out-dir") a.out_dir = v;
-    else if (flag == "--out") a.out = v;
-    else if (flag.rfind("--", 0) == 0) a.numbers[flag.substr(2)] = std::atof(v.c_str());
-    else throw mf::InputError("unknown argument " + flag);
-  }
-  if (a.model.empty()) a.model = mf::default_model_path();
-  if (a.model.empty()) throw mf::InputError("no default model: pass --model FILE");
-  return a;
+void add_options(CLI::App& app, Args& a) {
+  app.add_option("--model", a.model, "the prior (default: the default model, see mf::default_model_path())");
+  mf::bench::add_data_options(app, a.data);
+  mf::bench::add_threads_option(app, a.threads);
+  app.add_option("--clips", a.clips, "reference clips (validation clips walking or running)")
+      ->check(mf::cli::at_least(1));
+  mf::bench::add_list_option(app, "--paths", a.paths, "straight, circle<R> (radius R in metres), sine");
+  mf::bench::add_list_option(app, "--methods", a.methods, "turned (the baseline), nemf, nemf-adam")
+      ->check(CLI::IsMember({"turned", "nemf", "nemf-adam"}));
+  mf::bench::add_list_option(app, "--inits", a.inits,
+                             "the solver's starts, among turned, reference, random (default: the solver's)");
+  app.add_option("--write", a.write, "write BVH results, path CSVs and SVG top views of the first N clips");
+  app.add_option("--profile", a.profile, "print the cost of one energy evaluation, median of N (0: no)");
+  app.add_option("--verbose", a.verbose, "1: print every window's terms before and after the solve");
+  app.add_option("--out-dir", a.out_dir, "folder of the written results");
+  app.add_option("--out", a.out, "also write the markdown to FILE");
+  mf::bench::add_number_options(app, a.numbers,
+                                {{"iterations", "L-BFGS iteration cap per window (0: the default)"},
+                                 {"adam-iterations", "Adam iteration cap per window (0: the default)"},
+                                 {"ftol", "relative function tolerance"},
+                                 {"overlap", "frames shared by consecutive windows"},
+                                 {"w-path", "weight of the root path"},
+                                 {"w-joints", "weight of the soft-DTW divergence of the joints"},
+                                 {"w-heading", "weight of the soft-DTW divergence of the heading"},
+                                 {"w-skate", "weight of foot skating"},
+                                 {"w-continuity", "weight of the continuity with the previous window"}},
+                                "Solver settings (default: tasks/renav.h)");
 }
 
 mf::RenavOptions options_for(const Args& a, const std::string& method) {
@@ -319,20 +321,17 @@ std::string profile(const mf::NemfModel& model, const mf::Motion& ref, int n) {
   return s.str();
 }
 
-int run(int argc, char** argv) {
-  const Args args = parse_args(argc, argv);
+int run(Args& args, const std::string& command) {
+  if (args.model.empty()) args.model = mf::default_model_path();
+  if (args.model.empty()) throw mf::InputError("no default model: pass --model FILE");
+  for (const std::string& p : args.paths) test_polyline(p);  // fails early on an unknown path
   mf::set_compute_threads(args.threads);
-  std::string command = "renav-bench";
-  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
 
   mf::NemfModel model = mf::load_nemf(args.model);
   model.set_requires_grad(false);
   const mf::RigInfo& rig = model.rig();
   const double fps = model.config().fps;
-  mf::DatasetOptions data_options;
-  data_options.source = mf::default_train_archive();
-  data_options.cache_dir = mf::default_cache_dir();
-  const mf::Dataset data = mf::load_dataset(data_options);
+  const mf::Dataset data = mf::bench::load_data(args.data, false);
 
   // Foot joints and standing heights for the skating metric, from the model's rig.
   std::vector<mf::bench::FootJoint> feet = mf::bench::metric_foot_joints(rig.skeleton);
@@ -492,10 +491,11 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "renav-bench: %s\n", e.what());
-    return 1;
-  }
+  Args args;
+  CLI::App app{"Re-navigation (tasks/renav.h) of validation clips along NeMF's test paths (docs/BENCHMARKS.md, "
+               "\"Re-navigation\"); details at the top of bench/renav_bench.cc.",
+               "renav-bench"};
+  mf::cli::use_tool_defaults(app);
+  add_options(app, args);
+  return mf::cli::run(app, argc, argv, [&] { return run(args, mf::bench::command_line("renav-bench", argc, argv)); });
 }

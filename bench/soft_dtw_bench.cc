@@ -2,7 +2,7 @@
 // m x n cost matrix (m = n) at each thread count, then the divergence on
 // sequences the size of the re-navigation energy (128 frames, 22 joints x 3).
 // Prints markdown tables (median of several runs).
-//   usage: soft_dtw_bench [max_length] [threads ...]     (defaults: 4096, threads 1 2)
+//   usage: soft-dtw-bench [max_length] [threads ...]     (defaults: 4096, threads 1 2)
 #include <ATen/ATen.h>
 #include <ATen/Parallel.h>
 #include <torch/csrc/autograd/autograd.h>
@@ -10,11 +10,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <ctime>
 #include <vector>
 
 #include "tasks/soft_dtw.h"
+#include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 
 namespace {
@@ -48,13 +48,7 @@ Timing median_ms(F&& f, int reps) {
   return {wall[wall.size() / 2], cpu[cpu.size() / 2]};
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const int64_t max_length = argc > 1 ? std::atoll(argv[1]) : 4096;
-  std::vector<int> threads;
-  for (int i = 2; i < argc; ++i) threads.push_back(std::atoi(argv[i]));
-  if (threads.empty()) threads = {1, 2};
+int run(int64_t max_length, const std::vector<int>& threads) {
   const double gamma = mf::kNemfSoftDtwGamma;
   const auto f64 = at::TensorOptions().dtype(at::kDouble);
   at::manual_seed(0);
@@ -99,4 +93,20 @@ int main(int argc, char** argv) {
     }
   }
   return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int64_t max_length = 4096;
+  std::vector<int> threads{1, 2};
+  CLI::App app{"Times soft-DTW (tasks/soft_dtw.h) forward and forward + backward per sequence length and thread "
+               "count, and the divergence at the re-navigation energy's size.",
+               "soft-dtw-bench"};
+  mf::cli::use_tool_defaults(app);
+  app.add_option("max_length", max_length, "longest sequence length measured (of 16, 64, 128, 256, 1024, 4096)");
+  app.add_option("threads", threads, "thread counts to measure")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)
+      ->check(mf::cli::at_least(1));
+  return mf::cli::run(app, argc, argv, [&] { return run(max_length, threads); });
 }

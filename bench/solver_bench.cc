@@ -7,6 +7,7 @@
 // "Latent solvers").
 //
 //   solver-bench --model FILE [--split validation|train] [--threads N] [--max-windows N]
+//                [--source PATH] [--cache-dir DIR]
 //                [--tasks gap,sparse,caps,effector,partial,long,none] [--methods interp,nemf,nemf-adam]
 //                [--lengths 5,15] [--spacings 5,10] [--caps 5,10,20,40] [--speed N] [--out FILE]
 //                [--iterations N] [--ftol X] [--ptol X] [--rank N] [--eigen-scaling 0|1]
@@ -51,6 +52,7 @@
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/options.h"
 #include "bench/text.h"
 #include "bench/protocol.h"
 #include "prior/data/dataset.h"
@@ -63,22 +65,21 @@
 #include "tasks/initializers.h"
 #include "tasks/latent_solver.h"
 #include "tasks/transformer_methods.h"
+#include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 
 namespace {
 
 using mf::bench::fixed;
-using mf::bench::split_list;
-using mf::bench::int_list;
 using mf::bench::ms_since;
 
 using Clock = std::chrono::steady_clock;
 
 struct Args {
   std::string model;
-  std::string split = "validation";
+  mf::bench::SplitChoice split;
+  mf::bench::DataSource data;
   int threads = 1;
-  int max_windows = 0;
   std::vector<std::string> tasks{"gap", "sparse"};
   std::vector<std::string> methods{"interp", "nemf", "nemf-adam"};
   std::vector<int> lengths{5, 15, 30, 45, 90};
@@ -89,7 +90,7 @@ struct Args {
   std::map<std::string, double> numbers;  // solver overrides
   std::string penalty;
   std::string init;
-  std::string twostage, citl;   // transformer files (default: next to --model)
+  mf::bench::TransformerFiles transformer_files;  // default: next to --model
   mf::TaskContext transformers;  // the loaded transformers (filled by run())
 };
 
@@ -106,37 +107,51 @@ std::string transformer_initializer(const std::string& method) {
   return "";
 }
 
-Args parse_args(int argc, char** argv) {
-  Args a;
-  for (int i = 1; i < argc; ++i) {
-    const std::string flag = argv[i];
-    if (flag == "--help") {
-      std::printf("see the top of bench/solver_bench.cc\n");
-      std::exit(0);
-    }
-    if (i + 1 >= argc) throw mf::InputError("missing value for " + flag);
-    const std::string v = argv[++i];
-    if (flag == "--model") a.model = v;
-    else if (flag == "--split") a.split = v;
-    else if (flag == "--threads") a.threads = std::max(1, std::atoi(v.c_str()));
-    else if (flag == "--max-windows") a.max_windows = std::atoi(v.c_str());
-    else if (flag == "--tasks") a.tasks = split_list(v);
-    else if (flag == "--methods") a.methods = split_list(v);
-    else if (flag == "--lengths") a.lengths = int_list(v);
-    else if (flag == "--spacings") a.spacings = int_list(v);
-    else if (flag == "--caps") a.caps = int_list(v);
-    else if (flag == "--speed") a.speed = std::atoi(v.c_str());
-    else if (flag == "--out") a.out = v;
-    else if (flag == "--penalty") a.penalty = v;
-    else if (flag == "--init") a.init = v;
-    else if (flag == "--twostage") a.twostage = v;
-    else if (flag == "--citl") a.citl = v;
-    else if (flag.rfind("--", 0) == 0) a.numbers[flag.substr(2)] = std::atof(v.c_str());
-    else throw mf::InputError("unknown argument " + flag);
-  }
-  if (a.model.empty()) throw mf::InputError("--model FILE is required");
-  if (a.split != "validation" && a.split != "train") throw mf::InputError("--split is validation or train");
-  return a;
+void add_options(CLI::App& app, Args& a) {
+  app.add_option("--model", a.model, "the prior")->required();
+  mf::bench::add_split_options(app, a.split);
+  mf::bench::add_data_options(app, a.data);
+  mf::bench::add_threads_option(app, a.threads);
+  mf::bench::add_list_option(app, "--tasks", a.tasks, "gap, sparse, caps, effector, partial, long, none")
+      ->check(CLI::IsMember({"gap", "sparse", "caps", "effector", "partial", "long", "none"}));
+  mf::bench::add_list_option(app, "--methods", a.methods,
+                             "interp, nemf, nemf-adam; with the transformers context, detail, citl, nemf-context, "
+                             "nemf-detail, nemf-citl");
+  mf::bench::add_list_option(app, "--lengths", a.lengths, "gap lengths T of the gap and caps tasks");
+  mf::bench::add_list_option(app, "--spacings", a.spacings, "key spacings k of the sparse and caps tasks");
+  mf::bench::add_list_option(app, "--caps", a.caps, "L-BFGS iteration caps of the caps task");
+  app.add_option("--speed", a.speed, "add the speed table over N sparse windows (0: none)")
+      ->check(mf::cli::at_least(0));
+  app.add_option("--out", a.out, "also write the markdown to FILE");
+  app.add_option("--penalty", a.penalty, "squared or absolute (default: the solver's, squared)")
+      ->check(CLI::IsMember({"squared", "absolute"}));
+  app.add_option("--init", a.init,
+                 "the solver's initialiser (tasks/initializers.h; with the transformers also context-encoder, "
+                 "detail-encoder, citl-encoder)");
+  mf::bench::add_transformer_options(app, a.transformer_files);
+  mf::bench::add_number_options(app, a.numbers,
+                                {{"iterations", "L-BFGS iteration cap per window (0: the solver's default)"},
+                                 {"ftol", "L-BFGS relative function tolerance"},
+                                 {"ptol", "L-BFGS relative parameter tolerance"},
+                                 {"rank", "L-BFGS memory (rank of the Hessian approximation)"},
+                                 {"eigen-scaling", "1: Ceres' approximate eigenvalue scaling of L-BFGS, 0: off"},
+                                 {"keyed-iterations", "L-BFGS iterations on the key-frame terms first (0: none)"},
+                                 {"adam-iterations", "Adam iteration cap per window"},
+                                 {"adam-tol", "Adam's convergence tolerance (relative improvement)"}},
+                                "Solver settings (default: tasks/latent_solver.h)");
+  mf::bench::add_number_options(app, a.numbers,
+                                {{"overwrite", "1: overwrite the known values in the output, 0: the raw solution"},
+                                 {"lock-ramp", "foot-locking ramp in frames (negative: off)"},
+                                 {"effector-falloff", "end-effector IK falloff in frames (negative: off)"},
+                                 {"w-rot", "weight of the key rotations"},
+                                 {"w-pos", "weight of the key positions"},
+                                 {"w-root-rot", "weight of the key root orientations"},
+                                 {"w-root", "weight of the key root translations"},
+                                 {"w-prior", "weight of the latent prior"},
+                                 {"w-skate", "weight of foot skating"},
+                                 {"w-smooth", "weight of smoothness"},
+                                 {"w-effector", "weight of the end-effector targets"}},
+                                "Output and energy weights (default: tasks/latent_solver.h, tasks/energies.h)");
 }
 
 mf::LatentSolverOptions solver_options(const Args& a, const std::string& method) {
@@ -291,7 +306,7 @@ std::string constraint_table(const std::string& task, const std::string& method,
                              const std::vector<mf::Clip>& clips, const mf::bench::EvalStats& stats, const Args& args,
                              const Eigen::Vector3d& forward) {
   const int length = 128;
-  const auto windows = mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, 40), args.max_windows);
+  const auto windows = mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, 40), args.split.max_windows);
   const std::vector<int> keys = mf::bench::sparse_keyframes(length, 30);
   const std::vector<int> mids = {15, 45, 75, 105};
   const mf::Skeleton& skel = runner.model.rig().skeleton;
@@ -411,7 +426,7 @@ double mean_acceleration(const mf::GlobalPose& p, const std::vector<char>& selec
 std::string long_table(const std::string& method, const Runner& runner, const std::vector<mf::Clip>& clips,
                        const mf::bench::EvalStats& stats, const Args& args, const Eigen::Vector3d& forward) {
   const int length = 300;
-  const auto windows = mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, length), args.max_windows);
+  const auto windows = mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, length), args.split.max_windows);
   const std::vector<int> keys = mf::bench::sparse_keyframes(length, 20);
   std::vector<int> evaluated;
   for (int f = 0; f < length; ++f) {
@@ -496,7 +511,7 @@ Row gap_row(const Runner& runner, const std::string& method, const std::vector<m
   const mf::bench::ProtocolOptions protocol;
   const int length = protocol.context + T + 1, a = protocol.context, b = protocol.context + T;
   const auto windows =
-      mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, protocol.stride), runner.args.max_windows);
+      mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, protocol.stride), runner.args.split.max_windows);
   std::vector<int> evaluated, known;
   for (int f = 0; f < length; ++f) (f >= a && f < b ? evaluated : known).push_back(f);
   mf::bench::MetricAccumulator acc(stats);
@@ -518,7 +533,7 @@ Row sparse_row(const Runner& runner, const std::string& method, const std::vecto
   const mf::bench::ProtocolOptions protocol;
   const int length = protocol.sparse_window;
   const auto windows =
-      mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, protocol.stride), runner.args.max_windows);
+      mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, protocol.stride), runner.args.split.max_windows);
   const std::vector<int> keys = mf::bench::sparse_keyframes(length, k);
   std::vector<int> evaluated;
   for (int f = 0; f < length; ++f) {
@@ -536,26 +551,20 @@ Row sparse_row(const Runner& runner, const std::string& method, const std::vecto
   return row;
 }
 
-int run(int argc, char** argv) {
-  Args args = parse_args(argc, argv);
+int run(Args& args, const std::string& command) {
   mf::set_compute_threads(args.threads);
-  std::string command = "solver-bench";
-  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
 
   mf::NemfModel model = mf::load_nemf(args.model);
   model.set_requires_grad(false);
   for (const std::string kind : {"twostage", "citl"}) {
-    const std::string given = kind == "citl" ? args.citl : args.twostage;
+    const std::string given = kind == "citl" ? args.transformer_files.citl : args.transformer_files.twostage;
     const std::string path = given.empty() ? mf::inbetweener_path_next_to(args.model, kind) : given;
     if (given.empty() && !std::ifstream(path)) continue;
     (kind == "citl" ? args.transformers.citl : args.transformers.twostage) = mf::load_frozen_inbetweener(path, kind);
   }
-  mf::DatasetOptions data_options;
-  data_options.source = mf::default_train_archive();
-  data_options.cache_dir = mf::default_cache_dir();
-  const mf::Dataset data = mf::load_dataset(data_options);
+  const mf::Dataset data = mf::bench::load_data(args.data, false);
   const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);
-  const std::vector<mf::Clip>& clips = args.split == "train" ? data.train : data.validation;
+  const std::vector<mf::Clip>& clips = args.split.clips(data);
 
   std::ostringstream md;
   auto emit = [&](const std::string& text) {
@@ -563,7 +572,7 @@ int run(int argc, char** argv) {
     md << text;
   };
   emit("## solver-bench\n\n- command: `" + command + "`\n- model: " + args.model + " (" + model.config().describe() +
-       ")\n- split: " + args.split + " (" + std::to_string(clips.size()) + " clips)\n- torch threads: " +
+       ")\n- split: " + args.split.split + " (" + std::to_string(clips.size()) + " clips)\n- torch threads: " +
        std::to_string(at::get_num_threads()) + "\n- BLAS: " + mf::blas_library() + "\n");
   for (const char* kind : {"twostage", "citl"}) {
     const mf::InbetweenModel* t = args.transformers.inbetweener(kind);
@@ -681,13 +690,11 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
-    return run(argc, argv);
-  } catch (const mf::InputError& e) {
-    std::fprintf(stderr, "solver-bench: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "solver-bench: internal error: %s\n", e.what());
-    return 1;
-  }
+  Args args;
+  CLI::App app{"Quality and speed of the latent solvers against interpolation on the benchmark protocol's windows "
+               "(docs/BENCHMARKS.md, \"Latent solvers\"); the tasks are described at the top of bench/solver_bench.cc.",
+               "solver-bench"};
+  mf::cli::use_tool_defaults(app);
+  add_options(app, args);
+  return mf::cli::run(app, argc, argv, [&] { return run(args, mf::bench::command_line("solver-bench", argc, argv)); });
 }

@@ -12,6 +12,7 @@
 
 #include <cstdio>
 #include <exception>
+#include <limits>
 #include <string>
 
 #include "prior/motion/errors.h"
@@ -25,9 +26,14 @@ inline void use_tool_defaults(CLI::App& app) {
   app.get_formatter()->column_width(28);
 }
 
-/// An option that may be given several times and keeps every value.
+/// A check for integer options: at least `min` (CLI11's PositiveNumber prints
+/// the double range in full).
+inline CLI::Range at_least(int min) { return CLI::Range(min, std::numeric_limits<int>::max()); }
+
+/// An option that may be given several times, one value each time, and keeps
+/// every value ("--hp a=1 --hp b=2").
 inline CLI::Option* repeatable(CLI::Option* option) {
-  return option->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  return option->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)->allow_extra_args(false);
 }
 
 /// Parses argc/argv into `app`, then returns `body()`, mapping every outcome to

@@ -1,0 +1,61 @@
+#include "bench/options.h"
+
+#include "prior/util/command_line.h"
+
+namespace mf::bench {
+
+void add_transformer_options(CLI::App& app, TransformerFiles& files) {
+  app.add_option("--twostage", files.twostage,
+                 "the two-stage transformer (methods context, detail, nemf-context, nemf-detail; default: "
+                 "motionfield-twostage.mfm next to the model, if present)");
+  app.add_option("--citl", files.citl,
+                 "the CITL transformer (methods citl, nemf-citl; default: motionfield-citl.mfm next to the model, "
+                 "if present)");
+}
+
+void add_data_options(CLI::App& app, DataSource& data) {
+  app.add_option("--source", data.source, "BVH folder or .tar/.tar.xz/.tar.gz archive (default: the shared training "
+                                          "archive)");
+  app.add_option("--cache-dir", data.cache_dir, "extraction and parse cache (default: <project>/.cache)");
+}
+
+Dataset load_data(const DataSource& data, bool verbose) {
+  DatasetOptions options;
+  options.source = data.source;
+  options.cache_dir = data.cache_dir;
+  options.verbose = verbose;
+  return load_dataset(options);
+}
+
+const std::vector<Clip>& SplitChoice::clips(const Dataset& data) const {
+  return split == "train" ? data.train : data.validation;
+}
+
+void add_split_options(CLI::App& app, SplitChoice& choice) {
+  app.add_option("--split", choice.split,
+                 "validation or train: the clips the tables are measured on (tune on train)")
+      ->check(CLI::IsMember({"validation", "train"}));
+  app.add_option("--max-windows", choice.max_windows, "at most N windows per table row, spread evenly (0: all)")
+      ->check(mf::cli::at_least(0));
+}
+
+void add_threads_option(CLI::App& app, int& threads) {
+  app.add_option("--threads", threads, "torch intra-op threads")->check(mf::cli::at_least(1));
+}
+
+void add_number_options(CLI::App& app, std::map<std::string, double>& numbers, const NamedHelp& options,
+                        const std::string& group) {
+  for (const auto& [name, help] : options) {
+    app.add_option_function<double>(
+           "--" + name, [&numbers, name = name](double value) { numbers[name] = value; }, help)
+        ->group(group);
+  }
+}
+
+std::string command_line(const std::string& program, int argc, char** argv) {
+  std::string command = program;
+  for (int i = 1; i < argc; ++i) command += std::string(" ") + argv[i];
+  return command;
+}
+
+}  // namespace mf::bench

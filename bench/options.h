@@ -1,0 +1,73 @@
+// Command-line option groups shared by the benchmark programs, on CLI11
+// (prior/util/command_line.h runs them with the tools' exit codes): the
+// transformer files, the data set and its split, the thread count, lists and
+// numeric overrides of solver settings. Each group adds its options to a
+// CLI::App and fills a small struct whose defaults are the documented ones.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "prior/data/dataset.h"
+
+namespace mf::bench {
+
+/// --twostage PATH, --citl PATH: the transformer files; empty means the
+/// default file next to the model, when it exists
+/// (mf::inbetweener_path_next_to).
+struct TransformerFiles {
+  std::string twostage;
+  std::string citl;
+};
+void add_transformer_options(CLI::App& app, TransformerFiles& files);
+
+/// --source PATH, --cache-dir DIR: the clips (a BVH folder or archive) and the
+/// extraction and parse cache.
+struct DataSource {
+  std::string source = default_train_archive();
+  std::string cache_dir = default_cache_dir();
+};
+void add_data_options(CLI::App& app, DataSource& data);
+/// Loads `data` through the data pipeline (prior/data/dataset.h).
+Dataset load_data(const DataSource& data, bool verbose);
+
+/// --split validation|train, --max-windows N: the clips the tables are
+/// measured on (tune on train, report on validation) and how many windows
+/// per table row at most (0 = all).
+struct SplitChoice {
+  std::string split = "validation";
+  int max_windows = 0;
+  /// The chosen split of `data`.
+  const std::vector<Clip>& clips(const Dataset& data) const;
+};
+void add_split_options(CLI::App& app, SplitChoice& choice);
+
+/// --threads N (N >= 1): torch's intra-op threads; `threads` holds the default.
+void add_threads_option(CLI::App& app, int& threads);
+
+/// A comma-separated list, e.g. "--methods interp,nemf" or "--lengths 5,15":
+/// one argument per occurrence, split at the commas and converted to T.
+template <class T>
+CLI::Option* add_list_option(CLI::App& app, const std::string& name, std::vector<T>& values,
+                             const std::string& help) {
+  return app.add_option(name, values, help)
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+}
+
+/// One "--NAME X" option per (NAME, help) pair, in the group `group` of the
+/// help; a given value is stored in numbers[NAME] (absent when not given, so
+/// that the settings' own defaults apply).
+using NamedHelp = std::vector<std::pair<std::string, std::string>>;
+void add_number_options(CLI::App& app, std::map<std::string, double>& numbers, const NamedHelp& options,
+                        const std::string& group);
+
+/// "program arg1 arg2 ..." for the header of a report.
+std::string command_line(const std::string& program, int argc, char** argv);
+
+}  // namespace mf::bench
