@@ -4,65 +4,107 @@
 //                           [--zl N] [--zg N] [--max-minutes M] [--seed S] [--threads N] [--resume] ...
 //   motionfield-train twostage|citl --out DIR [--data PATH] [--hp key=value]... [--config FILE]
 //                           [--max-minutes M] [--seed S] [--threads N] [--resume] [--export PATH] ...
+//   motionfield-train rig --out FILE.json [--data PATH] [--cache-dir DIR] [--stride N]
 //
-// Exit codes: 0 ok, 2 bad input, 1 internal error.
+// `motionfield-train <command> --help` lists every option with its default.
+// --config FILE holds "key = value" lines ('#' starts a comment) with the
+// command's option names without "--"; an option given on the command line
+// takes precedence over the file. For twostage and citl any other key (and
+// "hp = KEY=VALUE") is a model hyperparameter.
+//
+// Exit codes: 0 ok, 2 bad input, 1 internal error (prior/util/command_line.h).
 #include <algorithm>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
 #include <map>
+#include <set>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "prior/data/dataset.h"
 #include "prior/inbetween/inbetweener.h"
 #include "prior/model/model_file.h"
 #include "prior/motion/errors.h"
 #include "prior/rig/retarget.h"
+#include "prior/util/command_line.h"
 #include "training/inbetween_trainer.h"
 #include "training/prior_trainer.h"
 
 namespace {
 
-const char* kUsage =
-    "usage: motionfield-train prior --out DIR [options]\n"
-    "       motionfield-train twostage --out DIR [in-betweener options]\n"
-    "       motionfield-train citl --out DIR [in-betweener options]\n"
-    "       motionfield-train rig --out FILE.json [--data PATH] [--cache-dir DIR] [--stride N]\n"
-    "                 measures the anatomy of the training data's rig (prior/rig/retarget.h) from the\n"
-    "                 training split, every N-th frame (default 2): models/motionfield-rig.json\n"
-    "\n"
-    "prior options:\n"
-    "  --data PATH          folder or .tar/.tar.xz/.tar.gz of BVH files (default: the shared training archive)\n"
-    "  --cache-dir DIR      extraction and parse cache (default: <project>/.cache)\n"
-    "  --config FILE        key = value lines, same keys as the flags below without '--'\n"
-    "  --width N --layers N --zl N --zg N --zg-layers N --encoder-channels N --pe N\n"
-    "  --gmp-width N --gmp-kernel N --gmp-blocks N --window N\n"
-    "  --max-minutes M      wall-time budget, counting earlier runs when resuming (default 60)\n"
-    "  --max-epochs N --batch N --stride N --frames-per-window N --lr X --lr-final X\n"
-    "  --kl-weight X --kl-warmup X --seed N --threads N (default 2) --max-train-clips N --max-steps N\n"
-    "  --resume             continue from DIR/last.* if present\n"
-    "  --export PATH        copy the best checkpoint to PATH at the end\n"
-    "  --quiet\n"
-    "\n"
-    "in-betweener options (twostage: context + detail transformers; citl):\n"
-    "  --data PATH --cache-dir DIR   as for the prior (same data, same split)\n"
-    "  --hp KEY=VALUE       a model hyperparameter (repeatable), e.g. --hp width=128 --hp layers=3\n"
-    "                       (keys of the kind: width, layers, heads, ffn, window, fps, ...)\n"
-    "  --config FILE        key = value lines: the options below without '--'; any other key is a\n"
-    "                       hyperparameter\n"
-    "  --max-minutes M      wall-time budget, counting earlier runs when resuming (default 60)\n"
-    "  --max-epochs N --max-steps N --batch N (32) --lr X (5e-4) --lr-final X (1e-5) --warmup F (0.03)\n"
-    "  --min-length N (12) --contact-weight X (0.5) --checkpoint-minutes M (5) --validate-minutes M (6)\n"
-    "  --epoch-steps N (0 = one pass over the training frames) --validation-windows N (256)\n"
-    "  --seed N --threads N (default 1) --max-train-clips N\n"
-    "  --resume             continue from DIR/last.* if present\n"
-    "  --export PATH        copy the best checkpoint to PATH at the end\n"
-    "  --quiet\n"
-    "\n"
-    "Exit codes: 0 ok, 2 bad input, 1 internal error.\n";
+// What every training command has besides its trainer's options.
+struct RunArgs {
+  std::string config;       // --config FILE
+  std::string export_path;  // --export PATH
+  bool quiet = false;
+};
 
-double number(const std::string& key, const std::string& value) {
+// The options the prior's and the in-betweeners' trainers share (same names in
+// both option structs).
+template <class Options>
+void add_run_options(CLI::App& cmd, Options& o, RunArgs& run) {
+  o.data = mf::default_train_archive();
+  o.cache_dir = mf::default_cache_dir();
+  cmd.add_option("--out", o.out_dir, "output folder: checkpoints, log.csv (required)");
+  cmd.add_option("--data", o.data, "folder or .tar/.tar.xz/.tar.gz of BVH files (default: the shared training archive)");
+  cmd.add_option("--cache-dir", o.cache_dir, "extraction and parse cache (default: <project>/.cache)");
+  cmd.add_option("--max-minutes", o.max_minutes, "wall-time budget, counting earlier runs when resuming");
+  cmd.add_option("--max-epochs", o.max_epochs, "at most this many epochs");
+  cmd.add_option("--max-steps", o.max_steps, "at most this many optimiser steps (0 = unlimited)");
+  cmd.add_option("--batch", o.batch, "windows per step");
+  cmd.add_option("--lr", o.lr, "learning rate (Adam)");
+  cmd.add_option("--lr-final", o.lr_final, "learning rate at the end of the cosine decay");
+  cmd.add_option("--seed", o.seed, "random seed");
+  cmd.add_option("--threads", o.threads, "torch intra-op threads");
+  cmd.add_option("--max-train-clips", o.max_train_clips, "use at most N training clips (0 = all)");
+  cmd.add_flag("--resume", o.resume, "continue from DIR/last.* if present");
+  cmd.add_option("--export", run.export_path, "copy the best checkpoint to PATH at the end");
+  cmd.add_flag("--quiet", run.quiet, "no progress lines on stderr");
+}
+
+void add_prior_options(CLI::App& cmd, mf::PriorTrainingOptions& o, RunArgs& run) {
+  cmd.add_option("--config", run.config, "key = value lines, same keys as the options without '--'");
+  add_run_options(cmd, o, run);
+  mf::NemfConfig& c = o.config;
+  const std::string sizes = "Model sizes (prior/model/nemf.h)";
+  cmd.add_option("--width", c.decoder_width, "decoder width")->group(sizes);
+  cmd.add_option("--layers", c.decoder_layers, "decoder layers")->group(sizes);
+  cmd.add_option("--zl", c.zl, "local latent size")->group(sizes);
+  cmd.add_option("--zg", c.zg, "global (root orientation) latent size")->group(sizes);
+  cmd.add_option("--zg-layers", c.zg_layers, "the last decoder layers that also take z_g")->group(sizes);
+  cmd.add_option("--encoder-channels", c.encoder_channels, "per-joint channels of the first skeleton convolution")
+      ->group(sizes);
+  cmd.add_option("--pe", c.pe_frequencies, "positional-encoding octaves")->group(sizes);
+  cmd.add_option("--gmp-width", c.gmp_width, "global motion predictor width")->group(sizes);
+  cmd.add_option("--gmp-kernel", c.gmp_kernel, "global motion predictor kernel")->group(sizes);
+  cmd.add_option("--gmp-blocks", c.gmp_blocks, "global motion predictor blocks")->group(sizes);
+  cmd.add_option("--window", c.window, "frames per window")->group(sizes);
+  cmd.add_option("--stride", o.stride, "frames between training windows");
+  cmd.add_option("--frames-per-window", o.frames_per_window, "decoded frames per window and step");
+  cmd.add_option("--kl-weight", o.kl_weight, "weight of the KL term after the warm-up");
+  cmd.add_option("--kl-warmup", o.kl_warmup, "fraction of the budget over which the KL weight rises from 0");
+}
+
+void add_inbetweener_options(CLI::App& cmd, mf::InbetweenTrainingOptions& o, std::vector<std::string>& hp,
+                             RunArgs& run) {
+  mf::cli::repeatable(cmd.add_option("--hp", hp,
+                                     "a model hyperparameter KEY=VALUE (repeatable), e.g. --hp width=128 --hp "
+                                     "layers=3 (keys of the kind: width, layers, heads, ffn, window, fps, ...)"));
+  cmd.add_option("--config", run.config,
+                 "key = value lines: the options without '--'; any other key is a hyperparameter");
+  add_run_options(cmd, o, run);
+  cmd.add_option("--warmup", o.warmup, "fraction of the budget with a linear learning-rate warm-up");
+  cmd.add_option("--min-length", o.min_length, "shortest training window, frames");
+  cmd.add_option("--contact-weight", o.contact_weight, "weight of the foot-contact loss");
+  cmd.add_option("--checkpoint-minutes", o.checkpoint_minutes, "write last.* at least this often");
+  cmd.add_option("--validate-minutes", o.validate_minutes, "an epoch ends after at most this long");
+  cmd.add_option("--epoch-steps", o.epoch_steps, "steps per epoch (0 = one pass over the training frames)");
+  cmd.add_option("--validation-windows", o.validation_windows, "validation windows (fixed seed)");
+  cmd.footer("Model hyperparameters go in --hp KEY=VALUE.");
+}
+
+double number(const std::string& what, const std::string& value) {
   size_t used = 0;
   double v = 0;
   try {
@@ -70,133 +112,82 @@ double number(const std::string& key, const std::string& value) {
   } catch (const std::exception&) {
     used = 0;
   }
-  if (used != value.size()) throw mf::InputError("--" + key + ": not a number: '" + value + "'");
+  if (used != value.size()) throw mf::InputError(what + ": not a number: '" + value + "'");
   return v;
 }
 
-void apply(mf::PriorTrainingOptions& o, std::string& export_path, const std::string& key, const std::string& value) {
-  auto i = [&] { return static_cast<int>(number(key, value)); };
-  auto d = [&] { return number(key, value); };
-  if (key == "data") o.data = value;
-  else if (key == "cache-dir") o.cache_dir = value;
-  else if (key == "out") o.out_dir = value;
-  else if (key == "width") o.config.decoder_width = i();
-  else if (key == "layers") o.config.decoder_layers = i();
-  else if (key == "zl") o.config.zl = i();
-  else if (key == "zg") o.config.zg = i();
-  else if (key == "zg-layers") o.config.zg_layers = i();
-  else if (key == "encoder-channels") o.config.encoder_channels = i();
-  else if (key == "pe") o.config.pe_frequencies = i();
-  else if (key == "gmp-width") o.config.gmp_width = i();
-  else if (key == "gmp-kernel") o.config.gmp_kernel = i();
-  else if (key == "gmp-blocks") o.config.gmp_blocks = i();
-  else if (key == "window") o.config.window = i();
-  else if (key == "max-minutes") o.max_minutes = d();
-  else if (key == "max-epochs") o.max_epochs = i();
-  else if (key == "batch") o.batch = i();
-  else if (key == "stride") o.stride = i();
-  else if (key == "frames-per-window") o.frames_per_window = i();
-  else if (key == "lr") o.lr = d();
-  else if (key == "lr-final") o.lr_final = d();
-  else if (key == "kl-weight") o.kl_weight = d();
-  else if (key == "kl-warmup") o.kl_warmup = d();
-  else if (key == "seed") o.seed = static_cast<uint64_t>(d());
-  else if (key == "threads") o.threads = i();
-  else if (key == "max-train-clips") o.max_train_clips = i();
-  else if (key == "max-steps") o.max_steps = i();
-  else if (key == "export") export_path = value;
-  else throw mf::InputError("unknown option --" + key);
+std::string trim(const std::string& s) {
+  const size_t a = s.find_first_not_of(" \t\r"), b = s.find_last_not_of(" \t\r");
+  return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
 }
 
-void apply(mf::InbetweenTrainingOptions& o, std::string& export_path, const std::string& key,
-           const std::string& value);
-
-template <class Options>
-void read_config(Options& o, std::string& export_path, const std::string& path) {
+// Applies the config file of `cmd` (see the top of this file) after the
+// command line was parsed. Keys that name no option of `cmd`, and the values
+// of "hp" keys, go to `hyperparameters` as "KEY=VALUE", or are an error when
+// it is null.
+void apply_config_file(CLI::App& cmd, const std::string& path, std::vector<std::string>* hyperparameters) {
   std::ifstream in(path);
   if (!in) throw mf::InputError(path + ": cannot open the config file");
+  std::set<const CLI::Option*> from_command_line;
+  for (const CLI::Option* opt : cmd.get_options()) {
+    if (opt->count() > 0) from_command_line.insert(opt);
+  }
   std::string line;
-  int n = 0;
-  while (std::getline(in, line)) {
-    ++n;
-    size_t hash = line.find('#');
-    if (hash != std::string::npos) line.resize(hash);
-    size_t eq = line.find('=');
-    auto trim = [](std::string s) {
-      size_t a = s.find_first_not_of(" \t\r"), b = s.find_last_not_of(" \t\r");
-      return a == std::string::npos ? std::string() : s.substr(a, b - a + 1);
-    };
-    if (trim(line).empty()) continue;
-    if (eq == std::string::npos) throw mf::InputError(path + ":" + std::to_string(n) + ": expected key = value");
-    apply(o, export_path, trim(line.substr(0, eq)), trim(line.substr(eq + 1)));
-  }
-}
-
-void apply(mf::InbetweenTrainingOptions& o, std::string& export_path, const std::string& key,
-           const std::string& value) {
-  auto i = [&] { return static_cast<int>(number(key, value)); };
-  auto d = [&] { return number(key, value); };
-  if (key == "data") o.data = value;
-  else if (key == "cache-dir") o.cache_dir = value;
-  else if (key == "out") o.out_dir = value;
-  else if (key == "max-minutes") o.max_minutes = d();
-  else if (key == "max-epochs") o.max_epochs = i();
-  else if (key == "max-steps") o.max_steps = i();
-  else if (key == "batch") o.batch = i();
-  else if (key == "lr") o.lr = d();
-  else if (key == "lr-final") o.lr_final = d();
-  else if (key == "warmup") o.warmup = d();
-  else if (key == "min-length") o.min_length = i();
-  else if (key == "contact-weight") o.contact_weight = d();
-  else if (key == "checkpoint-minutes") o.checkpoint_minutes = d();
-  else if (key == "validate-minutes") o.validate_minutes = d();
-  else if (key == "epoch-steps") o.epoch_steps = i();
-  else if (key == "validation-windows") o.validation_windows = i();
-  else if (key == "seed") o.seed = static_cast<uint64_t>(d());
-  else if (key == "threads") o.threads = i();
-  else if (key == "max-train-clips") o.max_train_clips = i();
-  else if (key == "export") export_path = value;
-  else if (key == "hp") {
-    size_t eq = value.find('=');
-    if (eq == std::string::npos || eq == 0) throw mf::InputError("--hp: expected KEY=VALUE, got '" + value + "'");
-    std::string k = value.substr(0, eq);
-    o.hyperparameters[k] = number("hp " + k, value.substr(eq + 1));
-  } else {
-    o.hyperparameters[key] = number(key, value);  // config files: any other key is a hyperparameter
-  }
-}
-
-int train_inbetweener_main(const std::string& kind, int argc, char** argv) {
-  mf::InbetweenTrainingOptions o;
-  o.kind = kind;
-  o.data = mf::default_train_archive();
-  o.cache_dir = mf::default_cache_dir();
-  std::string export_path;
-  for (int i = 2; i < argc; ++i) {
-    std::string a = argv[i];
-    if (a == "--resume") o.resume = true;
-    else if (a == "--quiet") o.verbose = false;
-    else if (a == "--help") {
-      std::fputs(kUsage, stdout);
-      return 0;
-    } else if (a.rfind("--", 0) == 0 && i + 1 < argc) {
-      std::string key = a.substr(2), value = argv[++i];
-      if (key == "config") read_config(o, export_path, value);
-      else {
-        // Flags on the command line must be known options or --hp.
-        static const char* known[] = {"data", "cache-dir", "out", "max-minutes", "max-epochs", "max-steps", "batch",
-                                      "lr", "lr-final", "warmup", "min-length", "contact-weight",
-                                      "checkpoint-minutes", "validate-minutes", "epoch-steps",
-                                      "validation-windows", "seed", "threads", "max-train-clips", "export", "hp"};
-        bool ok = false;
-        for (const char* k : known) ok = ok || key == k;
-        if (!ok) throw mf::InputError("unknown option --" + key + " (model hyperparameters go in --hp KEY=VALUE)");
-        apply(o, export_path, key, value);
-      }
-    } else {
-      throw mf::InputError("unexpected argument '" + a + "' (options take a value)");
+  for (int n = 1; std::getline(in, line); ++n) {
+    line = trim(line.substr(0, line.find('#')));
+    if (line.empty()) continue;
+    const std::string where = path + ":" + std::to_string(n) + ": ";
+    const size_t eq = line.find('=');
+    if (eq == std::string::npos) throw mf::InputError(where + "expected key = value");
+    const std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
+    CLI::Option* opt = key == "config" || key == "hp" ? nullptr : cmd.get_option_no_throw("--" + key);
+    if (opt == cmd.get_help_ptr()) opt = nullptr;
+    if (opt == nullptr) {
+      if (hyperparameters == nullptr) throw mf::InputError(where + "unknown option '" + key + "'");
+      hyperparameters->push_back(key == "hp" ? value : key + "=" + value);
+      continue;
+    }
+    if (from_command_line.count(opt)) continue;
+    try {
+      opt->clear();
+      opt->add_result(value);
+      opt->run_callback();
+    } catch (const CLI::Error& e) {
+      throw mf::InputError(where + e.what());
     }
   }
+}
+
+// "KEY=VALUE" lists (the config file's first, then the command line's, which
+// wins) into a hyperparameter map.
+std::map<std::string, double> hyperparameter_map(const std::vector<std::string>& from_config,
+                                                 const std::vector<std::string>& from_command_line) {
+  std::map<std::string, double> out;
+  for (const auto* list : {&from_config, &from_command_line}) {
+    for (const std::string& item : *list) {
+      const size_t eq = item.find('=');
+      if (eq == std::string::npos || eq == 0) throw mf::InputError("--hp: expected KEY=VALUE, got '" + item + "'");
+      const std::string key = trim(item.substr(0, eq));
+      out[key] = number("--hp " + key, trim(item.substr(eq + 1)));
+    }
+  }
+  return out;
+}
+
+int train_prior_main(mf::PriorTrainingOptions o, const RunArgs& run) {
+  o.verbose = !run.quiet;
+  mf::PriorTrainingResult r = mf::train_prior(o);
+  std::printf("trained %d epochs, %lld steps in %.1f min; best validation score %.4f: %s\n", r.epochs,
+              static_cast<long long>(r.steps), r.minutes, r.best_validation, r.best_path.c_str());
+  if (!run.export_path.empty()) {
+    mf::save_nemf(mf::load_nemf(r.best_path), run.export_path);
+    std::printf("exported %s\n", run.export_path.c_str());
+  }
+  return 0;
+}
+
+int train_inbetweener_main(mf::InbetweenTrainingOptions o, const RunArgs& run) {
+  o.verbose = !run.quiet;
   // Fail on bad hyperparameters before loading any data.
   if (!o.resume) {
     mf::RigInfo probe;
@@ -208,97 +199,82 @@ int train_inbetweener_main(const std::string& kind, int argc, char** argv) {
   mf::InbetweenTrainingResult r = mf::train_inbetweener(o);
   std::printf("trained %s: %d epochs, %lld steps in %.1f min (%.2f steps/s this run, %d threads); best validation "
               "loss %.4f: %s\n",
-              kind.c_str(), r.epochs, static_cast<long long>(r.steps), r.minutes, r.steps_per_second,
+              o.kind.c_str(), r.epochs, static_cast<long long>(r.steps), r.minutes, r.steps_per_second,
               std::max(1, o.threads), r.best_validation, r.best_path.c_str());
-  if (!export_path.empty()) {
-    mf::save_inbetweener(*mf::load_inbetweener(r.best_path), export_path);
-    std::printf("exported %s\n", export_path.c_str());
+  if (!run.export_path.empty()) {
+    mf::save_inbetweener(*mf::load_inbetweener(r.best_path), run.export_path);
+    std::printf("exported %s\n", run.export_path.c_str());
   }
+  return 0;
+}
+
+struct RigArgs {
+  mf::DatasetOptions data;
+  std::string out;
+  int stride = 2;
+};
+
+void add_rig_options(CLI::App& cmd, RigArgs& a) {
+  a.data.source = mf::default_train_archive();
+  a.data.cache_dir = mf::default_cache_dir();
+  cmd.add_option("--out", a.out, "the JSON file to write (models/motionfield-rig.json)")->required();
+  cmd.add_option("--data", a.data.source, "folder or .tar/.tar.xz/.tar.gz of BVH files (default: the shared training "
+                                          "archive)");
+  cmd.add_option("--cache-dir", a.data.cache_dir, "extraction and parse cache (default: <project>/.cache)");
+  cmd.add_option("--stride", a.stride, "every N-th frame of the training split")->check(mf::cli::at_least(1));
+}
+
+// motionfield-train rig: the rig anatomy of the training split, as JSON.
+int measure_rig_main(const RigArgs& a) {
+  const mf::Dataset data = mf::load_dataset(a.data);
+  mf::Motion all = mf::Motion::identity(data.skeleton, 0, 30.0);
+  for (const mf::Clip& c : data.train) {
+    for (int f = 0; f < c.motion.num_frames(); f += a.stride) {
+      for (int j = 0; j < c.motion.num_joints(); ++j) all.rotations.push_back(c.motion.rotation(f, j));
+      all.root_positions.push_back(c.motion.root_positions[f]);
+    }
+  }
+  const mf::RigAnatomy anatomy = mf::estimate_anatomy(all, mf::find_rig_parts(data.skeleton));
+  std::ofstream file(a.out);
+  file << anatomy.to_json(data.skeleton) << "\n";
+  if (!file) throw std::runtime_error("cannot write " + a.out);
+  std::printf("measured the rig anatomy on %d frames of %zu training clips: %s\n", all.num_frames(),
+              data.train.size(), a.out.c_str());
   return 0;
 }
 
 }  // namespace
 
-// motionfield-train rig: the rig anatomy of the training split, as JSON.
-int measure_rig_main(int argc, char** argv) {
-  mf::DatasetOptions d;
-  d.source = mf::default_train_archive();
-  d.cache_dir = mf::default_cache_dir();
-  std::string out;
-  int stride = 2;
-  for (int i = 2; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a.rfind("--", 0) != 0 || i + 1 >= argc) throw mf::InputError("unexpected argument '" + a + "'");
-    const std::string key = a.substr(2), value = argv[++i];
-    if (key == "out") out = value;
-    else if (key == "data") d.source = value;
-    else if (key == "cache-dir") d.cache_dir = value;
-    else if (key == "stride") stride = static_cast<int>(number(key, value));
-    else throw mf::InputError("unknown option --" + key + " for rig");
-  }
-  if (out.empty()) throw mf::InputError("rig: --out FILE is required");
-  if (stride < 1) throw mf::InputError("rig: --stride must be at least 1");
-  const mf::Dataset data = mf::load_dataset(d);
-  mf::Motion all = mf::Motion::identity(data.skeleton, 0, 30.0);
-  for (const mf::Clip& c : data.train) {
-    for (int f = 0; f < c.motion.num_frames(); f += stride) {
-      for (int j = 0; j < c.motion.num_joints(); ++j) all.rotations.push_back(c.motion.rotation(f, j));
-      all.root_positions.push_back(c.motion.root_positions[f]);
-    }
-  }
-  const mf::RigAnatomy a = mf::estimate_anatomy(all, mf::find_rig_parts(data.skeleton));
-  std::ofstream file(out);
-  file << a.to_json(data.skeleton) << "\n";
-  if (!file) throw std::runtime_error("cannot write " + out);
-  std::printf("measured the rig anatomy on %d frames of %zu training clips: %s\n", all.num_frames(),
-              data.train.size(), out.c_str());
-  return 0;
-}
-
 int main(int argc, char** argv) {
-  try {
-    if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h") {
-      std::fputs(kUsage, argc < 2 ? stderr : stdout);
-      return argc < 2 ? 2 : 0;
+  CLI::App app{"Trains motionfield's models from a folder or archive of BVH files.", "motionfield-train"};
+  mf::cli::use_tool_defaults(app);
+  app.require_subcommand(1);
+  mf::PriorTrainingOptions prior_options;
+  mf::InbetweenTrainingOptions inbetweener_options;
+  std::vector<std::string> hp;
+  RunArgs run;
+  RigArgs rig_args;
+  CLI::App* prior = app.add_subcommand("prior", "the NeMF prior (training/prior_trainer.h)");
+  add_prior_options(*prior, prior_options, run);
+  CLI::App* twostage = app.add_subcommand(mf::kTwoStageKind, "the two-stage in-betweener: context + detail "
+                                                             "transformers (training/inbetween_trainer.h)");
+  add_inbetweener_options(*twostage, inbetweener_options, hp, run);
+  CLI::App* citl = app.add_subcommand(mf::kCitlKind, "the CITL in-betweener (training/inbetween_trainer.h)");
+  add_inbetweener_options(*citl, inbetweener_options, hp, run);
+  CLI::App* rig = app.add_subcommand("rig", "measures the anatomy of the training data's rig (prior/rig/retarget.h) "
+                                            "from the training split: models/motionfield-rig.json");
+  add_rig_options(*rig, rig_args);
+  return mf::cli::run(app, argc, argv, [&] {
+    if (rig->parsed()) return measure_rig_main(rig_args);
+    if (prior->parsed()) {
+      if (!run.config.empty()) apply_config_file(*prior, run.config, nullptr);
+      return train_prior_main(prior_options, run);
     }
-    const std::string kind = argv[1];
-    if (kind == "rig") return measure_rig_main(argc, argv);
-    if (kind == mf::kTwoStageKind || kind == mf::kCitlKind) return train_inbetweener_main(kind, argc, argv);
-    if (kind != "prior") {
-      throw mf::InputError("unknown model kind '" + kind + "' (expected prior, twostage or citl)");
-    }
-    mf::PriorTrainingOptions o;
-    o.data = mf::default_train_archive();
-    o.cache_dir = mf::default_cache_dir();
-    std::string export_path;
-    for (int i = 2; i < argc; ++i) {
-      std::string a = argv[i];
-      if (a == "--resume") o.resume = true;
-      else if (a == "--quiet") o.verbose = false;
-      else if (a == "--help") {
-        std::fputs(kUsage, stdout);
-        return 0;
-      } else if (a.rfind("--", 0) == 0 && i + 1 < argc) {
-        std::string key = a.substr(2), value = argv[++i];
-        if (key == "config") read_config(o, export_path, value);
-        else apply(o, export_path, key, value);
-      } else {
-        throw mf::InputError("unexpected argument '" + a + "' (options take a value)");
-      }
-    }
-    mf::PriorTrainingResult r = mf::train_prior(o);
-    std::printf("trained %d epochs, %lld steps in %.1f min; best validation score %.4f: %s\n", r.epochs,
-                static_cast<long long>(r.steps), r.minutes, r.best_validation, r.best_path.c_str());
-    if (!export_path.empty()) {
-      mf::save_nemf(mf::load_nemf(r.best_path), export_path);
-      std::printf("exported %s\n", export_path.c_str());
-    }
-    return 0;
-  } catch (const mf::InputError& e) {
-    std::fprintf(stderr, "motionfield-train: %s\n", e.what());
-    return 2;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "motionfield-train: internal error: %s\n", e.what());
-    return 1;
-  }
+    CLI::App* cmd = twostage->parsed() ? twostage : citl;
+    std::vector<std::string> config_hp;
+    if (!run.config.empty()) apply_config_file(*cmd, run.config, &config_hp);
+    inbetweener_options.kind = cmd->get_name();
+    inbetweener_options.hyperparameters = hyperparameter_map(config_hp, hp);
+    return train_inbetweener_main(inbetweener_options, run);
+  });
 }
