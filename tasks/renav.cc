@@ -3,12 +3,9 @@
 #include <ATen/ATen.h>
 
 #include <algorithm>
-#include <cctype>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <exception>
-#include <fstream>
 #include <limits>
 #include <random>
 #include <sstream>
@@ -47,191 +44,9 @@ double heading_yaw(const Eigen::Quaterniond& root, const Eigen::Vector3d& forwar
   return std::atan2(f.x(), f.z());
 }
 
-std::string trim(const std::string& s) {
-  size_t b = 0, e = s.size();
-  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
-  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
-  return s.substr(b, e - b);
-}
-
-// A number of a CSV field, locale-independent; false if it is not one number.
-bool parse_number(const std::string& field, double* out) {
-  std::string f = trim(field);
-  if (!f.empty() && f[0] == '+') f.erase(0, 1);
-  if (f.empty()) return false;
-  const char* b = f.data();
-  const char* e = b + f.size();
-  const auto r = std::from_chars(b, e, *out);
-  return r.ec == std::errc() && r.ptr == e;
-}
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
 int default_iterations(RenavSolver s) { return s == RenavSolver::Adam ? 600 : 100; }
 
 }  // namespace
-
-// ---------------------------------------------------------------- paths
-
-std::vector<Eigen::Vector2d> parse_path_csv(const std::string& text, const std::string& source) {
-  std::vector<Eigen::Vector2d> out;
-  size_t pos = 0;
-  int line_no = 0;
-  bool first_content = true;
-  std::string body = text;
-  if (body.compare(0, 3, "\xEF\xBB\xBF") == 0) body.erase(0, 3);  // UTF-8 BOM
-  while (pos <= body.size()) {
-    size_t end = body.find('\n', pos);
-    if (end == std::string::npos) end = body.size();
-    const std::string line = trim(body.substr(pos, end - pos));
-    pos = end + 1;
-    ++line_no;
-    if (line.empty() || line[0] == '#') {
-      if (end == body.size()) break;
-      continue;
-    }
-    const std::string where = source + ":" + std::to_string(line_no) + ": ";
-    if (first_content) {
-      first_content = false;
-      std::string compact;
-      for (char c : line) {
-        if (c != ' ' && c != '\t') compact += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-      }
-      if (compact == "x,z") {
-        if (end == body.size()) break;
-        continue;
-      }
-    }
-    const size_t comma = line.find(',');
-    if (comma == std::string::npos || line.find(',', comma + 1) != std::string::npos)
-      throw InputError(where + "expected two comma-separated numbers x,z (metres), got '" + line + "'");
-    double x = 0, z = 0;
-    if (!parse_number(line.substr(0, comma), &x) || !parse_number(line.substr(comma + 1), &z))
-      throw InputError(where + "expected two comma-separated numbers x,z (metres), got '" + line + "'");
-    if (!std::isfinite(x) || !std::isfinite(z)) throw InputError(where + "non-finite value in '" + line + "'");
-    if (out.size() >= static_cast<size_t>(kMaxPathFrames))
-      throw InputError(where + "the path has more than " + std::to_string(kMaxPathFrames) + " points");
-    out.emplace_back(x, z);
-    if (end == body.size()) break;
-  }
-  if (out.size() < 2)
-    throw InputError(source + ": a path needs at least two points (x,z rows), got " + std::to_string(out.size()));
-  return out;
-}
-
-std::vector<Eigen::Vector2d> read_path_csv(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError(path + ": cannot open the path file");
-  std::ostringstream text;
-  text << file.rdbuf();
-  if (file.bad()) throw InputError(path + ": cannot read the path file");
-  return parse_path_csv(text.str(), path);
-}
-
-double path_length(const std::vector<Eigen::Vector2d>& path) {
-  double L = 0.0;
-  for (size_t i = 1; i < path.size(); ++i) L += (path[i] - path[i - 1]).norm();
-  return L;
-}
-
-void validate_path(const std::vector<Eigen::Vector2d>& path) {
-  if (path.size() < 2)
-    throw InputError("a path needs at least two points, got " + std::to_string(path.size()));
-  if (path.size() > static_cast<size_t>(kMaxPathFrames))
-    throw InputError("the path has more than " + std::to_string(kMaxPathFrames) + " points");
-  for (size_t i = 0; i < path.size(); ++i) {
-    if (!path[i].allFinite()) throw InputError("path point " + std::to_string(i) + " is not finite");
-  }
-  if (path_length(path) < 1e-3)
-    throw InputError("the path has zero length: its points are all the same (at least 1 mm of travel is needed)");
-}
-
-double mean_ground_speed(const Motion& motion) {
-  const int N = motion.num_frames();
-  if (N < 2 || !(motion.fps > 0)) return 0.0;
-  double L = 0.0;
-  for (int f = 1; f < N; ++f) {
-    const Eigen::Vector3d d = motion.root_positions[f] - motion.root_positions[f - 1];
-    L += std::hypot(d.x(), d.z());
-  }
-  return L / ((N - 1) / motion.fps);
-}
-
-int polyline_frame_count(const std::vector<Eigen::Vector2d>& vertices, double speed, double fps) {
-  validate_path(vertices);
-  if (!(std::isfinite(fps) && fps > 0)) throw InputError("the path's frame rate must be finite and positive");
-  if (!std::isfinite(speed) || speed < 0.01)
-    throw InputError("the reference barely moves (mean ground speed " + fmt(speed) +
-                     " m/s): give the polyline's frame count explicitly");
-  const double frames = std::round(path_length(vertices) / speed * fps) + 1.0;
-  if (frames > kMaxPathFrames)
-    throw InputError("the polyline would take more than " + std::to_string(kMaxPathFrames) + " frames");
-  return std::max(2, static_cast<int>(frames));
-}
-
-std::vector<Eigen::Vector2d> resample_polyline(const std::vector<Eigen::Vector2d>& vertices, int frames) {
-  validate_path(vertices);
-  if (frames < 2 || frames > kMaxPathFrames)
-    throw InputError("a resampled path needs 2 to " + std::to_string(kMaxPathFrames) + " frames, not " +
-                     std::to_string(frames));
-  std::vector<double> cum(vertices.size(), 0.0);
-  for (size_t i = 1; i < vertices.size(); ++i) cum[i] = cum[i - 1] + (vertices[i] - vertices[i - 1]).norm();
-  const double L = cum.back();
-  std::vector<Eigen::Vector2d> out(frames);
-  size_t seg = 1;
-  for (int i = 0; i < frames; ++i) {
-    if (i == frames - 1) {
-      out[i] = vertices.back();
-      break;
-    }
-    const double s = L * i / (frames - 1);
-    while (seg + 1 < vertices.size() && cum[seg] < s) ++seg;
-    const double len = cum[seg] - cum[seg - 1];
-    const double t = len > 0 ? std::clamp((s - cum[seg - 1]) / len, 0.0, 1.0) : 0.0;
-    out[i] = vertices[seg - 1] + (vertices[seg] - vertices[seg - 1]) * t;
-  }
-  return out;
-}
-
-std::vector<double> tangent_yaws(const std::vector<Eigen::Vector2d>& p, const std::vector<double>& fallback) {
-  const int N = static_cast<int>(p.size());
-  constexpr int k = 2;
-  constexpr double eps = 1e-3;
-  std::vector<double> yaw(N, 0.0);
-  std::vector<char> valid(N, 0);
-  for (int f = 0; f < N; ++f) {
-    const Eigen::Vector2d d = p[std::min(N - 1, f + k)] - p[std::max(0, f - k)];
-    if (d.norm() >= eps) {
-      yaw[f] = std::atan2(d.x(), d.y());
-      valid[f] = 1;
-    }
-  }
-  // Where no tangent is defined, hold the nearest valid one (the earlier on a tie).
-  std::vector<int> left(N, -1), right(N, -1);
-  for (int f = 0, last = -1; f < N; ++f) {
-    if (valid[f]) last = f;
-    left[f] = last;
-  }
-  for (int f = N - 1, next = -1; f >= 0; --f) {
-    if (valid[f]) next = f;
-    right[f] = next;
-  }
-  if (left[N - 1] < 0) {
-    for (int f = 0; f < N; ++f) yaw[f] = fallback.size() == static_cast<size_t>(N) ? fallback[f] : 0.0;
-    return yaw;
-  }
-  std::vector<double> held(yaw);
-  for (int f = 0; f < N; ++f) {
-    if (valid[f]) continue;
-    const int a = left[f], b = right[f];
-    held[f] = (a >= 0 && (b < 0 || f - a <= b - f)) ? yaw[a] : yaw[b];
-  }
-  return held;
-}
 
 // ---------------------------------------------------------------- the window
 
@@ -515,8 +330,11 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
   Motion ref_m = reference;
   if (!same_rate(reference.fps, fm)) {
     const int frames = static_cast<int>(std::floor((reference.num_frames() - 1) * fm / reference.fps + 1e-6)) + 1;
-    if (frames < 2)
-      throw InputError("the reference is too short: it needs at least two frames at the model's " + fmt(fm) + " fps");
+    if (frames < 2) {
+      std::ostringstream msg;
+      msg << "the reference is too short: it needs at least two frames at the model's " << fm << " fps";
+      throw InputError(msg.str());
+    }
     ref_m = resample_interpolate(reference, fm, frames);
   }
   ref_m.fps = fm;

@@ -4,17 +4,14 @@
 // section 1) with the soft-DTW divergence of tasks/soft_dtw.h.
 //
 // Paths. A ground path is a list of (x, z) points in metres, world frame (Y up,
-// prior/motion/skeleton.h). It comes either
+// prior/motion/skeleton.h; tasks/ground_path.h). It comes either
 //   * per frame: one point per output frame, at the path's frame rate (by
 //     default the reference's); the output has exactly as many frames, or
 //   * as a polyline: a few vertices, resampled by arc length at constant speed
 //     (resample_polyline()) to a number of frames that is given, or by default
 //     the one that makes the speed the reference's mean horizontal root speed
 //     (polyline_frame_count()).
-// Both read from CSV text (parse_path_csv()): one "x,z" pair per line, metres;
-// an optional first line "x,z" (a header); blank lines and lines starting with
-// '#' (after spaces) are skipped; a third column is an error. Bad input throws
-// mf::InputError naming the source and line.
+// Both read from CSV text (tasks/path_csv.h: one "x,z" pair per line).
 //
 // Energy of one window of T frames (the model's window or less), in the
 // window's canonical frame (below), with weights RenavWeights:
@@ -41,9 +38,8 @@
 //                   geodesic angle of every local rotation (root included) plus
 //                   10 x mean squared distance of the heading-frame joint
 //                   positions (m^2) against that window's solution
-// Tangents: direction of p(t + 2) - p(t - 2) (clamped at the ends); where it
-// is shorter than 1 mm the nearest valid tangent is held; a reference that
-// never moves uses its own heading (c = 1).
+// Tangents: tangent_yaws() of tasks/ground_path.h (the direction of
+// p(t + 2) - p(t - 2)); a reference that never moves uses its own heading (c = 1).
 //
 // Windows. The solve runs at the model's frame rate: a reference at another
 // rate is resampled first (interpolation), the path is resampled in time to
@@ -92,60 +88,16 @@
 
 #include "prior/model/representation.h"
 #include "prior/motion/motion.h"
-#include "tasks/task_context.h"
+#include "tasks/ground_path.h"
 #include "tasks/latent_energy.h"
 #include "tasks/latent_optimizer.h"
+#include "tasks/path_csv.h"  // parse_path_csv(), read_path_csv() for the callers
 #include "tasks/soft_dtw.h"
+#include "tasks/task_context.h"
 
 namespace mf {
 
 class NemfModel;
-
-// ---------------------------------------------------------------- paths
-
-/// Longest path accepted (points per frame, or frames of a resampled polyline).
-constexpr int kMaxPathFrames = 1'000'000;
-
-/// Parses path CSV text (see the top of this file) into (x, z) points, metres.
-/// Throws mf::InputError "<source>:<line>: ..." on a malformed line (not two
-/// comma-separated numbers, a third column, text after the numbers), on a
-/// non-finite value, and "<source>: ..." when fewer than two points remain or
-/// there are more than kMaxPathFrames. Does not check the path's length (see
-/// validate_path()). Numbers are parsed independently of the locale.
-std::vector<Eigen::Vector2d> parse_path_csv(const std::string& text, const std::string& source);
-/// Reads a file and parses it; InputError "<path>: cannot open ..." if it cannot be read.
-std::vector<Eigen::Vector2d> read_path_csv(const std::string& path);
-
-/// Throws mf::InputError unless the path has at least two points, at most
-/// kMaxPathFrames, every value finite, and a total length (sum of the
-/// distances between consecutive points) of at least 1 mm.
-void validate_path(const std::vector<Eigen::Vector2d>& path);
-
-/// Total length of a polyline, metres.
-double path_length(const std::vector<Eigen::Vector2d>& path);
-
-/// Mean horizontal root speed of a motion (m/s): the summed ground distance
-/// between consecutive root positions over the duration. 0 for one frame.
-double mean_ground_speed(const Motion& motion);
-
-/// Frames of a polyline walked at `speed` (m/s) and `fps`:
-/// round(length / speed * fps) + 1, at least 2. Throws mf::InputError if the
-/// speed is below 1 cm/s (the reference barely moves: give a frame count),
-/// fps or speed are not finite and positive, or the result exceeds
-/// kMaxPathFrames.
-int polyline_frame_count(const std::vector<Eigen::Vector2d>& vertices, double speed, double fps);
-
-/// `frames` (>= 2) points at equal arc-length spacing along the polyline
-/// `vertices` (validated with validate_path()): point i at arc length
-/// L * i / (frames - 1); the first and last points are the first and last
-/// vertices. Zero-length segments (repeated vertices) are skipped.
-std::vector<Eigen::Vector2d> resample_polyline(const std::vector<Eigen::Vector2d>& vertices, int frames);
-
-/// Yaw (radians, atan2(dx, dz): 0 = +Z, the heading convention of
-/// representation.h) of the ground tangent of `points` at every point, as
-/// described at the top of this file; `fallback` (one value per point, or
-/// empty for 0) where no point of the path moves.
-std::vector<double> tangent_yaws(const std::vector<Eigen::Vector2d>& points, const std::vector<double>& fallback = {});
 
 // ---------------------------------------------------------------- the energy
 

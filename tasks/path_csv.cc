@@ -1,0 +1,90 @@
+#include "tasks/path_csv.h"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "prior/motion/errors.h"
+#include "tasks/ground_path.h"
+
+namespace mf {
+namespace {
+
+std::string trim(const std::string& s) {
+  size_t b = 0, e = s.size();
+  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
+  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
+  return s.substr(b, e - b);
+}
+
+// A number of a CSV field, locale-independent; false if it is not one number.
+bool parse_number(const std::string& field, double* out) {
+  std::string f = trim(field);
+  if (!f.empty() && f[0] == '+') f.erase(0, 1);
+  if (f.empty()) return false;
+  const char* b = f.data();
+  const char* e = b + f.size();
+  const auto r = std::from_chars(b, e, *out);
+  return r.ec == std::errc() && r.ptr == e;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector2d> parse_path_csv(const std::string& text, const std::string& source) {
+  std::vector<Eigen::Vector2d> out;
+  size_t pos = 0;
+  int line_no = 0;
+  bool first_content = true;
+  std::string body = text;
+  if (body.compare(0, 3, "\xEF\xBB\xBF") == 0) body.erase(0, 3);  // UTF-8 BOM
+  while (pos <= body.size()) {
+    size_t end = body.find('\n', pos);
+    if (end == std::string::npos) end = body.size();
+    const std::string line = trim(body.substr(pos, end - pos));
+    pos = end + 1;
+    ++line_no;
+    if (line.empty() || line[0] == '#') {
+      if (end == body.size()) break;
+      continue;
+    }
+    const std::string where = source + ":" + std::to_string(line_no) + ": ";
+    if (first_content) {
+      first_content = false;
+      std::string compact;
+      for (char c : line) {
+        if (c != ' ' && c != '\t') compact += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      }
+      if (compact == "x,z") {
+        if (end == body.size()) break;
+        continue;
+      }
+    }
+    const size_t comma = line.find(',');
+    if (comma == std::string::npos || line.find(',', comma + 1) != std::string::npos)
+      throw InputError(where + "expected two comma-separated numbers x,z (metres), got '" + line + "'");
+    double x = 0, z = 0;
+    if (!parse_number(line.substr(0, comma), &x) || !parse_number(line.substr(comma + 1), &z))
+      throw InputError(where + "expected two comma-separated numbers x,z (metres), got '" + line + "'");
+    if (!std::isfinite(x) || !std::isfinite(z)) throw InputError(where + "non-finite value in '" + line + "'");
+    if (out.size() >= static_cast<size_t>(kMaxPathFrames))
+      throw InputError(where + "the path has more than " + std::to_string(kMaxPathFrames) + " points");
+    out.emplace_back(x, z);
+    if (end == body.size()) break;
+  }
+  if (out.size() < 2)
+    throw InputError(source + ": a path needs at least two points (x,z rows), got " + std::to_string(out.size()));
+  return out;
+}
+
+std::vector<Eigen::Vector2d> read_path_csv(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError(path + ": cannot open the path file");
+  std::ostringstream text;
+  text << file.rdbuf();
+  if (file.bad()) throw InputError(path + ": cannot read the path file");
+  return parse_path_csv(text.str(), path);
+}
+
+}  // namespace mf
