@@ -116,28 +116,35 @@ TEST(JsonlTest, RejectsBadNumbers) {
   EXPECT_EQ(error_column("-1234567890123456789012345678901234567890e300"), 1);
 }
 
+// Syntax errors name the column where nlohmann's lexer detected them (for a
+// truncated token, one past its end) and quote what it last read.
 TEST(JsonlTest, RejectsBadLiteralsAndStrings) {
-  EXPECT_EQ(error_column("tru"), 1);
+  std::string m;
+  EXPECT_EQ(error_column("tru", &m), 4);
+  EXPECT_NE(m.find("last read: 'tru'"), std::string::npos) << m;
   EXPECT_EQ(error_column("nulll"), 5);
   EXPECT_EQ(error_column("True"), 1);
-  EXPECT_EQ(error_column("\"abc"), 1);              // unterminated
+  EXPECT_EQ(error_column("\"abc"), 5);              // unterminated
   EXPECT_EQ(error_column("\"a\tb\""), 3);           // raw control character
-  EXPECT_EQ(error_column(R"("a\xb")"), 3);          // unknown escape
+  EXPECT_EQ(error_column(R"("a\xb")"), 4);          // unknown escape
   EXPECT_EQ(error_column(R"("\u12G4")"), 6);        // bad hex digit
-  EXPECT_EQ(error_column(R"("\u12")"), 2);          // truncated
-  EXPECT_EQ(error_column(R"("\ude00")"), 2);        // lone low surrogate
-  EXPECT_EQ(error_column(R"("\ud83dx")"), 2);       // high surrogate alone
-  EXPECT_EQ(error_column(R"("\ud83d\u0041")"), 8);  // high surrogate + non-low
+  EXPECT_EQ(error_column(R"("\u12")"), 6);          // truncated
+  EXPECT_EQ(error_column(R"("\ude00")"), 7);        // lone low surrogate
+  EXPECT_EQ(error_column(R"("\ud83dx")"), 8);       // high surrogate alone
+  EXPECT_EQ(error_column(R"("\ud83d\u0041")"), 13); // high surrogate + non-low
   EXPECT_EQ(error_column("\"\xFF\""), 2);           // invalid UTF-8
-  EXPECT_EQ(error_column("\"\xC3\""), 2);           // truncated UTF-8
+  EXPECT_EQ(error_column("\"\xC3\""), 3);           // truncated UTF-8
   EXPECT_EQ(error_column("\"\xC0\xAF\""), 2);       // overlong encoding
-  EXPECT_EQ(error_column("\"\xED\xA0\x80\""), 2);   // UTF-8-encoded surrogate
+  EXPECT_EQ(error_column("\"\xED\xA0\x80\""), 3);   // UTF-8-encoded surrogate
 }
 
 TEST(JsonlTest, RejectsDuplicateKeysAndDeepNesting) {
   std::string m;
   EXPECT_EQ(error_column(R"({"a": 1, "a": 2})", &m), 10);
   EXPECT_NE(m.find("duplicate key \"a\""), std::string::npos) << m;
+  EXPECT_EQ(error_column(R"({"x": {"a\"": 1, "a\"": 2}})", &m), 18);  // escaped quotes in the key
+  EXPECT_NE(m.find("duplicate key \"a\"\""), std::string::npos) << m;
+  EXPECT_NO_THROW(parse_json(R"({"a": {"a": 1}, "b": {"a": 2}, "c": [{"a": 3}, {"a": 4}]})"));  // other objects
   const std::string ok = std::string(kJsonMaxDepth, '[') + std::string(kJsonMaxDepth, ']');
   EXPECT_NO_THROW(parse_json(ok));
   const std::string deep = std::string(kJsonMaxDepth + 1, '[') + std::string(kJsonMaxDepth + 1, ']');

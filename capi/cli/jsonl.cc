@@ -1,11 +1,15 @@
 #include "capi/cli/jsonl.h"
 
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
-#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <iterator>
 #include <limits>
+#include <optional>
 #include <set>
 #include <utility>
 
@@ -153,317 +157,139 @@ void dump_value(const JsonValue& v, std::string& out) {
   }
 }
 
-// Recursive-descent parser over the raw bytes; positions are byte offsets,
-// converted to character columns only when an error is reported.
-class Parser {
+// Byte iterator over the input that publishes how far nlohmann's lexer has read,
+// so that the SAX handler can place the errors it raises itself (duplicate
+// keys, nesting) at a column.
+class CountingIterator {
  public:
-  explicit Parser(const std::string& text) : s_(text) {}
+  using iterator_category = std::input_iterator_tag;
+  using value_type = char;
+  using difference_type = std::ptrdiff_t;
+  using pointer = const char*;
+  using reference = const char&;
 
-  JsonValue parse_document() {
-    skip_ws();
-    JsonValue v = parse_value(0);
-    skip_ws();
-    if (pos_ < s_.size()) fail(pos_, "unexpected " + describe(pos_) + " after the JSON value");
-    return v;
+  CountingIterator(const char* p, const char* base, size_t* consumed) : p_(p), base_(base), consumed_(consumed) {}
+  reference operator*() const { return *p_; }
+  CountingIterator& operator++() {
+    ++p_;
+    *consumed_ = static_cast<size_t>(p_ - base_);
+    return *this;
+  }
+  CountingIterator operator++(int) {
+    CountingIterator old = *this;
+    ++*this;
+    return old;
+  }
+  bool operator==(const CountingIterator& o) const { return p_ == o.p_; }
+  bool operator!=(const CountingIterator& o) const { return p_ != o.p_; }
+
+ private:
+  const char* p_;
+  const char* base_;
+  size_t* consumed_;
+};
+
+// Builds a JsonValue from nlohmann's SAX events and adds the checks nlohmann
+// leaves to its callers: duplicate keys and the depth limit.
+class Builder : public nlohmann::json_sax<nlohmann::json> {
+ public:
+  Builder(const std::string& text, const size_t* consumed) : s_(text), consumed_(*consumed) {}
+
+  JsonValue result;
+  std::optional<JsonError> error;
+
+  bool null() override { return add(JsonValue()); }
+  bool boolean(bool b) override { return add(JsonValue::boolean(b)); }
+  bool number_integer(number_integer_t n) override { return add(JsonValue::number(static_cast<double>(n))); }
+  bool number_unsigned(number_unsigned_t n) override { return add(JsonValue::number(static_cast<double>(n))); }
+  bool number_float(number_float_t d, const string_t&) override { return add(JsonValue::number(d)); }
+  bool string(string_t& s) override { return add(JsonValue::string(std::move(s))); }
+  bool binary(binary_t&) override { return fail(consumed_, "unexpected binary value"); }  // not in JSON text
+
+  bool start_object(std::size_t) override { return open(true); }
+  bool key(string_t& k) override {
+    Frame& f = stack_.back();
+    if (!f.seen.insert(k).second) {
+      // The key's closing quote was the last character read; find its opening quote.
+      size_t at = consumed_ - 1;
+      while (at > 0) {
+        --at;
+        size_t backslashes = 0;
+        while (backslashes < at && s_[at - 1 - backslashes] == '\\') ++backslashes;
+        if (s_[at] == '"' && backslashes % 2 == 0) break;
+      }
+      return fail(at, "duplicate key \"" + k + "\"");
+    }
+    f.keys.push_back(std::move(k));
+    return true;
+  }
+  bool end_object() override { return close(); }
+  bool start_array(std::size_t) override { return open(false); }
+  bool end_array() override { return close(); }
+
+  bool parse_error(std::size_t position, const std::string& last_token, const nlohmann::detail::exception& e) override {
+    // Overflow (exception 406) is reported after the number: point at its start.
+    if (e.id == 406)
+      return fail(position - std::min(position, last_token.size()), "number out of range: " + last_token);
+    // e.what(): "[json.exception.parse_error.101] parse error at line 1, column 9: syntax error ..."
+    std::string message = e.what();
+    const size_t column = message.find(", column ");
+    if (column != std::string::npos) {
+      const size_t colon = message.find(": ", column);
+      if (colon != std::string::npos) message.erase(0, colon + 2);
+    }
+    // position counts the characters read, the offending one included.
+    const size_t at = std::min(position > 0 ? position - 1 : 0, s_.size());
+    if (at < s_.size() && (s_[at] == '}' || s_[at] == ']')) {
+      size_t k = at;
+      while (k > 0 && std::strchr(" \t\r\n", s_[k - 1]) != nullptr) --k;
+      if (k > 0 && s_[k - 1] == ',') message += " (trailing comma?)";
+    }
+    return fail(at, message);
   }
 
  private:
-  [[noreturn]] void fail(size_t at, const std::string& message) const {
-    int column = 1;
-    for (size_t i = 0; i < at && i < s_.size(); ++i)
-      if ((static_cast<unsigned char>(s_[i]) & 0xC0) != 0x80) ++column;
-    throw JsonError(column, message);
-  }
-
-  std::string describe(size_t at) const {
-    if (at >= s_.size()) return "end of input";
-    const unsigned char c = static_cast<unsigned char>(s_[at]);
-    if (c < 0x20 || c >= 0x7F) {
-      char buf[16];
-      std::snprintf(buf, sizeof buf, "byte 0x%02X", c);
-      return buf;
-    }
-    return std::string("character '") + static_cast<char>(c) + "'";
-  }
-
-  void skip_ws() {
-    while (pos_ < s_.size() && (s_[pos_] == ' ' || s_[pos_] == '\t' || s_[pos_] == '\n' || s_[pos_] == '\r')) ++pos_;
-  }
-
-  bool at_end() const { return pos_ >= s_.size(); }
-
-  JsonValue parse_value(int depth) {
-    if (at_end()) fail(pos_, "expected a JSON value, found end of input");
-    switch (s_[pos_]) {
-      case '{': return parse_object(depth + 1);
-      case '[': return parse_array(depth + 1);
-      case '"': return JsonValue::string(parse_string());
-      case 't': return parse_literal("true", JsonValue::boolean(true));
-      case 'f': return parse_literal("false", JsonValue::boolean(false));
-      case 'n': return parse_literal("null", JsonValue());
-      default:
-        if (s_[pos_] == '-' || (s_[pos_] >= '0' && s_[pos_] <= '9')) return parse_number();
-        fail(pos_, "expected a JSON value, found " + describe(pos_));
-    }
-  }
-
-  JsonValue parse_literal(const char* word, JsonValue value) {
-    const std::string w(word);
-    if (s_.compare(pos_, w.size(), w) != 0) fail(pos_, "invalid literal (expected " + w + ")");
-    pos_ += w.size();
-    // "trueX" must not parse as true followed by garbage at the same token.
-    if (!at_end() && (std::isalnum(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_'))
-      fail(pos_, "invalid literal (expected " + w + ")");
-    return value;
-  }
-
-  JsonValue parse_object(int depth) {
-    if (depth > kJsonMaxDepth) fail(pos_, "nesting deeper than " + std::to_string(kJsonMaxDepth) + " levels");
-    ++pos_;  // '{'
+  struct Frame {
+    bool object = false;
     std::vector<std::string> keys;
     std::vector<JsonValue> values;
     std::set<std::string> seen;
-    skip_ws();
-    if (!at_end() && s_[pos_] == '}') {
-      ++pos_;
-      return JsonValue::object({}, {});
-    }
-    while (true) {
-      skip_ws();
-      if (!at_end() && s_[pos_] == '}' && !keys.empty()) fail(pos_, "expected a string key, found '}' (trailing comma?)");
-      if (at_end() || s_[pos_] != '"') fail(pos_, "expected a string key, found " + describe(pos_));
-      const size_t key_pos = pos_;
-      std::string key = parse_string();
-      if (!seen.insert(key).second) fail(key_pos, "duplicate key \"" + key + "\"");
-      skip_ws();
-      if (at_end() || s_[pos_] != ':') fail(pos_, "expected ':' after an object key, found " + describe(pos_));
-      ++pos_;
-      skip_ws();
-      values.push_back(parse_value(depth));
-      keys.push_back(std::move(key));
-      skip_ws();
-      if (at_end()) fail(pos_, "expected ',' or '}' in an object, found end of input");
-      if (s_[pos_] == ',') {
-        ++pos_;
-        continue;
-      }
-      if (s_[pos_] == '}') {
-        ++pos_;
-        return JsonValue::object(std::move(keys), std::move(values));
-      }
-      fail(pos_, "expected ',' or '}' in an object, found " + describe(pos_));
-    }
+  };
+
+  bool fail(size_t at, const std::string& message) {
+    int column = 1;
+    for (size_t i = 0; i < at && i < s_.size(); ++i)
+      if ((static_cast<unsigned char>(s_[i]) & 0xC0) != 0x80) ++column;
+    error.emplace(column, message);
+    return false;
   }
 
-  JsonValue parse_array(int depth) {
-    if (depth > kJsonMaxDepth) fail(pos_, "nesting deeper than " + std::to_string(kJsonMaxDepth) + " levels");
-    ++pos_;  // '['
-    std::vector<JsonValue> items;
-    skip_ws();
-    if (!at_end() && s_[pos_] == ']') {
-      ++pos_;
-      return JsonValue::array({});
-    }
-    while (true) {
-      skip_ws();
-      if (!at_end() && s_[pos_] == ']') fail(pos_, "expected a JSON value, found ']' (trailing comma?)");
-      items.push_back(parse_value(depth));
-      skip_ws();
-      if (at_end()) fail(pos_, "expected ',' or ']' in an array, found end of input");
-      if (s_[pos_] == ',') {
-        ++pos_;
-        continue;
-      }
-      if (s_[pos_] == ']') {
-        ++pos_;
-        return JsonValue::array(std::move(items));
-      }
-      fail(pos_, "expected ',' or ']' in an array, found " + describe(pos_));
-    }
+  bool add(JsonValue v) {
+    if (stack_.empty())
+      result = std::move(v);
+    else
+      stack_.back().values.push_back(std::move(v));
+    return true;
   }
 
-  static int hex_digit(char c) {
-    if (c >= '0' && c <= '9') return c - '0';
-    if (c >= 'a' && c <= 'f') return c - 'a' + 10;
-    if (c >= 'A' && c <= 'F') return c - 'A' + 10;
-    return -1;
+  bool open(bool object) {
+    if (stack_.size() >= static_cast<size_t>(kJsonMaxDepth))
+      return fail(consumed_ - 1, "nesting deeper than " + std::to_string(kJsonMaxDepth) + " levels");
+    stack_.emplace_back();
+    stack_.back().object = object;
+    return true;
   }
 
-  // Reads the 4 hex digits of a \u escape whose 'u' is at pos_ - 1.
-  unsigned read_hex4(size_t escape_pos) {
-    if (pos_ + 4 > s_.size()) fail(escape_pos, "truncated \\u escape (expected four hex digits)");
-    unsigned v = 0;
-    for (int i = 0; i < 4; ++i) {
-      const int d = hex_digit(s_[pos_ + i]);
-      if (d < 0) fail(pos_ + i, "invalid hex digit in \\u escape: " + describe(pos_ + i));
-      v = v * 16 + static_cast<unsigned>(d);
-    }
-    pos_ += 4;
-    return v;
-  }
-
-  static void append_utf8(unsigned cp, std::string& out) {
-    if (cp < 0x80) {
-      out += static_cast<char>(cp);
-    } else if (cp < 0x800) {
-      out += static_cast<char>(0xC0 | (cp >> 6));
-      out += static_cast<char>(0x80 | (cp & 0x3F));
-    } else if (cp < 0x10000) {
-      out += static_cast<char>(0xE0 | (cp >> 12));
-      out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-      out += static_cast<char>(0x80 | (cp & 0x3F));
-    } else {
-      out += static_cast<char>(0xF0 | (cp >> 18));
-      out += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
-      out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-      out += static_cast<char>(0x80 | (cp & 0x3F));
-    }
-  }
-
-  // Validates one UTF-8 sequence starting at pos_ (a byte >= 0x80) and appends it.
-  void copy_utf8(std::string& out) {
-    const size_t start = pos_;
-    const unsigned char c = static_cast<unsigned char>(s_[pos_]);
-    int len = 0;
-    unsigned cp = 0, min = 0;
-    if (c >= 0xC2 && c <= 0xDF) {
-      len = 2, cp = c & 0x1F, min = 0x80;
-    } else if (c >= 0xE0 && c <= 0xEF) {
-      len = 3, cp = c & 0x0F, min = 0x800;
-    } else if (c >= 0xF0 && c <= 0xF4) {
-      len = 4, cp = c & 0x07, min = 0x10000;
-    } else {
-      fail(start, "invalid UTF-8 in string");
-    }
-    if (start + len > s_.size()) fail(start, "truncated UTF-8 sequence in string");
-    for (int i = 1; i < len; ++i) {
-      const unsigned char cc = static_cast<unsigned char>(s_[start + i]);
-      if ((cc & 0xC0) != 0x80) fail(start, "invalid UTF-8 in string");
-      cp = (cp << 6) | (cc & 0x3F);
-    }
-    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) fail(start, "invalid UTF-8 in string");
-    out.append(s_, start, static_cast<size_t>(len));
-    pos_ = start + len;
-  }
-
-  std::string parse_string() {
-    const size_t open = pos_;
-    ++pos_;  // opening quote
-    std::string out;
-    while (true) {
-      if (at_end()) fail(open, "unterminated string");
-      const unsigned char c = static_cast<unsigned char>(s_[pos_]);
-      if (c == '"') {
-        ++pos_;
-        return out;
-      }
-      if (c < 0x20) fail(pos_, "unescaped control character (" + describe(pos_) + ") in string");
-      if (c >= 0x80) {
-        copy_utf8(out);
-        continue;
-      }
-      if (c != '\\') {
-        out += static_cast<char>(c);
-        ++pos_;
-        continue;
-      }
-      const size_t escape_pos = pos_;
-      ++pos_;
-      if (at_end()) fail(open, "unterminated string");
-      const char e = s_[pos_++];
-      switch (e) {
-        case '"': out += '"'; break;
-        case '\\': out += '\\'; break;
-        case '/': out += '/'; break;
-        case 'b': out += '\b'; break;
-        case 'f': out += '\f'; break;
-        case 'n': out += '\n'; break;
-        case 'r': out += '\r'; break;
-        case 't': out += '\t'; break;
-        case 'u': {
-          unsigned cp = read_hex4(escape_pos);
-          if (cp >= 0xDC00 && cp <= 0xDFFF) fail(escape_pos, "lone low surrogate in \\u escape");
-          if (cp >= 0xD800 && cp <= 0xDBFF) {
-            if (s_.compare(pos_, 2, "\\u") != 0) fail(escape_pos, "high surrogate not followed by a \\u low surrogate");
-            const size_t low_pos = pos_;
-            pos_ += 2;
-            const unsigned low = read_hex4(low_pos);
-            if (low < 0xDC00 || low > 0xDFFF) fail(low_pos, "high surrogate not followed by a low surrogate");
-            cp = 0x10000 + ((cp - 0xD800) << 10) + (low - 0xDC00);
-          }
-          append_utf8(cp, out);
-          break;
-        }
-        default: fail(escape_pos, std::string("invalid escape '\\") + e + "' in string");
-      }
-    }
-  }
-
-  JsonValue parse_number() {
-    const size_t start = pos_;
-    auto digit = [&](size_t i) { return i < s_.size() && s_[i] >= '0' && s_[i] <= '9'; };
-    size_t i = pos_;
-    if (s_[i] == '-') ++i;
-    if (!digit(i)) fail(i, "expected a digit in number, found " + describe(i));
-    if (s_[i] == '0') {
-      ++i;
-      if (digit(i)) fail(i, "leading zeros are not allowed in numbers");
-    } else {
-      while (digit(i)) ++i;
-    }
-    if (i < s_.size() && s_[i] == '.') {
-      ++i;
-      if (!digit(i)) fail(i, "expected a digit after the decimal point, found " + describe(i));
-      while (digit(i)) ++i;
-    }
-    if (i < s_.size() && (s_[i] == 'e' || s_[i] == 'E')) {
-      ++i;
-      if (i < s_.size() && (s_[i] == '+' || s_[i] == '-')) ++i;
-      if (!digit(i)) fail(i, "expected a digit in the exponent, found " + describe(i));
-      while (digit(i)) ++i;
-    }
-    double value = 0.0;
-    const auto r = std::from_chars(s_.data() + start, s_.data() + i, value);
-    if (r.ec == std::errc::result_out_of_range) {
-      // Underflow to zero is harmless; overflow is not representable.
-      if (decimal_magnitude(start, i) > 0) fail(start, "number out of range");
-      value = 0.0;
-    } else if (r.ec != std::errc() || r.ptr != s_.data() + i) {
-      fail(start, "invalid number");
-    }
-    pos_ = i;
-    return JsonValue::number(value);
-  }
-
-  // Power of ten of the leading significant digit of the number in [begin, end)
-  // (whose syntax is already checked), e.g. 2 for 123.4, -3 for 0.00123e0.
-  long decimal_magnitude(size_t begin, size_t end) const {
-    size_t e = begin;
-    while (e < end && s_[e] != 'e' && s_[e] != 'E') ++e;
-    long exponent = 0;
-    if (e < end) {
-      size_t k = e + 1;
-      const bool negative = s_[k] == '-';
-      if (s_[k] == '-' || s_[k] == '+') ++k;
-      for (; k < end; ++k) exponent = std::min(exponent * 10 + (s_[k] - '0'), 1L << 40);
-      if (negative) exponent = -exponent;
-    }
-    long position = 0;  // power of ten of the digit being scanned
-    size_t k = begin;
-    if (s_[k] == '-') ++k;
-    size_t int_digits = 0;
-    while (k < e && s_[k] != '.') ++int_digits, ++k;
-    position = static_cast<long>(int_digits) - 1;
-    for (k = begin; k < e; ++k) {
-      if (s_[k] == '-' || s_[k] == '.') continue;
-      if (s_[k] != '0') return position + exponent;
-      --position;
-    }
-    return std::numeric_limits<long>::min() / 2;  // zero
+  bool close() {
+    Frame f = std::move(stack_.back());
+    stack_.pop_back();
+    return add(f.object ? JsonValue::object(std::move(f.keys), std::move(f.values))
+                        : JsonValue::array(std::move(f.values)));
   }
 
   const std::string& s_;
-  size_t pos_ = 0;
+  const size_t& consumed_;
+  std::vector<Frame> stack_;
 };
 
 std::string where(const std::string& key) { return "\"" + key + "\""; }
@@ -505,7 +331,16 @@ std::string JsonValue::dump() const {
   return out;
 }
 
-JsonValue parse_json(const std::string& text) { return Parser(text).parse_document(); }
+JsonValue parse_json(const std::string& text) {
+  size_t consumed = 0;
+  Builder builder(text, &consumed);
+  const char* base = text.data();
+  const bool ok = nlohmann::json::sax_parse(CountingIterator(base, base, &consumed),
+                                            CountingIterator(base + text.size(), base, &consumed), &builder);
+  if (builder.error) throw *builder.error;
+  if (!ok) throw JsonError(1, "invalid JSON");  // not reached: every failure sets an error
+  return std::move(builder.result);
+}
 
 const char* json_type_name(JsonValue::Type type) {
   switch (type) {

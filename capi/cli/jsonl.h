@@ -1,16 +1,19 @@
-// JSON Lines for `motionfield batch`: a small, strict JSON parser (RFC 8259)
-// and the translation of one parsed line into a batch job.
+// JSON Lines for `motionfield batch`: strict JSON (RFC 8259) parsed by
+// nlohmann-json's SAX parser into a small value type, and the translation of
+// one parsed line into a batch job.
 //
-// The parser accepts exactly one JSON value surrounded by optional whitespace
-// (space, tab, CR, LF): objects, arrays, strings (every escape of RFC 8259,
-// including \uXXXX and surrogate pairs, decoded to UTF-8), numbers in JSON's
-// grammar (no leading zeros, no leading '+', no NaN/Infinity, no hex), true,
-// false and null. It rejects what lenient parsers let through: trailing commas,
-// comments, single quotes, unescaped control characters in strings, invalid
-// UTF-8, lone surrogates, duplicate object keys, numbers that overflow a double,
-// nesting deeper than kJsonMaxDepth and anything after the value. Errors are
-// JsonError, whose message starts with "column N: " (1-based, counted in
-// characters of the UTF-8 input).
+// parse_json accepts exactly one JSON value surrounded by optional whitespace
+// and rejects, with nlohmann's own checks, trailing commas, comments, single
+// quotes, unescaped control characters in strings, invalid UTF-8, lone
+// surrogates, numbers that overflow a double and anything after the value; it
+// adds two checks of its own: duplicate object keys and nesting deeper than
+// kJsonMaxDepth (the parser is iterative, so deep input cannot overflow the
+// stack either way). "\u0000" is accepted and decodes to a NUL character.
+// Errors are JsonError, whose message starts with "column N: " (1-based,
+// counted in characters of the UTF-8 input): for a syntax error the column
+// where it was detected (one past a truncated token) and nlohmann's
+// description, which quotes what was last read; for a duplicate key, the
+// key; for too deep nesting, the bracket; for an overflowing number, its start.
 #pragma once
 
 #include <stdexcept>

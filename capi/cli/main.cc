@@ -1,7 +1,7 @@
 // motionfield: the command-line front end (in-betweening, gap filling,
 // resampling, re-navigation, batch runs, rig descriptions). It is a client of the C API
-// (motionfield.h) and calls nothing else of motionfield; the JSON Lines parser
-// (jsonl.h) is its own.
+// (motionfield.h) and calls nothing else of motionfield; the JSON Lines reading
+// (jsonl.h, on nlohmann-json) is its own.
 // Exit codes: 0 ok, 2 bad input, 1 internal error; every message goes to
 // stderr, prefixed with "motionfield: ".
 #include <unistd.h>
