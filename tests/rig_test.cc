@@ -186,7 +186,7 @@ TEST(RigMap, UnmappableRigListsWhatWasFound) {
   } catch (const InputError& e) {
     const std::string m = e.what();
     EXPECT_NE(m.find("missing hips"), std::string::npos) << m;
-    EXPECT_NE(m.find("--rig-map"), std::string::npos) << m;
+    EXPECT_NE(m.find("rig map"), std::string::npos) << m;
   }
 }
 

@@ -172,6 +172,55 @@ Quaterniond json_quat(const nlohmann::json& v, const std::string& what) {
 
 nlohmann::json quat_json(const Quaterniond& q) { return {q.w(), q.x(), q.y(), q.z()}; }
 
+// Destination joints between two corresponding ones (corr >= 0): the nearest
+// such joint above and below, and the arc-length fraction between them.
+struct Between {
+  int above = -1, below = -1;
+  double s = 0;
+};
+
+std::vector<Between> between_joints(const Skeleton& D, const std::vector<int>& corr) {
+  const int JD = D.num_joints();
+  std::vector<Between> between(JD);
+  const auto kids = D.children();
+  for (int j = 0; j < JD; ++j) {
+    if (corr[j] >= 0) continue;
+    int above = D.parents[j];
+    double up = D.offsets[j].norm();
+    while (above >= 0 && corr[above] < 0) up += D.offsets[above].norm(), above = D.parents[above];
+    if (above < 0) continue;
+    int below = -1;
+    double down = 0;
+    std::vector<std::pair<int, double>> queue;  // breadth first, with the arc length so far
+    for (int c : kids[j]) queue.emplace_back(c, D.offsets[c].norm());
+    for (size_t q = 0; q < queue.size() && below < 0; ++q) {
+      if (corr[queue[q].first] >= 0) below = queue[q].first, down = queue[q].second;
+      else
+        for (int c : kids[queue[q].first]) queue.emplace_back(c, queue[q].second + D.offsets[c].norm());
+    }
+    if (below >= 0) between[j] = {above, below, up + down > 1e-12 ? up / (up + down) : 0.5};
+  }
+  return between;
+}
+
+// The root translation of frame f of `out` (local rotations set) that puts
+// joint `hips` at `target`; the root's own translation is the reference's
+// (zero without one) when the hips are not the root.
+Vector3d root_placing_hips(const Motion& out, int f, int hips, const Vector3d& target, const Motion* reference) {
+  if (hips == 0) return target;
+  const Skeleton& D = out.skeleton;
+  const Vector3d root = reference ? reference->root_positions[f] : Vector3d(0, 0, 0);
+  std::vector<int> chain;
+  for (int j = hips; j > 0; j = D.parents[j]) chain.push_back(j);
+  Vector3d pos = root;
+  Quaterniond rot = out.rotation(f, 0);
+  for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+    pos += rot * D.offsets[*it];
+    rot = rot * out.rotation(f, *it);
+  }
+  return root + (target - pos);
+}
+
 }  // namespace
 
 double leg_length(const Skeleton& s, const RigParts& p) {
@@ -337,32 +386,7 @@ Motion Retargeter::transfer(const Motion& src, bool to_model, const Motion* refe
     return toes_ && foot ? a.toe_frames[j] : a.frames[j];
   };
 
-  // Destination joints between two corresponding ones: the nearest mapped
-  // joint above and below, and the arc-length fraction.
-  struct Between {
-    int above = -1, below = -1;
-    double s = 0;
-  };
-  std::vector<Between> between(JD);
-  const auto kids = D.children();
-  for (int j = 0; j < JD; ++j) {
-    if (corr[j] >= 0) continue;
-    int above = D.parents[j];
-    double up = D.offsets[j].norm();
-    while (above >= 0 && corr[above] < 0) up += D.offsets[above].norm(), above = D.parents[above];
-    if (above < 0) continue;
-    int below = -1;
-    double down = 0;
-    std::vector<std::pair<int, double>> queue;
-    for (int c : kids[j]) queue.emplace_back(c, D.offsets[c].norm());
-    for (size_t q = 0; q < queue.size() && below < 0; ++q) {
-      if (corr[queue[q].first] >= 0) below = queue[q].first, down = queue[q].second;
-      else
-        for (int c : kids[queue[q].first]) queue.emplace_back(c, queue[q].second + D.offsets[c].norm());
-    }
-    if (below < 0) continue;
-    between[j] = {above, below, up + down > 1e-12 ? up / (up + down) : 0.5};
-  }
+  const std::vector<Between> between = between_joints(D, corr);
 
   const GlobalPose g = forward_kinematics(src);
   Motion out = Motion::identity(D, F, src.fps);
@@ -402,20 +426,7 @@ Motion Retargeter::transfer(const Motion& src, bool to_model, const Motion* refe
     }
     // Root: the hips land where the source's hips are, scaled.
     const Vector3d hips_target = g.position(f, hips_src) * scale;
-    if (hips_dst == 0) {
-      out.root_positions[f] = hips_target;
-    } else {
-      Vector3d root = reference ? reference->root_positions[f] : Vector3d(0, 0, 0);
-      Vector3d pos = root;
-      std::vector<int> chain;
-      for (int j = hips_dst; j > 0; j = D.parents[j]) chain.push_back(j);
-      Quaterniond rot = out.rotation(f, 0);
-      for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
-        pos += rot * D.offsets[*it];
-        rot = rot * out.rotation(f, *it);
-      }
-      out.root_positions[f] = root + (hips_target - pos);
-    }
+    out.root_positions[f] = root_placing_hips(out, f, hips_dst, hips_target, reference);
   }
   return out;
 }

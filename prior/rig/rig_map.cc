@@ -182,128 +182,151 @@ int name_side(const std::string& name) {
   return split_side(name, &rest);
 }
 
-RigParts find_rig_parts(const Skeleton& s) {
+namespace {
+
+// The steps of find_rig_parts over one skeleton, each filling what it can.
+struct PartFinder {
+  const Skeleton& s;
+  Tree t;
+  std::vector<Kind> kinds;
+  std::vector<int> sides;
   RigParts p;
-  const int J = s.num_joints();
-  if (J == 0) return p;
-  const Tree t(s);
-  std::vector<Kind> kinds(J);
-  std::vector<int> sides(J);
-  for (int j = 0; j < J; ++j) kinds[j] = classify(s.names[j], &sides[j]);
-  auto first_of = [&](Kind k, int side, int below) {  // topmost joint of a kind under `below`
-    for (int j = 0; j < J; ++j)
+
+  explicit PartFinder(const Skeleton& sk) : s(sk), t(sk), kinds(sk.num_joints()), sides(sk.num_joints()) {
+    for (int j = 0; j < sk.num_joints(); ++j) kinds[j] = classify(sk.names[j], &sides[j]);
+  }
+
+  // Topmost joint of a kind and side under `below` (anywhere when below < 0).
+  int first_of(Kind k, int side, int below) const {
+    for (int j = 0; j < s.num_joints(); ++j)
       if (kinds[j] == k && sides[j] == side && (below < 0 || (j != below && t.is_ancestor(below, j)))) return j;
     return -1;
-  };
-
-  // Legs by name, then the hips as their common ancestor.
-  for (int side = 0; side < 2; ++side) {
-    LegParts& l = p.legs[side];
-    l.thigh = first_of(Kind::Thigh, side, -1);
-    l.shin = first_of(Kind::Shin, side, l.thigh);
-    l.foot = first_of(Kind::Foot, side, l.shin >= 0 ? l.shin : l.thigh);
-    if (l.foot >= 0) {
-      l.toe = first_of(Kind::Toe, side, l.foot);
-      if (l.toe < 0) l.toe = first_of(Kind::Foot, side, l.foot);  // SMPL: ankle, then foot = toes
-    }
-  }
-  if (p.legs[0].thigh >= 0 && p.legs[1].thigh >= 0) p.hips = t.lca(p.legs[0].thigh, p.legs[1].thigh);
-  if (p.hips < 0)
-    for (int j = 0; j < J && p.hips < 0; ++j)
-      if (kinds[j] == Kind::Hips) p.hips = j;
-  if (p.hips < 0) return p;
-
-  // Legs by shape where names left gaps: the significant joints of the chain
-  // below the hips' child on that side.
-  for (int side = 0; side < 2; ++side) {
-    LegParts& l = p.legs[side];
-    if (l.thigh >= 0 && l.shin >= 0 && l.foot >= 0) continue;
-    int root = -1;
-    for (int c : t.kids[p.hips])
-      if (sides[c] == side || (l.thigh >= 0 && t.is_ancestor(c, l.thigh))) root = c;
-    if (root < 0) continue;
-    const std::vector<int> sig = significant(t, t.main_chain(root), kinds);
-    if (sig.size() < 3) continue;
-    l.thigh = sig[0], l.shin = sig[1], l.foot = sig[2], l.toe = sig.size() > 3 ? sig[3] : -1;
   }
 
-  // Arms by name; "shoulder" is the clavicle when an upper arm is named too,
-  // else the upper arm (SMPL: L_Collar, L_Shoulder, L_Elbow, L_Wrist).
-  for (int side = 0; side < 2; ++side) {
-    ArmParts& a = p.arms[side];
-    const int clav = first_of(Kind::Clavicle, side, p.hips), shoulder = first_of(Kind::Shoulder, side, p.hips);
-    a.upper = first_of(Kind::UpperArm, side, p.hips);
-    if (a.upper >= 0) {
-      a.shoulder = clav >= 0 ? clav : shoulder;
-    } else {
-      a.shoulder = clav;
-      a.upper = shoulder;
-    }
-    if (a.shoulder >= 0 && a.upper >= 0 && !t.is_ancestor(a.shoulder, a.upper)) a.shoulder = -1;
-    a.fore = first_of(Kind::Fore, side, a.upper);
-    a.hand = first_of(Kind::Hand, side, a.fore >= 0 ? a.fore : a.upper);
+  // The largest child of `j` on `side` (-1: unsided).
+  int largest_child(int j, int side) const {
+    int best = -1;
+    for (int c : t.kids[j])
+      if (sides[c] == side && (best < 0 || t.size[c] > t.size[best])) best = c;
+    return best;
   }
 
-  // The chest: where both arms meet; spine = the joints between it and the hips.
-  const int left_top = p.arms[0].shoulder >= 0 ? p.arms[0].shoulder : p.arms[0].upper;
-  const int right_top = p.arms[1].shoulder >= 0 ? p.arms[1].shoulder : p.arms[1].upper;
-  if (left_top >= 0 && right_top >= 0) p.chest = t.lca(left_top, right_top);
-  if (p.chest < 0 || p.chest == p.hips || !t.is_ancestor(p.hips, p.chest)) {
-    // By shape: down the spine side of the hips to the first joint with two
-    // side branches (the arms).
-    p.chest = -1;
-    int spine_root = -1;
-    for (int c : t.kids[p.hips])
-      if (sides[c] < 0 && (spine_root < 0 || t.size[c] > t.size[spine_root])) spine_root = c;
-    for (int j = spine_root; j >= 0 && p.chest < 0;) {
-      int sided = 0, next = -1;
-      for (int c : t.kids[j]) {
-        if (sides[c] >= 0 && t.size[c] >= 3) ++sided;
-        if (sides[c] < 0 && (next < 0 || t.size[c] > t.size[next])) next = c;
+  void legs_by_name() {
+    for (int side = 0; side < 2; ++side) {
+      LegParts& l = p.legs[side];
+      l.thigh = first_of(Kind::Thigh, side, -1);
+      l.shin = first_of(Kind::Shin, side, l.thigh);
+      l.foot = first_of(Kind::Foot, side, l.shin >= 0 ? l.shin : l.thigh);
+      if (l.foot >= 0) {
+        l.toe = first_of(Kind::Toe, side, l.foot);
+        if (l.toe < 0) l.toe = first_of(Kind::Foot, side, l.foot);  // SMPL: ankle, then foot = toes
       }
+    }
+  }
+
+  // Where both legs meet, else a joint named like the hips.
+  void hips() {
+    if (p.legs[0].thigh >= 0 && p.legs[1].thigh >= 0) p.hips = t.lca(p.legs[0].thigh, p.legs[1].thigh);
+    for (int j = 0; j < s.num_joints() && p.hips < 0; ++j)
+      if (kinds[j] == Kind::Hips) p.hips = j;
+  }
+
+  // Where names left gaps: the significant joints of the chain below the
+  // hips' child on that side.
+  void legs_by_shape() {
+    for (int side = 0; side < 2; ++side) {
+      LegParts& l = p.legs[side];
+      if (l.thigh >= 0 && l.shin >= 0 && l.foot >= 0) continue;
+      int root = -1;
+      for (int c : t.kids[p.hips])
+        if (sides[c] == side || (l.thigh >= 0 && t.is_ancestor(c, l.thigh))) root = c;
+      if (root < 0) continue;
+      const std::vector<int> sig = significant(t, t.main_chain(root), kinds);
+      if (sig.size() < 3) continue;
+      l.thigh = sig[0], l.shin = sig[1], l.foot = sig[2], l.toe = sig.size() > 3 ? sig[3] : -1;
+    }
+  }
+
+  // "shoulder" is the clavicle when an upper arm is named too, else the upper
+  // arm (SMPL: L_Collar, L_Shoulder, L_Elbow, L_Wrist).
+  void arms_by_name() {
+    for (int side = 0; side < 2; ++side) {
+      ArmParts& a = p.arms[side];
+      const int clav = first_of(Kind::Clavicle, side, p.hips), shoulder = first_of(Kind::Shoulder, side, p.hips);
+      a.upper = first_of(Kind::UpperArm, side, p.hips);
+      a.shoulder = a.upper >= 0 ? (clav >= 0 ? clav : shoulder) : clav;
+      if (a.upper < 0) a.upper = shoulder;
+      if (a.shoulder >= 0 && a.upper >= 0 && !t.is_ancestor(a.shoulder, a.upper)) a.shoulder = -1;
+      a.fore = first_of(Kind::Fore, side, a.upper);
+      a.hand = first_of(Kind::Hand, side, a.fore >= 0 ? a.fore : a.upper);
+    }
+  }
+
+  // Where both arms meet; by shape, the first joint down the spine side of
+  // the hips with two side branches.
+  void chest() {
+    const int left_top = p.arms[0].shoulder >= 0 ? p.arms[0].shoulder : p.arms[0].upper;
+    const int right_top = p.arms[1].shoulder >= 0 ? p.arms[1].shoulder : p.arms[1].upper;
+    if (left_top >= 0 && right_top >= 0) p.chest = t.lca(left_top, right_top);
+    if (p.chest >= 0 && p.chest != p.hips && t.is_ancestor(p.hips, p.chest)) return;
+    p.chest = -1;
+    for (int j = largest_child(p.hips, -1); j >= 0 && p.chest < 0; j = largest_child(j, -1)) {
+      int sided = 0;
+      for (int c : t.kids[j])
+        if (sides[c] >= 0 && t.size[c] >= 3) ++sided;
       if (sided >= 2) p.chest = j;
-      j = next;
     }
   }
-  if (p.chest < 0) return p;
-  p.spine = t.between(p.hips, p.chest);
 
-  // Arms by shape where names left gaps: chains from the chest's side children.
-  for (int side = 0; side < 2; ++side) {
-    ArmParts& a = p.arms[side];
-    if (a.upper >= 0 && a.fore >= 0 && a.hand >= 0) continue;
-    int root = -1;
-    for (int c : t.kids[p.chest])
-      if (sides[c] == side && (root < 0 || t.size[c] > t.size[root])) root = c;
-    if (root < 0) continue;
-    std::vector<int> chain;
-    for (int j : t.main_chain(root)) {  // stop at the hand: where fingers branch
-      chain.push_back(j);
-      if (t.kids[j].size() >= 2) break;
+  // Where names left gaps: the chest's side chains up to where fingers branch.
+  void arms_by_shape() {
+    for (int side = 0; side < 2; ++side) {
+      ArmParts& a = p.arms[side];
+      if (a.upper >= 0 && a.fore >= 0 && a.hand >= 0) continue;
+      const int root = largest_child(p.chest, side);
+      if (root < 0) continue;
+      std::vector<int> chain;
+      for (int j : t.main_chain(root)) {
+        chain.push_back(j);
+        if (t.kids[j].size() >= 2) break;
+      }
+      const std::vector<int> sig = significant(t, chain, kinds);
+      if (sig.size() >= 4) a = {sig[sig.size() - 4], sig[sig.size() - 3], sig[sig.size() - 2], sig.back()};
+      else if (sig.size() == 3) a = {-1, sig[0], sig[1], sig[2]};
     }
-    const std::vector<int> sig = significant(t, chain, kinds);
-    if (sig.size() >= 4) a = {sig[sig.size() - 4], sig[sig.size() - 3], sig[sig.size() - 2], sig.back()};
-    else if (sig.size() == 3) a = {-1, sig[0], sig[1], sig[2]};
   }
 
-  // Head and neck: on the chest's unsided branch.
-  for (int j = 0; j < J && p.head < 0; ++j)
-    if (kinds[j] == Kind::Head && t.is_ancestor(p.chest, j)) p.head = j;
-  if (p.head < 0) {
-    int top = -1;
-    for (int c : t.kids[p.chest])
-      if (sides[c] < 0 && (top < 0 || t.size[c] > t.size[top])) top = c;
-    if (top >= 0) {
+  // On the chest's unsided branch: a joint named head, else the branch's end.
+  void head_and_neck() {
+    for (int j = 0; j < s.num_joints() && p.head < 0; ++j)
+      if (kinds[j] == Kind::Head && t.is_ancestor(p.chest, j)) p.head = j;
+    const int top = largest_child(p.chest, -1);
+    if (p.head < 0 && top >= 0) {
       const std::vector<int> sig = significant(t, t.main_chain(top), kinds);
       if (!sig.empty()) p.head = sig.back();
     }
-  }
-  if (p.head >= 0) {
-    const std::vector<int> neck = t.between(p.chest, p.head);
-    for (int j : neck)
+    if (p.head < 0) return;
+    for (int j : t.between(p.chest, p.head))
       if (kinds[j] != Kind::Helper && p.neck < 0) p.neck = j;
   }
-  return p;
+};
+
+}  // namespace
+
+RigParts find_rig_parts(const Skeleton& s) {
+  if (s.num_joints() == 0) return {};
+  PartFinder f(s);
+  f.legs_by_name();
+  f.hips();
+  if (f.p.hips < 0) return f.p;
+  f.legs_by_shape();
+  f.arms_by_name();
+  f.chest();
+  if (f.p.chest < 0) return f.p;
+  f.p.spine = f.t.between(f.p.hips, f.p.chest);
+  f.arms_by_shape();
+  f.head_and_neck();
+  return f.p;
 }
 
 std::vector<std::pair<std::string, int>> RigParts::list() const {
@@ -379,15 +402,12 @@ std::string describe(const RigParts& parts, const Skeleton& s) {
 
 }  // namespace
 
-RigMap map_rig(const Skeleton& user, const Skeleton& model, const std::string& map_json) {
-  RigMap map;
-  const int M = model.num_joints();
-  map.model_parts = find_rig_parts(model);
-  if (!map.model_parts.missing().empty())
-    throw InputError("the model's skeleton is not a humanoid the rig map understands (missing: " +
-                     map.model_parts.missing().front() + ")");
-  map.user_of_model.assign(M, -1);
-  map.how.assign(M, "");
+namespace {
+
+// The automatic map: the user's parts matched to the model's, part by part.
+void match_parts(const Skeleton& user, RigMap* out) {
+  RigMap& map = *out;
+  const int M = static_cast<int>(map.user_of_model.size());
   const RigParts up = find_rig_parts(user);
   auto set = [&](int m, int u) {
     if (m >= 0 && u >= 0) map.user_of_model[m] = u, map.how[m] = "name";
@@ -412,53 +432,61 @@ RigMap map_rig(const Skeleton& user, const Skeleton& model, const std::string& m
       const Kind k = classify(user.names[map.user_of_model[m]], &side);
       if (k == Kind::None || k == Kind::Helper) map.how[m] = "shape";
     }
+}
 
-  if (!map_json.empty()) {
-    std::set<std::string> seen_keys;
-    std::string duplicate;
-    int depth = 0;
-    const auto callback = [&](int d, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
-      if (event == nlohmann::json::parse_event_t::object_start) ++depth;
-      if (event == nlohmann::json::parse_event_t::object_end) --depth;
-      if (event == nlohmann::json::parse_event_t::key && depth == 1 && !seen_keys.insert(parsed.get<std::string>()).second &&
-          duplicate.empty())
-        duplicate = parsed.get<std::string>();
-      (void)d;
-      return true;
-    };
-    nlohmann::json j;
-    try {
-      j = nlohmann::json::parse(map_json, callback);
-    } catch (const nlohmann::json::parse_error& e) {
-      throw InputError(std::string("rig map: not valid JSON (") + e.what() + ")");
-    }
-    if (!j.is_object()) throw InputError("rig map: expected a JSON object {\"user joint\": \"model joint\", ...}");
-    if (!duplicate.empty())
-      throw InputError("rig map: user joint '" + duplicate + "' is mapped twice (conflicting entries)");
-    std::map<int, std::string> given;  // model joint -> user joint named in the file
-    for (auto it = j.begin(); it != j.end(); ++it) {
-      const int u = user.find(it.key());
-      if (u < 0) throw InputError("rig map: the motion has no joint named '" + it.key() + "'");
-      for (int m = 0; m < M; ++m)  // the file's entry replaces what was found for this user joint
-        if (map.user_of_model[m] == u) map.user_of_model[m] = -1, map.how[m] = "";
-      if (it.value().is_null()) continue;
-      if (!it.value().is_string())
-        throw InputError("rig map: the value for '" + it.key() + "' must be a model joint name or null");
-      const std::string target = it.value().get<std::string>();
-      const int m = model.find(target);
-      if (m < 0) {
-        std::string names;
-        for (const std::string& n : model.names) names += (names.empty() ? "" : ", ") + n;
-        throw InputError("rig map: the model has no joint named '" + target + "' (its joints: " + names + ")");
-      }
-      if (given.count(m))
-        throw InputError("rig map: model joint '" + target + "' is given two user joints ('" + given[m] + "' and '" +
-                         it.key() + "')");
-      given[m] = it.key();
-      map.user_of_model[m] = u, map.how[m] = "map file";
-    }
+// A map file's entries replace what was found for the joints they name.
+void apply_map_json(const std::string& map_json, const Skeleton& user, const Skeleton& model, RigMap* out) {
+  RigMap& map = *out;
+  const int M = model.num_joints();
+  std::set<std::string> seen_keys;
+  std::string duplicate;
+  int depth = 0;
+  const auto callback = [&](int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    if (event == nlohmann::json::parse_event_t::object_start) ++depth;
+    if (event == nlohmann::json::parse_event_t::object_end) --depth;
+    if (event == nlohmann::json::parse_event_t::key && depth == 1 && !seen_keys.insert(parsed.get<std::string>()).second &&
+        duplicate.empty())
+      duplicate = parsed.get<std::string>();
+    return true;
+  };
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(map_json, callback);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(std::string("rig map: not valid JSON (") + e.what() + ")");
   }
+  if (!j.is_object()) throw InputError("rig map: expected a JSON object {\"user joint\": \"model joint\", ...}");
+  if (!duplicate.empty())
+    throw InputError("rig map: user joint '" + duplicate + "' is mapped twice (conflicting entries)");
+  std::map<int, std::string> given;  // model joint -> user joint named in the file
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const int u = user.find(it.key());
+    if (u < 0) throw InputError("rig map: the motion has no joint named '" + it.key() + "'");
+    for (int m = 0; m < M; ++m)  // the file's entry replaces what was found for this user joint
+      if (map.user_of_model[m] == u) map.user_of_model[m] = -1, map.how[m] = "";
+    if (it.value().is_null()) continue;
+    if (!it.value().is_string())
+      throw InputError("rig map: the value for '" + it.key() + "' must be a model joint name or null");
+    const std::string target = it.value().get<std::string>();
+    const int m = model.find(target);
+    if (m < 0) {
+      std::string names;
+      for (const std::string& n : model.names) names += (names.empty() ? "" : ", ") + n;
+      throw InputError("rig map: the model has no joint named '" + target + "' (its joints: " + names + ")");
+    }
+    if (given.count(m))
+      throw InputError("rig map: model joint '" + target + "' is given two user joints ('" + given[m] + "' and '" +
+                       it.key() + "')");
+    given[m] = it.key();
+    map.user_of_model[m] = u, map.how[m] = "map file";
+  }
+}
 
+// The map must give every required part and nest like the model.
+void check_map(const Skeleton& user, const Skeleton& model, RigMap* out) {
+  RigMap& map = *out;
+  const int M = model.num_joints();
+  const RigParts up = find_rig_parts(user);
   // Parts implied by the (possibly edited) map must make a humanoid whose
   // joints nest like the model's.
   map.user_parts = induced_parts(map.model_parts, map.user_of_model);
@@ -468,8 +496,7 @@ RigMap map_rig(const Skeleton& user, const Skeleton& model, const std::string& m
     for (const std::string& s : missing) m += (m.empty() ? "" : ", ") + s;
     throw InputError("cannot map this skeleton (" + std::to_string(user.num_joints()) +
                      " joints) onto the model's humanoid: found " + describe(up, user) + "; missing " + m +
-                     ". Name the joints in a rig map file (--rig-map, JSON {\"user joint\": \"model joint\"}; "
-                     "the model's joints are listed by `motionfield rig`)");
+                     ". Name the joints in a rig map (JSON {\"user joint\": \"model joint\"}, docs/RIGS.md)");
   }
   const Tree t(user);
   for (int m = 1; m < M; ++m) {  // every mapped joint's nearest mapped model ancestor must be a user ancestor too
@@ -482,6 +509,21 @@ RigMap map_rig(const Skeleton& user, const Skeleton& model, const std::string& m
                        user.names[map.user_of_model[pm]] + "' (playing '" + model.names[pm] +
                        "') is not above it in the motion's hierarchy");
   }
+}
+
+}  // namespace
+
+RigMap map_rig(const Skeleton& user, const Skeleton& model, const std::string& map_json) {
+  RigMap map;
+  map.model_parts = find_rig_parts(model);
+  if (!map.model_parts.missing().empty())
+    throw InputError("the model's skeleton is not a humanoid the rig map understands (missing: " +
+                     map.model_parts.missing().front() + ")");
+  map.user_of_model.assign(model.num_joints(), -1);
+  map.how.assign(model.num_joints(), "");
+  match_parts(user, &map);
+  if (!map_json.empty()) apply_map_json(map_json, user, model, &map);
+  check_map(user, model, &map);
   return map;
 }
 
