@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <random>
 
 #include "prior/inbetween/inbetweener.h"
@@ -211,271 +212,352 @@ StepLosses compute_losses(const InbetweenModel& model, const Batch& b, double co
 
 double item(const at::Tensor& t) { return t.defined() ? t.item<double>() : 0.0; }
 
-void save_checkpoint(const InbetweenModel& model, torch::optim::Adam& optimizer, const training::TrainerState& state,
-                     const std::string& dir) {
-  save_inbetweener(model, dir + "/last.mfm");
-  torch::save(optimizer, dir + "/last.optim.tmp");
-  fs::rename(dir + "/last.optim.tmp", dir + "/last.optim");
-  training::save_trainer_state(dir + "/last.state", state);
-}
+using Clock = std::chrono::steady_clock;
 
-}  // namespace
+double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-InbetweenTrainingResult train_inbetweener(const InbetweenTrainingOptions& o) {
+void check_options(const InbetweenTrainingOptions& o) {
   if (o.out_dir.empty()) throw InputError("train: an output directory is required");
   if (o.batch < 1 || o.min_length < 2 || !(o.max_minutes > 0) || !(o.lr > 0) || o.validation_windows < 0 ||
       !(o.warmup >= 0 && o.warmup < 1)) {
     throw InputError(
         "train: batch, time budget and learning rate must be positive, min length at least 2, warm-up in [0, 1)");
   }
-  mf::set_compute_threads(std::max(1, o.threads));
-  fs::create_directories(o.out_dir);
-  const auto t0 = std::chrono::steady_clock::now();
+}
 
-  Dataset data = training::load_training_data(o.data, o.cache_dir, o.max_train_clips, 0.0, o.verbose);
-  const std::string last_model = o.out_dir + "/last.mfm", last_optim = o.out_dir + "/last.optim",
-                    last_state = o.out_dir + "/last.state", best_model = o.out_dir + "/best.mfm",
-                    log_path = o.out_dir + "/log.csv";
-  const bool resuming = o.resume && fs::exists(last_model) && fs::exists(last_state) && fs::exists(last_optim);
+// A new model of o.kind, or the checkpoint's when resuming (checked against the options).
+std::unique_ptr<InbetweenModel> load_or_make_model(const InbetweenTrainingOptions& o, const Dataset& data,
+                                                   const training::RunFiles& files, bool resuming) {
   at::manual_seed(o.seed);
-  std::unique_ptr<InbetweenModel> model =
-      resuming ? load_inbetweener(last_model)
-               : make_inbetweener(o.kind, o.hyperparameters, training::measure_training_rig(data));
-  if (resuming) {
-    if (model->kind() != o.kind) {
-      throw InputError("train: --resume: the checkpoint holds a '" + model->kind() + "' model, not '" + o.kind + "'");
-    }
-    auto hp = model->hyperparameters();
-    for (const auto& [k, v] : o.hyperparameters) {
-      auto it = hp.find(k);
-      if (it == hp.end() || it->second != v) {
-        throw InputError("train: --resume with other hyperparameters than the checkpoint (" + model->describe() + ")");
-      }
+  if (!resuming) return make_inbetweener(o.kind, o.hyperparameters, training::measure_training_rig(data));
+  std::unique_ptr<InbetweenModel> model = load_inbetweener(files.last_model);
+  if (model->kind() != o.kind) {
+    throw InputError("train: --resume: the checkpoint holds a '" + model->kind() + "' model, not '" + o.kind + "'");
+  }
+  const auto hp = model->hyperparameters();
+  for (const auto& [k, v] : o.hyperparameters) {
+    auto it = hp.find(k);
+    if (it == hp.end() || it->second != v) {
+      throw InputError("train: --resume with other hyperparameters than the checkpoint (" + model->describe() + ")");
     }
   }
+  return model;
+}
+
+// The training clips' frame rate and skeleton must be the model's.
+void check_data_fits(const InbetweenModel& model, const Dataset& data) {
   for (const Clip& c : data.train) {
-    if (std::abs(c.motion.fps - model->fps()) > 1e-3) {
+    if (std::abs(c.motion.fps - model.fps()) > 1e-3) {
       throw InputError("train: clip " + c.name + " is at " + std::to_string(c.motion.fps) + " fps, the model at " +
-                       std::to_string(model->fps()) + " fps");
+                       std::to_string(model.fps()) + " fps");
     }
   }
-  const RigInfo& rig = model->rig();
-  if (!rig.skeleton.same_as(data.skeleton)) throw InputError("train: the checkpoint's skeleton differs from the data's");
-  const int W = model->window();
-  Sampler train_sampler(data.train, rig, W, o.min_length);
-  if (train_sampler.empty()) throw InputError("train: no training clip has 2 frames or more");
-  Sampler val_sampler(data.validation, rig, W, o.min_length);
-  std::vector<at::Tensor> train_contacts = clip_contacts(data.train, rig, model->fps());
-  std::vector<at::Tensor> val_contacts = clip_contacts(data.validation, rig, model->fps());
+  if (!model.rig().skeleton.same_as(data.skeleton)) {
+    throw InputError("train: the checkpoint's skeleton differs from the data's");
+  }
+}
 
-  if (!resuming) {
-    // Pose statistics over sampled training windows (root positions depend on
-    // the canonical frame, so measure them as the model will see them).
-    at::NoGradGuard no_grad;
-    std::mt19937_64 rng(o.seed * 31 + 7);
-    std::vector<Sample> samples;
-    const int n = std::max(64, std::min(2000, static_cast<int>(train_sampler.total_frames() / 32)));
-    for (int i = 0; i < n; ++i) samples.push_back(train_sampler.draw(rng));
-    std::vector<at::Tensor> frames;
-    for (size_t i = 0; i < samples.size(); i += 64) {
-      Batch b = make_batch(data.train, train_contacts, samples, i, std::min(samples.size(), i + 64), rig);
-      frames.push_back(b.target.flatten(0, 1).index({b.input.valid.flatten() > 0.5}));
-    }
-    at::Tensor all = at::cat(frames, 0).to(at::kDouble);
-    model->stats().pose_mean = all.mean(0).to(at::kFloat);
-    model->stats().pose_std = all.std(0).clamp_min(1e-3).to(at::kFloat);
-  }
+// Training-loss sums of one epoch: total, one per stage, contact.
+struct EpochSums {
+  explicit EpochSums(size_t stages) : values(stages + 2, 0.0) {}
+  std::vector<double> values;
+  int count = 0;
+  double mean(size_t k) const { return values[k] / count; }
+  double total() const { return mean(0); }
+  double contact() const { return mean(values.size() - 1); }
+};
 
-  // Fixed validation set.
-  std::vector<Batch> val_batches;
-  if (!val_sampler.empty()) {
-    std::mt19937_64 rng(0x5eed5eedULL);
-    std::vector<Sample> samples;
-    for (int i = 0; i < o.validation_windows; ++i) samples.push_back(val_sampler.draw(rng));
-    for (size_t i = 0; i < samples.size(); i += 64) {
-      val_batches.push_back(make_batch(data.validation, val_contacts, samples, i, std::min(samples.size(), i + 64), rig));
-    }
-  }
+// Validation losses per frame of the last stage (score, parts, contact) and per stage.
+struct Validation {
+  double score = 0, rot = 0, pos = 0, root = 0, contact = 0;
+  std::vector<double> stages;
+};
 
-  model->set_requires_grad(true);
-  model->train(true);
-  torch::optim::Adam optimizer(model->parameters(), torch::optim::AdamOptions(o.lr));
-  training::TrainerState state;
-  if (resuming) {
-    torch::load(optimizer, last_optim);
-    state = training::load_trainer_state(last_state);
-  }
-  const std::vector<std::string> stage_names = model->stage_names();
-  if (!resuming || !fs::exists(log_path)) {
-    std::ofstream log(log_path);
-    log << "epoch,step,minutes,lr,steps_per_s,train_loss";
-    for (const auto& s : stage_names) log << ",train_" << s;
-    log << ",train_contact,val_score,val_rot,val_pos_cm,val_root_cm";
-    for (const auto& s : stage_names) log << ",val_" << s;
-    log << ",val_contact,best\n";
-  }
-  const double base_minutes = state.minutes;
-  auto minutes_now = [&] {
-    return base_minutes + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / 60.0;
-  };
-  const double mean_length = 0.5 * (std::min(o.min_length, W) + W);
-  const int epoch_steps = o.epoch_steps > 0 ? o.epoch_steps
-                                            : std::max(1, static_cast<int>(train_sampler.total_frames() /
-                                                                           (mean_length * o.batch)));
-  if (o.verbose) {
-    std::fprintf(stderr,
-                 "train %s: %zu training clips, %zu validation clips (%zu validation windows), %d threads; %s; %lld "
-                 "parameters; epoch = %d steps%s\n",
-                 model->kind().c_str(), data.train.size(), data.validation.size(),
-                 static_cast<size_t>(o.validation_windows), std::max(1, o.threads), model->describe().c_str(),
-                 static_cast<long long>(model->num_parameters()), epoch_steps, resuming ? "; resumed" : "");
-  }
+// One training run: the set-up in the constructor, then train().
+class InbetweenRun {
+ public:
+  explicit InbetweenRun(const InbetweenTrainingOptions& o);
+  InbetweenTrainingResult train();
 
-  const bool profile = std::getenv("MF_PROFILE") != nullptr;
-  if (o.verbose) {
-    std::fprintf(stderr, "train: set-up (data, statistics, validation set) in %.1f s\n",
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+ private:
+  void measure_pose_statistics();
+  void make_validation_set();
+  void open_log() const;
+  void print_setup() const;
+  double minutes_now() const { return base_minutes_ + seconds_between(t0_, Clock::now()) / 60.0; }
+  // The fraction of the budget used (time, or steps with max_steps).
+  double progress() const;
+  // Returns true when the budget is used up.
+  bool train_epoch(EpochSums* sums);
+  void train_step(EpochSums* sums);
+  void print_progress(const EpochSums& sums);
+  Validation validate();
+  void end_epoch(const EpochSums& sums, const Validation& v);
+  void save_checkpoint();
+
+  const InbetweenTrainingOptions& o_;
+  const Clock::time_point t0_;
+  const training::RunFiles files_;
+  Dataset data_;
+  bool resuming_;
+  std::unique_ptr<InbetweenModel> model_;
+  Sampler train_sampler_, val_sampler_;
+  std::vector<at::Tensor> train_contacts_, val_contacts_;
+  std::vector<Batch> val_batches_;
+  std::unique_ptr<torch::optim::Adam> optimizer_;
+  training::TrainerState state_;
+  std::vector<std::string> stage_names_;
+  double base_minutes_ = 0;
+  int epoch_steps_ = 0;
+  bool profile_ = std::getenv("MF_PROFILE") != nullptr;
+  int64_t first_step_ = 0;
+  Clock::time_point run_start_, last_checkpoint_, last_progress_;
+  double lr_;
+};
+
+InbetweenRun::InbetweenRun(const InbetweenTrainingOptions& o)
+    : o_(o),
+      t0_(Clock::now()),
+      files_(o.out_dir),
+      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, 0.0, o.verbose)),
+      resuming_(o.resume && files_.has_checkpoint()),
+      model_(load_or_make_model(o, data_, files_, resuming_)),
+      train_sampler_(data_.train, model_->rig(), model_->window(), o.min_length),
+      val_sampler_(data_.validation, model_->rig(), model_->window(), o.min_length),
+      lr_(o.lr) {
+  check_data_fits(*model_, data_);
+  if (train_sampler_.empty()) throw InputError("train: no training clip has 2 frames or more");
+  train_contacts_ = clip_contacts(data_.train, model_->rig(), model_->fps());
+  val_contacts_ = clip_contacts(data_.validation, model_->rig(), model_->fps());
+  if (!resuming_) measure_pose_statistics();
+  make_validation_set();
+  model_->set_requires_grad(true);
+  model_->train(true);
+  optimizer_ = std::make_unique<torch::optim::Adam>(model_->parameters(), torch::optim::AdamOptions(o.lr));
+  if (resuming_) {
+    torch::load(*optimizer_, files_.last_optim);
+    state_ = training::load_trainer_state(files_.last_state);
   }
-  const int64_t first_step = state.step;
-  const auto run_start = std::chrono::steady_clock::now();
-  auto last_checkpoint = run_start, last_progress = run_start;
-  InbetweenTrainingResult result;
+  stage_names_ = model_->stage_names();
+  if (!resuming_ || !fs::exists(files_.log)) open_log();
+  base_minutes_ = state_.minutes;
+  const double mean_length = 0.5 * (std::min(o.min_length, model_->window()) + model_->window());
+  epoch_steps_ = o.epoch_steps > 0
+                     ? o.epoch_steps
+                     : std::max(1, static_cast<int>(train_sampler_.total_frames() / (mean_length * o.batch)));
+  if (o.verbose) print_setup();
+}
+
+// Pose statistics over sampled training windows (root positions depend on the
+// canonical frame, so measure them as the model will see them).
+void InbetweenRun::measure_pose_statistics() {
+  at::NoGradGuard no_grad;
+  std::mt19937_64 rng(o_.seed * 31 + 7);
+  std::vector<Sample> samples;
+  const int n = std::max(64, std::min(2000, static_cast<int>(train_sampler_.total_frames() / 32)));
+  for (int i = 0; i < n; ++i) samples.push_back(train_sampler_.draw(rng));
+  std::vector<at::Tensor> frames;
+  for (size_t i = 0; i < samples.size(); i += 64) {
+    Batch b = make_batch(data_.train, train_contacts_, samples, i, std::min(samples.size(), i + 64), model_->rig());
+    frames.push_back(b.target.flatten(0, 1).index({b.input.valid.flatten() > 0.5}));
+  }
+  at::Tensor all = at::cat(frames, 0).to(at::kDouble);
+  model_->stats().pose_mean = all.mean(0).to(at::kFloat);
+  model_->stats().pose_std = all.std(0).clamp_min(1e-3).to(at::kFloat);
+}
+
+// A fixed validation set: the same windows every epoch and run.
+void InbetweenRun::make_validation_set() {
+  if (val_sampler_.empty()) return;
+  std::mt19937_64 rng(0x5eed5eedULL);
+  std::vector<Sample> samples;
+  for (int i = 0; i < o_.validation_windows; ++i) samples.push_back(val_sampler_.draw(rng));
+  for (size_t i = 0; i < samples.size(); i += 64) {
+    val_batches_.push_back(
+        make_batch(data_.validation, val_contacts_, samples, i, std::min(samples.size(), i + 64), model_->rig()));
+  }
+}
+
+void InbetweenRun::open_log() const {
+  std::ofstream log(files_.log);
+  log << "epoch,step,minutes,lr,steps_per_s,train_loss";
+  for (const auto& s : stage_names_) log << ",train_" << s;
+  log << ",train_contact,val_score,val_rot,val_pos_cm,val_root_cm";
+  for (const auto& s : stage_names_) log << ",val_" << s;
+  log << ",val_contact,best\n";
+}
+
+void InbetweenRun::print_setup() const {
+  std::fprintf(stderr,
+               "train %s: %zu training clips, %zu validation clips (%zu validation windows), %d threads; %s; %lld "
+               "parameters; epoch = %d steps%s\n",
+               model_->kind().c_str(), data_.train.size(), data_.validation.size(),
+               static_cast<size_t>(o_.validation_windows), std::max(1, o_.threads), model_->describe().c_str(),
+               static_cast<long long>(model_->num_parameters()), epoch_steps_, resuming_ ? "; resumed" : "");
+  std::fprintf(stderr, "train: set-up (data, statistics, validation set) in %.1f s\n",
+               seconds_between(t0_, Clock::now()));
+}
+
+InbetweenTrainingResult InbetweenRun::train() {
+  first_step_ = state_.step;
+  run_start_ = last_checkpoint_ = last_progress_ = Clock::now();
   bool done = false;
-  double lr = o.lr;
-  while (!done && state.epoch < o.max_epochs) {
-    const auto epoch_start = std::chrono::steady_clock::now();
-    std::vector<double> sums(stage_names.size() + 2, 0.0);  // total, stages..., contact
-    int count = 0;
-    for (int s = 0; s < epoch_steps; ++s) {
-      double progress = minutes_now() / o.max_minutes;
-      if (o.max_steps > 0) progress = std::max(progress, static_cast<double>(state.step) / o.max_steps);
-      if (progress >= 1.0) {
-        done = true;
-        break;
-      }
-      if (std::chrono::duration<double>(std::chrono::steady_clock::now() - epoch_start).count() >
-          60.0 * o.validate_minutes && count > 0) {
-        break;
-      }
-      lr = training::scheduled_lr(o.lr, o.lr_final, progress, o.warmup);
-      training::set_learning_rate(optimizer, lr);
-      // Per-step seeds: the sample stream does not depend on where a run resumed.
-      std::mt19937_64 rng(o.seed * 1000003ULL + static_cast<uint64_t>(state.step));
-      at::manual_seed(o.seed * 7919ULL + static_cast<uint64_t>(state.step));
-      std::vector<Sample> samples;
-      for (int i = 0; i < o.batch; ++i) samples.push_back(train_sampler.draw(rng));
-      const auto c0 = std::chrono::steady_clock::now();
-      Batch b = make_batch(data.train, train_contacts, samples, 0, samples.size(), rig);
-      const auto c1 = std::chrono::steady_clock::now();
-      StepLosses L = compute_losses(*model, b, o.contact_weight);
-      const auto c2 = std::chrono::steady_clock::now();
-      optimizer.zero_grad();
-      L.total.backward();
-      const auto c3 = std::chrono::steady_clock::now();
-      torch::nn::utils::clip_grad_norm_(model->parameters(), 1.0);
-      optimizer.step();
-      if (profile) {
-        std::fprintf(stderr, "  batch %.3f s  forward+loss %.3f s  backward %.3f s  step %.3f s (T = %lld)\n",
-                     std::chrono::duration<double>(c1 - c0).count(), std::chrono::duration<double>(c2 - c1).count(),
-                     std::chrono::duration<double>(c3 - c2).count(),
-                     std::chrono::duration<double>(std::chrono::steady_clock::now() - c3).count(),
-                     static_cast<long long>(b.target.size(1)));
-      }
-      ++state.step;
-      ++count;
-      sums[0] += item(L.total);
-      for (size_t k = 0; k < L.stages.size() && k < stage_names.size(); ++k) sums[k + 1] += item(L.stages[k]);
-      sums.back() += item(L.contact);
-      const auto now = std::chrono::steady_clock::now();
-      if (o.verbose && (state.step == first_step + 1 ||
-                        std::chrono::duration<double>(now - last_progress).count() > 30.0)) {
-        last_progress = now;
-        const double sps = (state.step - first_step) / std::chrono::duration<double>(now - run_start).count();
-        std::fprintf(stderr, "  step %lld  epoch %d  %.1f/%.0f min  lr %.2e  loss %.4f", static_cast<long long>(state.step),
-                     state.epoch + 1, minutes_now(), o.max_minutes, lr, sums[0] / count);
-        for (size_t k = 0; k < stage_names.size(); ++k) {
-          std::fprintf(stderr, "  %s %.4f", stage_names[k].c_str(), sums[k + 1] / count);
-        }
-        std::fprintf(stderr, "  contact %.4f  %.2f steps/s\n", sums.back() / count, sps);
-      }
-      if (std::chrono::duration<double>(now - last_checkpoint).count() > 60.0 * o.checkpoint_minutes) {
-        state.minutes = minutes_now();
-        save_checkpoint(*model, optimizer, state, o.out_dir);
-        last_checkpoint = std::chrono::steady_clock::now();
-      }
-      if (o.max_steps > 0 && state.step >= o.max_steps) {
-        done = true;
-        break;
-      }
-    }
-    if (count == 0) break;
-
-    // Validation.
-    double score = 0, rot = 0, pos = 0, root = 0, contact = 0, frames = 0;
-    std::vector<double> stage_val(stage_names.size(), 0.0);
-    if (!val_batches.empty()) {
-      at::NoGradGuard no_grad;
-      model->train(false);
-      for (const Batch& b : val_batches) {
-        StepLosses L = compute_losses(*model, b, o.contact_weight);
-        const double n = item(b.input.valid.sum());
-        score += item(L.stages.back()) * n;
-        rot += item(L.last.rotation) * n;
-        pos += item(L.last.position) * n;
-        root += item(L.last.root) * n;
-        contact += item(L.contact) * n;
-        for (size_t k = 0; k < L.stages.size() && k < stage_val.size(); ++k) stage_val[k] += item(L.stages[k]) * n;
-        frames += n;
-      }
-      model->train(true);
-      frames = std::max(frames, 1.0);
-      score /= frames;
-      rot /= frames;
-      pos /= frames;
-      root /= frames;
-      contact /= frames;
-      for (double& v : stage_val) v /= frames;
-    } else {
-      score = sums[0] / count;  // no validation clips: the training loss decides
-    }
-    ++state.epoch;
-    state.minutes = minutes_now();
-    const bool best = score < state.best;
-    if (best) {
-      state.best = score;
-      save_inbetweener(*model, best_model);
-    }
-    save_checkpoint(*model, optimizer, state, o.out_dir);
-    last_checkpoint = std::chrono::steady_clock::now();
-    const double sps =
-        (state.step - first_step) / std::max(1e-9, std::chrono::duration<double>(last_checkpoint - run_start).count());
-    {
-      std::ofstream log(log_path, std::ios::app);
-      log.precision(6);
-      log << state.epoch << "," << state.step << "," << state.minutes << "," << lr << "," << sps << ","
-          << sums[0] / count;
-      for (size_t k = 0; k < stage_names.size(); ++k) log << "," << sums[k + 1] / count;
-      log << "," << sums.back() / count << "," << score << "," << rot << "," << pos * 100 << "," << root * 100;
-      for (double v : stage_val) log << "," << v;
-      log << "," << contact << "," << (best ? 1 : 0) << "\n";
-    }
-    if (o.verbose) {
-      std::fprintf(stderr,
-                   "epoch %d  step %lld  %.1f min  train %.4f | val score %.4f (rot %.4f pos %.2f cm root %.2f cm "
-                   "contact %.4f)%s\n",
-                   state.epoch, static_cast<long long>(state.step), state.minutes, sums[0] / count, score, rot,
-                   pos * 100, root * 100, contact, best ? " (best)" : "");
-    }
+  while (!done && state_.epoch < o_.max_epochs) {
+    EpochSums sums(stage_names_.size());
+    done = train_epoch(&sums);
+    if (sums.count == 0) break;
+    end_epoch(sums, validate());
   }
-  result.epochs = state.epoch;
-  result.steps = state.step;
-  result.minutes = state.minutes;
-  result.steps_per_second =
-      (state.step - first_step) /
-      std::max(1e-9, std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count());
-  result.best_validation = state.best;
-  result.best_path = best_model;
+  InbetweenTrainingResult result;
+  result.epochs = state_.epoch;
+  result.steps = state_.step;
+  result.minutes = state_.minutes;
+  result.steps_per_second = (state_.step - first_step_) / std::max(1e-9, seconds_between(run_start_, Clock::now()));
+  result.best_validation = state_.best;
+  result.best_path = files_.best_model;
   return result;
+}
+
+double InbetweenRun::progress() const {
+  double p = minutes_now() / o_.max_minutes;
+  if (o_.max_steps > 0) p = std::max(p, static_cast<double>(state_.step) / o_.max_steps);
+  return p;
+}
+
+// An epoch ends after epoch_steps steps or validate_minutes of wall time.
+bool InbetweenRun::train_epoch(EpochSums* sums) {
+  const auto epoch_start = Clock::now();
+  for (int s = 0; s < epoch_steps_; ++s) {
+    const double p = progress();
+    if (p >= 1.0) return true;
+    if (seconds_between(epoch_start, Clock::now()) > 60.0 * o_.validate_minutes && sums->count > 0) return false;
+    lr_ = training::scheduled_lr(o_.lr, o_.lr_final, p, o_.warmup);
+    training::set_learning_rate(*optimizer_, lr_);
+    train_step(sums);
+    print_progress(*sums);
+    if (seconds_between(last_checkpoint_, Clock::now()) > 60.0 * o_.checkpoint_minutes) {
+      state_.minutes = minutes_now();
+      save_checkpoint();
+    }
+    if (o_.max_steps > 0 && state_.step >= o_.max_steps) return true;
+  }
+  return false;
+}
+
+void InbetweenRun::train_step(EpochSums* sums) {
+  // Per-step seeds: the sample stream does not depend on where a run resumed.
+  std::mt19937_64 rng(o_.seed * 1000003ULL + static_cast<uint64_t>(state_.step));
+  at::manual_seed(o_.seed * 7919ULL + static_cast<uint64_t>(state_.step));
+  std::vector<Sample> samples;
+  for (int i = 0; i < o_.batch; ++i) samples.push_back(train_sampler_.draw(rng));
+  const auto c0 = Clock::now();
+  Batch b = make_batch(data_.train, train_contacts_, samples, 0, samples.size(), model_->rig());
+  const auto c1 = Clock::now();
+  StepLosses L = compute_losses(*model_, b, o_.contact_weight);
+  const auto c2 = Clock::now();
+  optimizer_->zero_grad();
+  L.total.backward();
+  const auto c3 = Clock::now();
+  torch::nn::utils::clip_grad_norm_(model_->parameters(), 1.0);
+  optimizer_->step();
+  if (profile_) {
+    std::fprintf(stderr, "  batch %.3f s  forward+loss %.3f s  backward %.3f s  step %.3f s (T = %lld)\n",
+                 seconds_between(c0, c1), seconds_between(c1, c2), seconds_between(c2, c3),
+                 seconds_between(c3, Clock::now()), static_cast<long long>(b.target.size(1)));
+  }
+  ++state_.step;
+  ++sums->count;
+  sums->values[0] += item(L.total);
+  for (size_t k = 0; k < L.stages.size() && k < stage_names_.size(); ++k) sums->values[k + 1] += item(L.stages[k]);
+  sums->values.back() += item(L.contact);
+}
+
+// A progress line after the run's first step and then every 30 s.
+void InbetweenRun::print_progress(const EpochSums& sums) {
+  const auto now = Clock::now();
+  if (!o_.verbose || (state_.step != first_step_ + 1 && seconds_between(last_progress_, now) <= 30.0)) return;
+  last_progress_ = now;
+  const double sps = (state_.step - first_step_) / seconds_between(run_start_, now);
+  std::fprintf(stderr, "  step %lld  epoch %d  %.1f/%.0f min  lr %.2e  loss %.4f", static_cast<long long>(state_.step),
+               state_.epoch + 1, minutes_now(), o_.max_minutes, lr_, sums.total());
+  for (size_t k = 0; k < stage_names_.size(); ++k) {
+    std::fprintf(stderr, "  %s %.4f", stage_names_[k].c_str(), sums.mean(k + 1));
+  }
+  std::fprintf(stderr, "  contact %.4f  %.2f steps/s\n", sums.contact(), sps);
+}
+
+// Per-frame means over the fixed validation set; none (zeros) without validation clips.
+Validation InbetweenRun::validate() {
+  Validation v;
+  v.stages.assign(stage_names_.size(), 0.0);
+  if (val_batches_.empty()) return v;
+  at::NoGradGuard no_grad;
+  model_->train(false);
+  double frames = 0;
+  for (const Batch& b : val_batches_) {
+    StepLosses L = compute_losses(*model_, b, o_.contact_weight);
+    const double n = item(b.input.valid.sum());
+    v.score += item(L.stages.back()) * n;
+    v.rot += item(L.last.rotation) * n;
+    v.pos += item(L.last.position) * n;
+    v.root += item(L.last.root) * n;
+    v.contact += item(L.contact) * n;
+    for (size_t k = 0; k < L.stages.size() && k < v.stages.size(); ++k) v.stages[k] += item(L.stages[k]) * n;
+    frames += n;
+  }
+  model_->train(true);
+  frames = std::max(frames, 1.0);
+  for (double* x : {&v.score, &v.rot, &v.pos, &v.root, &v.contact}) *x /= frames;
+  for (double& x : v.stages) x /= frames;
+  return v;
+}
+
+// Keeps the best model, writes the checkpoint and the log line.
+void InbetweenRun::end_epoch(const EpochSums& sums, const Validation& v) {
+  const double score = val_batches_.empty() ? sums.total() : v.score;  // no validation clips: the training loss decides
+  ++state_.epoch;
+  state_.minutes = minutes_now();
+  const bool best = score < state_.best;
+  if (best) {
+    state_.best = score;
+    save_inbetweener(*model_, files_.best_model);
+  }
+  save_checkpoint();
+  const double sps = (state_.step - first_step_) / std::max(1e-9, seconds_between(run_start_, last_checkpoint_));
+  {
+    std::ofstream log(files_.log, std::ios::app);
+    log.precision(6);
+    log << state_.epoch << "," << state_.step << "," << state_.minutes << "," << lr_ << "," << sps << ","
+        << sums.total();
+    for (size_t k = 0; k < stage_names_.size(); ++k) log << "," << sums.mean(k + 1);
+    log << "," << sums.contact() << "," << score << "," << v.rot << "," << v.pos * 100 << "," << v.root * 100;
+    for (double x : v.stages) log << "," << x;
+    log << "," << v.contact << "," << (best ? 1 : 0) << "\n";
+  }
+  if (o_.verbose) {
+    std::fprintf(stderr,
+                 "epoch %d  step %lld  %.1f min  train %.4f | val score %.4f (rot %.4f pos %.2f cm root %.2f cm "
+                 "contact %.4f)%s\n",
+                 state_.epoch, static_cast<long long>(state_.step), state_.minutes, sums.total(), score, v.rot,
+                 v.pos * 100, v.root * 100, v.contact, best ? " (best)" : "");
+  }
+}
+
+void InbetweenRun::save_checkpoint() {
+  save_inbetweener(*model_, files_.last_model);
+  torch::save(*optimizer_, files_.last_optim + ".tmp");
+  fs::rename(files_.last_optim + ".tmp", files_.last_optim);
+  training::save_trainer_state(files_.last_state, state_);
+  last_checkpoint_ = Clock::now();
+}
+
+}  // namespace
+
+InbetweenTrainingResult train_inbetweener(const InbetweenTrainingOptions& options) {
+  check_options(options);
+  set_compute_threads(std::max(1, options.threads));
+  fs::create_directories(options.out_dir);
+  return InbetweenRun(options).train();
 }
 
 }  // namespace mf

@@ -140,7 +140,6 @@ struct Losses {
 Losses compute_losses(const NemfModel& model, const Batch& b, int frames_per_window) {
   const RigInfo& rig = model.rig();
   const int64_t B = b.rot.size(0), W = b.rot.size(1), J = rig.num_joints();
-  const double fps = model.config().fps;
   Losses L;
   at::Tensor root6d = torch_rot::matrix_to_sixd(b.rot.select(2, 0));
   NemfLatent z = model.encode_features(b.features, root6d, b.mask);
@@ -213,167 +212,244 @@ void compute_stats(NemfModel& model, const std::vector<Clip>& clips, const std::
 
 double item(const at::Tensor& t) { return t.item<double>(); }
 
-}  // namespace
+using Clock = std::chrono::steady_clock;
 
-PriorTrainingResult train_prior(const PriorTrainingOptions& o) {
+double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+void check_options(const PriorTrainingOptions& o) {
   if (o.out_dir.empty()) throw InputError("train: an output directory is required");
   if (o.batch < 1 || o.stride < 1 || o.frames_per_window < 1 || !(o.max_minutes > 0)) {
     throw InputError("train: batch, stride, frames per window and the time budget must be positive");
   }
   std::string problem = o.config.validate();
   if (!problem.empty()) throw InputError("train: " + problem);
-  mf::set_compute_threads(o.threads);
-  fs::create_directories(o.out_dir);
-  const auto t0 = std::chrono::steady_clock::now();
+}
 
-  Dataset data = training::load_training_data(o.data, o.cache_dir, o.max_train_clips, o.config.fps, o.verbose);
-  std::vector<Clip>& train = data.train;
-  const std::string last_model = o.out_dir + "/last.mfm", last_optim = o.out_dir + "/last.optim",
-                    last_state = o.out_dir + "/last.state", best_model = o.out_dir + "/best.mfm",
-                    log_path = o.out_dir + "/log.csv";
-  const bool resuming = o.resume && fs::exists(last_model) && fs::exists(last_state) && fs::exists(last_optim);
+// A new model of o.config, or the checkpoint's when resuming (same sizes).
+NemfModel load_or_make_model(const PriorTrainingOptions& o, const Dataset& data, const training::RunFiles& files,
+                             bool resuming) {
   at::manual_seed(o.seed);
-  NemfModel model = resuming ? load_nemf(last_model) : NemfModel(o.config, training::measure_training_rig(data));
-  if (resuming && model.config().to_map() != o.config.to_map()) {
+  if (!resuming) return NemfModel(o.config, training::measure_training_rig(data));
+  NemfModel model = load_nemf(files.last_model);
+  if (model.config().to_map() != o.config.to_map()) {
     throw InputError("train: --resume with different sizes than the checkpoint (" + model.config().describe() + ")");
   }
-  const auto p0 = std::chrono::steady_clock::now();
-  std::vector<ClipTensors> train_pre = precompute(train, model.rig(), model.config().fps);
-  std::vector<ClipTensors> val_pre = precompute(data.validation, model.rig(), model.config().fps);
-  if (o.verbose) {
-    std::fprintf(stderr, "train: per-clip features in %.1f s\n",
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - p0).count());
-  }
-  if (!resuming) compute_stats(model, train, train_pre);
-  model.set_requires_grad(true);
-  model.train(true);
+  return model;
+}
 
-  torch::optim::Adam optimizer(model.parameters(), torch::optim::AdamOptions(o.lr));
-  training::TrainerState state;
-  if (resuming) {
-    torch::load(optimizer, last_optim);
-    state = training::load_trainer_state(last_state);
+// Validation windows: every clip cut into whole windows (a shorter clip is one window).
+std::vector<Window> validation_windows(const std::vector<Clip>& clips, int W) {
+  std::vector<Window> out;
+  for (size_t c = 0; c < clips.size(); ++c) {
+    const int n = clips[c].motion.num_frames();
+    if (n < 2) continue;
+    if (n <= W) out.push_back({static_cast<int>(c), 0, n});
+    else
+      for (int s = 0; s + W <= n; s += W) out.push_back({static_cast<int>(c), s, W});
   }
-  if (!resuming) {
-    std::ofstream log(log_path);
-    log << "epoch,step,minutes,lr,beta,train_rot,train_root,train_pos,train_kl,train_vel,train_height,train_trans,"
-           "train_contact,val_rot_deg,val_root_deg,val_pos_cm,val_trans_cm,val_score\n";
+  return out;
+}
+
+// Training-loss sums of one epoch (rot, root, pos, kl, vel, height, trans,
+// contact) and the last learning rate and KL weight.
+struct EpochSums {
+  double values[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+  int count = 0;
+  double lr = 0, beta = 0;
+  double mean(int k) const { return values[k] / count; }
+};
+
+// Validation per frame: rotation, root orientation (rad), position, translation (m) and the score.
+struct Validation {
+  double rot = 0, root = 0, pos = 0, trans = 0;
+  double score() const { return rot + root + 10.0 * pos; }
+};
+
+// One training run: the set-up in the constructor, then train().
+class PriorRun {
+ public:
+  explicit PriorRun(const PriorTrainingOptions& o);
+  PriorTrainingResult train();
+
+ private:
+  void open_log() const;
+  double minutes_now() const { return base_minutes_ + seconds_between(t0_, Clock::now()) / 60.0; }
+  // Returns true when the budget (time or steps) is used up.
+  bool train_epoch(EpochSums* sums);
+  void train_step(const Batch& b, double beta, EpochSums* sums);
+  Validation validate();
+  void end_epoch(const EpochSums& sums, const Validation& v);
+
+  const PriorTrainingOptions& o_;
+  const Clock::time_point t0_;
+  const training::RunFiles files_;
+  Dataset data_;
+  bool resuming_;
+  NemfModel model_;
+  const int W_;
+  std::vector<ClipTensors> train_pre_, val_pre_;
+  std::vector<Window> val_windows_;
+  torch::optim::Adam optimizer_;
+  training::TrainerState state_;
+  double base_minutes_ = 0;
+  bool profile_ = std::getenv("MF_PROFILE") != nullptr;
+};
+
+PriorRun::PriorRun(const PriorTrainingOptions& o)
+    : o_(o),
+      t0_(Clock::now()),
+      files_(o.out_dir),
+      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, o.config.fps, o.verbose)),
+      resuming_(o.resume && files_.has_checkpoint()),
+      model_(load_or_make_model(o, data_, files_, resuming_)),
+      W_(model_.config().window),
+      optimizer_(model_.parameters(), torch::optim::AdamOptions(o.lr)) {
+  const auto p0 = Clock::now();
+  train_pre_ = precompute(data_.train, model_.rig(), model_.config().fps);
+  val_pre_ = precompute(data_.validation, model_.rig(), model_.config().fps);
+  if (o.verbose) std::fprintf(stderr, "train: per-clip features in %.1f s\n", seconds_between(p0, Clock::now()));
+  if (!resuming_) compute_stats(model_, data_.train, train_pre_);
+  model_.set_requires_grad(true);
+  model_.train(true);
+  if (resuming_) {
+    torch::load(optimizer_, files_.last_optim);
+    state_ = training::load_trainer_state(files_.last_state);
+  } else {
+    open_log();
   }
-  const double base_minutes = state.minutes;
-  auto minutes_now = [&] {
-    return base_minutes + std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / 60.0;
-  };
+  base_minutes_ = state_.minutes;
   if (o.verbose) {
     std::fprintf(stderr, "train: %zu training clips, %zu validation clips, %d threads; model %s; %lld parameters%s\n",
-                 train.size(), data.validation.size(), o.threads, model.config().describe().c_str(),
-                 static_cast<long long>(model.num_parameters()), resuming ? "; resumed" : "");
+                 data_.train.size(), data_.validation.size(), o.threads, model_.config().describe().c_str(),
+                 static_cast<long long>(model_.num_parameters()), resuming_ ? "; resumed" : "");
   }
+  val_windows_ = validation_windows(data_.validation, W_);
+}
 
-  // Fixed validation windows.
-  std::vector<Window> val_windows;
-  const int W = model.config().window;
-  for (size_t c = 0; c < data.validation.size(); ++c) {
-    const int n = data.validation[c].motion.num_frames();
-    if (n < 2) continue;
-    if (n <= W) val_windows.push_back({static_cast<int>(c), 0, n});
-    else
-      for (int s = 0; s + W <= n; s += W) val_windows.push_back({static_cast<int>(c), s, W});
-  }
+void PriorRun::open_log() const {
+  std::ofstream log(files_.log);
+  log << "epoch,step,minutes,lr,beta,train_rot,train_root,train_pos,train_kl,train_vel,train_height,train_trans,"
+         "train_contact,val_rot_deg,val_root_deg,val_pos_cm,val_trans_cm,val_score\n";
+}
 
-  PriorTrainingResult result;
+PriorTrainingResult PriorRun::train() {
   bool out_of_time = false;
-  while (!out_of_time && state.epoch < o.max_epochs) {
-    std::mt19937_64 rng(o.seed * 1000003ULL + static_cast<uint64_t>(state.epoch));
-    at::manual_seed(o.seed * 7919ULL + static_cast<uint64_t>(state.epoch));
-    std::vector<Window> windows = epoch_windows(train, W, o.stride, rng);
-    double sums[8] = {0, 0, 0, 0, 0, 0, 0, 0};
-    int count = 0;
-    double lr = o.lr, beta = o.kl_weight;
-    for (size_t i = 0; i < windows.size(); i += o.batch) {
-      double progress = std::min(1.0, minutes_now() / o.max_minutes);
-      if (progress >= 1.0 || (o.max_steps > 0 && state.step >= o.max_steps)) {
-        out_of_time = true;
-        break;
-      }
-      lr = training::scheduled_lr(o.lr, o.lr_final, progress);
-      beta = o.kl_weight * std::min(1.0, progress / std::max(1e-9, o.kl_warmup));
-      training::set_learning_rate(optimizer, lr);
-      auto c0 = std::chrono::steady_clock::now();
-      Batch b = make_batch(train, train_pre, windows, i, std::min(windows.size(), i + o.batch), model.rig(), W);
-      auto c1 = std::chrono::steady_clock::now();
-      Losses L = compute_losses(model, b, o.frames_per_window);
-      at::Tensor total = L.total(beta);
-      auto c2 = std::chrono::steady_clock::now();
-      optimizer.zero_grad();
-      total.backward();
-      auto c3 = std::chrono::steady_clock::now();
-      if (std::getenv("MF_PROFILE")) {
-        std::fprintf(stderr, "batch %.3f s forward %.3f s backward %.3f s\n", std::chrono::duration<double>(c1 - c0).count(),
-                     std::chrono::duration<double>(c2 - c1).count(), std::chrono::duration<double>(c3 - c2).count());
-      }
-      torch::nn::utils::clip_grad_norm_(model.parameters(), 1.0);
-      optimizer.step();
-      ++state.step;
-      const at::Tensor parts[8] = {L.rot, L.root, L.pos, L.kl, L.vel, L.height, L.trans, L.contact};
-      for (int k = 0; k < 8; ++k) sums[k] += item(parts[k]);
-      ++count;
-      if (o.verbose && state.step % 100 == 0) {
-        std::fprintf(stderr, "  step %lld  %.1f min  lr %.2e  rot %.4f pos %.4f kl %.1f trans %.4f\n",
-                     static_cast<long long>(state.step), minutes_now(), lr, sums[0] / count, sums[2] / count,
-                     sums[3] / count, sums[6] / count);
-      }
-    }
-    if (count == 0) break;
-    // Validation.
-    double v[5] = {0, 0, 0, 0, 0};
-    double vw = 0;
-    {
-      at::NoGradGuard no_grad;
-      for (size_t i = 0; i < val_windows.size(); i += 64) {
-        Batch b = make_batch(data.validation, val_pre, val_windows, i, std::min(val_windows.size(), i + 64), model.rig(), W);
-        Losses L = compute_losses(model, b, 0);
-        double n = item(b.mask.sum());
-        v[0] += item(L.rot) * n;
-        v[1] += item(L.root) * n;
-        v[2] += item(L.pos) * n;
-        v[3] += item(L.trans) * n;
-        vw += n;
-      }
-    }
-    for (int k = 0; k < 4; ++k) v[k] /= std::max(vw, 1.0);
-    const double score = v[0] + v[1] + 10.0 * v[2];
-    ++state.epoch;
-    state.minutes = minutes_now();
-    const bool best = score < state.best;
-    if (best) {
-      state.best = score;
-      save_nemf(model, best_model);
-    }
-    save_nemf(model, last_model);
-    torch::save(optimizer, last_optim);
-    training::save_trainer_state(last_state, state);
-    {
-      std::ofstream log(log_path, std::ios::app);
-      log.precision(6);
-      log << state.epoch << "," << state.step << "," << state.minutes << "," << lr << "," << beta;
-      for (int k = 0; k < 8; ++k) log << "," << sums[k] / count;
-      log << "," << v[0] * 180 / M_PI << "," << v[1] * 180 / M_PI << "," << v[2] * 100 << "," << v[3] * 100 << ","
-          << score << "\n";
-    }
-    if (o.verbose) {
-      std::fprintf(stderr,
-                   "epoch %d  step %lld  %.1f min  train rot %.4f pos %.4f | val rot %.2f deg root %.2f deg pos %.2f cm "
-                   "trans %.2f cm score %.4f%s\n",
-                   state.epoch, static_cast<long long>(state.step), state.minutes, sums[0] / count, sums[2] / count,
-                   v[0] * 180 / M_PI, v[1] * 180 / M_PI, v[2] * 100, v[3] * 100, score, best ? " (best)" : "");
+  while (!out_of_time && state_.epoch < o_.max_epochs) {
+    EpochSums sums;
+    out_of_time = train_epoch(&sums);
+    if (sums.count == 0) break;
+    end_epoch(sums, validate());
+  }
+  PriorTrainingResult result;
+  result.epochs = state_.epoch;
+  result.steps = state_.step;
+  result.minutes = state_.minutes;
+  result.best_validation = state_.best;
+  result.best_path = files_.best_model;
+  return result;
+}
+
+// One pass over the training windows (a random phase per clip and epoch).
+bool PriorRun::train_epoch(EpochSums* sums) {
+  std::mt19937_64 rng(o_.seed * 1000003ULL + static_cast<uint64_t>(state_.epoch));
+  at::manual_seed(o_.seed * 7919ULL + static_cast<uint64_t>(state_.epoch));
+  const std::vector<Window> windows = epoch_windows(data_.train, W_, o_.stride, rng);
+  sums->lr = o_.lr;
+  sums->beta = o_.kl_weight;
+  for (size_t i = 0; i < windows.size(); i += o_.batch) {
+    const double progress = std::min(1.0, minutes_now() / o_.max_minutes);
+    if (progress >= 1.0 || (o_.max_steps > 0 && state_.step >= o_.max_steps)) return true;
+    sums->lr = training::scheduled_lr(o_.lr, o_.lr_final, progress);
+    sums->beta = o_.kl_weight * std::min(1.0, progress / std::max(1e-9, o_.kl_warmup));
+    training::set_learning_rate(optimizer_, sums->lr);
+    const auto c0 = Clock::now();
+    Batch b = make_batch(data_.train, train_pre_, windows, i, std::min(windows.size(), i + o_.batch), model_.rig(), W_);
+    if (profile_) std::fprintf(stderr, "batch %.3f s ", seconds_between(c0, Clock::now()));
+    train_step(b, sums->beta, sums);
+    if (o_.verbose && state_.step % 100 == 0) {
+      std::fprintf(stderr, "  step %lld  %.1f min  lr %.2e  rot %.4f pos %.4f kl %.1f trans %.4f\n",
+                   static_cast<long long>(state_.step), minutes_now(), sums->lr, sums->mean(0), sums->mean(2),
+                   sums->mean(3), sums->mean(6));
     }
   }
-  result.epochs = state.epoch;
-  result.steps = state.step;
-  result.minutes = state.minutes;
-  result.best_validation = state.best;
-  result.best_path = best_model;
-  return result;
+  return false;
+}
+
+void PriorRun::train_step(const Batch& b, double beta, EpochSums* sums) {
+  const auto c1 = Clock::now();
+  Losses L = compute_losses(model_, b, o_.frames_per_window);
+  at::Tensor total = L.total(beta);
+  const auto c2 = Clock::now();
+  optimizer_.zero_grad();
+  total.backward();
+  if (profile_) {
+    std::fprintf(stderr, "forward %.3f s backward %.3f s\n", seconds_between(c1, c2), seconds_between(c2, Clock::now()));
+  }
+  torch::nn::utils::clip_grad_norm_(model_.parameters(), 1.0);
+  optimizer_.step();
+  ++state_.step;
+  const at::Tensor parts[8] = {L.rot, L.root, L.pos, L.kl, L.vel, L.height, L.trans, L.contact};
+  for (int k = 0; k < 8; ++k) sums->values[k] += item(parts[k]);
+  ++sums->count;
+}
+
+// Encode the mean, decode every frame of the fixed validation windows.
+Validation PriorRun::validate() {
+  at::NoGradGuard no_grad;
+  Validation v;
+  double frames = 0;
+  for (size_t i = 0; i < val_windows_.size(); i += 64) {
+    Batch b = make_batch(data_.validation, val_pre_, val_windows_, i, std::min(val_windows_.size(), i + 64),
+                         model_.rig(), W_);
+    Losses L = compute_losses(model_, b, 0);
+    const double n = item(b.mask.sum());
+    v.rot += item(L.rot) * n;
+    v.root += item(L.root) * n;
+    v.pos += item(L.pos) * n;
+    v.trans += item(L.trans) * n;
+    frames += n;
+  }
+  for (double* x : {&v.rot, &v.root, &v.pos, &v.trans}) *x /= std::max(frames, 1.0);
+  return v;
+}
+
+// Keeps the best model, writes the checkpoint and the log line.
+void PriorRun::end_epoch(const EpochSums& sums, const Validation& v) {
+  const double score = v.score();
+  ++state_.epoch;
+  state_.minutes = minutes_now();
+  const bool best = score < state_.best;
+  if (best) {
+    state_.best = score;
+    save_nemf(model_, files_.best_model);
+  }
+  save_nemf(model_, files_.last_model);
+  torch::save(optimizer_, files_.last_optim);
+  training::save_trainer_state(files_.last_state, state_);
+  {
+    std::ofstream log(files_.log, std::ios::app);
+    log.precision(6);
+    log << state_.epoch << "," << state_.step << "," << state_.minutes << "," << sums.lr << "," << sums.beta;
+    for (int k = 0; k < 8; ++k) log << "," << sums.mean(k);
+    log << "," << v.rot * 180 / M_PI << "," << v.root * 180 / M_PI << "," << v.pos * 100 << "," << v.trans * 100
+        << "," << score << "\n";
+  }
+  if (o_.verbose) {
+    std::fprintf(stderr,
+                 "epoch %d  step %lld  %.1f min  train rot %.4f pos %.4f | val rot %.2f deg root %.2f deg pos %.2f cm "
+                 "trans %.2f cm score %.4f%s\n",
+                 state_.epoch, static_cast<long long>(state_.step), state_.minutes, sums.mean(0), sums.mean(2),
+                 v.rot * 180 / M_PI, v.root * 180 / M_PI, v.pos * 100, v.trans * 100, score, best ? " (best)" : "");
+  }
+}
+
+}  // namespace
+
+PriorTrainingResult train_prior(const PriorTrainingOptions& options) {
+  check_options(options);
+  set_compute_threads(options.threads);
+  fs::create_directories(options.out_dir);
+  return PriorRun(options).train();
 }
 
 }  // namespace mf

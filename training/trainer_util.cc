@@ -51,6 +51,18 @@ at::Tensor masked_mean(const at::Tensor& value, const at::Tensor& mask) {
   return (v * mask).sum() / mask.sum().clamp_min(1.0);
 }
 
+RunFiles::RunFiles(const std::string& out_dir)
+    : last_model(out_dir + "/last.mfm"),
+      last_optim(out_dir + "/last.optim"),
+      last_state(out_dir + "/last.state"),
+      best_model(out_dir + "/best.mfm"),
+      log(out_dir + "/log.csv") {}
+
+bool RunFiles::has_checkpoint() const {
+  namespace fs = std::filesystem;
+  return fs::exists(last_model) && fs::exists(last_state) && fs::exists(last_optim);
+}
+
 void save_trainer_state(const std::string& path, const TrainerState& s) {
   {
     std::ofstream out(path + ".tmp");

@@ -33,6 +33,18 @@ at::Tensor padded_slice(const at::Tensor& x, int start, int length, int W);
 /// frames where mask [B, S] is 1.
 at::Tensor masked_mean(const at::Tensor& value, const at::Tensor& mask);
 
+/// The files a run writes in its output folder.
+struct RunFiles {
+  explicit RunFiles(const std::string& out_dir);
+  std::string last_model;  ///< out_dir/last.mfm
+  std::string last_optim;  ///< out_dir/last.optim
+  std::string last_state;  ///< out_dir/last.state
+  std::string best_model;  ///< out_dir/best.mfm
+  std::string log;         ///< out_dir/log.csv
+  /// True when an earlier run left a checkpoint to resume from (last.*).
+  bool has_checkpoint() const;
+};
+
 /// What a run needs to resume besides the model and optimiser (out_dir/last.state).
 struct TrainerState {
   int epoch = 0;
