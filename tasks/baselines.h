@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "prior/motion/motion.h"
+#include "tasks/motion_constraints.h"
 
 namespace mf {
 
@@ -42,5 +43,16 @@ Motion resample_interpolate(const Motion& input, double new_fps, int frames);
 /// Resampling by holding the most recent input frame (zero velocity): output
 /// frame i copies input frame floor(s), s as above.
 Motion resample_zero_velocity(const Motion& input, double new_fps, int frames);
+
+/// Interpolation under partial keys, the fill of the latent solvers' default
+/// initialiser (tasks/initializers.h): a motion of `window`'s length whose
+/// constrained values are those of `window`. With full-pose keys only it is
+/// interpolate_motion() over the key frames; otherwise each joint's rotation
+/// is interpolated (SLERP) over the keys that constrain it, the root position
+/// (LERP) over the keys that give it, each held before its first and after its
+/// last key, and a joint no key constrains keeps the identity (a root
+/// position no key gives, zero). Reads only what `constraints` names; throws
+/// mf::InputError without keys.
+Motion fill_by_interpolation(const Motion& window, const MotionConstraints& constraints);
 
 }  // namespace mf

@@ -6,64 +6,10 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "tasks/baselines.h"
-#include "tasks/transformer_methods.h"
+#include "tasks/inbetweener_files.h"
+#include "tasks/inbetweener_fill.h"
 
 namespace mf {
-
-namespace {
-
-// Value at frame f of a series known at sorted `frames`: interpolated between
-// the surrounding known frames, held before the first and after the last.
-template <typename Lerp, typename Get>
-auto interpolate_at(int f, const std::vector<int>& frames, Get get, Lerp lerp) {
-  auto it = std::lower_bound(frames.begin(), frames.end(), f);
-  if (it == frames.end()) return get(frames.back());
-  if (*it == f || it == frames.begin()) return get(*it);
-  const int b = *it, a = *(it - 1);
-  return lerp(get(a), get(b), static_cast<double>(f - a) / (b - a));
-}
-
-}  // namespace
-
-Motion fill_by_interpolation(const Motion& window, const MotionConstraints& constraints) {
-  bool full = true;
-  std::vector<int> frames;
-  for (size_t k = 0; k < constraints.keys.size(); ++k) {
-    full = full && constraints.keys[k].joints.empty() && constraints.keys[k].root_position;
-    frames.push_back(constraints.keys[k].frame);
-  }
-  if (frames.empty()) throw InputError("interpolation needs at least one key");
-  if (full) return interpolate_motion(window, frames);
-
-  const int T = window.num_frames(), J = window.num_joints();
-  Motion out = Motion::identity(window.skeleton, T, window.fps);
-  for (int j = 0; j < J; ++j) {
-    std::vector<int> known;
-    for (size_t k = 0; k < constraints.keys.size(); ++k) {
-      if (constraints.key_has_joint(k, j)) known.push_back(constraints.keys[k].frame);
-    }
-    if (known.empty()) continue;
-    for (int f = 0; f < T; ++f) {
-      out.rotation(f, j) = interpolate_at(
-          f, known, [&](int g) { return window.rotation(g, j).normalized(); },
-          [](const Eigen::Quaterniond& a, const Eigen::Quaterniond& b, double t) { return slerp(a, b, t); });
-    }
-  }
-  std::vector<int> rooted;
-  for (const PoseKey& k : constraints.keys) {
-    if (k.root_position) rooted.push_back(k.frame);
-  }
-  if (!rooted.empty()) {
-    for (int f = 0; f < T; ++f) {
-      out.root_positions[f] = interpolate_at(
-          f, rooted, [&](int g) { return window.root_positions[g]; },
-          [](const Eigen::Vector3d& a, const Eigen::Vector3d& b, double t) -> Eigen::Vector3d {
-            return a + (b - a) * t;
-          });
-    }
-  }
-  return out;
-}
 
 InitialGuess encode_window(const NemfModel& model, const Motion& window, int anchor) {
   at::NoGradGuard no_grad;
@@ -91,9 +37,10 @@ TransformerEncoderInitializer::TransformerEncoderInitializer(std::string name, s
 
 InitialGuess TransformerEncoderInitializer::initialize(const InitRequest& r) const {
   if (!r.model || !r.window || !r.constraints) throw std::invalid_argument("InitRequest is incomplete");
-  const InbetweenModel* transformer = bound_ ? bound_.get() : r.context ? r.context->inbetweener(kind_) : nullptr;
-  if (!transformer) throw InputError(missing_inbetweener_message("initialiser '" + name_ + "'", kind_));
-  const Motion filled = inbetweener_fill(*transformer, stage_, *r.window, *r.constraints, LongGapPolicy::Interpolate);
+  const std::string what = "initialiser '" + name_ + "'";
+  if (!bound_ && !r.context) throw ModelMissingError(missing_inbetweener_message(what, kind_));
+  const InbetweenModel& transformer = bound_ ? *bound_ : require_inbetweener(*r.context, kind_, what);
+  const Motion filled = inbetweener_fill(transformer, stage_, *r.window, *r.constraints, LongGapPolicy::Interpolate);
   return encode_window(*r.model, filled, r.anchor);
 }
 
@@ -116,8 +63,8 @@ std::shared_ptr<const LatentInitializer> make_named(const std::string& name, con
     if (name != t.name) continue;
     std::shared_ptr<const InbetweenModel> bound;
     if (context) {
+      require_inbetweener(*context, t.kind, "initialiser '" + name + "'");
       bound = t.kind == std::string("citl") ? context->citl : context->twostage;
-      if (!bound) throw InputError(missing_inbetweener_message("initialiser '" + name + "'", t.kind));
     }
     return std::make_shared<TransformerEncoderInitializer>(t.name, t.kind, t.stage, std::move(bound));
   }

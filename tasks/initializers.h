@@ -51,11 +51,11 @@ class LatentInitializer {
 };
 
 /// NeMF's initialiser ("interp-encoder"): unknown frames filled by interpolation
-/// (tasks/baselines.h interpolate_motion when every key is a full pose; with
-/// partial keys each joint is interpolated over the keys that constrain it, the
-/// root position over the keys that give it, and a joint no key constrains
-/// keeps the identity), the filled window canonicalised at the anchor and
-/// encoded; the codes are the posterior means.
+/// (fill_by_interpolation() of tasks/baselines.h: interpolate_motion when every
+/// key is a full pose; with partial keys each joint is interpolated over the
+/// keys that constrain it, the root position over the keys that give it, and
+/// a joint no key constrains keeps the identity), the filled window
+/// canonicalised at the anchor and encoded; the codes are the posterior means.
 class InterpolationEncoderInitializer : public LatentInitializer {
  public:
   std::string name() const override { return "interp-encoder"; }
@@ -72,7 +72,7 @@ class ZeroInitializer : public LatentInitializer {
 /// The transformer initialisers: the window's constraints (full and partial
 /// keys, each joint's rotation and the root position known where a key gives
 /// them) -> one pass of a transformer in-betweener (inbetweener_fill() of
-/// tasks/transformer_methods.h: gaps longer than the transformer's window stay
+/// tasks/inbetweener_fill.h: gaps longer than the transformer's window stay
 /// interpolated, frames before the first and after the last key that fixes
 /// the root are held) -> the filled window canonicalised at the anchor and
 /// encoded (encode_window); the codes are the posterior means.
@@ -111,10 +111,5 @@ std::shared_ptr<const LatentInitializer> make_initializer(const std::string& nam
 /// The window `window` (all frames meaningful) canonicalised at `anchor` and
 /// encoded: the posterior means. For initialisers that produce a full motion.
 InitialGuess encode_window(const NemfModel& model, const Motion& window, int anchor);
-
-/// The fill of InterpolationEncoderInitializer: a motion of the window's length
-/// whose constrained values are those of `window` and every other value is
-/// interpolated as described there. Reads only what `constraints` names.
-Motion fill_by_interpolation(const Motion& window, const MotionConstraints& constraints);
 
 }  // namespace mf

@@ -6,7 +6,7 @@
 
 #include "prior/motion/errors.h"
 #include "tasks/model_rig.h"
-#include "tasks/transformer_methods.h"
+#include "tasks/inbetweener_files.h"
 
 namespace mf {
 namespace {

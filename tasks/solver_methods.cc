@@ -5,7 +5,7 @@
 #include "prior/motion/errors.h"
 #include "tasks/latent_solver.h"
 #include "tasks/method.h"
-#include "tasks/transformer_methods.h"
+#include "tasks/inbetweener_files.h"
 
 namespace mf {
 

@@ -1,89 +1,18 @@
 // The transformer in-betweeners (prior/inbetween/inbetweener.h) as task
-// methods and as the fill of the latent solvers' transformer initialisers.
-//
-// Methods (tasks/method.h, registered by tasks/jobs.cc):
+// methods (tasks/method.h, transformer_methods(), registered by tasks/jobs.cc):
 //   "context"  stage 0 of the two-stage model (Context Transformer)
 //   "detail"   stage 1 of the two-stage model (Detail Transformer)
 //   "citl"     the CITL model
 // Each needs its model in TaskContext (twostage / citl); the C API loads them
 // from motionfield-twostage.mfm and motionfield-citl.mfm next to the prior's
-// model file.
+// model file (tasks/inbetweener_files.h). Each fills the motion with one pass
+// of its model (inbetweener_fill() of tasks/inbetweener_fill.h,
+// LongGapPolicy::Throw).
 //
-// How a motion is filled (inbetweener_fill):
-//  * Keys that fix the root (root rotation and root position, see
-//    MotionConstraints::key_fixes_root) bound the gaps: every run of frames
-//    between two consecutive such keys is a gap. Partial keys inside a gap are
-//    given to the model with their known mask (per joint, root position).
-//  * Windows start at a key that fixes the root (the window is canonical
-//    there, as in training) and end at one, hold at most model.window()
-//    frames, and are given the keys of the last up to 10 frames before the
-//    gap they fill as context (or, when the keys are sparse, the previous key
-//    if it is at most 40 frames back): the known patterns of training. A
-//    window extends over as many following gaps as fit. Each gap is produced
-//    by exactly one window, so the pieces meet only at known frames; all
-//    windows of a call run as one batch.
-//  * A gap longer than the window (two keys more than window() - 1 frames
-//    apart) cannot be filled by one pass: LongGapPolicy::Throw says so with
-//    mf::InputError (the methods), LongGapPolicy::Interpolate leaves that gap
-//    interpolated (the initialisers, where the solver refines it anyway).
-//  * Frames before the first and after the last key that fixes the root, and
-//    the unconstrained joints of those keys, are filled like
-//    fill_by_interpolation() (held before the first and after the last key).
-//  * Constrained values come out exactly as given (copied from the input);
-//    no other value of the input is read. So that the output does not jump
-//    next to a key where the model's own output misses it, the residual at
-//    the two keys that bound a gap (per joint where the key gives it, and the
-//    root position) is spread over the gap with smoothstep weights (the full
-//    residual next to each key, fading to zero at the other).
-//  * The input's frames are taken as frames of the model (no resampling to
-//    the model's fps). Deterministic for a given input and thread count.
+// This header also brings in those two headers for the callers that include
+// it for them (the C API, the benchmarks).
 #pragma once
 
-#include <memory>
-#include <string>
-#include <vector>
-
-#include "prior/motion/motion.h"
-#include "tasks/motion_constraints.h"
+#include "tasks/inbetweener_files.h"
+#include "tasks/inbetweener_fill.h"
 #include "tasks/method.h"
-
-namespace mf {
-
-class InbetweenModel;
-
-/// Model file names of the transformers, looked for in the directory of the
-/// prior's model file.
-constexpr char kTwoStageFileName[] = "motionfield-twostage.mfm";
-constexpr char kCitlFileName[] = "motionfield-citl.mfm";
-
-/// kTwoStageFileName for "twostage", kCitlFileName for "citl"; InputError otherwise.
-std::string inbetweener_file_name(const std::string& kind);
-
-/// Where the transformer of `kind` is looked for next to the prior file
-/// `prior_path`: the same directory, inbetweener_file_name(kind).
-std::string inbetweener_path_next_to(const std::string& prior_path, const std::string& kind);
-
-/// Loads a transformer file (load_inbetweener), checks that it is of `kind`
-/// (InputError naming the file otherwise) and freezes it (no gradients for
-/// its parameters), ready to be shared between threads.
-std::shared_ptr<const InbetweenModel> load_frozen_inbetweener(const std::string& path, const std::string& kind);
-
-/// The error of a method or initialiser (`what`, e.g. "method 'citl'") whose
-/// transformer of `kind` is not loaded: names the file it needs.
-std::string missing_inbetweener_message(const std::string& what, const std::string& kind);
-
-enum class LongGapPolicy {
-  Throw,        ///< mf::InputError naming the keys and the window
-  Interpolate,  ///< that gap stays interpolated
-};
-
-/// Completes `input` under `constraints` (full or partial keys; end-effector
-/// targets are ignored) with one pass of `model`, using the output of stage
-/// `stage` (0-based; -1 = the last stage). See the top of this file. Throws
-/// mf::InputError for constraints that do not validate, a skeleton whose
-/// joint count differs from the model's, a stage the model does not have, or
-/// (LongGapPolicy::Throw) a gap longer than the window.
-Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
-                        const MotionConstraints& constraints, LongGapPolicy policy);
-
-}  // namespace mf

@@ -13,6 +13,7 @@
 #include "prior/model/representation.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/kinematics_torch.h"
+#include "tasks/baselines.h"
 #include "tasks/energies.h"
 #include "tasks/initializers.h"
 #include "tests/test_util.h"

@@ -14,4 +14,12 @@ class InputError : public std::runtime_error {
   explicit InputError(const std::string& message) : std::runtime_error(message) {}
 };
 
+/// Bad input of one kind: the request needs a model that is not loaded (the
+/// prior, a transformer in-betweener). The C API can map it to its model
+/// status instead of the invalid-argument one.
+class ModelMissingError : public InputError {
+ public:
+  explicit ModelMissingError(const std::string& message) : InputError(message) {}
+};
+
 }  // namespace mf

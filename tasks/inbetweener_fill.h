@@ -1,0 +1,59 @@
+// How a transformer in-betweener (prior/inbetween/inbetweener.h) fills a
+// motion in one pass: inbetweener_fill(), behind the transformer methods
+// (tasks/transformer_methods.h) and the transformer initialisers of the latent
+// solvers (tasks/initializers.h).
+//
+//  * Keys that fix the root (root rotation and root position, see
+//    MotionConstraints::key_fixes_root) bound the gaps: every run of frames
+//    between two consecutive such keys is a gap. Partial keys inside a gap are
+//    given to the model with their known mask (per joint, root position).
+//  * Windows start at a key that fixes the root (the window is canonical
+//    there, as in training) and end at one, hold at most model.window()
+//    frames, and are given the keys of the last up to 10 frames before the
+//    gap they fill as context (or, when the keys are sparse, the previous key
+//    if it is at most 40 frames back): the known patterns of training. A
+//    window extends over as many following gaps as fit. Each gap is produced
+//    by exactly one window, so the pieces meet only at known frames; all
+//    windows of a call run as one batch.
+//  * A gap longer than the window (two keys more than window() - 1 frames
+//    apart) cannot be filled by one pass: LongGapPolicy::Throw says so with
+//    mf::InputError (the methods), LongGapPolicy::Interpolate leaves that gap
+//    interpolated (the initialisers, where the solver refines it anyway).
+//  * Frames before the first and after the last key that fixes the root, and
+//    the unconstrained joints of those keys, are filled like
+//    fill_by_interpolation() of tasks/baselines.h (held before the first and
+//    after the last key).
+//  * Constrained values come out exactly as given (copied from the input);
+//    no other value of the input is read. So that the output does not jump
+//    next to a key where the model's own output misses it, the residual at
+//    the two keys that bound a gap (per joint where the key gives it, and the
+//    root position) is spread over the gap with smoothstep weights, each
+//    key's residual fading from full next to it to none at the other key
+//    (the two residual rotations composed; unlike tasks/residuals.h, which
+//    interpolates between them).
+//  * The input's frames are taken as frames of the model (no resampling to
+//    the model's fps). Deterministic for a given input and thread count.
+#pragma once
+
+#include "prior/motion/motion.h"
+#include "tasks/motion_constraints.h"
+
+namespace mf {
+
+class InbetweenModel;
+
+enum class LongGapPolicy {
+  Throw,        ///< mf::InputError naming the keys and the window
+  Interpolate,  ///< that gap stays interpolated
+};
+
+/// Completes `input` under `constraints` (full or partial keys; end-effector
+/// targets are ignored) with one pass of `model`, using the output of stage
+/// `stage` (0-based; -1 = the last stage). See the top of this file. Throws
+/// mf::InputError for constraints that do not validate, a skeleton whose
+/// joint count differs from the model's, a stage the model does not have, or
+/// (LongGapPolicy::Throw) a gap longer than the window.
+Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
+                        const MotionConstraints& constraints, LongGapPolicy policy);
+
+}  // namespace mf
