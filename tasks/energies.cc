@@ -11,6 +11,7 @@
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations_torch.h"
 #include "tasks/residuals.h"
+#include "tasks/task_context.h"
 
 namespace mf {
 namespace {
@@ -44,10 +45,7 @@ WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int 
                                   const MotionConstraints& constraints, int anchor) {
   const Skeleton& s = rig.skeleton;
   const int J = s.num_joints();
-  if (motion.num_joints() != J || motion.skeleton.names != s.names || motion.skeleton.parents != s.parents) {
-    throw InputError("the motion's skeleton does not match the model's (" + std::to_string(motion.num_joints()) +
-                     " joints given, the model has " + std::to_string(J) + "; names and parents must agree)");
-  }
+  check_model_skeleton(rig, motion.skeleton, "motion");
   if (begin < 0 || length < 2 || begin + length > motion.num_frames())
     throw InputError("window [" + std::to_string(begin) + ", " + std::to_string(begin + length) +
                      ") does not fit the motion (at least 2 frames)");

@@ -5,8 +5,8 @@
 #include <sstream>
 
 #include "prior/motion/errors.h"
-#include "tasks/model_rig.h"
 #include "tasks/inbetweener_files.h"
+#include "tasks/model_rig.h"
 
 namespace mf {
 namespace {
@@ -19,26 +19,22 @@ std::string method_list() {
   return s;
 }
 
-// Empty -> the default; anything not registered -> InputError naming the choices.
-const Method& resolve_method(const std::string& method, const TaskContext& ctx) {
-  const std::string m = method.empty() ? default_method(ctx) : method;
-  for (const Method& a : registered_methods()) {
-    if (a.name != m) continue;
-    if (a.needs_model && !ctx.model) {
-      throw InputError("method '" + m + "' needs the prior, and no model is loaded (name one with --model)");
-    }
-    if (!a.needs_inbetweener.empty() && !ctx.inbetweener(a.needs_inbetweener))
-      throw InputError(missing_inbetweener_message("method '" + m + "'", a.needs_inbetweener));
-    return a;
-  }
-  throw InputError("unknown method '" + method + "' (available: " + method_list() + ")");
-}
-
 void check_motion(const Motion& input) {
   if (input.num_frames() < 1) throw InputError("the input motion has no frames");
   if (input.rotations.size() != static_cast<size_t>(input.num_frames()) * input.num_joints())
     throw InputError("the input motion's rotation count does not match its frames and joints");
   if (!(std::isfinite(input.fps) && input.fps > 0)) throw InputError("the input motion's fps must be finite and positive");
+}
+
+// Runs `complete` of `m` on validated input (the common end of
+// run_known_frames and run_fill): methods that need the model run on the
+// model's rig and rate (tasks/model_rig.h).
+Motion complete_with(const Method& m, const Motion& input, const std::vector<int>& known, const TaskContext& ctx) {
+  if (!m.complete) throw InputError("method '" + m.name + "' does not do in-betweening or gap filling");
+  if (!m.needs_model) return m.complete(input, known, ctx);
+  return complete_on_model_rig(input, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
+    return m.complete(in, k, ctx);
+  });
 }
 
 }  // namespace
@@ -71,6 +67,17 @@ std::string default_method(const TaskContext& ctx) {
 }
 
 std::string default_resample_method(const TaskContext& ctx) { return ctx.model ? "prior" : "interp"; }
+
+const Method& resolve_method(const std::string& method, const TaskContext& ctx) {
+  const std::string m = method.empty() ? default_method(ctx) : method;
+  for (const Method& a : registered_methods()) {
+    if (a.name != m) continue;
+    if (a.needs_model) require_prior(ctx, "method '" + m + "'");
+    if (!a.needs_inbetweener.empty()) require_inbetweener(ctx, a.needs_inbetweener, "method '" + m + "'");
+    return a;
+  }
+  throw InputError("unknown method '" + method + "' (available: " + method_list() + ")");
+}
 
 void validate_keyframes(const std::vector<int>& keyframes, int frames) {
   if (keyframes.size() < 2)
@@ -126,11 +133,7 @@ Motion run_known_frames(const Motion& input, const std::vector<int>& known, cons
   const Method& m = resolve_method(method, ctx);
   check_motion(input);
   validate_keyframes(known, input.num_frames());
-  if (!m.complete) throw InputError("method '" + m.name + "' does not do in-betweening or gap filling");
-  if (!m.needs_model) return m.complete(input, known, ctx);
-  return complete_on_model_rig(input, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
-    return m.complete(in, k, ctx);
-  });
+  return complete_with(m, input, known, ctx);
 }
 
 Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method,
@@ -139,9 +142,10 @@ Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, con
 }
 
 Motion run_fill(const Motion& input, int a, int b, const std::string& method, const TaskContext& ctx) {
-  resolve_method(method, ctx);
+  const Method& m = resolve_method(method, ctx);
   check_motion(input);
-  return run_known_frames(input, known_frames_outside_gap(input.num_frames(), a, b), method, ctx);
+  // Sorted, unique, in range and at least two (frame 0 and the last): valid keyframes.
+  return complete_with(m, input, known_frames_outside_gap(input.num_frames(), a, b), ctx);
 }
 
 Motion run_resample(const Motion& input, double fps, const std::string& method, std::vector<std::string>* warnings,

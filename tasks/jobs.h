@@ -1,15 +1,18 @@
-// The task entry points behind the CLI, the batch mode and the benchmark: input
-// validation (bad input throws mf::InputError with a message for the user) and
-// dispatch to a method by name. Later issues register the prior's solvers and
-// the transformers here; the default method is the best measured one.
+// The task entry points behind the C API (and so the CLI, the batch mode and
+// Python) and the benchmark: the one place where a request is validated and
+// dispatched to a method by name. Bad input throws mf::InputError with a
+// message for the user; a method whose model is not loaded throws its
+// subclass mf::ModelMissingError (prior/motion/errors.h). (Methods keep the
+// few checks they need for callers that use them directly, like the benchmark.)
 //
 // Methods are registered in tasks/method.h. An empty method name means
 // default_method(ctx); an unregistered name throws InputError listing the
-// available ones; a method that needs the prior throws InputError when the
-// context has no model, or the transformer it needs (Method::needs_inbetweener:
-// missing_inbetweener_message() of tasks/transformer_methods.h); a method that
-// does not support the task throws
-// InputError saying so.
+// available ones; a method that needs the prior throws ModelMissingError when
+// the context has no model, or the transformer it needs
+// (Method::needs_inbetweener: require_inbetweener() of
+// tasks/inbetweener_files.h); a method that does not support the task throws
+// InputError saying so. Motions on another rig or at another frame rate than
+// the model's go through the model-rig adapter (tasks/model_rig.h).
 #pragma once
 
 #include <string>
@@ -23,7 +26,7 @@ namespace mf {
 /// Every registered method (baselines, the prior's, the solvers', the
 /// transformers'), in a fixed order.
 const std::vector<Method>& registered_methods();
-/// Names accepted by --method, e.g. {"interp", "zerovel", ...}.
+/// Names of the registered methods, e.g. {"interp", "zerovel", ...}.
 std::vector<std::string> available_methods();
 /// What runs when no method is given for in-betweening and gap filling: the
 /// best measured method that can run in this context ("nemf-detail" with the
@@ -32,6 +35,12 @@ std::vector<std::string> available_methods();
 std::string default_method(const TaskContext& ctx = {});
 /// The same for resampling: "prior" with a model, "interp" without one.
 std::string default_resample_method(const TaskContext& ctx = {});
+
+/// The method `method` names (empty: default_method(ctx)), checked against
+/// the context: InputError listing the available methods for an unknown
+/// name, ModelMissingError when it needs the prior or a transformer that
+/// `ctx` does not hold.
+const Method& resolve_method(const std::string& method, const TaskContext& ctx);
 
 /// Throws InputError unless: at least two keyframes, strictly increasing (so
 /// sorted and unique), every one in [0, frames). The message names the

@@ -186,11 +186,7 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
   if (!bad.empty()) throw InputError("invalid solver options: " + bad);
   const RigInfo& rig = model.rig();
   const int N = input.num_frames(), J = input.num_joints();
-  if (J != rig.num_joints() || input.skeleton.names != rig.skeleton.names ||
-      input.skeleton.parents != rig.skeleton.parents) {
-    throw InputError("the motion's skeleton does not match the model's: " + std::to_string(J) + " joints given, the model has " +
-                     std::to_string(rig.num_joints()) + " (joint names and parents must agree)");
-  }
+  check_model_skeleton(rig, input.skeleton, "motion");
   if (N < 2) throw InputError("the motion needs at least two frames");
   if (input.rotations.size() != static_cast<size_t>(N) * J)
     throw InputError("the motion's rotation count does not match its frames and joints");

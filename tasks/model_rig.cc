@@ -16,11 +16,6 @@
 namespace mf {
 namespace {
 
-const NemfModel& prior_of(const TaskContext& ctx) {
-  if (!ctx.model) throw InputError("this method needs the prior, and no model is loaded");
-  return *ctx.model;
-}
-
 bool same_rate(double a, double b) { return std::abs(a - b) <= 1e-5 * b; }
 
 // Model-rate frames of a motion at `fps` with `frames` frames: enough to cover
@@ -79,11 +74,11 @@ bool needs_model_rig(const Motion& input, const TaskContext& ctx) {
 }
 
 RigMap model_rig_map(const Skeleton& user, const TaskContext& ctx) {
-  return map_rig(user, prior_of(ctx).rig().skeleton, ctx.rig_map);
+  return map_rig(user, require_prior(ctx, "this method").rig().skeleton, ctx.rig_map);
 }
 
 Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, const TaskContext& ctx) {
-  const Skeleton& model = prior_of(ctx).rig().skeleton;
+  const Skeleton& model = require_prior(ctx, "this method").rig().skeleton;
   if (!ctx.model_anatomy)
     throw InputError("the motion's skeleton (" + std::to_string(input.num_joints()) +
                      " joints) is not the model's, and the model has no rig anatomy to retarget with "
@@ -104,7 +99,7 @@ Motion match_known_frames(const Motion& out_in, const Motion& input, const std::
 Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
                              const CompleteFn& complete) {
   if (!needs_model_rig(input, ctx)) return complete(input, known);
-  const NemfModel& prior = prior_of(ctx);
+  const NemfModel& prior = require_prior(ctx, "this method");
   const double model_fps = prior.config().fps;
   const bool native = input.skeleton.same_as(prior.rig().skeleton);
   // The reference: interpolation between the known frames on the user's rig

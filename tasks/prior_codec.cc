@@ -25,15 +25,6 @@ void check_fps(double fps, const char* what) {
   if (!std::isfinite(fps) || fps <= 0.0) throw InputError(std::string(what) + " must be finite and positive");
 }
 
-void check_rig(const NemfModel& model, const Skeleton& skeleton) {
-  const Skeleton& rig = model.rig().skeleton;
-  if (skeleton.names != rig.names || skeleton.parents != rig.parents) {
-    throw InputError("the motion's skeleton (" + std::to_string(skeleton.num_joints()) +
-                     " joints) does not match the model's rig (" + std::to_string(rig.num_joints()) +
-                     " joints): joint names and parents must agree");
-  }
-}
-
 // Position s in frames of a sequence at fps_in for time i / fps_out, snapped to
 // an integer when within 1e-5 relative (as the interpolation baseline does).
 double snapped_position(double s) {
@@ -126,7 +117,7 @@ std::vector<double> blend_weights(const std::vector<WindowCode>& windows, double
 EncodedMotion encode_motion(const NemfModel& model, const Motion& motion, const CodecOptions& options) {
   motion.validate();
   if (motion.num_frames() < 2) throw InputError("the prior needs a motion of at least 2 frames");
-  check_rig(model, motion.skeleton);
+  check_model_skeleton(model.rig(), motion.skeleton, "motion");
   const NemfConfig& c = model.config();
   const int hop = options.hop == 0 ? c.window / 2 : options.hop;
   if (hop < 1 || hop >= c.window) {
@@ -385,7 +376,7 @@ Motion resample_core(const NemfModel& model, const Motion& input, double fps, in
 
 Motion resample_with_prior(const Motion& motion, double fps, int frames, const TaskContext& ctx,
                            const PriorResampleOptions& options) {
-  if (!ctx.model) throw InputError("resampling with the prior needs a model");
+  if (!ctx.model) throw ModelMissingError("resampling with the prior needs a model, and none is loaded");
   check_fps(fps, "output fps");
   if (frames < 0) throw InputError("output frame count must not be negative");
   motion.validate();

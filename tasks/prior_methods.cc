@@ -72,7 +72,7 @@ std::vector<Method> prior_methods() {
       "the input's, else encode/decode corrected to pass through every input frame (resampling)";
   prior.needs_model = true;
   prior.resample = [](const Motion& in, double fps, int frames, const TaskContext& ctx) {
-    if (!ctx.model) throw InputError("method 'prior' needs the prior, and no model is loaded");
+    require_prior(ctx, "method 'prior'");
     PriorResampleOptions options;
     options.residual = true;
     options.root = RootSource::kInput;

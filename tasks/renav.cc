@@ -56,11 +56,7 @@ RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, i
   const RigInfo& rig = model.rig();
   const int J = rig.num_joints();
   const int W = model.config().window;
-  if (reference.num_joints() != J || reference.skeleton.names != rig.skeleton.names ||
-      reference.skeleton.parents != rig.skeleton.parents) {
-    throw InputError("the reference's skeleton does not match the model's: " + std::to_string(reference.num_joints()) +
-                     " joints given, the model has " + std::to_string(J) + " (joint names and parents must agree)");
-  }
+  check_model_skeleton(rig, reference.skeleton, "reference");
   if (ref_begin < 0 || ref_length < 2 || ref_begin + ref_length > reference.num_frames())
     throw InputError("reference segment [" + std::to_string(ref_begin) + ", " + std::to_string(ref_begin + ref_length) +
                      ") does not fit the reference (" + std::to_string(reference.num_frames()) + " frames, at least 2)");
@@ -311,12 +307,7 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
   const std::string bad = options.validate();
   if (!bad.empty()) throw InputError("invalid re-navigation options: " + bad);
   const RigInfo& rig = model.rig();
-  const int J = rig.num_joints();
-  if (reference.num_joints() != J || reference.skeleton.names != rig.skeleton.names ||
-      reference.skeleton.parents != rig.skeleton.parents) {
-    throw InputError("the reference's skeleton does not match the model's: " + std::to_string(reference.num_joints()) +
-                     " joints given, the model has " + std::to_string(J) + " (joint names and parents must agree)");
-  }
+  check_model_skeleton(rig, reference.skeleton, "reference");
   if (reference.num_frames() < 2) throw InputError("the reference needs at least two frames");
   reference.validate();
   validate_path(path);
@@ -500,16 +491,16 @@ Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& pa
     for (const std::string& n : renav_methods()) list += (list.empty() ? "" : ", ") + n;
     throw InputError("unknown re-navigation method '" + method + "' (available: " + list + ")");
   }
-  if (!ctx.model) throw InputError("re-navigation needs the prior, and no model is loaded (name one with --model)");
+  const NemfModel& model = require_prior(ctx, "re-navigation");
   if (reference.num_frames() < 2) throw InputError("the reference needs at least two frames");
   if (!(std::isfinite(reference.fps) && reference.fps > 0))
     throw InputError("the reference's fps must be finite and positive");
   if (!std::isfinite(path_fps) || path_fps < 0) throw InputError("the path's frame rate must be finite and positive");
   const double fps = path_fps > 0 ? path_fps : reference.fps;
   // renavigate() takes any frame rate itself; only another rig needs the adapter.
-  if (!reference.skeleton.same_as(ctx.model->rig().skeleton))
+  if (!reference.skeleton.same_as(model.rig().skeleton))
     return renavigate_on_model_rig(reference, path, fps, default_renav_options(solver), ctx, report);
-  return renavigate(*ctx.model, reference, path, fps, default_renav_options(solver), ctx, report);
+  return renavigate(model, reference, path, fps, default_renav_options(solver), ctx, report);
 }
 
 }  // namespace mf

@@ -2,10 +2,10 @@
 // "nemf-adam" (NeMF's Adam-600 reference), and L-BFGS started from a
 // transformer in-betweener (tasks/initializers.h TransformerEncoderInitializer):
 // "nemf-context", "nemf-detail" (two-stage model) and "nemf-citl".
-#include "prior/motion/errors.h"
+#include "prior/model/nemf.h"
+#include "tasks/inbetweener_files.h"
 #include "tasks/latent_solver.h"
 #include "tasks/method.h"
-#include "tasks/inbetweener_files.h"
 
 namespace mf {
 
@@ -25,10 +25,9 @@ Method solver_method(const char* name, const char* description, SolverMethod met
   const std::string method_name = name;
   m.complete = [options, method_name, inbetweener](const Motion& input, const std::vector<int>& known,
                                                    const TaskContext& ctx) {
-    if (!ctx.model) throw InputError("this method needs the prior, and no model is loaded");
-    if (!inbetweener.empty() && !ctx.inbetweener(inbetweener))
-      throw InputError(missing_inbetweener_message("method '" + method_name + "'", inbetweener));
-    return complete_motion(*ctx.model, input, MotionConstraints::full_pose(known), options, ctx);
+    const NemfModel& model = require_prior(ctx, "method '" + method_name + "'");
+    if (!inbetweener.empty()) require_inbetweener(ctx, inbetweener, "method '" + method_name + "'");
+    return complete_motion(model, input, MotionConstraints::full_pose(known), options, ctx);
   };
   return m;
 }

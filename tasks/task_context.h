@@ -1,6 +1,7 @@
 // The context every task method runs in: the models it may use (the prior,
 // the transformer in-betweeners, the prior rig's anatomy), the seed, and the
-// progress callback and cancel flag of long-running methods.
+// progress callback and cancel flag of long-running methods; and the checks
+// that a request fits it (the prior is loaded, a motion is on its skeleton).
 #pragma once
 
 #include <atomic>
@@ -15,6 +16,8 @@ namespace mf {
 class NemfModel;
 class InbetweenModel;
 struct RigAnatomy;
+struct RigInfo;
+struct Skeleton;
 
 /// Progress of a long-running method (a solver's iterations).
 struct TaskProgress {
@@ -69,5 +72,13 @@ struct TaskContext {
     if ((cancel && cancel->load() != 0) || (progress && !progress(p))) throw CancelledError();
   }
 };
+
+/// The prior of `ctx`; throws mf::ModelMissingError "<what> needs the prior,
+/// and no model is loaded" when there is none.
+const NemfModel& require_prior(const TaskContext& ctx, const std::string& what);
+
+/// Throws mf::InputError "the <whose>'s skeleton does not match the model's:
+/// ..." unless `skeleton` has the joints (names) and parents of `rig`'s.
+void check_model_skeleton(const RigInfo& rig, const Skeleton& skeleton, const std::string& whose);
 
 }  // namespace mf
