@@ -45,6 +45,14 @@ int window_iterations(const LatentSolverOptions& o, const MotionConstraints& wc,
   return (!wc.effectors.empty() || longest >= 40) ? 60 : default_iterations(o.method);
 }
 
+// Iterations of the keys-only first stage of solve_latents(); 0 when it does
+// not run (Adam, no keyed_iterations, or no dense term to save).
+int keyed_stage_iterations(const LatentSolverOptions& o) {
+  const EnergyWeights& w = o.weights;
+  const bool dense = w.root_translation > 0 || w.effector > 0 || w.foot_skating > 0 || w.smoothness > 0;
+  return o.method == SolverMethod::Lbfgs && o.keyed_iterations > 0 && dense ? o.keyed_iterations : 0;
+}
+
 // The energy of a window's problem as a function of the codes.
 CodeEnergy window_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& weights) {
   return [&model, &problem, &weights](const at::Tensor& z_l, const at::Tensor& z_g) {
@@ -111,6 +119,225 @@ void overwrite_known(const Motion& input, const MotionConstraints& c, Motion* ou
   spread_root_residual(input, raw, frames, ResidualRamp::Smoothstep, out);
 }
 
+// ---------------------------------------------------------------------------
+// complete_motion() in steps
+
+// Throws InputError unless the call can run: valid options, the model's
+// skeleton, a well-formed motion and constraints, finite known values.
+void check_completion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
+                      const LatentSolverOptions& options) {
+  const std::string bad = options.validate();
+  if (!bad.empty()) throw InputError("invalid solver options: " + bad);
+  const int N = input.num_frames(), J = input.num_joints();
+  check_model_skeleton(model.rig(), input.skeleton, "motion");
+  if (N < 2) throw InputError("the motion needs at least two frames");
+  if (input.rotations.size() != static_cast<size_t>(N) * J)
+    throw InputError("the motion's rotation count does not match its frames and joints");
+  constraints.validate(N, J);
+  for (size_t k = 0; k < constraints.keys.size(); ++k) {
+    const int f = constraints.keys[k].frame;
+    for (int j = 0; j < J; ++j) {
+      if (!constraints.key_has_joint(k, j)) continue;
+      const Eigen::Quaterniond& q = input.rotation(f, j);
+      if (!q.coeffs().allFinite() || q.norm() < 1e-6)
+        throw InputError("the rotation of joint " + input.skeleton.names[j] + " at known frame " + std::to_string(f) +
+                         " is not a finite, non-zero quaternion");
+    }
+    if (constraints.keys[k].root_position && !input.root_positions[f].allFinite())
+      throw InputError("the root position at known frame " + std::to_string(f) + " is not finite");
+  }
+}
+
+// One window of the solve, in solve order.
+struct WindowPlan {
+  int start = 0, length = 0;
+  /// Window frames [shared_begin, shared_end) shared with windows solved
+  /// before (none when shared_begin >= shared_end).
+  int shared_begin = 0, shared_end = 0;
+  /// The caller's constraints of the window (window frames), and the same
+  /// with full-pose keys at the shared frames (what the window is solved under).
+  MotionConstraints user, constraints;
+  int anchor = 0;      ///< window frame of the first key that fixes the root
+  int iterations = 0;  ///< the window's cap (window_iterations())
+};
+
+// Full-pose keys at window frames [begin, end) merged into `user`'s keys (a
+// user key there is replaced by the full-pose key).
+MotionConstraints with_shared_keys(const MotionConstraints& user, int begin, int end, int length) {
+  MotionConstraints c = user;
+  std::vector<PoseKey> merged;
+  size_t u = 0;
+  for (int f = 0; f < length; ++f) {
+    while (u < user.keys.size() && user.keys[u].frame < f) merged.push_back(user.keys[u++]);
+    const bool given = u < user.keys.size() && user.keys[u].frame == f;
+    if (f < begin || f >= end) continue;
+    PoseKey full;
+    full.frame = f;
+    merged.push_back(full);
+    if (given) ++u;
+  }
+  while (u < user.keys.size()) merged.push_back(user.keys[u++]);
+  c.keys = merged;
+  return c;
+}
+
+// The windows in solve order: the first window that holds a key fixing the
+// root, the later ones forward, then the earlier ones backward; each
+// constrained, where it overlaps windows solved before, by full-pose keys
+// taken from their solution.
+std::vector<WindowPlan> plan_windows(int W, int N, const MotionConstraints& constraints,
+                                     const LatentSolverOptions& options) {
+  const std::vector<int> starts = window_starts(N, W, W - std::min(options.overlap, W / 2));
+  const int windows = static_cast<int>(starts.size());
+  auto length_of = [&](int k) { return std::min(W, N - starts[k]); };
+  int first = -1;
+  for (size_t k = 0; k < constraints.keys.size() && first < 0; ++k) {
+    if (!constraints.key_fixes_root(k)) continue;
+    for (int w = 0; w < windows && first < 0; ++w) {
+      if (constraints.keys[k].frame >= starts[w] && constraints.keys[k].frame < starts[w] + length_of(w)) first = w;
+    }
+  }
+  std::vector<int> order;
+  for (int w = first; w < windows; ++w) order.push_back(w);
+  for (int w = first - 1; w >= 0; --w) order.push_back(w);
+
+  std::vector<WindowPlan> plan;
+  std::vector<char> solved(N, 0);
+  for (int w : order) {
+    WindowPlan p;
+    p.start = starts[w];
+    p.length = length_of(w);
+    p.shared_begin = p.length;
+    for (int f = 0; f < p.length; ++f) {
+      if (!solved[p.start + f]) continue;
+      p.shared_begin = std::min(p.shared_begin, f);
+      p.shared_end = std::max(p.shared_end, f + 1);
+    }
+    p.user = constraints.slice(p.start, p.length);
+    p.constraints = p.shared_begin < p.shared_end
+                        ? with_shared_keys(p.user, p.shared_begin, p.shared_end, p.length)
+                        : p.user;
+    p.anchor = -1;
+    for (size_t k = 0; k < p.constraints.keys.size() && p.anchor < 0; ++k) {
+      if (p.constraints.key_fixes_root(k)) p.anchor = p.constraints.keys[k].frame;
+    }
+    if (p.anchor < 0) {
+      throw InputError("frames " + std::to_string(p.start) + ".." + std::to_string(p.start + p.length - 1) +
+                       " hold no key that fixes the root");  // cannot happen after validation
+    }
+    p.iterations = window_iterations(options, p.constraints, p.length);
+    std::fill(solved.begin() + p.start, solved.begin() + p.start + p.length, 1);
+    plan.push_back(std::move(p));
+  }
+  return plan;
+}
+
+// The frames of window `w` of `input`, the shared frames' unconstrained
+// values taken from the solution so far (`out`).
+Motion window_source(const Motion& input, const Motion& out, const WindowPlan& w) {
+  Motion src = input.slice(w.start, w.start + w.length);
+  size_t u = 0;
+  for (int f = w.shared_begin; f < w.shared_end; ++f) {
+    while (u < w.user.keys.size() && w.user.keys[u].frame < f) ++u;
+    const bool given = u < w.user.keys.size() && w.user.keys[u].frame == f;
+    for (int j = 0; j < input.num_joints(); ++j) {
+      if (!(given && w.user.key_has_joint(u, j))) src.rotation(f, j) = out.rotation(w.start + f, j);
+    }
+    if (!(given && w.user.keys[u].root_position)) src.root_positions[f] = out.root_positions[w.start + f];
+  }
+  return src;
+}
+
+// The solution so far: the motion and the predictor's foot contact
+// probabilities [frames, feet].
+struct SolvedMotion {
+  Motion motion;
+  std::vector<float> contacts;
+  std::vector<char> solved;  // per frame
+};
+
+// Window `w`'s decoded solution cross-faded into `out` over the frames it
+// shares with windows solved before (its weight rising away from them; SLERP /
+// LERP, linear weights) and copied elsewhere.
+void blend_window(const WindowPlan& w, const Motion& piece, const at::Tensor& piece_contacts, int feet,
+                  SolvedMotion* out) {
+  const at::Tensor pc_tensor = piece_contacts.contiguous();
+  const float* pc = pc_tensor.data_ptr<float>();
+  const bool solved_before = w.shared_begin < w.shared_end && w.shared_begin == 0;
+  const int n_ov = w.shared_end - w.shared_begin;
+  for (int f = 0; f < w.length; ++f) {
+    const int g = w.start + f;
+    double wn = 1.0;
+    if (out->solved[g]) {
+      const int pos = solved_before ? f - w.shared_begin + 1 : w.shared_end - f;
+      wn = static_cast<double>(pos) / (n_ov + 1);
+    }
+    cross_fade_frame(piece, f, wn, &out->motion, g);
+    for (int k = 0; k < feet; ++k) {
+      float& c = out->contacts[static_cast<size_t>(g) * feet + k];
+      c = static_cast<float>(c * (1.0 - wn) + pc[f * feet + k] * wn);
+    }
+    out->solved[g] = 1;
+  }
+}
+
+// Solves the windows of `plan` in order (the progress total is the sum of
+// their caps) and joins their solutions.
+SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const std::vector<WindowPlan>& plan,
+                           const LatentSolverOptions& options, const TaskContext& ctx, CompletionReport* rep) {
+  const RigInfo& rig = model.rig();
+  const int N = input.num_frames(), F = rig.num_feet();
+  std::shared_ptr<const LatentInitializer> init = options.initializer;
+  if (!init) init = std::make_shared<InterpolationEncoderInitializer>();
+  int total = 0;
+  for (const WindowPlan& w : plan) total += w.iterations + keyed_stage_iterations(options);
+
+  SolvedMotion out{Motion::identity(input.skeleton, N, input.fps), std::vector<float>(static_cast<size_t>(N) * F, 0.0f),
+                   std::vector<char>(N, 0)};
+  int iterations = 0;
+  for (const WindowPlan& w : plan) {
+    const Motion src = window_source(input, out.motion, w);
+    const WindowProblem problem = make_window_problem(rig, src, 0, w.length, w.constraints, w.anchor);
+    InitRequest request;
+    request.model = &model;
+    request.window = &src;
+    request.constraints = &w.constraints;
+    request.anchor = w.anchor;
+    request.context = &ctx;
+    const InitialGuess start = init->initialize(request);
+    LatentSolverOptions window_options = options;
+    window_options.max_iterations = w.iterations;
+    LatentSolution sol = solve_latents(model, problem, start, window_options, ctx, iterations, total);
+    iterations += sol.summary.iterations;
+    rep->windows.push_back(sol.summary);
+    rep->window_starts.push_back(w.start);
+
+    const DecodedWindow dec = decode_window(model, problem, sol.z_l, sol.z_g);
+    Motion piece = Motion::identity(input.skeleton, w.length, input.fps);
+    write_window(dec.local_rotations, dec.root_positions, problem.transform, &piece, 0);
+    blend_window(w, piece, dec.contacts, F, &out);
+  }
+  rep->iterations = iterations;
+  return out;
+}
+
+// The known values made exact (see the header): the overwrite, foot locking
+// and end-effector IK, each as the options ask, with their errors reported.
+void make_known_values_exact(const RigInfo& rig, const Motion& input, const MotionConstraints& constraints,
+                             const LatentSolverOptions& options, const std::vector<float>& contacts, Motion* out,
+                             CompletionReport* rep) {
+  measure_effectors(*out, constraints, &rep->raw_effectors);
+  if (options.overwrite_known) {
+    overwrite_known(input, constraints, out, &rep->raw_known);
+    if (options.foot_lock_ramp >= 0) lock_feet(rig, constraints, contacts, options.foot_lock_ramp, out);
+    if (options.effector_falloff >= 0) reach_effectors(constraints, options.effector_falloff, out);
+  } else {
+    Motion copy = *out;
+    overwrite_known(input, constraints, &copy, &rep->raw_known);
+  }
+  measure_effectors(*out, constraints, &rep->effectors);
+}
+
 }  // namespace
 
 std::string LatentSolverOptions::validate() const {
@@ -153,15 +380,13 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
   SolveSummary& s = out.summary;
   s.initial_terms = energy.terms(x0, &s.initial_energy);
   at::Tensor x = x0;
-  const EnergyWeights& w = options.weights;
-  const bool dense = w.root_translation > 0 || w.effector > 0 || w.foot_skating > 0 || w.smoothness > 0;
-  if (options.method == SolverMethod::Lbfgs && options.keyed_iterations > 0 && dense) {
-    EnergyWeights keyed = w;
+  if (const int keyed_cap = keyed_stage_iterations(options); keyed_cap > 0) {
+    EnergyWeights keyed = options.weights;
     keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
     const FlatLatentEnergy cheap(window_energy(model, problem, keyed), zl, zg);
     LatentOptimizerStats first;
-    x = minimize_latent(cheap.total(), x, options.method, options.capped(options.keyed_iterations), ctx, &first,
-                        iteration_offset, total);
+    x = minimize_latent(cheap.total(), x, options.method, options.capped(keyed_cap), ctx, &first, iteration_offset,
+                        total);
     s.keyed_iterations = first.iterations;
     s.evaluations += first.evaluations;
   }
@@ -182,151 +407,14 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
 Motion complete_motion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
                        const LatentSolverOptions& options, const TaskContext& ctx, CompletionReport* report) {
   const auto t0 = Clock::now();
-  const std::string bad = options.validate();
-  if (!bad.empty()) throw InputError("invalid solver options: " + bad);
-  const RigInfo& rig = model.rig();
-  const int N = input.num_frames(), J = input.num_joints();
-  check_model_skeleton(rig, input.skeleton, "motion");
-  if (N < 2) throw InputError("the motion needs at least two frames");
-  if (input.rotations.size() != static_cast<size_t>(N) * J)
-    throw InputError("the motion's rotation count does not match its frames and joints");
-  constraints.validate(N, J);
-  for (size_t k = 0; k < constraints.keys.size(); ++k) {
-    const int f = constraints.keys[k].frame;
-    for (int j = 0; j < J; ++j) {
-      if (!constraints.key_has_joint(k, j)) continue;
-      const Eigen::Quaterniond& q = input.rotation(f, j);
-      if (!q.coeffs().allFinite() || q.norm() < 1e-6)
-        throw InputError("the rotation of joint " + input.skeleton.names[j] + " at known frame " + std::to_string(f) +
-                         " is not a finite, non-zero quaternion");
-    }
-    if (constraints.keys[k].root_position && !input.root_positions[f].allFinite())
-      throw InputError("the root position at known frame " + std::to_string(f) + " is not finite");
-  }
-
-  const int W = model.config().window;
-  const std::vector<int> starts = window_starts(N, W, W - std::min(options.overlap, W / 2));
-  const int windows = static_cast<int>(starts.size());
-  auto length_of = [&](int k) { return std::min(W, N - starts[k]); };
-
-  // First window holding a key that fixes the root.
-  int first = -1;
-  for (size_t k = 0; k < constraints.keys.size() && first < 0; ++k) {
-    if (!constraints.key_fixes_root(k)) continue;
-    for (int w = 0; w < windows; ++w) {
-      if (constraints.keys[k].frame >= starts[w] && constraints.keys[k].frame < starts[w] + length_of(w)) {
-        first = w;
-        break;
-      }
-    }
-  }
-  std::vector<int> order;
-  for (int w = first; w < windows; ++w) order.push_back(w);
-  for (int w = first - 1; w >= 0; --w) order.push_back(w);
-
-  std::shared_ptr<const LatentInitializer> init = options.initializer;
-  if (!init) init = std::make_shared<InterpolationEncoderInitializer>();
-  const int cap = options.max_iterations > 0 ? options.max_iterations
-                 : options.method == SolverMethod::Adam ? default_iterations(options.method) : 60;
-
+  check_completion(model, input, constraints, options);
+  const std::vector<WindowPlan> plan = plan_windows(model.config().window, input.num_frames(), constraints, options);
   CompletionReport rep;
-  Motion out = Motion::identity(input.skeleton, N, input.fps);
-  std::vector<char> solved(N, 0);
-  const int F = rig.num_feet();
-  std::vector<float> contacts(static_cast<size_t>(N) * F, 0.0f);
-  int iterations = 0;
-  for (int w : order) {
-    const int s = starts[w], T = length_of(w);
-    MotionConstraints wc = constraints.slice(s, T);
-    Motion src = input.slice(s, s + T);
-    // Overlap with an already solved neighbour: full-pose keys from its solution
-    // (the user's own constrained values kept where there are some).
-    int ov_a = T, ov_b = 0;
-    for (int f = 0; f < T; ++f) {
-      if (!solved[s + f]) continue;
-      ov_a = std::min(ov_a, f);
-      ov_b = std::max(ov_b, f + 1);
-    }
-    if (ov_a < ov_b) {
-      std::vector<PoseKey> merged;
-      size_t u = 0;
-      for (int f = 0; f < T; ++f) {
-        while (u < wc.keys.size() && wc.keys[u].frame < f) merged.push_back(wc.keys[u++]);
-        const bool user = u < wc.keys.size() && wc.keys[u].frame == f;
-        if (f < ov_a || f >= ov_b) continue;
-        for (int j = 0; j < J; ++j) {
-          if (!(user && wc.key_has_joint(u, j))) src.rotation(f, j) = out.rotation(s + f, j);
-        }
-        if (!(user && wc.keys[u].root_position)) src.root_positions[f] = out.root_positions[s + f];
-        PoseKey full;
-        full.frame = f;
-        merged.push_back(full);
-        if (user) ++u;
-      }
-      while (u < wc.keys.size()) merged.push_back(wc.keys[u++]);
-      wc.keys = merged;
-    }
-    int anchor = -1;
-    for (size_t k = 0; k < wc.keys.size() && anchor < 0; ++k) {
-      if (wc.key_fixes_root(k)) anchor = wc.keys[k].frame;
-    }
-    if (anchor < 0) {
-      throw InputError("frames " + std::to_string(s) + ".." + std::to_string(s + T - 1) +
-                       " hold no key that fixes the root");  // cannot happen after validation
-    }
-    const WindowProblem problem = make_window_problem(rig, src, 0, T, wc, anchor);
-    InitRequest request;
-    request.model = &model;
-    request.window = &src;
-    request.constraints = &wc;
-    request.anchor = anchor;
-    request.context = &ctx;
-    const InitialGuess start = init->initialize(request);
-    LatentSolverOptions window_options = options;
-    window_options.max_iterations = window_iterations(options, wc, T);
-    LatentSolution sol = solve_latents(model, problem, start, window_options, ctx, iterations, cap * windows);
-    iterations += sol.summary.iterations;
-    rep.windows.push_back(sol.summary);
-    rep.window_starts.push_back(s);
-
-    const DecodedWindow dec = decode_window(model, problem, sol.z_l, sol.z_g);
-    Motion piece = Motion::identity(input.skeleton, T, input.fps);
-    write_window(dec.local_rotations, dec.root_positions, problem.transform, &piece, 0);
-    const at::Tensor piece_contacts = dec.contacts.contiguous();
-    const float* pc = piece_contacts.data_ptr<float>();
-    // Cross-fade over the overlap; the new window's weight rises away from the solved side.
-    const bool solved_before = ov_a < ov_b && ov_a == 0;
-    const int n_ov = ov_b - ov_a;
-    for (int f = 0; f < T; ++f) {
-      const int g = s + f;
-      double wn = 1.0;
-      if (solved[g]) {
-        const int pos = solved_before ? f - ov_a + 1 : ov_b - f;
-        wn = static_cast<double>(pos) / (n_ov + 1);
-      }
-      cross_fade_frame(piece, f, wn, &out, g);
-      for (int k = 0; k < F; ++k) {
-        float& c = contacts[static_cast<size_t>(g) * F + k];
-        c = static_cast<float>(c * (1.0 - wn) + pc[f * F + k] * wn);
-      }
-      solved[g] = 1;
-    }
-  }
-
-  measure_effectors(out, constraints, &rep.raw_effectors);
-  if (options.overwrite_known) {
-    overwrite_known(input, constraints, &out, &rep.raw_known);
-    if (options.foot_lock_ramp >= 0) lock_feet(rig, constraints, contacts, options.foot_lock_ramp, &out);
-    if (options.effector_falloff >= 0) reach_effectors(constraints, options.effector_falloff, &out);
-  } else {
-    Motion copy = out;
-    overwrite_known(input, constraints, &copy, &rep.raw_known);
-  }
-  measure_effectors(out, constraints, &rep.effectors);
-  rep.iterations = iterations;
+  SolvedMotion solved = solve_windows(model, input, plan, options, ctx, &rep);
+  make_known_values_exact(model.rig(), input, constraints, options, solved.contacts, &solved.motion, &rep);
   rep.wall_ms = ms_since(t0);
   if (report) *report = std::move(rep);
-  return out;
+  return std::move(solved.motion);
 }
 
 }  // namespace mf
