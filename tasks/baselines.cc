@@ -51,19 +51,22 @@ void blend_frames(const Motion& from, int a, int b, double t, Motion& to, int f_
   for (int j = 0; j < J; ++j) to.rotation(f_to, j) = slerp(from.rotation(a, j), from.rotation(b, j), t);
 }
 
-// Input frame position (in input frames, possibly fractional) of output frame i.
-// Positions within 1e-5 relative of an integer snap to it, so that output
-// frames that coincide with input frames copy them exactly although BVH frame
-// times carry only about six digits (0.0333333 s is 30.00003 fps).
+// Input frame position (in input frames, possibly fractional) of output
+// frame i, snapped (snap_frame_position) and held at the last frame.
 double source_position(int i, double fps_in, double fps_out, int frames_in) {
-  double s = static_cast<double>(i) * fps_in / fps_out;
-  const double r = std::round(s);
-  if (std::abs(s - r) <= 1e-5 * std::max(1.0, r)) s = r;
+  double s = snap_frame_position(static_cast<double>(i) * fps_in / fps_out);
   if (s > frames_in - 1) s = frames_in - 1;
   return s;
 }
 
 }  // namespace
+
+bool same_frame_rate(double a, double b) { return std::abs(a - b) <= 1e-5 * b; }
+
+double snap_frame_position(double s) {
+  const double r = std::round(s);
+  return std::abs(s - r) <= 1e-5 * std::max(1.0, std::abs(r)) ? r : s;
+}
 
 Motion interpolate_motion(const Motion& input, const std::vector<int>& known) {
   check_shape(input);

@@ -30,6 +30,16 @@ Motion interpolate_motion(const Motion& input, const std::vector<int>& known);
 /// length and fps.
 Motion zero_velocity_motion(const Motion& input, const std::vector<int>& known);
 
+/// True when frame rates `a` and `b` are the same within 1e-5 relative to
+/// `b` (BVH frame times carry about six digits: 0.0333333 s is 30.00003 fps).
+bool same_frame_rate(double a, double b);
+
+/// A frame position (in frames, possibly fractional) snapped to the nearest
+/// whole frame when within 1e-5 relative of it (at least 1e-5), so that
+/// frames that coincide in time copy each other exactly despite six-digit
+/// frame times.
+double snap_frame_position(double s);
+
 /// Resampling by interpolation at continuous times: output frame i sits at time
 /// i / new_fps, i.e. at input frame position s = i * input.fps / new_fps; root
 /// LERP and rotation SLERP between input frames floor(s) and floor(s) + 1.

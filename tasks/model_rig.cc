@@ -16,8 +16,6 @@
 namespace mf {
 namespace {
 
-bool same_rate(double a, double b) { return std::abs(a - b) <= 1e-5 * b; }
-
 // Model-rate frames of a motion at `fps` with `frames` frames: enough to cover
 // its time span (the last model frame may reach past the end; it is clamped).
 int model_rate_frames(int frames, double fps, double model_fps) {
@@ -70,7 +68,7 @@ std::shared_ptr<const RigAnatomy> load_rig_anatomy_next_to(const std::string& pr
 
 bool needs_model_rig(const Motion& input, const TaskContext& ctx) {
   if (!ctx.model) return false;
-  return !input.skeleton.same_as(ctx.model->rig().skeleton) || !same_rate(input.fps, ctx.model->config().fps);
+  return !input.skeleton.same_as(ctx.model->rig().skeleton) || !same_frame_rate(input.fps, ctx.model->config().fps);
 }
 
 RigMap model_rig_map(const Skeleton& user, const TaskContext& ctx) {
@@ -110,7 +108,7 @@ Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known,
   const Motion on_model = native ? reference : rig->to_model(reference);
 
   Motion result;
-  if (same_rate(input.fps, model_fps)) {
+  if (same_frame_rate(input.fps, model_fps)) {
     result = complete(on_model, known);
   } else {
     const int frames = model_rate_frames(input.num_frames(), input.fps, model_fps);

@@ -25,13 +25,6 @@ void check_fps(double fps, const char* what) {
   if (!std::isfinite(fps) || fps <= 0.0) throw InputError(std::string(what) + " must be finite and positive");
 }
 
-// Position s in frames of a sequence at fps_in for time i / fps_out, snapped to
-// an integer when within 1e-5 relative (as the interpolation baseline does).
-double snapped_position(double s) {
-  const double r = std::round(s);
-  return std::abs(s - r) <= 1e-5 * std::max(1.0, std::abs(r)) ? r : s;
-}
-
 // Uniform Catmull-Rom spline through points p[0 .. n-1] ([n, 3] row-major) at
 // position s in [0, n - 1]; end points are repeated. C1, exact at integers.
 Eigen::Vector3d catmull_rom(const double* p, int n, double s) {
@@ -127,7 +120,7 @@ EncodedMotion encode_motion(const NemfModel& model, const Motion& motion, const 
   // The sequence at the model's rate.
   Motion seq;
   const Motion* src = &motion;
-  if (std::abs(motion.fps - c.fps) > 1e-5 * c.fps) {
+  if (!same_frame_rate(motion.fps, c.fps)) {
     const double span = (motion.num_frames() - 1) * c.fps / motion.fps;
     const int n = static_cast<int>(std::ceil(span - 1e-5)) + 1;
     if (n > 10000000) throw InputError("motion too long to encode");
@@ -304,7 +297,7 @@ Motion decode_times(const NemfModel& model, const EncodedMotion& code, const std
     const std::vector<Eigen::Vector3d>& src = code.source_root_positions;
     const int n = static_cast<int>(src.size());
     for (int i = 0; i < T; ++i) {
-      const double s = std::clamp(snapped_position(times[i] * code.source_fps), 0.0, static_cast<double>(n - 1));
+      const double s = std::clamp(snap_frame_position(times[i] * code.source_fps), 0.0, static_cast<double>(n - 1));
       const int a = static_cast<int>(std::floor(s));
       const int b = std::min(a + 1, n - 1);
       const double u = s - a;
@@ -353,7 +346,7 @@ Motion resample_core(const NemfModel& model, const Motion& input, double fps, in
     pos_res[k] = input.root_positions[k] - all.root_positions[frames + k];
   }
   for (int i = 0; i < frames; ++i) {
-    const double s = std::min(snapped_position(i * input.fps / fps), static_cast<double>(N - 1));
+    const double s = std::min(snap_frame_position(i * input.fps / fps), static_cast<double>(N - 1));
     const int a = static_cast<int>(std::floor(s));
     const double u = s - a;
     if (u == 0.0) {

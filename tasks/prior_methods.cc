@@ -47,7 +47,7 @@ bool upsample_by_solving(const Motion& in, double fps, int frames, const TaskCon
       solved.rotation(f, j) = dense.rotation(f, j).slerp(kPriorWeight, solved_raw.rotation(f, j));
     solved.root_positions[f] = dense.root_positions[f] * (1 - kPriorWeight) + solved_raw.root_positions[f] * kPriorWeight;
   }
-  if (std::abs(fps - model_fps) <= 1e-5 * model_fps) {
+  if (same_frame_rate(fps, model_fps)) {
     *out = resample_interpolate(solved, fps, frames);  // copies the solved frames, holds past the end
   } else {
     *out = resample_with_prior(solved, fps, frames, ctx, options);

@@ -50,18 +50,16 @@ int default_iterations(RenavSolver s) { return s == RenavSolver::Adam ? 600 : 10
 
 // ---------------------------------------------------------------- the window
 
-RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, int ref_begin, int ref_length,
-                              const std::vector<Eigen::Vector2d>& path, int begin, int length, const Motion* previous,
-                              int shared) {
-  const RigInfo& rig = model.rig();
-  const int J = rig.num_joints();
+namespace {
+
+void check_window_arguments(const NemfModel& model, const Motion& reference, int ref_begin, int ref_length, int N,
+                            int begin, int length, const Motion* previous, int shared) {
   const int W = model.config().window;
-  check_model_skeleton(rig, reference.skeleton, "reference");
+  check_model_skeleton(model.rig(), reference.skeleton, "reference");
   if (ref_begin < 0 || ref_length < 2 || ref_begin + ref_length > reference.num_frames())
     throw InputError("reference segment [" + std::to_string(ref_begin) + ", " + std::to_string(ref_begin + ref_length) +
                      ") does not fit the reference (" + std::to_string(reference.num_frames()) + " frames, at least 2)");
   if (ref_length > W) throw InputError("a reference segment may have at most the model's window of frames");
-  const int N = static_cast<int>(path.size());
   if (begin < 0 || length < 2 || length > W || begin + length > N)
     throw InputError("window [" + std::to_string(begin) + ", " + std::to_string(begin + length) +
                      ") does not fit the path (" + std::to_string(N) + " points, 2 to " + std::to_string(W) +
@@ -69,116 +67,144 @@ RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, i
   if (shared < 0 || shared >= length || (shared > 0 && !previous))
     throw InputError("bad number of frames shared with the previous window");
   if (previous && shared > 0 &&
-      (previous->num_joints() != J || begin + shared > previous->num_frames()))
+      (previous->num_joints() != model.rig().num_joints() || begin + shared > previous->num_frames()))
     throw InputError("the previous solution does not cover the shared frames");
+}
 
-  RenavWindow w;
-  w.length = length;
-  const Eigen::Vector3d fwd = rig.root_forward;
+// The reference segment's heading and travel direction (yaw) per frame.
+struct ReferenceCourse {
+  std::vector<double> heading, travel;
+};
 
-  // The reference: heading, travel direction, facing offset, signals.
-  Motion seg = reference.slice(ref_begin, ref_begin + ref_length);
-  const int R = ref_length;
-  std::vector<double> ref_heading(R);
-  std::vector<Eigen::Vector2d> ref_xz(R);
+ReferenceCourse reference_course(const Motion& seg, const Eigen::Vector3d& forward) {
+  const int R = seg.num_frames();
+  ReferenceCourse c;
+  c.heading.resize(R);
+  std::vector<Eigen::Vector2d> xz(R);
   for (int f = 0; f < R; ++f) {
-    ref_heading[f] = heading_yaw(seg.rotation(f, 0), fwd);
-    ref_xz[f] = Eigen::Vector2d(seg.root_positions[f].x(), seg.root_positions[f].z());
+    c.heading[f] = heading_yaw(seg.rotation(f, 0), forward);
+    xz[f] = Eigen::Vector2d(seg.root_positions[f].x(), seg.root_positions[f].z());
   }
-  const std::vector<double> ref_travel = tangent_yaws(ref_xz, ref_heading);
-  {
-    at::NoGradGuard no_grad;
-    const WindowTensors t = window_tensors(seg, 0, R, rig, 0);
-    w.reference_joints = heading_relative_positions(t.local_rotations, rig).flatten(-2).contiguous();
-    w.reference_heading = at::empty({1, R, 1}, at::kFloat);
-    float* c = w.reference_heading.data_ptr<float>();
-    for (int f = 0; f < R; ++f) c[f] = static_cast<float>(std::cos(ref_heading[f] - ref_travel[f]));
-  }
+  c.travel = tangent_yaws(xz, c.heading);
+  return c;
+}
 
-  // The target's tangents over the whole path (context beyond the window's ends).
-  const std::vector<double> target_yaw = tangent_yaws(path);
+// The reference's signals of the energy: heading-frame joint positions and c(t).
+void set_reference_signals(const RigInfo& rig, const Motion& seg, const ReferenceCourse& course, RenavWindow* w) {
+  at::NoGradGuard no_grad;
+  const int R = seg.num_frames();
+  const WindowTensors t = window_tensors(seg, 0, R, rig, 0);
+  w->reference_joints = heading_relative_positions(t.local_rotations, rig).flatten(-2).contiguous();
+  w->reference_heading = at::empty({1, R, 1}, at::kFloat);
+  float* c = w->reference_heading.data_ptr<float>();
+  for (int f = 0; f < R; ++f) c[f] = static_cast<float>(std::cos(course.heading[f] - course.travel[f]));
+}
 
-  // The canonical frame.
-  Eigen::Vector2d origin;
-  double yaw;
-  if (previous && shared > 0) {
-    const Eigen::Vector3d& r = previous->root_positions[begin];
-    origin = Eigen::Vector2d(r.x(), r.z());
-    yaw = heading_yaw(previous->rotation(begin, 0), fwd, target_yaw[begin]);
-  } else {
-    origin = path[begin];
-    yaw = wrap_angle(target_yaw[begin] + (ref_heading[0] - ref_travel[0]));
-  }
-  w.transform.yaw = yaw;
-  w.transform.x = origin.x();
-  w.transform.z = origin.y();
+// The target path of the window and its tangents, in the canonical frame `transform`.
+void set_target_signals(const std::vector<Eigen::Vector2d>& path, const std::vector<double>& target_yaw, int begin,
+                        int length, RenavWindow* w) {
+  const double yaw = w->transform.yaw;
   const Eigen::Matrix3d unturn = rot_y(-yaw);
-  auto to_canonical = [&](const Eigen::Vector2d& p) {
-    const Eigen::Vector3d c = unturn * Eigen::Vector3d(p.x() - origin.x(), 0.0, p.y() - origin.y());
-    return Eigen::Vector2d(c.x(), c.z());
-  };
-
-  w.target_xz = at::empty({length, 2}, at::kFloat);
-  w.target_tangent = at::empty({length, 2}, at::kFloat);
-  {
-    float* t = w.target_xz.data_ptr<float>();
-    float* g = w.target_tangent.data_ptr<float>();
-    for (int f = 0; f < length; ++f) {
-      const Eigen::Vector2d c = to_canonical(path[begin + f]);
-      t[2 * f] = static_cast<float>(c.x());
-      t[2 * f + 1] = static_cast<float>(c.y());
-      const double a = target_yaw[begin + f] - yaw;
-      g[2 * f] = static_cast<float>(std::sin(a));
-      g[2 * f + 1] = static_cast<float>(std::cos(a));
-    }
+  w->target_xz = at::empty({length, 2}, at::kFloat);
+  w->target_tangent = at::empty({length, 2}, at::kFloat);
+  float* t = w->target_xz.data_ptr<float>();
+  float* g = w->target_tangent.data_ptr<float>();
+  for (int f = 0; f < length; ++f) {
+    const Eigen::Vector2d& p = path[begin + f];
+    const Eigen::Vector3d c = unturn * Eigen::Vector3d(p.x() - w->transform.x, 0.0, p.y() - w->transform.z);
+    t[2 * f] = static_cast<float>(c.x());
+    t[2 * f + 1] = static_cast<float>(c.z());
+    const double a = target_yaw[begin + f] - yaw;
+    g[2 * f] = static_cast<float>(std::sin(a));
+    g[2 * f + 1] = static_cast<float>(std::cos(a));
   }
-  w.start_xz = at::zeros({1, 2}, at::kFloat);
+  w->start_xz = at::zeros({1, 2}, at::kFloat);
+}
 
-  // The reference turned to follow the target: each frame's root turned about +Y
-  // by (target travel - reference travel), placed on the path with the
-  // reference's height; then one rigid ground motion so that frame 0 sits at the
-  // canonical origin with the canonical heading.
-  const int Tt = std::min(R, length);
+// The reference turned to follow the target: each frame's root turned about +Y
+// by (target travel - reference travel), placed on the path with the
+// reference's height; then one rigid ground motion so that frame 0 sits at the
+// canonical origin with the canonical heading.
+Motion turned_reference(const Motion& seg, const ReferenceCourse& course, const std::vector<Eigen::Vector2d>& path,
+                        const std::vector<double>& target_yaw, int begin, int length, const GroundTransform& canonical,
+                        const Eigen::Vector3d& forward) {
+  const int Tt = std::min(seg.num_frames(), length);
   Motion turned = seg.slice(0, Tt);
   for (int f = 0; f < Tt; ++f) {
-    const double delta = target_yaw[begin + f] - ref_travel[f];
+    const double delta = target_yaw[begin + f] - course.travel[f];
     turned.rotation(f, 0) = (Eigen::Quaterniond(Eigen::AngleAxisd(delta, Eigen::Vector3d::UnitY())) *
                              seg.rotation(f, 0).normalized())
                                 .normalized();
     turned.root_positions[f] = Eigen::Vector3d(path[begin + f].x(), seg.root_positions[f].y(), path[begin + f].y());
   }
-  {
-    const double fix = wrap_angle(yaw - heading_yaw(turned.rotation(0, 0), fwd));
-    const Eigen::Quaterniond q(Eigen::AngleAxisd(fix, Eigen::Vector3d::UnitY()));
-    const Eigen::Vector3d pivot(path[begin].x(), 0.0, path[begin].y());
-    const Eigen::Vector3d target(origin.x(), 0.0, origin.y());
-    for (int f = 0; f < Tt; ++f) {
-      turned.rotation(f, 0) = (q * turned.rotation(f, 0)).normalized();
-      const Eigen::Vector3d p = turned.root_positions[f];
-      const Eigen::Vector3d g = q * Eigen::Vector3d(p.x() - pivot.x(), 0.0, p.z() - pivot.z());
-      turned.root_positions[f] = Eigen::Vector3d(g.x() + target.x(), p.y(), g.z() + target.z());
-    }
+  const double fix = wrap_angle(canonical.yaw - heading_yaw(turned.rotation(0, 0), forward));
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(fix, Eigen::Vector3d::UnitY()));
+  const Eigen::Vector3d pivot(path[begin].x(), 0.0, path[begin].y());
+  const Eigen::Vector3d target(canonical.x, 0.0, canonical.z);
+  for (int f = 0; f < Tt; ++f) {
+    turned.rotation(f, 0) = (q * turned.rotation(f, 0)).normalized();
+    const Eigen::Vector3d p = turned.root_positions[f];
+    const Eigen::Vector3d g = q * Eigen::Vector3d(p.x() - pivot.x(), 0.0, p.z() - pivot.z());
+    turned.root_positions[f] = Eigen::Vector3d(g.x() + target.x(), p.y(), g.z() + target.z());
   }
-  w.reference_segment = std::move(seg);
-  w.turned_segment = std::move(turned);
+  return turned;
+}
 
-  // Continuity with the previous solution on the shared frames.
-  if (previous && shared > 0) {
-    at::NoGradGuard no_grad;
-    w.shared_frames = at::arange(shared, at::kLong);
-    at::Tensor rot = at::empty({1, shared, J, 3, 3}, at::kFloat);
-    float* r = rot.data_ptr<float>();
-    for (int f = 0; f < shared; ++f) {
-      for (int j = 0; j < J; ++j) {
-        Eigen::Matrix3d m = previous->rotation(begin + f, j).normalized().toRotationMatrix();
-        if (j == 0) m = unturn * m;
-        for (int a = 0; a < 3; ++a)
-          for (int b = 0; b < 3; ++b) *r++ = static_cast<float>(m(a, b));
-      }
+// Continuity with the previous solution on the `shared` frames from `begin`:
+// its local rotations (root in the window's canonical frame) and heading-frame
+// joint positions there.
+void set_shared_frames(const RigInfo& rig, const Motion& previous, int begin, int shared, RenavWindow* w) {
+  at::NoGradGuard no_grad;
+  const int J = rig.num_joints();
+  const Eigen::Matrix3d unturn = rot_y(-w->transform.yaw);
+  w->shared_frames = at::arange(shared, at::kLong);
+  at::Tensor rot = at::empty({1, shared, J, 3, 3}, at::kFloat);
+  float* r = rot.data_ptr<float>();
+  for (int f = 0; f < shared; ++f) {
+    for (int j = 0; j < J; ++j) {
+      Eigen::Matrix3d m = previous.rotation(begin + f, j).normalized().toRotationMatrix();
+      if (j == 0) m = unturn * m;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) *r++ = static_cast<float>(m(a, b));
     }
-    w.shared_rotations = rot.squeeze(0).contiguous();
-    w.shared_joints = heading_relative_positions(rot, rig).squeeze(0).contiguous();
   }
+  w->shared_rotations = rot.squeeze(0).contiguous();
+  w->shared_joints = heading_relative_positions(rot, rig).squeeze(0).contiguous();
+}
+
+}  // namespace
+
+RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, int ref_begin, int ref_length,
+                              const std::vector<Eigen::Vector2d>& path, int begin, int length, const Motion* previous,
+                              int shared) {
+  check_window_arguments(model, reference, ref_begin, ref_length, static_cast<int>(path.size()), begin, length,
+                         previous, shared);
+  const RigInfo& rig = model.rig();
+  const Eigen::Vector3d fwd = rig.root_forward;
+  RenavWindow w;
+  w.length = length;
+  Motion seg = reference.slice(ref_begin, ref_begin + ref_length);
+  const ReferenceCourse course = reference_course(seg, fwd);
+  set_reference_signals(rig, seg, course, &w);
+  // The target's tangents over the whole path (context beyond the window's ends).
+  const std::vector<double> target_yaw = tangent_yaws(path);
+
+  // The canonical frame: at the previous solution where it continues one, else
+  // on the path heading along it with the reference's facing offset.
+  if (previous && shared > 0) {
+    const Eigen::Vector3d& r = previous->root_positions[begin];
+    w.transform.x = r.x();
+    w.transform.z = r.z();
+    w.transform.yaw = heading_yaw(previous->rotation(begin, 0), fwd, target_yaw[begin]);
+  } else {
+    w.transform.x = path[begin].x();
+    w.transform.z = path[begin].y();
+    w.transform.yaw = wrap_angle(target_yaw[begin] + (course.heading[0] - course.travel[0]));
+  }
+  set_target_signals(path, target_yaw, begin, length, &w);
+  w.turned_segment = turned_reference(seg, course, path, target_yaw, begin, length, w.transform, fwd);
+  w.reference_segment = std::move(seg);
+  if (previous && shared > 0) set_shared_frames(rig, *previous, begin, shared, &w);
   return w;
 }
 
@@ -301,25 +327,23 @@ RenavOptions default_renav_options(RenavSolver solver) {
   return o;
 }
 
-Motion renavigate(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
-                  double path_fps, const RenavOptions& options, const TaskContext& ctx, RenavReport* report) {
-  const auto t0 = Clock::now();
+namespace {
+
+void check_renav_input(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
+                       double path_fps, const RenavOptions& options) {
   const std::string bad = options.validate();
   if (!bad.empty()) throw InputError("invalid re-navigation options: " + bad);
-  const RigInfo& rig = model.rig();
-  check_model_skeleton(rig, reference.skeleton, "reference");
+  check_model_skeleton(model.rig(), reference.skeleton, "reference");
   if (reference.num_frames() < 2) throw InputError("the reference needs at least two frames");
   reference.validate();
   validate_path(path);
   if (!(std::isfinite(path_fps) && path_fps > 0)) throw InputError("the path's frame rate must be finite and positive");
+}
 
-  const double fm = model.config().fps;
-  const int W = model.config().window;
-  auto same_rate = [](double a, double b) { return std::abs(a - b) <= 1e-5 * b; };
-
-  // Everything at the model's rate.
+// The reference at the model's rate `fm` (interpolated over its time span).
+Motion reference_at_model_rate(const Motion& reference, double fm) {
   Motion ref_m = reference;
-  if (!same_rate(reference.fps, fm)) {
+  if (!same_frame_rate(reference.fps, fm)) {
     const int frames = static_cast<int>(std::floor((reference.num_frames() - 1) * fm / reference.fps + 1e-6)) + 1;
     if (frames < 2) {
       std::ostringstream msg;
@@ -329,30 +353,120 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
     ref_m = resample_interpolate(reference, fm, frames);
   }
   ref_m.fps = fm;
+  return ref_m;
+}
+
+// The path (points at `path_fps`) at the model's rate `fm`: linear in time,
+// the last point at or past the path's end time.
+std::vector<Eigen::Vector2d> path_at_model_rate(const std::vector<Eigen::Vector2d>& path, double path_fps, double fm) {
+  if (same_frame_rate(path_fps, fm)) return path;
   const int N = static_cast<int>(path.size());
-  std::vector<Eigen::Vector2d> path_m;
-  if (same_rate(path_fps, fm)) {
-    path_m = path;
-  } else {
-    const double span = (N - 1) * fm / path_fps;
-    const int M = static_cast<int>(std::ceil(span - 1e-6)) + 1;
-    if (M > kMaxPathFrames) throw InputError("the path is too long at the model's frame rate");
-    path_m.resize(std::max(2, M));
-    for (int i = 0; i < static_cast<int>(path_m.size()); ++i) {
-      const double u = std::min<double>(N - 1, i * path_fps / fm);
-      const int a = std::min(N - 2, static_cast<int>(std::floor(u)));
-      const double t = u - a;
-      path_m[i] = path[a] * (1.0 - t) + path[a + 1] * t;
+  const double span = (N - 1) * fm / path_fps;
+  const int M = static_cast<int>(std::ceil(span - 1e-6)) + 1;
+  if (M > kMaxPathFrames) throw InputError("the path is too long at the model's frame rate");
+  std::vector<Eigen::Vector2d> path_m(std::max(2, M));
+  for (int i = 0; i < static_cast<int>(path_m.size()); ++i) {
+    const double u = std::min<double>(N - 1, i * path_fps / fm);
+    const int a = std::min(N - 2, static_cast<int>(std::floor(u)));
+    const double t = u - a;
+    path_m[i] = path[a] * (1.0 - t) + path[a + 1] * t;
+  }
+  return path_m;
+}
+
+// Output frames [begin, begin + length) of one window (model rate), the
+// reference segment it is compared with, and the frames it shares with the
+// window before.
+struct RenavSpan {
+  int begin = 0, length = 0;
+  int ref_begin = 0, ref_length = 0;
+  int shared = 0;
+};
+
+// The windows of an M-frame path with an R-frame reference (see the header:
+// the same reference frames when the reference is as long, else segments
+// spread evenly over it).
+std::vector<RenavSpan> renav_spans(int M, int R, int W, int overlap) {
+  const std::vector<int> starts = window_starts(M, W, W - overlap);
+  std::vector<RenavSpan> spans;
+  for (size_t k = 0; k < starts.size(); ++k) {
+    RenavSpan w;
+    w.begin = starts[k];
+    w.length = std::min(W, M - w.begin);
+    w.ref_length = std::min(R, w.length);
+    if (R >= M) {
+      w.ref_begin = w.begin;  // time-aligned
+    } else if (R > w.length && M > w.length) {
+      w.ref_begin = static_cast<int>(std::lround(static_cast<double>(w.begin) * (R - w.length) / (M - w.length)));
+    }
+    w.ref_begin = std::clamp(w.ref_begin, 0, R - w.ref_length);
+    w.shared = k > 0 ? std::max(0, starts[k - 1] + std::min(W, M - starts[k - 1]) - w.begin) : 0;
+    spans.push_back(w);
+  }
+  return spans;
+}
+
+// The initial codes of window `k`: z_l from the reference segment, z_g from
+// each candidate of `inits`; the lowest energy is kept (recorded in *sum).
+at::Tensor initial_codes(const NemfModel& model, const RenavWindow& window, const FlatLatentEnergy& energy,
+                         const std::vector<std::string>& inits, uint64_t seed, int k, RenavWindowSummary* sum) {
+  const int zg = model.config().zg;
+  const InitialGuess ref_code = encode_window(model, window.reference_segment, 0);
+  at::Tensor x0;
+  double best = std::numeric_limits<double>::infinity();
+  for (const std::string& name : inits) {
+    at::Tensor z_g;
+    if (name == "turned") {
+      z_g = encode_window(model, window.turned_segment, 0).z_g;
+    } else if (name == "reference") {
+      z_g = ref_code.z_g;
+    } else {
+      std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + static_cast<uint64_t>(k));
+      std::normal_distribution<float> normal(0.0f, 1.0f);
+      z_g = at::empty({1, zg}, at::kFloat);
+      for (int i = 0; i < zg; ++i) z_g.data_ptr<float>()[i] = normal(rng);
+    }
+    const at::Tensor x = energy.join(ref_code.z_l, z_g);
+    const double e = energy.cost(x);
+    sum->init_energies.emplace_back(name, e);
+    if (e < best || !x0.defined()) {
+      best = e;
+      x0 = x;
+      sum->init = name;
     }
   }
-  const int M = static_cast<int>(path_m.size());
-  const int R = ref_m.num_frames();
+  return x0;
+}
 
+// Mean and maximum horizontal distance of the output's root from the path, cm.
+void measure_path_error(const Motion& result, const std::vector<Eigen::Vector2d>& path, RenavReport* rep) {
+  const int N = static_cast<int>(path.size());
+  double err_sum = 0.0;
+  for (int f = 0; f < N; ++f) {
+    const Eigen::Vector3d& r = result.root_positions[f];
+    const double e = std::hypot(r.x() - path[f].x(), r.z() - path[f].y()) * 100.0;
+    err_sum += e;
+    rep->path_error_max_cm = std::max(rep->path_error_max_cm, e);
+  }
+  rep->path_error_mean_cm = err_sum / N;
+}
+
+}  // namespace
+
+Motion renavigate(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
+                  double path_fps, const RenavOptions& options, const TaskContext& ctx, RenavReport* report) {
+  const auto t0 = Clock::now();
+  check_renav_input(model, reference, path, path_fps, options);
+  const double fm = model.config().fps;
+  const int W = model.config().window;
+  // Everything at the model's rate.
+  const Motion ref_m = reference_at_model_rate(reference, fm);
+  const std::vector<Eigen::Vector2d> path_m = path_at_model_rate(path, path_fps, fm);
+  const int M = static_cast<int>(path_m.size());
   const int overlap = options.overlap > 0 ? std::min(options.overlap, W / 2) : std::max(1, W / 4);
-  const std::vector<int> starts = window_starts(M, W, W - overlap);
-  const int windows = static_cast<int>(starts.size());
+  const std::vector<RenavSpan> spans = renav_spans(M, ref_m.num_frames(), W, overlap);
+  const int windows = static_cast<int>(spans.size());
   const int cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.solver);
-  const int zl = model.config().zl, zg = model.config().zg;
   const std::vector<std::string> inits = options.inits.empty() ? init_names() : options.inits;
 
   RenavReport rep;
@@ -360,49 +474,16 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
   int iterations = 0;
   for (int k = 0; k < windows; ++k) {
     const auto tw = Clock::now();
-    const int s = starts[k];
-    const int T = std::min(W, M - s);
-    int ref_begin = 0, ref_len = std::min(R, T);
-    if (R >= M) {
-      ref_begin = s;  // time-aligned
-    } else if (R > T && M > T) {
-      ref_begin = static_cast<int>(std::lround(static_cast<double>(s) * (R - T) / (M - T)));  // spread over the reference
-    }
-    ref_begin = std::clamp(ref_begin, 0, R - ref_len);
-    const int shared = k > 0 ? std::max(0, starts[k - 1] + std::min(W, M - starts[k - 1]) - s) : 0;
+    const RenavSpan& span = spans[k];
     ctx.report({iterations, cap * windows, 0.0});
-    const RenavWindow window =
-        make_renav_window(model, ref_m, ref_begin, ref_len, path_m, s, T, k > 0 ? &out : nullptr, shared);
-
-    // Initial codes: z_l from the reference, z_g from each candidate; keep the lowest energy.
+    const RenavWindow window = make_renav_window(model, ref_m, span.ref_begin, span.ref_length, path_m, span.begin,
+                                                 span.length, k > 0 ? &out : nullptr, span.shared);
     RenavWindowSummary sum;
-    sum.begin = s;
-    sum.length = T;
-    const InitialGuess ref_code = encode_window(model, window.reference_segment, 0);
-    const FlatLatentEnergy energy(window_energy(model, window, options.weights), zl, zg);
-    at::Tensor x0;
-    double best = std::numeric_limits<double>::infinity();
-    for (const std::string& name : inits) {
-      at::Tensor z_g;
-      if (name == "turned") {
-        z_g = encode_window(model, window.turned_segment, 0).z_g;
-      } else if (name == "reference") {
-        z_g = ref_code.z_g;
-      } else {
-        std::mt19937_64 rng(ctx.seed * 0x9E3779B97F4A7C15ull + static_cast<uint64_t>(k));
-        std::normal_distribution<float> normal(0.0f, 1.0f);
-        z_g = at::empty({1, zg}, at::kFloat);
-        for (int i = 0; i < zg; ++i) z_g.data_ptr<float>()[i] = normal(rng);
-      }
-      const at::Tensor x = energy.join(ref_code.z_l, z_g);
-      const double e = energy.cost(x);
-      sum.init_energies.emplace_back(name, e);
-      if (e < best || !x0.defined()) {
-        best = e;
-        x0 = x;
-        sum.init = name;
-      }
-    }
+    sum.begin = span.begin;
+    sum.length = span.length;
+    const FlatLatentEnergy energy(window_energy(model, window, options.weights), model.config().zl,
+                                  model.config().zg);
+    const at::Tensor x0 = initial_codes(model, window, energy, inits, ctx.seed, k, &sum);
     sum.initial_terms = energy.terms(x0, &sum.initial_energy);
     LatentOptimizerStats stats;
     const at::Tensor x = minimize_latent(energy.total(), x0, options.solver, options.capped(cap), ctx, &stats,
@@ -415,27 +496,20 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
     iterations += sum.iterations;
 
     const RenavDecoded dec = decode_renav_window(model, window, energy.z_l(x), energy.z_g(x));
-    Motion piece = Motion::identity(reference.skeleton, T, fm);
+    Motion piece = Motion::identity(reference.skeleton, span.length, fm);
     write_window(dec.local_rotations, dec.root_positions, window.transform, &piece, 0);
-    for (int f = 0; f < T; ++f) {
-      const int g = s + f;
-      const double wn = f < shared ? static_cast<double>(f + 1) / (shared + 1) : 1.0;
-      cross_fade_frame(piece, f, wn, &out, g);
+    for (int f = 0; f < span.length; ++f) {
+      const double wn = f < span.shared ? static_cast<double>(f + 1) / (span.shared + 1) : 1.0;
+      cross_fade_frame(piece, f, wn, &out, span.begin + f);
     }
     sum.wall_ms = ms_since(tw);
     rep.windows.push_back(std::move(sum));
   }
 
-  Motion result = same_rate(path_fps, fm) ? out : resample_interpolate(out, path_fps, N);
+  const int N = static_cast<int>(path.size());
+  Motion result = same_frame_rate(path_fps, fm) ? out : resample_interpolate(out, path_fps, N);
   result.fps = path_fps;
-  double err_sum = 0.0;
-  for (int f = 0; f < N; ++f) {
-    const Eigen::Vector3d& r = result.root_positions[f];
-    const double e = std::hypot(r.x() - path[f].x(), r.z() - path[f].y()) * 100.0;
-    err_sum += e;
-    rep.path_error_max_cm = std::max(rep.path_error_max_cm, e);
-  }
-  rep.path_error_mean_cm = err_sum / N;
+  measure_path_error(result, path, &rep);
   rep.iterations = iterations;
   rep.wall_ms = ms_since(t0);
   if (report) *report = std::move(rep);
