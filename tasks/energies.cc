@@ -41,55 +41,51 @@ int WindowProblem::num_effectors() const {
   return effector_frames.defined() ? static_cast<int>(effector_frames.size(0)) : 0;
 }
 
-WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int begin, int length,
-                                  const MotionConstraints& constraints, int anchor) {
-  const Skeleton& s = rig.skeleton;
-  const int J = s.num_joints();
+namespace {
+
+// Throws unless the window fits the motion, its keys lie inside it and
+// `anchor` is a key that fixes the root.
+void check_window(const RigInfo& rig, const Motion& motion, int begin, int length, const MotionConstraints& c,
+                  int anchor) {
   check_model_skeleton(rig, motion.skeleton, "motion");
   if (begin < 0 || length < 2 || begin + length > motion.num_frames())
     throw InputError("window [" + std::to_string(begin) + ", " + std::to_string(begin + length) +
                      ") does not fit the motion (at least 2 frames)");
-  const int K = static_cast<int>(constraints.keys.size());
   int anchor_key = -1;
-  for (int k = 0; k < K; ++k) {
-    const int f = constraints.keys[k].frame;
+  for (size_t k = 0; k < c.keys.size(); ++k) {
+    const int f = c.keys[k].frame;
     if (f < 0 || f >= length) throw InputError("a key lies outside its window");
-    if (f == anchor && constraints.key_fixes_root(k)) anchor_key = k;
+    if (f == anchor && c.key_fixes_root(k)) anchor_key = static_cast<int>(k);
   }
   if (anchor_key < 0) throw InputError("the window's anchor frame must be a key that fixes the root");
+}
 
-  WindowProblem p;
-  p.length = length;
-  p.anchor = anchor;
-  {
-    const Eigen::Quaterniond& r = motion.rotation(begin + anchor, 0);
-    Eigen::Vector3d f = r.normalized() * rig.root_forward;
-    p.transform.yaw = (f.x() * f.x() + f.z() * f.z() < 1e-12) ? 0.0 : std::atan2(f.x(), f.z());
-    p.transform.x = motion.root_positions[begin + anchor].x();
-    p.transform.z = motion.root_positions[begin + anchor].z();
-  }
-  const Eigen::Matrix3d unturn = rot_y(-p.transform.yaw);
-  const Eigen::Vector3d origin(p.transform.x, 0.0, p.transform.z);
-
-  p.key_frames = at::empty({K}, at::kLong);
-  p.key_rotations = at::eye(3, at::kFloat).repeat({K, J, 1, 1}).contiguous();
-  p.key_rotation_mask = at::zeros({K, J}, at::kFloat);
-  p.key_position_mask = at::zeros({K, J}, at::kFloat);
-  p.key_root = at::zeros({K, 3}, at::kFloat);
-  p.key_root_mask = at::zeros({K}, at::kFloat);
-  int64_t* kf = p.key_frames.data_ptr<int64_t>();
-  float* rot = p.key_rotations.data_ptr<float>();
-  float* rmask = p.key_rotation_mask.data_ptr<float>();
-  float* pmask = p.key_position_mask.data_ptr<float>();
-  float* root = p.key_root.data_ptr<float>();
-  float* root_mask = p.key_root_mask.data_ptr<float>();
+// The pose keys' targets in the canonical frame (see WindowProblem).
+void set_key_targets(const RigInfo& rig, const Motion& motion, int begin, const MotionConstraints& c,
+                     WindowProblem* p) {
+  const Skeleton& s = rig.skeleton;
+  const int J = s.num_joints(), K = static_cast<int>(c.keys.size());
+  const Eigen::Matrix3d unturn = rot_y(-p->transform.yaw);
+  const Eigen::Vector3d origin(p->transform.x, 0.0, p->transform.z);
+  p->key_frames = at::empty({K}, at::kLong);
+  p->key_rotations = at::eye(3, at::kFloat).repeat({K, J, 1, 1}).contiguous();
+  p->key_rotation_mask = at::zeros({K, J}, at::kFloat);
+  p->key_position_mask = at::zeros({K, J}, at::kFloat);
+  p->key_root = at::zeros({K, 3}, at::kFloat);
+  p->key_root_mask = at::zeros({K}, at::kFloat);
+  int64_t* kf = p->key_frames.data_ptr<int64_t>();
+  float* rot = p->key_rotations.data_ptr<float>();
+  float* rmask = p->key_rotation_mask.data_ptr<float>();
+  float* pmask = p->key_position_mask.data_ptr<float>();
+  float* root = p->key_root.data_ptr<float>();
+  float* root_mask = p->key_root_mask.data_ptr<float>();
   std::vector<char> chain(J);
   for (int k = 0; k < K; ++k) {
-    const PoseKey& key = constraints.keys[k];
+    const PoseKey& key = c.keys[k];
     const int f = begin + key.frame;
     kf[k] = key.frame;
     for (int j = 0; j < J; ++j) {
-      const bool on = constraints.key_has_joint(k, j);
+      const bool on = c.key_has_joint(k, j);
       chain[j] = on && (j == 0 || chain[s.parents[j]]);
       if (j > 0 && chain[j]) pmask[k * J + j] = 1.0f;
       if (!on) continue;
@@ -107,23 +103,45 @@ WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int 
     }
   }
   at::Tensor offsets = offsets_tensor(s);
-  p.key_positions = forward_kinematics(s.parents, offsets, p.key_rotations, at::zeros({K, 3}, at::kFloat)).positions;
+  p->key_positions = forward_kinematics(s.parents, offsets, p->key_rotations, at::zeros({K, 3}, at::kFloat)).positions;
+}
 
-  const int E = static_cast<int>(constraints.effectors.size());
-  p.effector_frames = at::empty({E}, at::kLong);
-  p.effector_joints = at::empty({E}, at::kLong);
-  p.effector_targets = at::empty({E, 3}, at::kFloat);
-  p.effector_weights = at::empty({E}, at::kFloat);
+// The end-effector targets in the canonical frame.
+void set_effector_targets(int J, int length, const MotionConstraints& c, WindowProblem* p) {
+  const Eigen::Matrix3d unturn = rot_y(-p->transform.yaw);
+  const Eigen::Vector3d origin(p->transform.x, 0.0, p->transform.z);
+  const int E = static_cast<int>(c.effectors.size());
+  p->effector_frames = at::empty({E}, at::kLong);
+  p->effector_joints = at::empty({E}, at::kLong);
+  p->effector_targets = at::empty({E, 3}, at::kFloat);
+  p->effector_weights = at::empty({E}, at::kFloat);
   for (int e = 0; e < E; ++e) {
-    const EffectorTarget& t = constraints.effectors[e];
+    const EffectorTarget& t = c.effectors[e];
     if (t.frame < 0 || t.frame >= length) throw InputError("an end-effector target lies outside its window");
     if (t.joint < 0 || t.joint >= J) throw InputError("end-effector joint out of range");
-    p.effector_frames[e] = t.frame;
-    p.effector_joints[e] = t.joint;
+    p->effector_frames[e] = t.frame;
+    p->effector_joints[e] = t.joint;
     Eigen::Vector3d x = unturn * (t.position - origin);
-    for (int a = 0; a < 3; ++a) p.effector_targets[e][a] = static_cast<float>(x[a]);
-    p.effector_weights[e] = static_cast<float>(t.weight);
+    for (int a = 0; a < 3; ++a) p->effector_targets[e][a] = static_cast<float>(x[a]);
+    p->effector_weights[e] = static_cast<float>(t.weight);
   }
+}
+
+}  // namespace
+
+WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int begin, int length,
+                                  const MotionConstraints& constraints, int anchor) {
+  check_window(rig, motion, begin, length, constraints, anchor);
+  WindowProblem p;
+  p.length = length;
+  p.anchor = anchor;
+  const Eigen::Quaterniond& r = motion.rotation(begin + anchor, 0);
+  Eigen::Vector3d f = r.normalized() * rig.root_forward;
+  p.transform.yaw = (f.x() * f.x() + f.z() * f.z() < 1e-12) ? 0.0 : std::atan2(f.x(), f.z());
+  p.transform.x = motion.root_positions[begin + anchor].x();
+  p.transform.z = motion.root_positions[begin + anchor].z();
+  set_key_targets(rig, motion, begin, constraints, &p);
+  set_effector_targets(rig.num_joints(), length, constraints, &p);
   return p;
 }
 
@@ -241,101 +259,134 @@ void blend_residuals(const WindowProblem& p, const at::Tensor& rotations, const 
 
 }  // namespace
 
+namespace {
+
+// Which terms are active (a positive weight and something to measure) and
+// how many items each averages over.
+struct ActiveTerms {
+  double n_rot = 0, n_root_rot = 0, n_pos = 0, n_root = 0;
+  bool rot = false, root_rot = false, pos = false, root = false, eff = false, skate = false, smooth = false;
+  bool dense = false;  // a term that needs the whole window decoded
+  bool keyed = false;  // a term that needs the key frames decoded
+};
+
+ActiveTerms active_terms(const RigInfo& rig, const WindowProblem& problem, const EnergyWeights& w) {
+  const int J = rig.num_joints(), T = problem.length;
+  ActiveTerms a;
+  if (problem.num_keys() > 0) {
+    a.n_rot = problem.key_rotation_mask.narrow(1, 1, J - 1).sum().item<double>();
+    a.n_root_rot = problem.key_rotation_mask.select(1, 0).sum().item<double>();
+    a.n_pos = problem.key_position_mask.sum().item<double>();
+    a.n_root = problem.key_root_mask.sum().item<double>();
+  }
+  a.rot = w.rotation > 0 && a.n_rot > 0;
+  a.root_rot = w.root_orientation > 0 && a.n_root_rot > 0;
+  a.pos = w.position > 0 && a.n_pos > 0;
+  a.root = w.root_translation > 0 && a.n_root > 0;
+  a.eff = w.effector > 0 && problem.num_effectors() > 0;
+  a.skate = w.foot_skating > 0 && rig.num_feet() > 0 && T >= 2;
+  a.smooth = w.smoothness > 0 && T >= 3;
+  a.dense = a.root || a.eff || a.skate || a.smooth;
+  a.keyed = a.rot || a.root_rot || a.pos;
+  return a;
+}
+
+void add_term(EnergyTerms* out, const char* name, double weight, const at::Tensor& value) {
+  out->terms.emplace_back(name, value * weight);
+}
+
+// The terms at the key frames: rotation, root orientation, position.
+// key_rot [K, J, 3, 3] decoded at the key frames.
+void add_key_terms(const Skeleton& skel, const WindowProblem& problem, const EnergyWeights& w, const ActiveTerms& a,
+                   const at::Tensor& key_rot, const at::Tensor& offsets, EnergyTerms* out) {
+  const int J = skel.num_joints(), K = problem.num_keys();
+  const at::TensorOptions opt = offsets.options();  // the codes' (evaluate_energy)
+  if (a.rot || a.root_rot) {
+    at::Tensor pen = penalty_of_angle(torch_rot::geodesic_angle(key_rot, problem.key_rotations.to(opt)), w.penalty);
+    if (a.rot) {
+      add_term(out, "rotation", w.rotation,
+               masked_mean(pen.narrow(1, 1, J - 1), problem.key_rotation_mask.narrow(1, 1, J - 1), a.n_rot));
+    }
+    if (a.root_rot) {
+      add_term(out, "root_orientation", w.root_orientation,
+               masked_mean(pen.select(1, 0), problem.key_rotation_mask.select(1, 0), a.n_root_rot));
+    }
+  }
+  if (a.pos) {
+    at::Tensor p = forward_kinematics(skel.parents, offsets, key_rot, at::zeros({K, 3}, opt)).positions;
+    at::Tensor d2 = (p - problem.key_positions).square().sum(-1);  // [K, J]
+    add_term(out, "position", w.position,
+             masked_mean(penalty_of_squared(d2, w.penalty), problem.key_position_mask, a.n_pos));
+  }
+}
+
+// The terms on the output motion (see EnergyWeights::on_output): effector,
+// foot skating, smoothness. rotations [1, T, J, 3, 3], path [1, T, 3].
+void add_output_terms(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& w,
+                      const ActiveTerms& a, const at::Tensor& rotations, const at::Tensor& path, const GmpOutput& gmp,
+                      const at::Tensor& offsets, EnergyTerms* out) {
+  const RigInfo& rig = model.rig();
+  const int J = rig.num_joints(), T = problem.length, E = problem.num_effectors();
+  const double fps = model.config().fps;
+  at::Tensor out_rot = rotations, out_path = path;
+  if (w.on_output) blend_residuals(problem, rotations, path, &out_rot, &out_path);
+  at::Tensor pos = forward_kinematics(rig.skeleton.parents, offsets, out_rot, out_path).positions;  // [1, T, J, 3]
+  if (a.eff) {
+    at::Tensor idx = problem.effector_frames * J + problem.effector_joints;
+    at::Tensor p = pos.reshape({T * J, 3}).index_select(0, idx);
+    at::Tensor d2 = (p - problem.effector_targets).square().sum(-1);
+    add_term(out, "effector", w.effector, (penalty_of_squared(d2, w.penalty) * problem.effector_weights).sum() / E);
+  }
+  if (a.skate) {
+    at::Tensor feet = at::tensor(std::vector<int64_t>(rig.foot_joints.begin(), rig.foot_joints.end()), at::kLong);
+    at::Tensor fp = pos.index_select(2, feet);                             // [1, T, F, 3]
+    at::Tensor v = (fp.narrow(1, 1, T - 1) - fp.narrow(1, 0, T - 1)) * fps;  // [1, T-1, F, 3]
+    at::Tensor speed2 = v.select(-1, 0).square() + v.select(-1, 2).square();
+    at::Tensor contact = at::sigmoid(gmp.contact_logits.narrow(1, 1, T - 1)).detach();
+    add_term(out, "foot_skating", w.foot_skating, (contact * speed2).mean());
+  }
+  if (a.smooth) {
+    at::Tensor rel = pos - out_path.unsqueeze(2);
+    at::Tensor acc = (rel.narrow(1, 2, T - 2) - 2 * rel.narrow(1, 1, T - 2) + rel.narrow(1, 0, T - 2)) * (fps * fps);
+    add_term(out, "smoothness", w.smoothness, acc.square().sum(-1).mean());
+  }
+}
+
+// The terms on the whole window: root translation, then the output terms.
+// dense_rot [1, T, J, 3, 3] decoded at every frame.
+void add_dense_terms(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& w,
+                     const ActiveTerms& a, const at::Tensor& dense_rot, const at::Tensor& offsets, EnergyTerms* out) {
+  GmpOutput gmp;
+  at::Tensor path = aligned_root_path(model, problem, dense_rot, &gmp);  // [1, T, 3]
+  if (a.root) {
+    at::Tensor d2 = (path.squeeze(0).index_select(0, problem.key_frames) - problem.key_root).square().sum(-1);
+    add_term(out, "root_translation", w.root_translation,
+             masked_mean(penalty_of_squared(d2, w.penalty), problem.key_root_mask, a.n_root));
+  }
+  if (a.eff || a.skate || a.smooth) add_output_terms(model, problem, w, a, dense_rot, path, gmp, offsets, out);
+}
+
+}  // namespace
+
 EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& w,
                             const at::Tensor& z_l, const at::Tensor& z_g) {
   const RigInfo& rig = model.rig();
-  const Skeleton& skel = rig.skeleton;
-  const int J = rig.num_joints();
-  const int K = problem.num_keys();
-  const int E = problem.num_effectors();
-  const int T = problem.length;
-  const double fps = model.config().fps;
+  const ActiveTerms a = active_terms(rig, problem, w);
   const at::TensorOptions opt = z_l.options();
-
-  // Normalisers: how many items each term averages over.
-  double n_rot = 0, n_root_rot = 0, n_pos = 0, n_root = 0;
-  if (K > 0) {
-    n_rot = problem.key_rotation_mask.narrow(1, 1, J - 1).sum().item<double>();
-    n_root_rot = problem.key_rotation_mask.select(1, 0).sum().item<double>();
-    n_pos = problem.key_position_mask.sum().item<double>();
-    n_root = problem.key_root_mask.sum().item<double>();
-  }
-  const bool use_rot = w.rotation > 0 && n_rot > 0;
-  const bool use_root_rot = w.root_orientation > 0 && n_root_rot > 0;
-  const bool use_pos = w.position > 0 && n_pos > 0;
-  const bool use_root = w.root_translation > 0 && n_root > 0;
-  const bool use_eff = w.effector > 0 && E > 0;
-  const bool use_skate = w.foot_skating > 0 && rig.num_feet() > 0 && T >= 2;
-  const bool use_smooth = w.smoothness > 0 && T >= 3;
-  const bool dense = use_root || use_eff || use_skate || use_smooth;
-  const bool keyed = use_rot || use_root_rot || use_pos;
-
   EnergyTerms out;
-  auto add = [&](const char* name, double weight, const at::Tensor& value) {
-    out.terms.emplace_back(name, value * weight);
-  };
-
+  // Decode the whole window when a dense term needs it (the key frames then
+  // gathered from it), else only the key frames.
   at::Tensor dense_rot, key_rot;
-  if (dense) {
-    dense_rot = model.decode(at::arange(T, at::kFloat), z_l, z_g);  // [1, T, J, 3, 3]
-    if (keyed) key_rot = dense_rot.index_select(1, problem.key_frames).squeeze(0);
-  } else if (keyed) {
+  if (a.dense) {
+    dense_rot = model.decode(at::arange(problem.length, at::kFloat), z_l, z_g);  // [1, T, J, 3, 3]
+    if (a.keyed) key_rot = dense_rot.index_select(1, problem.key_frames).squeeze(0);
+  } else if (a.keyed) {
     key_rot = model.decode(problem.key_frames.to(at::kFloat), z_l, z_g).squeeze(0);  // [K, J, 3, 3]
   }
-
-  if (use_rot || use_root_rot) {
-    at::Tensor pen = penalty_of_angle(torch_rot::geodesic_angle(key_rot, problem.key_rotations.to(opt)), w.penalty);
-    if (use_rot) {
-      add("rotation", w.rotation,
-          masked_mean(pen.narrow(1, 1, J - 1), problem.key_rotation_mask.narrow(1, 1, J - 1), n_rot));
-    }
-    if (use_root_rot) {
-      add("root_orientation", w.root_orientation,
-          masked_mean(pen.select(1, 0), problem.key_rotation_mask.select(1, 0), n_root_rot));
-    }
-  }
-  const at::Tensor offsets = offsets_tensor(skel).to(opt);
-  if (use_pos) {
-    at::Tensor p = forward_kinematics(skel.parents, offsets, key_rot, at::zeros({K, 3}, opt)).positions;
-    at::Tensor d2 = (p - problem.key_positions).square().sum(-1);  // [K, J]
-    add("position", w.position, masked_mean(penalty_of_squared(d2, w.penalty), problem.key_position_mask, n_pos));
-  }
-
-  if (dense) {
-    GmpOutput gmp;
-    at::Tensor path = aligned_root_path(model, problem, dense_rot, &gmp);  // [1, T, 3]
-    if (use_root) {
-      at::Tensor d2 = (path.squeeze(0).index_select(0, problem.key_frames) - problem.key_root).square().sum(-1);
-      add("root_translation", w.root_translation,
-          masked_mean(penalty_of_squared(d2, w.penalty), problem.key_root_mask, n_root));
-    }
-    if (use_eff || use_skate || use_smooth) {
-      at::Tensor out_rot = dense_rot, out_path = path;
-      if (w.on_output) blend_residuals(problem, dense_rot, path, &out_rot, &out_path);
-      at::Tensor pos = forward_kinematics(skel.parents, offsets, out_rot, out_path).positions;  // [1, T, J, 3]
-      if (use_eff) {
-        at::Tensor idx = problem.effector_frames * J + problem.effector_joints;
-        at::Tensor p = pos.reshape({T * J, 3}).index_select(0, idx);
-        at::Tensor d2 = (p - problem.effector_targets).square().sum(-1);
-        add("effector", w.effector, (penalty_of_squared(d2, w.penalty) * problem.effector_weights).sum() / E);
-      }
-      if (use_skate) {
-        at::Tensor feet = at::tensor(std::vector<int64_t>(rig.foot_joints.begin(), rig.foot_joints.end()), at::kLong);
-        at::Tensor fp = pos.index_select(2, feet);                             // [1, T, F, 3]
-        at::Tensor v = (fp.narrow(1, 1, T - 1) - fp.narrow(1, 0, T - 1)) * fps;  // [1, T-1, F, 3]
-        at::Tensor speed2 = v.select(-1, 0).square() + v.select(-1, 2).square();
-        at::Tensor contact = at::sigmoid(gmp.contact_logits.narrow(1, 1, T - 1)).detach();
-        add("foot_skating", w.foot_skating, (contact * speed2).mean());
-      }
-      if (use_smooth) {
-        at::Tensor rel = pos - out_path.unsqueeze(2);
-        at::Tensor acc = (rel.narrow(1, 2, T - 2) - 2 * rel.narrow(1, 1, T - 2) + rel.narrow(1, 0, T - 2)) * (fps * fps);
-        add("smoothness", w.smoothness, acc.square().sum(-1).mean());
-      }
-    }
-  }
-  if (w.latent_prior > 0) add("latent_prior", w.latent_prior, 0.5 * (z_l.square().sum() + z_g.square().sum()));
-
+  const at::Tensor offsets = offsets_tensor(rig.skeleton).to(opt);
+  if (a.keyed) add_key_terms(rig.skeleton, problem, w, a, key_rot, offsets, &out);
+  if (a.dense) add_dense_terms(model, problem, w, a, dense_rot, offsets, &out);
+  if (w.latent_prior > 0) add_term(&out, "latent_prior", w.latent_prior, 0.5 * (z_l.square().sum() + z_g.square().sum()));
   out.total = at::zeros({}, opt);
   for (const auto& t : out.terms) out.total = out.total + t.second;
   return out;

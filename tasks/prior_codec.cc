@@ -159,35 +159,24 @@ EncodedMotion encode_motion(const NemfModel& model, const Motion& motion, const 
   return code;
 }
 
-Motion decode_times(const NemfModel& model, const EncodedMotion& code, const std::vector<double>& times, double fps,
-                    const DecodeOptions& options) {
-  check_fps(fps, "decode fps");
-  check_code(model, code);
-  for (double t : times) {
-    if (!std::isfinite(t)) throw InputError("decode times must be finite");
-  }
-  const int T = static_cast<int>(times.size());
-  const int J = code.skeleton.num_joints();
-  const std::vector<WindowCode>& win = code.windows;
-  const int K = static_cast<int>(win.size());
-  if (options.root == RootSource::kInput && code.source_root_positions.empty()) {
-    throw InputError("decoding with the input's root path needs EncodedMotion::source_root_positions");
-  }
+namespace {
 
-  Motion out = Motion::identity(code.skeleton, T, fps);
-  if (T == 0) return out;
+// Which samples each window covers and with what weight: per window k the
+// samples i it weighs (members[k]) and their raw weights (weights[k]); per
+// sample the sum of its raw weights.
+struct WindowSamples {
+  std::vector<std::vector<int>> members;
+  std::vector<std::vector<double>> weights;
+  std::vector<double> weight_sum;
+};
 
-  // Model-frame positions, clamped to the sequence, and the times sorted by them.
-  std::vector<double> pos(T);
-  for (int i = 0; i < T; ++i) pos[i] = std::clamp(times[i] * code.fps, 0.0, static_cast<double>(code.frames - 1));
+WindowSamples assign_samples(const std::vector<WindowCode>& win, const std::vector<double>& pos) {
+  const int T = static_cast<int>(pos.size()), K = static_cast<int>(win.size());
+  // The samples sorted by position, so that each window finds its own by bisection.
   std::vector<int> order(T);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return pos[a] < pos[b]; });
-
-  // Per window: the samples it covers and their raw weights; their sums per sample.
-  std::vector<std::vector<int>> members(K);
-  std::vector<std::vector<double>> weights(K);
-  std::vector<double> weight_sum(T, 0.0);
+  WindowSamples out{std::vector<std::vector<int>>(K), std::vector<std::vector<double>>(K), std::vector<double>(T, 0.0)};
   for (int k = 0; k < K; ++k) {
     const double a = win[k].start, b = win[k].start + win[k].length - 1;
     auto lo = std::lower_bound(order.begin(), order.end(), a, [&](int i, double v) { return pos[i] < v; });
@@ -195,94 +184,150 @@ Motion decode_times(const NemfModel& model, const EncodedMotion& code, const std
     for (auto it = lo; it != hi; ++it) {
       const double w = raw_weight(win, k, pos[*it]);
       if (w <= 0.0) continue;
-      members[k].push_back(*it);
-      weights[k].push_back(w);
-      weight_sum[*it] += w;
+      out.members[k].push_back(*it);
+      out.weights[k].push_back(w);
+      out.weight_sum[*it] += w;
     }
   }
   // Degenerate layouts only (gaps): samples no window weighs take the nearest window.
   for (int i = 0; i < T; ++i) {
-    if (weight_sum[i] > 0.0) continue;
+    if (out.weight_sum[i] > 0.0) continue;
     std::vector<double> w = blend_weights(win, pos[i]);
     const int k = static_cast<int>(std::max_element(w.begin(), w.end()) - w.begin());
-    members[k].push_back(i);
-    weights[k].push_back(1.0);
-    weight_sum[i] = 1.0;
+    out.members[k].push_back(i);
+    out.weights[k].push_back(1.0);
+    out.weight_sum[i] = 1.0;
   }
+  return out;
+}
+
+// Windows [k0, k1) decoded at their samples' local positions (rows padded to
+// the most samples, `smax`): quaternions [B, smax, J, 4], double.
+at::Tensor decode_window_batch(const NemfModel& model, const std::vector<WindowCode>& win, const WindowSamples& samples,
+                               const std::vector<double>& pos, int k0, int k1, size_t smax, at::Tensor* z_l,
+                               at::Tensor* z_g) {
+  at::Tensor frames = at::zeros({k1 - k0, static_cast<int64_t>(smax)}, at::kFloat);
+  std::vector<at::Tensor> zl, zg;
+  float* f = frames.data_ptr<float>();
+  for (int k = k0; k < k1; ++k) {
+    for (size_t m = 0; m < samples.members[k].size(); ++m) {
+      f[(k - k0) * smax + m] = static_cast<float>(pos[samples.members[k][m]] - win[k].start);
+    }
+    zl.push_back(win[k].z_l.reshape({1, -1}).to(at::kFloat));
+    zg.push_back(win[k].z_g.reshape({1, -1}).to(at::kFloat));
+  }
+  *z_l = at::cat(zl, 0);
+  *z_g = at::cat(zg, 0);
+  return torch_rot::matrix_to_quat(model.decode(frames, *z_l, *z_g)).to(at::kDouble).contiguous();
+}
+
+// Adds the windows' weighted quaternions (root orientation in the world
+// frame), each flipped into the hemisphere of the sum so far, to `qsum` [T * J].
+void accumulate_rotations(const at::Tensor& quat, const std::vector<WindowCode>& win, const WindowSamples& samples,
+                          int k0, int k1, size_t smax, int J, std::vector<Eigen::Vector4d>* qsum) {
+  const double* q = quat.data_ptr<double>();  // [B, smax, J, 4]
+  for (int k = k0; k < k1; ++k) {
+    const Eigen::Quaterniond turn = yaw_quat(win[k].transform.yaw);
+    for (size_t m = 0; m < samples.members[k].size(); ++m) {
+      const int i = samples.members[k][m];
+      const double w = samples.weights[k][m] / samples.weight_sum[i];
+      const double* qs = q + ((static_cast<size_t>(k - k0) * smax + m) * J) * 4;
+      for (int j = 0; j < J; ++j) {
+        Eigen::Vector4d v(qs[4 * j], qs[4 * j + 1], qs[4 * j + 2], qs[4 * j + 3]);
+        if (j == 0) {
+          Eigen::Quaterniond r = turn * Eigen::Quaterniond(v[0], v[1], v[2], v[3]);
+          v = Eigen::Vector4d(r.w(), r.x(), r.y(), r.z());
+        }
+        Eigen::Vector4d& acc = (*qsum)[static_cast<size_t>(i) * J + j];
+        acc += (acc.dot(v) < 0.0 ? -w : w) * v;
+      }
+    }
+  }
+}
+
+// Adds the windows' weighted root paths (the global motion predictor's, per
+// window, placed by its GroundTransform; Catmull-Rom between model frames) to `psum`.
+void accumulate_prior_roots(const NemfModel& model, const std::vector<WindowCode>& win, const WindowSamples& samples,
+                            const std::vector<double>& pos, int k0, int k1, const at::Tensor& z_l,
+                            const at::Tensor& z_g, std::vector<Eigen::Vector3d>* psum) {
+  const int len = win[k0].length;
+  bool same_length = true;
+  for (int k = k0; k < k1; ++k) same_length = same_length && win[k].length == len;
+  // One batch when the windows have one length (always, for encode_motion's codes).
+  std::vector<std::pair<int, int>> groups;
+  if (same_length) {
+    groups.emplace_back(k0, k1);
+  } else {
+    for (int k = k0; k < k1; ++k) groups.emplace_back(k, k + 1);
+  }
+  for (auto [g0, g1] : groups) {
+    const int glen = win[g0].length;
+    at::Tensor dense =
+        model.decode(at::arange(glen, at::kFloat), z_l.narrow(0, g0 - k0, g1 - g0), z_g.narrow(0, g0 - k0, g1 - g0));
+    at::Tensor root = model.root_positions(dense, model.predict_global(dense)).to(at::kDouble).contiguous();  // [G, len, 3]
+    const double* r = root.data_ptr<double>();
+    for (int k = g0; k < g1; ++k) {
+      const Eigen::Matrix3d turn = yaw_quat(win[k].transform.yaw).toRotationMatrix();
+      const Eigen::Vector3d shift(win[k].transform.x, 0.0, win[k].transform.z);
+      const double* rk = r + static_cast<size_t>(k - g0) * glen * 3;
+      for (size_t m = 0; m < samples.members[k].size(); ++m) {
+        const int i = samples.members[k][m];
+        const double w = samples.weights[k][m] / samples.weight_sum[i];
+        const double s = std::clamp(pos[i] - win[k].start, 0.0, static_cast<double>(glen - 1));
+        (*psum)[i] += w * (turn * catmull_rom(rk, glen, s) + shift);
+      }
+    }
+  }
+}
+
+// RootSource::kInput: the input's root path, linear between its frames, at `times`.
+void input_root_path(const EncodedMotion& code, const std::vector<double>& times, Motion* out) {
+  const std::vector<Eigen::Vector3d>& src = code.source_root_positions;
+  const int n = static_cast<int>(src.size());
+  for (size_t i = 0; i < times.size(); ++i) {
+    const double s = std::clamp(snap_frame_position(times[i] * code.source_fps), 0.0, static_cast<double>(n - 1));
+    const int a = static_cast<int>(std::floor(s));
+    const int b = std::min(a + 1, n - 1);
+    const double u = s - a;
+    out->root_positions[i] = u == 0.0 ? src[a] : Eigen::Vector3d((1.0 - u) * src[a] + u * src[b]);
+  }
+}
+
+}  // namespace
+
+Motion decode_times(const NemfModel& model, const EncodedMotion& code, const std::vector<double>& times, double fps,
+                    const DecodeOptions& options) {
+  check_fps(fps, "decode fps");
+  check_code(model, code);
+  for (double t : times) {
+    if (!std::isfinite(t)) throw InputError("decode times must be finite");
+  }
+  if (options.root == RootSource::kInput && code.source_root_positions.empty()) {
+    throw InputError("decoding with the input's root path needs EncodedMotion::source_root_positions");
+  }
+  const int T = static_cast<int>(times.size());
+  const int J = code.skeleton.num_joints();
+  const std::vector<WindowCode>& win = code.windows;
+  const int K = static_cast<int>(win.size());
+  Motion out = Motion::identity(code.skeleton, T, fps);
+  if (T == 0) return out;
+
+  // Model-frame positions, clamped to the sequence; the windows' samples.
+  std::vector<double> pos(T);
+  for (int i = 0; i < T; ++i) pos[i] = std::clamp(times[i] * code.fps, 0.0, static_cast<double>(code.frames - 1));
+  const WindowSamples samples = assign_samples(win, pos);
 
   std::vector<Eigen::Vector4d> qsum(static_cast<size_t>(T) * J, Eigen::Vector4d::Zero());
   std::vector<Eigen::Vector3d> psum(T, Eigen::Vector3d::Zero());
-
   at::NoGradGuard no_grad;
   for (int k0 = 0; k0 < K; k0 += kWindowBatch) {
     const int k1 = std::min(K, k0 + kWindowBatch);
-    const int B = k1 - k0;
     size_t smax = 1;
-    for (int k = k0; k < k1; ++k) smax = std::max(smax, members[k].size());
-    at::Tensor frames = at::zeros({B, static_cast<int64_t>(smax)}, at::kFloat);
-    std::vector<at::Tensor> zl, zg;
-    {
-      float* f = frames.data_ptr<float>();
-      for (int k = k0; k < k1; ++k) {
-        for (size_t m = 0; m < members[k].size(); ++m) {
-          f[(k - k0) * smax + m] = static_cast<float>(pos[members[k][m]] - win[k].start);
-        }
-        zl.push_back(win[k].z_l.reshape({1, -1}).to(at::kFloat));
-        zg.push_back(win[k].z_g.reshape({1, -1}).to(at::kFloat));
-      }
-    }
-    at::Tensor z_l = at::cat(zl, 0), z_g = at::cat(zg, 0);
-    at::Tensor quat = torch_rot::matrix_to_quat(model.decode(frames, z_l, z_g)).to(at::kDouble).contiguous();
-    const double* q = quat.data_ptr<double>();  // [B, smax, J, 4]
-    for (int k = k0; k < k1; ++k) {
-      const Eigen::Quaterniond turn = yaw_quat(win[k].transform.yaw);
-      for (size_t m = 0; m < members[k].size(); ++m) {
-        const int i = members[k][m];
-        const double w = weights[k][m] / weight_sum[i];
-        const double* qs = q + ((static_cast<size_t>(k - k0) * smax + m) * J) * 4;
-        for (int j = 0; j < J; ++j) {
-          Eigen::Vector4d v(qs[4 * j], qs[4 * j + 1], qs[4 * j + 2], qs[4 * j + 3]);
-          if (j == 0) {
-            Eigen::Quaterniond r = turn * Eigen::Quaterniond(v[0], v[1], v[2], v[3]);
-            v = Eigen::Vector4d(r.w(), r.x(), r.y(), r.z());
-          }
-          Eigen::Vector4d& acc = qsum[static_cast<size_t>(i) * J + j];
-          acc += (acc.dot(v) < 0.0 ? -w : w) * v;
-        }
-      }
-    }
-
-    if (options.root == RootSource::kPrior) {
-      const int len = win[k0].length;
-      bool same_length = true;
-      for (int k = k0; k < k1; ++k) same_length = same_length && win[k].length == len;
-      // One batch when the windows have one length (always, for encode_motion's codes).
-      std::vector<std::pair<int, int>> groups;
-      if (same_length) {
-        groups.emplace_back(k0, k1);
-      } else {
-        for (int k = k0; k < k1; ++k) groups.emplace_back(k, k + 1);
-      }
-      for (auto [g0, g1] : groups) {
-        const int glen = win[g0].length;
-        at::Tensor dense = model.decode(at::arange(glen, at::kFloat), z_l.narrow(0, g0 - k0, g1 - g0),
-                                        z_g.narrow(0, g0 - k0, g1 - g0));
-        at::Tensor root =
-            model.root_positions(dense, model.predict_global(dense)).to(at::kDouble).contiguous();  // [G, len, 3]
-        const double* r = root.data_ptr<double>();
-        for (int k = g0; k < g1; ++k) {
-          const Eigen::Matrix3d turn = yaw_quat(win[k].transform.yaw).toRotationMatrix();
-          const Eigen::Vector3d shift(win[k].transform.x, 0.0, win[k].transform.z);
-          const double* rk = r + static_cast<size_t>(k - g0) * glen * 3;
-          for (size_t m = 0; m < members[k].size(); ++m) {
-            const int i = members[k][m];
-            const double w = weights[k][m] / weight_sum[i];
-            const double s = std::clamp(pos[i] - win[k].start, 0.0, static_cast<double>(glen - 1));
-            psum[i] += w * (turn * catmull_rom(rk, glen, s) + shift);
-          }
-        }
-      }
-    }
+    for (int k = k0; k < k1; ++k) smax = std::max(smax, samples.members[k].size());
+    at::Tensor z_l, z_g;
+    const at::Tensor quat = decode_window_batch(model, win, samples, pos, k0, k1, smax, &z_l, &z_g);
+    accumulate_rotations(quat, win, samples, k0, k1, smax, J, &qsum);
+    if (options.root == RootSource::kPrior) accumulate_prior_roots(model, win, samples, pos, k0, k1, z_l, z_g, &psum);
   }
 
   for (int i = 0; i < T; ++i) {
@@ -294,15 +339,7 @@ Motion decode_times(const NemfModel& model, const EncodedMotion& code, const std
   if (options.root == RootSource::kPrior) {
     out.root_positions = psum;
   } else {
-    const std::vector<Eigen::Vector3d>& src = code.source_root_positions;
-    const int n = static_cast<int>(src.size());
-    for (int i = 0; i < T; ++i) {
-      const double s = std::clamp(snap_frame_position(times[i] * code.source_fps), 0.0, static_cast<double>(n - 1));
-      const int a = static_cast<int>(std::floor(s));
-      const int b = std::min(a + 1, n - 1);
-      const double u = s - a;
-      out.root_positions[i] = u == 0.0 ? src[a] : Eigen::Vector3d((1.0 - u) * src[a] + u * src[b]);
-    }
+    input_root_path(code, times, &out);
   }
   return out;
 }
