@@ -77,8 +77,12 @@ std::vector<uint8_t> serialize_model_file(const std::string& kind, const std::ma
   return std::move(out.buffer());
 }
 
-ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::string& source,
-                                   const std::vector<std::string>& expected_kinds) {
+namespace {
+
+// The payload of a model file after checking its magic, format version, kind
+// (one of `expected_kinds`; stored in *kind), size and checksum.
+ByteReader checked_payload(const uint8_t* data, size_t size, const std::string& source,
+                           const std::vector<std::string>& expected_kinds, std::string* kind) {
   ByteReader head(data, size, source);
   char magic[8];
   if (size < sizeof(magic) || std::memcmp(data, kMagic, sizeof(magic)) != 0) {
@@ -90,14 +94,13 @@ ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::
     throw InputError(source + ": unsupported model format version " + std::to_string(version) +
                      " (this build reads version " + std::to_string(kModelFormatVersion) + ")");
   }
-  ModelFileContents c;
-  c.kind = head.str(64);
-  if (std::find(expected_kinds.begin(), expected_kinds.end(), c.kind) == expected_kinds.end()) {
+  *kind = head.str(64);
+  if (std::find(expected_kinds.begin(), expected_kinds.end(), *kind) == expected_kinds.end()) {
     std::string expected;
     for (size_t i = 0; i < expected_kinds.size(); ++i) {
       expected += (i ? (i + 1 == expected_kinds.size() ? "' or '" : "', '") : "") + expected_kinds[i];
     }
-    throw InputError(source + ": wrong kind of model: the file holds a '" + c.kind + "' model, expected '" + expected +
+    throw InputError(source + ": wrong kind of model: the file holds a '" + *kind + "' model, expected '" + expected +
                      "'");
   }
   uint64_t payload_size = head.u64();
@@ -111,16 +114,12 @@ ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::
   if (stored != fnv1a64_bytes(payload, payload_size)) {
     throw InputError(source + ": corrupted model file (checksum mismatch)");
   }
+  return ByteReader(payload, payload_size, source);
+}
 
-  ByteReader p(payload, payload_size, source);
-  uint32_t n = p.u32();
-  if (n > 1000) p.fail("too many hyperparameters");
-  for (uint32_t i = 0; i < n; ++i) {
-    std::string k = p.str(256);
-    c.hyperparameters[k] = p.f64();
-  }
-
-  RigInfo& rig = c.rig;
+// The rig as serialize_model_file() writes it.
+RigInfo read_rig(ByteReader& p, const std::string& source) {
+  RigInfo rig;
   uint32_t J = p.u32();
   if (J == 0 || J > 1024) p.fail("bad joint count " + std::to_string(J));
   for (uint32_t j = 0; j < J; ++j) {
@@ -146,7 +145,12 @@ ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::
     rig.foot_thresholds.push_back(p.f64());
   }
   rig.contact_speed = p.f64();
+  return rig;
+}
 
+// The named tensors as write_tensor() writes them; finite values only.
+std::map<std::string, at::Tensor> read_tensors(ByteReader& p) {
+  std::map<std::string, at::Tensor> tensors;
   uint32_t count = p.u32();
   if (count > 100000) p.fail("too many tensors");
   for (uint32_t i = 0; i < count; ++i) {
@@ -164,8 +168,25 @@ ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::
     at::Tensor t = at::empty(dims, at::kFloat);
     p.bytes(t.data_ptr<float>(), numel * sizeof(float));
     if (!at::isfinite(t).all().item<bool>()) p.fail("tensor '" + name + "' holds non-finite values");
-    c.tensors[name] = t;
+    tensors[name] = t;
   }
+  return tensors;
+}
+
+}  // namespace
+
+ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::string& source,
+                                   const std::vector<std::string>& expected_kinds) {
+  ModelFileContents c;
+  ByteReader p = checked_payload(data, size, source, expected_kinds, &c.kind);
+  uint32_t n = p.u32();
+  if (n > 1000) p.fail("too many hyperparameters");
+  for (uint32_t i = 0; i < n; ++i) {
+    std::string k = p.str(256);
+    c.hyperparameters[k] = p.f64();
+  }
+  c.rig = read_rig(p, source);
+  c.tensors = read_tensors(p);
   if (p.remaining() != 0) p.fail("unexpected trailing data");
   return c;
 }
