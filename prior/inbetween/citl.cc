@@ -257,29 +257,11 @@ class CitlModel final : public InbetweenModel {
   }
 
   InbetweenOutput forward(const InbetweenBatch& batch) const override {
-    const int64_t J = rig().num_joints(), D = pose_size();
-    const at::Tensor& pose = batch.pose;
-    if (!pose.defined() || pose.dim() != 3 || pose.size(2) != D) {
-      throw InputError("CITL: pose must be [B, T, " + std::to_string(D) + "]");
-    }
-    const int64_t B = pose.size(0), T = pose.size(1);
-    if (B < 1 || T < 1 || T > config_.window) {
-      throw InputError("CITL: windows must have 1 to " + std::to_string(config_.window) + " frames (got " +
-                       std::to_string(T) + ")");
-    }
-    if (!batch.known.defined() || batch.known.sizes() != at::IntArrayRef{B, T, J + 1}) {
-      throw InputError("CITL: known must be [B, T, " + std::to_string(J + 1) + "] matching pose");
-    }
-    if (!batch.valid.defined() || batch.valid.sizes() != at::IntArrayRef{B, T}) {
-      throw InputError("CITL: valid must be [B, T] matching pose");
-    }
-    const at::TensorOptions options = pose.options().dtype(at::kFloat);
-    at::Tensor mean = stats().pose_mean.defined() ? stats().pose_mean.to(options) : at::zeros({D}, options);
-    at::Tensor scale = stats().pose_std.defined() ? stats().pose_std.to(options) : at::ones({D}, options);
-    if (mean.numel() != D || scale.numel() != D) throw InputError("CITL: statistics do not match the pose size");
+    const Normalisation n = checked_normalisation(batch, config_.window, "CITL");
+    const int64_t D = pose_size();
     InbetweenOutput out;
-    out.stages.push_back(net_->forward(pose.to(at::kFloat), batch.known.to(options), batch.valid.to(options),
-                                       mean.reshape({D}), scale.reshape({D})));
+    out.stages.push_back(net_->forward(batch.pose.to(at::kFloat), batch.known.to(n.options), batch.valid.to(n.options),
+                                       n.mean.reshape({D}), n.scale.reshape({D})));
     return out;
   }
 

@@ -138,6 +138,32 @@ InbetweenModel::InbetweenModel(const RigInfo& rig) : rig_(rig) {
   stats_.pose_std = at::ones({pose_size()});
 }
 
+InbetweenModel::Normalisation InbetweenModel::checked_normalisation(const InbetweenBatch& batch, int window,
+                                                                   const std::string& name) const {
+  const int64_t J = rig().num_joints(), D = pose_size();
+  const at::Tensor& pose = batch.pose;
+  if (!pose.defined() || pose.dim() != 3 || pose.size(2) != D) {
+    throw InputError(name + ": pose must be [B, T, " + std::to_string(D) + "]");
+  }
+  const int64_t B = pose.size(0), T = pose.size(1);
+  if (B < 1 || T < 1 || T > window) {
+    throw InputError(name + ": windows must have 1 to " + std::to_string(window) + " frames (got " +
+                     std::to_string(T) + ")");
+  }
+  if (!batch.known.defined() || batch.known.sizes() != at::IntArrayRef{B, T, J + 1}) {
+    throw InputError(name + ": known must be [B, T, " + std::to_string(J + 1) + "] matching pose");
+  }
+  if (!batch.valid.defined() || batch.valid.sizes() != at::IntArrayRef{B, T}) {
+    throw InputError(name + ": valid must be [B, T] matching pose");
+  }
+  Normalisation n;
+  n.options = pose.options().dtype(at::kFloat);
+  n.mean = stats().pose_mean.defined() ? stats().pose_mean.to(n.options) : at::zeros({D}, n.options);
+  n.scale = stats().pose_std.defined() ? stats().pose_std.to(n.options) : at::ones({D}, n.options);
+  if (n.mean.numel() != D || n.scale.numel() != D) throw InputError(name + ": statistics do not match the pose size");
+  return n;
+}
+
 int InbetweenModel::window() const {
   auto hp = hyperparameters();
   auto it = hp.find("window");

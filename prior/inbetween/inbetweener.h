@@ -105,6 +105,17 @@ class InbetweenModel {
  protected:
   explicit InbetweenModel(const RigInfo& rig);
 
+  /// What forward() normalises with, after checking `batch` (pose
+  /// [B, T, pose_size()] with 1 <= T <= `window`, known [B, T, J + 1], valid
+  /// [B, T]; mf::InputError "<name>: ..." otherwise): stats() as float
+  /// tensors [D] on the pose's device (zeros and ones when unset) and those
+  /// tensor options.
+  struct Normalisation {
+    at::Tensor mean, scale;
+    at::TensorOptions options;
+  };
+  Normalisation checked_normalisation(const InbetweenBatch& batch, int window, const std::string& name) const;
+
  private:
   RigInfo rig_;
   InbetweenStats stats_;

@@ -291,29 +291,11 @@ class TwoStageModel final : public InbetweenModel {
   }
 
   InbetweenOutput forward(const InbetweenBatch& batch) const override {
-    const int64_t J = rig().num_joints(), D = pose_size();
-    const at::Tensor& pose = batch.pose;
-    if (!pose.defined() || pose.dim() != 3 || pose.size(2) != D) {
-      throw InputError("twostage: pose must be [B, T, " + std::to_string(D) + "]");
-    }
-    const int64_t B = pose.size(0), T = pose.size(1);
-    if (B < 1 || T < 1 || T > config_.window) {
-      throw InputError("twostage: windows must have 1 to " + std::to_string(config_.window) + " frames (got " +
-                       std::to_string(T) + ")");
-    }
-    if (!batch.known.defined() || batch.known.sizes() != at::IntArrayRef{B, T, J + 1}) {
-      throw InputError("twostage: known must be [B, T, " + std::to_string(J + 1) + "] matching pose");
-    }
-    if (!batch.valid.defined() || batch.valid.sizes() != at::IntArrayRef{B, T}) {
-      throw InputError("twostage: valid must be [B, T] matching pose");
-    }
-    const at::TensorOptions options = pose.options().dtype(at::kFloat);
-    at::Tensor mean = stats().pose_mean.defined() ? stats().pose_mean.to(options) : at::zeros({D}, options);
-    at::Tensor scale = stats().pose_std.defined() ? stats().pose_std.to(options) : at::ones({D}, options);
-    if (mean.numel() != D || scale.numel() != D) throw InputError("twostage: statistics do not match the pose size");
+    const Normalisation n = checked_normalisation(batch, config_.window, "twostage");
+    const int64_t D = pose_size();
     // A constant channel (std 0) must not turn the input into inf/NaN.
-    return net_->forward(pose.to(at::kFloat), batch.known.to(options), batch.valid.to(options), mean.reshape({D}),
-                         scale.reshape({D}).clamp_min(1e-6));
+    return net_->forward(batch.pose.to(at::kFloat), batch.known.to(n.options), batch.valid.to(n.options),
+                         n.mean.reshape({D}), n.scale.reshape({D}).clamp_min(1e-6));
   }
 
   std::vector<std::pair<std::string, at::Tensor>> named_parameters() const override {
