@@ -20,6 +20,7 @@ level (`x = {...}`) are skipped.
 import argparse
 import os
 import re
+import signal
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -81,7 +82,6 @@ def functions(path):
         line_at.append(line)
         line += c == "\n"
     found = []
-    depth = 0        # open braces that are namespaces or classes
     function = None  # (first line, name, depth inside it) of the function being read
     header_start = 0
     i = 0
@@ -102,7 +102,7 @@ def functions(path):
             stripped = header.strip()
             before_paren = stripped.split("(")[0]
             if CONTAINER.search(before_paren) or stripped in ("extern", ""):
-                depth += 1
+                pass  # a namespace or class body: its functions are found inside
             elif "(" in stripped and not re.search(r"=\s*$", stripped):
                 first_char = header_start + len(header) - len(header.lstrip())
                 words = before_paren.split()
@@ -114,8 +114,6 @@ def functions(path):
                     if level == 0:
                         break
                     i += 1
-        elif c == "}":
-            depth = max(0, depth - 1)
         header_start = i + 1
         i += 1
     return found
@@ -136,6 +134,7 @@ def files(paths):
 
 
 def main():
+    signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # quiet under `| head`
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--max", type=int, default=80, help="longest allowed function, in lines (default 80)")
     parser.add_argument("--all", action="store_true", help="list every function, not only the long ones")
