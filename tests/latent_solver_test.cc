@@ -450,7 +450,10 @@ TEST(LatentSolver, HandTargetBeyondTheArmsReachSwingsTheShoulderThenMovesTheRoot
   Motion out = complete_motion(model, m, c, o, {}, &report);
   EXPECT_LT((forward_kinematics(out).position(f, hand) - turned).norm(), 1e-3);
   EXPECT_LT(report.effectors.max_cm, 0.1);
-  EXPECT_LT((out.root_positions[f] - solved.root_positions[f]).norm(), 1e-9);  // the swing was enough
+  // The swing was (nearly) enough: at most a sub-millimetre root shift. Exactly
+  // zero depends on the untrained model's weights, i.e. on the torch RNG state
+  // other tests leave behind (ctest runs this test alone).
+  EXPECT_LT((out.root_positions[f] - solved.root_positions[f]).norm(), 1e-3);
   EXPECT_GT(out.rotation(f, shoulder).angularDistance(solved.rotation(f, shoulder)), 0.1);
 
   // (2) Beyond even the swung arm: the root moves by the rest.
