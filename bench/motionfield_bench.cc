@@ -140,13 +140,7 @@ int run(Args& args, const std::string& command) {
     model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));
     model->set_requires_grad(false);
     ctx.model = model;
-    for (const std::string kind : {mf::kTwoStageKind, mf::kCitlKind}) {
-      const std::string given = kind == mf::kCitlKind ? args.transformers.citl : args.transformers.twostage;
-      const std::string path = given.empty() ? mf::inbetweener_path_next_to(args.model, kind) : given;
-      if (given.empty() && !std::ifstream(path)) continue;
-      std::cerr << "loading transformer " << path << "\n";
-      (kind == mf::kCitlKind ? ctx.citl : ctx.twostage) = mf::load_frozen_inbetweener(path, kind);
-    }
+    mf::bench::load_transformers(args.transformers, args.model, &ctx, true);
     ctx.model_anatomy = mf::load_rig_anatomy_next_to(args.model, model->rig().skeleton);
   }
 

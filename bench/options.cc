@@ -1,16 +1,34 @@
 #include "bench/options.h"
 
+#include <filesystem>
+#include <iostream>
+
+#include "prior/inbetween/inbetweener.h"
 #include "prior/util/command_line.h"
+#include "tasks/inbetweener_files.h"
 
 namespace mf::bench {
 
 void add_transformer_options(CLI::App& app, TransformerFiles& files) {
-  app.add_option("--twostage", files.twostage,
-                 "the two-stage transformer (methods context, detail, nemf-context, nemf-detail; default: "
-                 "motionfield-twostage.mfm next to the model, if present)");
-  app.add_option("--citl", files.citl,
-                 "the CITL transformer (methods citl, nemf-citl; default: motionfield-citl.mfm next to the model, "
-                 "if present)");
+  for (const InbetweenerKind& kind : inbetweener_kinds()) {
+    std::string methods;
+    for (const InbetweenerStage& s : kind.stages) methods += (methods.empty() ? "" : ", ") + s.name + ", nemf-" + s.name;
+    app.add_option("--" + kind.name, files.by_kind[kind.name],
+                   "the " + kind.title + " (methods " + methods + "; default: " + kind.file_name +
+                       " next to the model, if present)");
+  }
+}
+
+void load_transformers(const TransformerFiles& files, const std::string& model_path, ModelSet* models, bool verbose) {
+  for (const InbetweenerKind& kind : inbetweener_kinds()) {
+    auto given = files.by_kind.find(kind.name);
+    const bool named = given != files.by_kind.end() && !given->second.empty();
+    const std::string path = named ? given->second : inbetweener_path_next_to(model_path, kind.name);
+    std::error_code ec;
+    if (!named && !std::filesystem::exists(path, ec)) continue;
+    if (verbose) std::cerr << "loading " << kind.title << " " << path << "\n";
+    models->add_inbetweener(load_frozen_inbetweener(path, kind.name, models->model.get()));
+  }
 }
 
 void add_data_options(CLI::App& app, DataSource& data) {

@@ -13,17 +13,20 @@
 #include <vector>
 
 #include "prior/data/dataset.h"
+#include "tasks/task_context.h"
 
 namespace mf::bench {
 
-/// --twostage PATH, --citl PATH: the transformer files; empty means the
-/// default file next to the model, when it exists
-/// (mf::inbetweener_path_next_to).
+/// --<kind> PATH for every in-betweener kind (--twostage, --citl): the
+/// in-betweener files by kind; a kind not given means its file next to the
+/// model, when it exists (mf::inbetweener_path_next_to).
 struct TransformerFiles {
-  std::string twostage;
-  std::string citl;
+  std::map<std::string, std::string> by_kind;
 };
 void add_transformer_options(CLI::App& app, TransformerFiles& files);
+/// Loads the in-betweeners of `files` (or next to `model_path`) into `models`
+/// (checked against its prior's skeleton when it has one), logging each file to stderr when `verbose`.
+void load_transformers(const TransformerFiles& files, const std::string& model_path, ModelSet* models, bool verbose);
 
 /// --source PATH, --cache-dir DIR: the clips (a BVH folder or archive) and the
 /// extraction and parse cache.

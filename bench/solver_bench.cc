@@ -94,17 +94,16 @@ struct Args {
   mf::TaskContext transformers;  // the loaded transformers (filled by run())
 };
 
-// "context", "detail", "citl": one transformer pass, no solver.
-bool is_transformer_method(const std::string& method) {
-  return method == "context" || method == "detail" || method == "citl";
-}
+// A stage of an in-betweener ("context", "detail", "citl"): one transformer
+// pass, no solver.
+bool is_transformer_method(const std::string& method) { return mf::find_inbetweener_stage(method) != nullptr; }
 
-// The initialiser of "nemf-context" etc.; "" for the other methods.
+// The initialiser of "nemf-<stage>" ("nemf-detail": "detail-encoder"); "" for
+// the other methods.
 std::string transformer_initializer(const std::string& method) {
-  if (method == "nemf-context") return "context-encoder";
-  if (method == "nemf-detail") return "detail-encoder";
-  if (method == "nemf-citl") return "citl-encoder";
-  return "";
+  const std::string prefix = "nemf-";
+  if (method.rfind(prefix, 0) != 0 || !is_transformer_method(method.substr(prefix.size()))) return "";
+  return method.substr(prefix.size()) + "-encoder";
 }
 
 void add_options(CLI::App& app, Args& a) {
@@ -223,11 +222,10 @@ std::string describe(const mf::LatentSolverOptions& o) {
 // (inbetweener_fill; `report` stays empty).
 mf::Motion complete(const mf::NemfModel& model, const Args& args, const std::string& method, const mf::Motion& input,
                     const mf::MotionConstraints& constraints, mf::CompletionReport* report) {
-  if (is_transformer_method(method)) {
-    const bool citl = method == "citl";
-    const mf::InbetweenModel* t = args.transformers.inbetweener(citl ? "citl" : "twostage");
-    if (!t) throw mf::InputError(mf::missing_inbetweener_message("method '" + method + "'", citl ? "citl" : "twostage"));
-    return mf::inbetweener_fill(*t, method == "context" ? 0 : -1, input, constraints, mf::LongGapPolicy::Throw);
+  int stage = 0;
+  if (const mf::InbetweenerKind* kind = mf::find_inbetweener_stage(method, &stage)) {
+    const mf::InbetweenModel& t = mf::require_inbetweener(args.transformers, kind->name, "method '" + method + "'");
+    return mf::inbetweener_fill(t, stage, input, constraints, mf::LongGapPolicy::Throw);
   }
   return mf::complete_motion(model, input, constraints, solver_options(args, method), {}, report);
 }
@@ -556,12 +554,7 @@ int run(Args& args, const std::string& command) {
 
   mf::NemfModel model = mf::load_nemf(args.model);
   model.set_requires_grad(false);
-  for (const std::string kind : {"twostage", "citl"}) {
-    const std::string given = kind == "citl" ? args.transformer_files.citl : args.transformer_files.twostage;
-    const std::string path = given.empty() ? mf::inbetweener_path_next_to(args.model, kind) : given;
-    if (given.empty() && !std::ifstream(path)) continue;
-    (kind == "citl" ? args.transformers.citl : args.transformers.twostage) = mf::load_frozen_inbetweener(path, kind);
-  }
+  mf::bench::load_transformers(args.transformer_files, args.model, &args.transformers, false);
   const mf::Dataset data = mf::bench::load_data(args.data, false);
   const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);
   const std::vector<mf::Clip>& clips = args.split.clips(data);
@@ -574,9 +567,9 @@ int run(Args& args, const std::string& command) {
   emit("## solver-bench\n\n- command: `" + command + "`\n- model: " + args.model + " (" + model.config().describe() +
        ")\n- split: " + args.split.split + " (" + std::to_string(clips.size()) + " clips)\n- torch threads: " +
        std::to_string(at::get_num_threads()) + "\n- BLAS: " + mf::blas_library() + "\n");
-  for (const char* kind : {"twostage", "citl"}) {
-    const mf::InbetweenModel* t = args.transformers.inbetweener(kind);
-    emit(std::string("- ") + kind + " transformer: " + (t ? t->describe() : std::string("not loaded")) + "\n");
+  for (const mf::InbetweenerKind& kind : mf::inbetweener_kinds()) {
+    const mf::InbetweenModel* t = args.transformers.inbetweener(kind.name);
+    emit("- " + kind.name + " transformer: " + (t ? t->describe() : std::string("not loaded")) + "\n");
   }
   for (const std::string& m : args.methods) {
     if (is_transformer_method(m)) emit("- `" + m + "`: one pass of the transformer (no solver)\n");

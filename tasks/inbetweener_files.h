@@ -1,7 +1,7 @@
-// The transformer in-betweeners' model files (prior/inbetween/inbetweener.h):
-// their names, where they are looked for (next to the prior's model file),
-// loading one ready to be shared between threads, and the error of a method
-// whose transformer is not loaded.
+// The in-betweeners' model files (prior/inbetween/inbetweener.h): where each
+// kind's file is looked for (next to the prior's model file), loading one
+// ready to be shared between threads, and the error of a method whose
+// in-betweener is not loaded.
 #pragma once
 
 #include <memory>
@@ -13,33 +13,42 @@ namespace mf {
 
 class InbetweenModel;
 
-/// Model file names of the transformers, looked for in the directory of the
-/// prior's model file.
-constexpr char kTwoStageFileName[] = "motionfield-twostage.mfm";
-constexpr char kCitlFileName[] = "motionfield-citl.mfm";
-
-/// kTwoStageFileName for "twostage", kCitlFileName for "citl"; InputError otherwise.
+/// The file name of the product kind `kind` (InbetweenerKind::file_name);
+/// InputError listing the kinds otherwise.
 std::string inbetweener_file_name(const std::string& kind);
 
-/// What a transformer of `kind` is called in messages ("two-stage
-/// transformer", "CITL transformer"; `kind` itself for another kind).
+/// What an in-betweener of `kind` is called in messages (InbetweenerKind::title;
+/// `kind` itself for a kind that is not the product's).
 std::string inbetweener_title(const std::string& kind);
 
-/// Where the transformer of `kind` is looked for next to the prior file
+/// Where the in-betweener of `kind` is looked for next to the prior file
 /// `prior_path`: the same directory, inbetweener_file_name(kind).
 std::string inbetweener_path_next_to(const std::string& prior_path, const std::string& kind);
 
-/// Loads a transformer file (load_inbetweener), checks that it is of `kind`
-/// (InputError naming the file otherwise) and freezes it (no gradients for
-/// its parameters), ready to be shared between threads.
-std::shared_ptr<const InbetweenModel> load_frozen_inbetweener(const std::string& path, const std::string& kind);
+/// Makes a loaded model ready to be shared between threads: checks that it is
+/// of `kind` (unless empty) and on the skeleton of `prior` (unless null), then
+/// freezes it (evaluation mode, no gradients). InputError naming `source`
+/// otherwise.
+std::shared_ptr<const InbetweenModel> frozen_inbetweener(std::unique_ptr<InbetweenModel> model,
+                                                         const std::string& source, const std::string& kind,
+                                                         const NemfModel* prior = nullptr);
+
+/// load_inbetweener(path), then frozen_inbetweener.
+std::shared_ptr<const InbetweenModel> load_frozen_inbetweener(const std::string& path, const std::string& kind,
+                                                              const NemfModel* prior = nullptr);
+
+/// Loads the file of every product kind that exists next to `prior_path` into
+/// `models` (whose prior must be set); a file that does not load is recorded
+/// in models->inbetweener_errors, so the prior alone stays usable.
+void load_inbetweeners_next_to(const std::string& prior_path, ModelSet* models);
 
 /// The error of a method or initialiser (`what`, e.g. "method 'citl'") whose
-/// transformer of `kind` is not loaded: names the file it needs.
+/// in-betweener of `kind` is not loaded: names the file it needs.
 std::string missing_inbetweener_message(const std::string& what, const std::string& kind);
 
-/// The transformer of `kind` in `ctx`; throws mf::ModelMissingError with
-/// missing_inbetweener_message(what, kind) when it is not loaded.
-const InbetweenModel& require_inbetweener(const TaskContext& ctx, const std::string& kind, const std::string& what);
+/// The in-betweener of `kind` in `models`; throws mf::ModelMissingError with
+/// missing_inbetweener_message(what, kind), and why its file did not load
+/// when it did not, when it is not loaded.
+const InbetweenModel& require_inbetweener(const ModelSet& models, const std::string& kind, const std::string& what);
 
 }  // namespace mf

@@ -2,6 +2,7 @@
 
 #include <ATen/ATen.h>
 
+#include "prior/inbetween/inbetweener.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
@@ -45,7 +46,11 @@ InitialGuess TransformerEncoderInitializer::initialize(const InitRequest& r) con
 }
 
 std::vector<std::string> initializer_names() {
-  return {"interp-encoder", "zero", "context-encoder", "detail-encoder", "citl-encoder"};
+  std::vector<std::string> names = {"interp-encoder", "zero"};
+  for (const InbetweenerKind& kind : inbetweener_kinds()) {
+    for (const InbetweenerStage& stage : kind.stages) names.push_back(stage.name + "-encoder");
+  }
+  return names;
 }
 
 namespace {
@@ -53,20 +58,17 @@ namespace {
 std::shared_ptr<const LatentInitializer> make_named(const std::string& name, const TaskContext* context) {
   if (name == "interp-encoder") return std::make_shared<InterpolationEncoderInitializer>();
   if (name == "zero") return std::make_shared<ZeroInitializer>();
-  struct Transformer {
-    const char* name;
-    const char* kind;
-    int stage;
-  };
-  for (const Transformer& t : {Transformer{"context-encoder", "twostage", 0}, Transformer{"detail-encoder", "twostage", 1},
-                               Transformer{"citl-encoder", "citl", -1}}) {
-    if (name != t.name) continue;
-    std::shared_ptr<const InbetweenModel> bound;
-    if (context) {
-      require_inbetweener(*context, t.kind, "initialiser '" + name + "'");
-      bound = t.kind == std::string("citl") ? context->citl : context->twostage;
+  for (const InbetweenerKind& kind : inbetweener_kinds()) {
+    for (size_t stage = 0; stage < kind.stages.size(); ++stage) {
+      if (name != kind.stages[stage].name + "-encoder") continue;
+      std::shared_ptr<const InbetweenModel> bound;
+      if (context) {
+        require_inbetweener(*context, kind.name, "initialiser '" + name + "'");
+        bound = context->inbetweeners.at(kind.name);
+      }
+      return std::make_shared<TransformerEncoderInitializer>(name, kind.name, static_cast<int>(stage),
+                                                             std::move(bound));
     }
-    return std::make_shared<TransformerEncoderInitializer>(t.name, t.kind, t.stage, std::move(bound));
   }
   std::string list;
   for (const std::string& n : initializer_names()) list += (list.empty() ? "" : ", ") + n;

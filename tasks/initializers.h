@@ -76,14 +76,16 @@ class ZeroInitializer : public LatentInitializer {
 /// interpolated, frames before the first and after the last key that fixes
 /// the root are held) -> the filled window canonicalised at the anchor and
 /// encoded (encode_window); the codes are the posterior means.
-///   "context-encoder"  stage 0 of the two-stage model (TaskContext::twostage)
+/// One per stage of every in-betweener kind, "<stage>-encoder"
+/// (prior/inbetween/inbetweener.h InbetweenerKind::stages):
+///   "context-encoder"  stage 0 of the two-stage model
 ///   "detail-encoder"   stage 1 of the two-stage model
-///   "citl-encoder"     the CITL model (TaskContext::citl)
+///   "citl-encoder"     the CITL model
 /// The transformer is the one bound at construction, else the request
 /// context's; initialize() throws mf::InputError when there is none.
 class TransformerEncoderInitializer : public LatentInitializer {
  public:
-  /// `kind` "twostage" or "citl"; `stage` 0-based, -1 = the last.
+  /// `kind` an in-betweener kind; `stage` 0-based, -1 = the last.
   TransformerEncoderInitializer(std::string name, std::string kind, int stage,
                                 std::shared_ptr<const InbetweenModel> bound = nullptr);
   std::string name() const override { return name_; }

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "prior/inbetween/inbetweener.h"
 #include "prior/motion/errors.h"
 #include "tasks/inbetweener_files.h"
 #include "tasks/model_rig.h"
@@ -26,11 +27,26 @@ void check_motion(const Motion& input) {
   if (!(std::isfinite(input.fps) && input.fps > 0)) throw InputError("the input motion's fps must be finite and positive");
 }
 
+// The method of a request, checked once with the motion: the method and the
+// models it needs, the motion itself, and its rig when the method needs the
+// model.
+const Method& checked_method(const std::string& method, const Motion& input, const TaskContext& ctx) {
+  const Method& m = resolve_method(method, ctx);
+  check_motion(input);
+  if (m.needs_model) check_model_rig(input.skeleton, ctx);
+  return m;
+}
+
+// The first progress report of a validated request; it also honours a cancel
+// token cancelled before the call.
+void start(const TaskContext& ctx) { ctx.report(TaskProgress{}); }
+
 // Runs `complete` of `m` on validated input (the common end of
 // run_known_frames and run_fill): methods that need the model run on the
 // model's rig and rate (tasks/model_rig.h).
 Motion complete_with(const Method& m, const Motion& input, const std::vector<int>& known, const TaskContext& ctx) {
   if (!m.complete) throw InputError("method '" + m.name + "' does not do in-betweening or gap filling");
+  start(ctx);
   if (!m.needs_model) return m.complete(input, known, ctx);
   return complete_on_model_rig(input, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
     return m.complete(in, k, ctx);
@@ -62,7 +78,7 @@ std::vector<std::string> available_methods() {
 // foot skating at gaps of 15+ frames and keys 15+ frames apart (and ties it
 // below).
 std::string default_method(const TaskContext& ctx) {
-  if (ctx.model && ctx.twostage) return "nemf-detail";
+  if (ctx.model && ctx.inbetweener(kTwoStageKind)) return "nemf-detail";
   return ctx.model ? "nemf" : "interp";
 }
 
@@ -130,8 +146,7 @@ int resampled_frame_count(int frames, double fps_in, double fps_out, bool* round
 
 Motion run_known_frames(const Motion& input, const std::vector<int>& known, const std::string& method,
                         const TaskContext& ctx) {
-  const Method& m = resolve_method(method, ctx);
-  check_motion(input);
+  const Method& m = checked_method(method, input, ctx);
   validate_keyframes(known, input.num_frames());
   return complete_with(m, input, known, ctx);
 }
@@ -142,17 +157,15 @@ Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, con
 }
 
 Motion run_fill(const Motion& input, int a, int b, const std::string& method, const TaskContext& ctx) {
-  const Method& m = resolve_method(method, ctx);
-  check_motion(input);
+  const Method& m = checked_method(method, input, ctx);
   // Sorted, unique, in range and at least two (frame 0 and the last): valid keyframes.
   return complete_with(m, input, known_frames_outside_gap(input.num_frames(), a, b), ctx);
 }
 
 Motion run_resample(const Motion& input, double fps, const std::string& method, std::vector<std::string>* warnings,
                     const TaskContext& ctx) {
-  const Method& m = resolve_method(method.empty() ? default_resample_method(ctx) : method, ctx);
+  const Method& m = checked_method(method.empty() ? default_resample_method(ctx) : method, input, ctx);
   if (!m.resample) throw InputError("method '" + m.name + "' does not do resampling");
-  check_motion(input);
   bool rounded = false;
   const int frames = resampled_frame_count(input.num_frames(), input.fps, fps, &rounded);
   if (rounded && warnings) {
@@ -164,6 +177,7 @@ Motion run_resample(const Motion& input, double fps, const std::string& method, 
         << " s before the input's last frame";
     warnings->push_back(msg.str());
   }
+  start(ctx);
   if (!m.needs_model) return m.resample(input, fps, frames, ctx);
   return resample_on_model_rig(input, fps, frames, ctx, [&](const Motion& in, double f, int n) {
     return m.resample(in, f, n, ctx);

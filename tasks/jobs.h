@@ -61,6 +61,14 @@ std::vector<int> known_frames_outside_gap(int frames, int a, int b);
 /// result would exceed 10 million frames.
 int resampled_frame_count(int frames, double fps_in, double fps_out, bool* rounded);
 
+/// The task entry points below validate a request once, here: the method and
+/// the models it needs (resolve_method), the motion, the known frames, and a
+/// motion on another rig than the model's (check_model_rig of
+/// tasks/model_rig.h); then they make the first progress report (which also
+/// honours a cancel token cancelled before the call) and run the method.
+/// Errors: InputError (bad input), ModelMissingError (a model the request
+/// needs is not loaded), CancelledError.
+
 /// Sparse-keyframe in-betweening: the output has the input's length and fps;
 /// known frames are `keyframes` (validated with validate_keyframes()), the
 /// others are never read. Known frames are copied exactly.

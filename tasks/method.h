@@ -17,8 +17,8 @@ struct Method {
   std::string name;
   std::string description;
   bool needs_model = false;
-  /// Kind of transformer in-betweener the method needs besides the prior
-  /// ("twostage" or "citl", see TaskContext); empty for none.
+  /// Kind of in-betweener the method needs besides the prior (an
+  /// InbetweenerKind name, see ModelSet::inbetweeners); empty for none.
   std::string needs_inbetweener;
   /// Completes a motion from its known frames (sorted, unique, at least two,
   /// in range): every other frame is produced, known frames come out as given.

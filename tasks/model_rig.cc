@@ -72,15 +72,32 @@ bool needs_model_rig(const Motion& input, const TaskContext& ctx) {
 }
 
 RigMap model_rig_map(const Skeleton& user, const TaskContext& ctx) {
-  return map_rig(user, require_prior(ctx, "this method").rig().skeleton, ctx.rig_map);
+  const Skeleton& model = require_prior(ctx, "this method").rig().skeleton;
+  try {
+    return map_rig(user, model, ctx.rig_map);
+  } catch (const InputError& e) {
+    if (ctx.rig_map_source.empty()) throw;
+    throw InputError(ctx.rig_map_source + ": " + e.what());
+  }
+}
+
+void check_model_rig(const Skeleton& input, const TaskContext& ctx) {
+  if (!ctx.model || input.same_as(ctx.model->rig().skeleton)) return;
+  if (!ctx.model_anatomy) {
+    const std::string what = "the motion has " + std::to_string(input.num_joints()) +
+                             " joints on another rig than the model's (" +
+                             std::to_string(ctx.model->rig().num_joints()) + " joints), and ";
+    if (!ctx.model_anatomy_error.empty())
+      throw ModelMissingError(what + "the model's rig anatomy file did not load: " + ctx.model_anatomy_error);
+    throw InputError(what + "the model has no rig anatomy to retarget with (" + kRigAnatomyFileName +
+                     " next to the model file)");
+  }
+  model_rig_map(input, ctx);
 }
 
 Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, const TaskContext& ctx) {
   const Skeleton& model = require_prior(ctx, "this method").rig().skeleton;
-  if (!ctx.model_anatomy)
-    throw InputError("the motion's skeleton (" + std::to_string(input.num_joints()) +
-                     " joints) is not the model's, and the model has no rig anatomy to retarget with "
-                     "(motionfield-rig.json next to the model file)");
+  check_model_rig(input.skeleton, ctx);
   RigMap map = model_rig_map(input.skeleton, ctx);
   RigAnatomy user = estimate_anatomy(input, map.user_parts, known);
   return Retargeter(input.skeleton, model, std::move(map), std::move(user), *ctx.model_anatomy);

@@ -32,8 +32,16 @@ std::shared_ptr<const RigAnatomy> load_rig_anatomy_next_to(const std::string& pr
 bool needs_model_rig(const Motion& input, const TaskContext& ctx);
 
 /// The map of `user` onto the prior's skeleton with ctx.rig_map applied
-/// (map_rig). Throws InputError without a model.
+/// (map_rig; its errors are prefixed with ctx.rig_map_source). Throws
+/// ModelMissingError without a model.
 RigMap model_rig_map(const Skeleton& user, const TaskContext& ctx);
+
+/// Checks, before a model method runs, that a motion on `input` can be
+/// served: nothing for the prior's own skeleton (or without a prior); else
+/// the model needs its rig anatomy (ModelMissingError when the anatomy file
+/// next to the prior did not load, InputError when there is none) and the rig
+/// must map onto the prior's (model_rig_map's InputError).
+void check_model_rig(const Skeleton& input, const TaskContext& ctx);
 
 /// A retargeter from `input`'s rig to the model's, its anatomy measured on the
 /// frames `known` of `input` (all when empty). Throws InputError when the rig

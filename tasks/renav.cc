@@ -566,6 +566,7 @@ Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& pa
     throw InputError("unknown re-navigation method '" + method + "' (available: " + list + ")");
   }
   const NemfModel& model = require_prior(ctx, "re-navigation");
+  check_model_rig(reference.skeleton, ctx);
   if (reference.num_frames() < 2) throw InputError("the reference needs at least two frames");
   if (!(std::isfinite(reference.fps) && reference.fps > 0))
     throw InputError("the reference's fps must be finite and positive");

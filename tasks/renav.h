@@ -238,7 +238,8 @@ std::vector<std::string> renav_methods();
 
 /// The task entry point (the CLI, the C API, the benchmark): `method` empty =
 /// "nemf"; an unknown name throws InputError listing renav_methods(); no model
-/// in `ctx` throws InputError. path_fps <= 0 means the reference's fps.
+/// in `ctx` throws ModelMissingError; a reference on a rig that cannot be
+/// served fails as check_model_rig (tasks/model_rig.h) says. path_fps <= 0 means the reference's fps.
 /// A reference on another humanoid rig than the model's is retargeted to it
 /// (tasks/model_rig.h: needs ctx.model_anatomy; ctx.rig_map applies), the
 /// path (the reference's metres) scaled by the rigs' size ratio, and the

@@ -2,6 +2,7 @@
 // "nemf-adam" (NeMF's Adam-600 reference), and L-BFGS started from a
 // transformer in-betweener (tasks/initializers.h TransformerEncoderInitializer):
 // "nemf-context", "nemf-detail" (two-stage model) and "nemf-citl".
+#include "prior/inbetween/inbetweener.h"
 #include "prior/model/nemf.h"
 #include "tasks/inbetweener_files.h"
 #include "tasks/latent_solver.h"
@@ -13,7 +14,7 @@ namespace {
 
 // `initializer` empty: the default (interpolation); else a make_initializer()
 // name whose transformer (`inbetweener` kind) comes from the context.
-Method solver_method(const char* name, const char* description, SolverMethod method,
+Method solver_method(const std::string& name, const std::string& description, SolverMethod method,
                      const std::string& initializer = "", const std::string& inbetweener = "") {
   Method m;
   m.name = name;
@@ -22,8 +23,7 @@ Method solver_method(const char* name, const char* description, SolverMethod met
   m.needs_inbetweener = inbetweener;
   LatentSolverOptions options = default_solver_options(method);
   if (!initializer.empty()) options.initializer = make_initializer(initializer);
-  const std::string method_name = name;
-  m.complete = [options, method_name, inbetweener](const Motion& input, const std::vector<int>& known,
+  m.complete = [options, method_name = name, inbetweener](const Motion& input, const std::vector<int>& known,
                                                    const TaskContext& ctx) {
     const NemfModel& model = require_prior(ctx, "method '" + method_name + "'");
     if (!inbetweener.empty()) require_inbetweener(ctx, inbetweener, "method '" + method_name + "'");
@@ -35,16 +35,21 @@ Method solver_method(const char* name, const char* description, SolverMethod met
 }  // namespace
 
 std::vector<Method> solver_methods() {
-  return {solver_method("nemf", "latent optimisation of the prior with L-BFGS (Ceres), NeMF's energies",
-                        SolverMethod::Lbfgs),
-          solver_method("nemf-adam", "latent optimisation of the prior with Adam, 600 iterations (NeMF's reference)",
-                        SolverMethod::Adam),
-          solver_method("nemf-context", "L-BFGS latent optimisation started from the Context Transformer",
-                        SolverMethod::Lbfgs, "context-encoder", "twostage"),
-          solver_method("nemf-detail", "L-BFGS latent optimisation started from the two-stage transformer",
-                        SolverMethod::Lbfgs, "detail-encoder", "twostage"),
-          solver_method("nemf-citl", "L-BFGS latent optimisation started from the CITL transformer",
-                        SolverMethod::Lbfgs, "citl-encoder", "citl")};
+  std::vector<Method> methods = {
+      solver_method("nemf", "latent optimisation of the prior with L-BFGS (Ceres), NeMF's energies",
+                    SolverMethod::Lbfgs),
+      solver_method("nemf-adam", "latent optimisation of the prior with Adam, 600 iterations (NeMF's reference)",
+                    SolverMethod::Adam)};
+  // One per stage of every in-betweener kind: "nemf-context", "nemf-detail", "nemf-citl".
+  for (const InbetweenerKind& kind : inbetweener_kinds()) {
+    for (const InbetweenerStage& stage : kind.stages) {
+      methods.push_back(solver_method("nemf-" + stage.name,
+                                      "L-BFGS latent optimisation started from the " + kind.title + " (" +
+                                          stage.description + ")",
+                                      SolverMethod::Lbfgs, stage.name + "-encoder", kind.name));
+    }
+  }
+  return methods;
 }
 
 }  // namespace mf

@@ -1,13 +1,20 @@
 #include "tasks/task_context.h"
 
+#include "prior/inbetween/inbetweener.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 
 namespace mf {
 
 const NemfModel& require_prior(const TaskContext& ctx, const std::string& what) {
-  if (!ctx.model) throw ModelMissingError(what + " needs the prior, and no model is loaded");
+  if (!ctx.model) throw ModelMissingError(what + " needs a model (the prior), and none is loaded");
   return *ctx.model;
+}
+
+void ModelSet::add_inbetweener(std::shared_ptr<const InbetweenModel> m) {
+  const std::string kind = m->kind();
+  inbetweeners[kind] = std::move(m);
+  inbetweener_errors.erase(kind);
 }
 
 void check_model_skeleton(const RigInfo& rig, const Skeleton& skeleton, const std::string& whose) {

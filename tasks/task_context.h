@@ -1,5 +1,5 @@
 // The context every task method runs in: the models it may use (the prior,
-// the transformer in-betweeners, the prior rig's anatomy), the seed, and the
+// the in-betweeners by kind, the prior rig's anatomy), the seed, and the
 // progress callback and cancel flag of long-running methods; and the checks
 // that a request fits it (the prior is loaded, a motion is on its skeleton).
 #pragma once
@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -32,40 +33,49 @@ class CancelledError : public std::runtime_error {
   CancelledError() : std::runtime_error("cancelled") {}
 };
 
-/// What a method may use besides its input. Cheap to copy.
-struct TaskContext {
+/// The models a request may use, loaded together (the C API's mf_model holds
+/// one). Immutable once loaded, shared between threads; cheap to copy.
+struct ModelSet {
   /// The prior; required by methods with needs_model, unused by the baselines.
-  /// Immutable and shared between threads.
   std::shared_ptr<const NemfModel> model;
-  /// The transformer in-betweeners (prior/inbetween/inbetweener.h), each null
-  /// when not loaded: `twostage` (kind "twostage": methods "context", "detail",
-  /// the initialisers "context-encoder", "detail-encoder") and `citl` (kind
-  /// "citl": method "citl", initialiser "citl-encoder"). On the prior's
-  /// skeleton; frozen (set_requires_grad(false)), immutable and shared between
-  /// threads like the prior. The C API loads them from
-  /// motionfield-twostage.mfm and motionfield-citl.mfm next to the prior's file.
-  std::shared_ptr<const InbetweenModel> twostage;
-  std::shared_ptr<const InbetweenModel> citl;
+  /// The in-betweeners by kind (prior/inbetween/inbetweener.h: the product's
+  /// kinds are inbetweener_kinds()), on the prior's skeleton and frozen
+  /// (set_requires_grad(false)). The C API loads each kind's file_name next
+  /// to the prior's file (tasks/inbetweener_files.h).
+  std::map<std::string, std::shared_ptr<const InbetweenModel>> inbetweeners;
+  /// Why a kind's file next to the prior did not load (absent kinds have no
+  /// entry): the missing-model error of a method that needs it quotes it.
+  std::map<std::string, std::string> inbetweener_errors;
   /// The anatomy of the prior's rig (prior/rig/retarget.h), needed to serve
   /// motions on other rigs; the C API loads motionfield-rig.json next to the
   /// prior's file. Null: only the model's own rig is served.
   std::shared_ptr<const RigAnatomy> model_anatomy;
+  /// Why that file did not load ("" when it did or is absent).
+  std::string model_anatomy_error;
+
+  /// The in-betweener of `kind`; null when not loaded.
+  const InbetweenModel* inbetweener(const std::string& kind) const {
+    auto it = inbetweeners.find(kind);
+    return it == inbetweeners.end() ? nullptr : it->second.get();
+  }
+  /// Adds (or replaces) the in-betweener of `model`'s kind and forgets that
+  /// kind's load error.
+  void add_inbetweener(std::shared_ptr<const InbetweenModel> model);
+};
+
+/// What a method may use besides its input: the models, the caller's rig map,
+/// the seed, progress and cancel. Cheap to copy.
+struct TaskContext : ModelSet {
   /// A rig map's JSON text ({"user joint": "model joint" or null}) that
   /// overrides the automatic map of another rig onto the model's; empty: automatic.
   std::string rig_map;
+  /// Where `rig_map` came from (a file name) for its error messages; may be empty.
+  std::string rig_map_source;
   uint64_t seed = 0;
   /// Called now and then by long methods; returning false cancels.
   std::function<bool(const TaskProgress&)> progress;
   /// Non-zero cancels (thread-safe; set from any thread).
   const std::atomic<int>* cancel = nullptr;
-
-  /// The transformer of `kind` ("twostage" or "citl"); null when not loaded
-  /// or for any other kind.
-  const InbetweenModel* inbetweener(const std::string& kind) const {
-    if (kind == "twostage") return twostage.get();
-    if (kind == "citl") return citl.get();
-    return nullptr;
-  }
 
   /// Calls `progress` and checks `cancel`; throws CancelledError when asked to stop.
   void report(const TaskProgress& p) const {
@@ -73,8 +83,8 @@ struct TaskContext {
   }
 };
 
-/// The prior of `ctx`; throws mf::ModelMissingError "<what> needs the prior,
-/// and no model is loaded" when there is none.
+/// The prior of `ctx`; throws mf::ModelMissingError "<what> needs a model
+/// (the prior), and none is loaded" when there is none.
 const NemfModel& require_prior(const TaskContext& ctx, const std::string& what);
 
 /// Throws mf::InputError "the <whose>'s skeleton does not match the model's:

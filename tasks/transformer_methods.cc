@@ -22,10 +22,15 @@ Method transformer_method(const std::string& name, const std::string& descriptio
 }  // namespace
 
 std::vector<Method> transformer_methods() {
-  return {transformer_method("context", "two-stage transformer, Context Transformer only (one pass)", kTwoStageKind, 0),
-          transformer_method("detail", "two-stage transformer, Context + Detail Transformer (one pass)", kTwoStageKind,
-                             1),
-          transformer_method("citl", "CITL transformer (one pass)", kCitlKind, -1)};
+  std::vector<Method> methods;
+  for (const InbetweenerKind& kind : inbetweener_kinds()) {
+    for (size_t stage = 0; stage < kind.stages.size(); ++stage) {
+      const InbetweenerStage& s = kind.stages[stage];
+      methods.push_back(transformer_method(s.name, kind.title + ", " + s.description + " (one pass)", kind.name,
+                                           static_cast<int>(stage)));
+    }
+  }
+  return methods;
 }
 
 }  // namespace mf

@@ -327,7 +327,7 @@ TEST(RunRenav, EntryPointAndErrors) {
   const auto path = line_path(20, 0.05);
   EXPECT_NE(input_error([&] { run_renav(ref, path, 0, "magic", ctx); }).find("unknown re-navigation method 'magic'"),
             std::string::npos);
-  EXPECT_NE(input_error([&] { run_renav(ref, path, 0, "nemf", TaskContext{}); }).find("needs the prior"),
+  EXPECT_NE(input_error([&] { run_renav(ref, path, 0, "nemf", TaskContext{}); }).find("needs a model"),
             std::string::npos);
   EXPECT_NE(input_error([&] { run_renav(ref, {{0, 0}}, 0, "", ctx); }).find("at least two points"), std::string::npos);
   EXPECT_NE(input_error([&] { run_renav(ref, {{0, 0}, {INFINITY, 1}}, 0, "", ctx); }).find("not finite"),

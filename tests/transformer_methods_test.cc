@@ -18,6 +18,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "tasks/baselines.h"
+#include "tasks/inbetweener_files.h"
 #include "tasks/initializers.h"
 #include "tasks/jobs.h"
 #include "tasks/transformer_methods.h"
@@ -122,8 +123,8 @@ struct Fixture {
     twostage = std::make_shared<LinearInbetweener>(rig, kTwoStageKind, window);
     citl = std::make_shared<LinearInbetweener>(rig, kCitlKind, window);
     ctx.model = prior;
-    ctx.twostage = twostage;
-    ctx.citl = citl;
+    ctx.add_inbetweener(twostage);
+    ctx.add_inbetweener(citl);
   }
   Motion motion(int frames, uint32_t seed = 3) const {
     return test::random_motion(prior->rig().skeleton, frames, 30.0, seed);
@@ -170,10 +171,56 @@ TEST(TransformerMethods, RegisteredWithTheirNeedsAndTheDefault) {
   Fixture fx;
   EXPECT_EQ(default_method(fx.ctx), "nemf-detail");
   TaskContext prior_only = fx.ctx;
-  prior_only.twostage = nullptr;
+  prior_only.inbetweeners.erase(kTwoStageKind);
   EXPECT_EQ(default_method(prior_only), "nemf");
-  prior_only.citl = nullptr;
+  prior_only.inbetweeners.clear();
   EXPECT_EQ(default_method(prior_only), "nemf");
+}
+
+// Every stage of every in-betweener kind in the registry is a one-pass
+// method, a solver start ("nemf-<stage>") and an initialiser
+// ("<stage>-encoder"), all needing that kind.
+TEST(TransformerMethods, EveryKindsStagesBecomeMethodsAndInitialisers) {
+  ASSERT_EQ(inbetweener_kinds().size(), 2u);
+  const std::vector<std::string> inits = initializer_names();
+  int stages = 0;
+  for (const InbetweenerKind& kind : inbetweener_kinds()) {
+    EXPECT_EQ(inbetweener_file_name(kind.name), "motionfield-" + kind.name + ".mfm");
+    for (const InbetweenerStage& stage : kind.stages) {
+      ++stages;
+      for (const std::string& name : {stage.name, "nemf-" + stage.name}) {
+        const Method* found = nullptr;
+        for (const Method& m : registered_methods()) found = m.name == name ? &m : found;
+        ASSERT_NE(found, nullptr) << name;
+        EXPECT_EQ(found->needs_inbetweener, kind.name) << name;
+        EXPECT_TRUE(found->needs_model) << name;
+      }
+      EXPECT_NE(std::find(inits.begin(), inits.end(), stage.name + "-encoder"), inits.end()) << stage.name;
+    }
+  }
+  EXPECT_EQ(stages, 3);
+  EXPECT_EQ(find_inbetweener_stage("detail")->name, kTwoStageKind);
+  EXPECT_EQ(find_inbetweener_stage("nemf"), nullptr);
+  EXPECT_THROW(inbetweener_kind("keyframenet"), InputError);
+}
+
+// A kind whose file next to the prior did not load: the missing-model error
+// is typed (the C API's model status) and quotes why.
+TEST(TransformerMethods, MissingModelQuotesWhyItsFileDidNotLoad) {
+  Fixture fx;
+  TaskContext ctx;
+  ctx.model = fx.prior;
+  ctx.inbetweener_errors[kCitlKind] = "motionfield-citl.mfm: truncated";
+  try {
+    run_inbetween(fx.motion(20), {0, 10, 19}, "citl", ctx);
+    FAIL() << "no error";
+  } catch (const ModelMissingError& e) {
+    EXPECT_NE(std::string(e.what()).find("did not load: motionfield-citl.mfm: truncated"), std::string::npos)
+        << e.what();
+  }
+  ctx.add_inbetweener(fx.citl);
+  EXPECT_EQ(ctx.inbetweener_errors.count(kCitlKind), 0u);
+  EXPECT_NO_THROW(run_inbetween(fx.motion(20), {0, 10, 19}, "citl", ctx));
 }
 
 TEST(TransformerMethods, MissingModelNamesTheFile) {

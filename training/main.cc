@@ -256,11 +256,12 @@ int main(int argc, char** argv) {
   RigArgs rig_args;
   CLI::App* prior = app.add_subcommand("prior", "the NeMF prior (training/prior_trainer.h)");
   add_prior_options(*prior, prior_options, run);
-  CLI::App* twostage = app.add_subcommand(mf::kTwoStageKind, "the two-stage in-betweener: context + detail "
-                                                             "transformers (training/inbetween_trainer.h)");
-  add_inbetweener_options(*twostage, inbetweener_options, hp, run);
-  CLI::App* citl = app.add_subcommand(mf::kCitlKind, "the CITL in-betweener (training/inbetween_trainer.h)");
-  add_inbetweener_options(*citl, inbetweener_options, hp, run);
+  std::vector<CLI::App*> inbetweeners;  // one subcommand per in-betweener kind
+  for (const mf::InbetweenerKind& kind : mf::inbetweener_kinds()) {
+    inbetweeners.push_back(
+        app.add_subcommand(kind.name, "the " + kind.title + " (" + kind.file_name + "; training/inbetween_trainer.h)"));
+    add_inbetweener_options(*inbetweeners.back(), inbetweener_options, hp, run);
+  }
   CLI::App* rig = app.add_subcommand("rig", "measures the anatomy of the training data's rig (prior/rig/retarget.h) "
                                             "from the training split: models/motionfield-rig.json");
   add_rig_options(*rig, rig_args);
@@ -270,7 +271,7 @@ int main(int argc, char** argv) {
       if (!run.config.empty()) apply_config_file(*prior, run.config, nullptr);
       return train_prior_main(prior_options, run);
     }
-    CLI::App* cmd = twostage->parsed() ? twostage : citl;
+    CLI::App* cmd = *std::find_if(inbetweeners.begin(), inbetweeners.end(), [](CLI::App* c) { return c->parsed(); });
     std::vector<std::string> config_hp;
     if (!run.config.empty()) apply_config_file(*cmd, run.config, &config_hp);
     inbetweener_options.kind = cmd->get_name();

@@ -15,32 +15,14 @@
 #include "motionfield.h"
 #include "prior/motion/bvh.h"
 #include "prior/motion/motion.h"
+#include "tasks/task_context.h"
 
-namespace mf {
-class NemfModel;
-class InbetweenModel;
-struct RigAnatomy;
-struct TaskContext;
-}
 
-struct mf_model {
-  std::shared_ptr<const mf::NemfModel> model;
-  /// The transformer in-betweeners (null when absent): loaded from
-  /// motionfield-twostage.mfm / motionfield-citl.mfm next to the prior's file
-  /// by mf_model_load, or by mf_model_with_inbetweener.
-  std::shared_ptr<const mf::InbetweenModel> twostage;
-  std::shared_ptr<const mf::InbetweenModel> citl;
-  /// Why a transformer file next to the prior did not load ("" when it did or
-  /// is absent): the missing-transformer error of a method quotes it.
-  std::string twostage_error;
-  std::string citl_error;
-  /// The anatomy of the prior's rig (motionfield-rig.json next to the prior's
-  /// file, loaded by mf_model_load; null for models from memory or when absent
-  /// or broken): tasks on other rigs need it. Why it did not load ("" when it
-  /// did or is absent).
-  std::shared_ptr<const mf::RigAnatomy> anatomy;
-  std::string anatomy_error;
-};
+/// The prior, the in-betweeners by kind and the rig anatomy loaded together
+/// (tasks/task_context.h ModelSet): mf_model_load loads the in-betweeners and
+/// the anatomy found next to the prior's file and keeps why a file there did
+/// not load; mf_model_with_inbetweener adds one.
+struct mf_model : mf::ModelSet {};
 
 struct mf_motion {
   mf::Motion motion;
@@ -154,25 +136,9 @@ void skeleton_offsets(const Skeleton& s, float* out, size_t capacity, size_t* ne
 /// A new motion handle carrying `motion` and the BVH layout of `like` (if any).
 mf_motion* derived_motion(Motion motion, const mf_motion& like);
 
-/// Copies the model handle's prior, transformers and rig anatomy into `ctx`
-/// (model may be NULL).
-void set_models(const mf_model* model, TaskContext* ctx);
-
 /// The context of a task call from its options: models, seed, progress
 /// callback, cancel token and rig map (read from rig_map_path if given).
 TaskContext task_context(const mf_model* model, const mf_task_options& options);
-
-/// For a method that needs the model and an input on another skeleton than
-/// the model's: throws unless it can be retargeted (the model has a rig
-/// anatomy: MF_ERROR_MODEL when its file is broken; the rig maps:
-/// MF_ERROR_INVALID_ARGUMENT with the map's message, prefixed with the map
-/// file's path when it came from one). Nothing for the model's own skeleton.
-void check_model_rig(const mf_model* model, const Skeleton& input, const mf_task_options& options,
-                     const TaskContext& ctx);
-
-/// Throws MF_ERROR_MODEL when `method` needs a transformer that `model` lacks,
-/// naming the file (and why it did not load, if it was there).
-void require_inbetweener(const mf_model* model, const std::string& method, const std::string& kind);
 
 /// Applies the thread count of mf_set_num_threads() to the calling thread.
 void apply_num_threads();

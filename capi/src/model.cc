@@ -15,9 +15,8 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/rig/retarget.h"
-#include "tasks/method.h"
+#include "tasks/inbetweener_files.h"
 #include "tasks/model_rig.h"
-#include "tasks/transformer_methods.h"
 
 namespace mf::capi {
 namespace {
@@ -77,49 +76,15 @@ std::vector<uint8_t> read_file(const std::string& file) {
   return bytes;
 }
 
-// A transformer file for `prior`: MF_ERROR_IO when unreadable, MF_ERROR_MODEL
-// when it is not a transformer model or its skeleton is not the prior's.
-std::shared_ptr<const InbetweenModel> load_transformer(const std::string& file, const NemfModel& prior) {
+// The in-betweener file `file` for the prior of `model`: MF_ERROR_IO when
+// unreadable, MF_ERROR_MODEL when it is not an in-betweener or not on the
+// prior's skeleton.
+std::shared_ptr<const InbetweenModel> load_inbetweener_file(const std::string& file, const mf_model& model) {
   const std::vector<uint8_t> bytes = read_file(file);
-  std::unique_ptr<InbetweenModel> t;
   try {
-    t = deserialize_inbetweener(bytes.data(), bytes.size(), file);
+    return frozen_inbetweener(deserialize_inbetweener(bytes.data(), bytes.size(), file), file, "", model.model.get());
   } catch (const InputError& e) {
     throw ApiError(MF_ERROR_MODEL, e.what());
-  }
-  if (!t->rig().skeleton.same_as(prior.rig().skeleton))
-    throw ApiError(MF_ERROR_MODEL, file + ": the transformer's skeleton (" + std::to_string(t->rig().num_joints()) +
-                                       " joints) is not the prior's (" + std::to_string(prior.rig().num_joints()) +
-                                       " joints): train it on the prior's data");
-  t->set_requires_grad(false);
-  t->train(false);
-  return std::shared_ptr<const InbetweenModel>(std::move(t));
-}
-
-void set_transformer(mf_model* handle, std::shared_ptr<const InbetweenModel> t) {
-  if (t->kind() == kCitlKind) {
-    handle->citl = std::move(t);
-    handle->citl_error.clear();
-  } else {
-    handle->twostage = std::move(t);
-    handle->twostage_error.clear();
-  }
-}
-
-// The transformer files next to `prior_file` that exist; failures are kept
-// for the methods' error messages (the prior alone stays usable).
-void load_companions(mf_model* handle, const std::string& prior_file) {
-  for (const std::string kind : {kTwoStageKind, kCitlKind}) {
-    const std::string file = inbetweener_path_next_to(prior_file, kind);
-    std::error_code ec;
-    if (!fs::exists(file, ec)) continue;
-    try {
-      std::shared_ptr<const InbetweenModel> t = load_transformer(file, *handle->model);
-      if (t->kind() != kind) throw ApiError(MF_ERROR_MODEL, file + " holds a '" + t->kind() + "' model, not '" + kind + "'");
-      set_transformer(handle, std::move(t));
-    } catch (const std::exception& e) {
-      (kind == kCitlKind ? handle->citl_error : handle->twostage_error) = e.what();
-    }
   }
 }
 
@@ -127,9 +92,9 @@ void load_companions(mf_model* handle, const std::string& prior_file) {
 // error tasks on other rigs report (the prior stays usable on its own rig).
 void load_anatomy(mf_model* handle, const std::string& prior_file) {
   try {
-    handle->anatomy = load_rig_anatomy_next_to(prior_file, handle->model->rig().skeleton);
+    handle->model_anatomy = load_rig_anatomy_next_to(prior_file, handle->model->rig().skeleton);
   } catch (const std::exception& e) {
-    handle->anatomy_error = e.what();
+    handle->model_anatomy_error = e.what();
   }
 }
 
@@ -139,24 +104,6 @@ const NemfModel& get(const mf_model* model) {
 }
 
 }  // namespace
-
-void set_models(const mf_model* model, TaskContext* ctx) {
-  if (!model) return;
-  ctx->model = model->model;
-  ctx->twostage = model->twostage;
-  ctx->citl = model->citl;
-  ctx->model_anatomy = model->anatomy;
-}
-
-void require_inbetweener(const mf_model* model, const std::string& method, const std::string& kind) {
-  if (kind.empty()) return;
-  const bool citl = kind == kCitlKind;
-  if (model && (citl ? model->citl : model->twostage)) return;
-  std::string message = missing_inbetweener_message("method '" + method + "'", kind);
-  const std::string why = !model ? "" : citl ? model->citl_error : model->twostage_error;
-  if (!why.empty()) message += "; the file next to the prior did not load: " + why;
-  throw ApiError(MF_ERROR_MODEL, message);
-}
 
 }  // namespace mf::capi
 
@@ -185,7 +132,7 @@ int mf_model_load(const char* path, mf_model** out) {
     }
     const std::vector<uint8_t> bytes = mf::capi::read_file(file);
     std::unique_ptr<mf_model> handle = mf::capi::load_bytes(bytes.data(), bytes.size(), file);
-    mf::capi::load_companions(handle.get(), file);
+    mf::load_inbetweeners_next_to(file, handle.get());
     mf::capi::load_anatomy(handle.get(), file);
     *out = handle.release();
   });
@@ -209,7 +156,7 @@ int mf_model_with_inbetweener(const mf_model* model, const char* path, mf_model*
     require(out, "out");
     if (!*path) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the transformer model path is empty");
     auto handle = std::make_unique<mf_model>(*model);
-    mf::capi::set_transformer(handle.get(), mf::capi::load_transformer(path, *model->model));
+    handle->add_inbetweener(mf::capi::load_inbetweener_file(path, *model));
     *out = handle.release();
   });
 }
@@ -219,10 +166,7 @@ int mf_model_has_inbetweener(const mf_model* model, const char* kind, int32_t* o
     require(model, "model");
     require(kind, "kind");
     require(out, "out");
-    const std::string k = kind;
-    if (k != mf::kTwoStageKind && k != mf::kCitlKind)
-      throw ApiError(MF_ERROR_INVALID_ARGUMENT, "unknown transformer kind '" + k + "' (available: twostage, citl)");
-    *out = (k == mf::kCitlKind ? model->citl : model->twostage) ? 1 : 0;
+    *out = model->inbetweener(mf::inbetweener_kind(kind).name) ? 1 : 0;
   });
 }
 

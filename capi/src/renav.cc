@@ -48,20 +48,7 @@ int mf_renav(const mf_model* model, const mf_motion* reference, const float* pat
 
     const mf::TaskContext ctx = mf::capi::task_context(model, o);
     const std::string method = o.method ? o.method : "";
-    if (!method.empty()) {
-      bool known = false;
-      std::string list;
-      for (const std::string& m : mf::renav_methods()) {
-        known = known || m == method;
-        list += (list.empty() ? "" : ", ") + m;
-      }
-      if (!known)
-        throw ApiError(MF_ERROR_INVALID_ARGUMENT,
-                       "unknown re-navigation method '" + method + "' (available: " + list + ")");
-    }
-    if (!ctx.model) throw ApiError(MF_ERROR_MODEL, "re-navigation needs a model (the prior), and none was given");
     const mf::Motion& ref = reference->motion;
-    mf::capi::check_model_rig(model, ref.skeleton, o, ctx);
 
     std::vector<Eigen::Vector2d> path(point_count);
     for (size_t i = 0; i < point_count; ++i) path[i] = Eigen::Vector2d(path_xz[2 * i], path_xz[2 * i + 1]);

@@ -34,7 +34,7 @@ std::string describe_rig(const mf_model& model, const mf_motion& motion, const s
   for (int u = 0; u < user.num_joints(); ++u)
     if (!used[static_cast<size_t>(u)]) out["unmapped_user_joints"].push_back(user.names[static_cast<size_t>(u)]);
   out["model_joints"] = rig.names;
-  out["retargeting"] = model.anatomy != nullptr;
+  out["retargeting"] = model.model_anatomy != nullptr;
   return out.dump();
 }
 

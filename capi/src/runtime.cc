@@ -35,6 +35,8 @@ int fail_current_exception() noexcept {
     return fail(e.status(), e.what());
   } catch (const CancelledError&) {
     return fail(MF_ERROR_CANCELLED, "cancelled");
+  } catch (const ModelMissingError& e) {
+    return fail(MF_ERROR_MODEL, e.what());
   } catch (const InputError& e) {
     return fail(MF_ERROR_INVALID_ARGUMENT, e.what());
   } catch (const std::bad_alloc&) {
@@ -200,7 +202,7 @@ int mf_default_method(const mf_model* model, const char** name) {
   return guard([&] {
     require(name, "name");
     mf::TaskContext ctx;
-    mf::capi::set_models(model, &ctx);
+    if (model) static_cast<mf::ModelSet&>(ctx) = *model;
     const std::string d = mf::default_method(ctx);
     for (const mf::Method& m : mf::registered_methods()) {
       if (m.name == d) {

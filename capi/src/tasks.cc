@@ -5,11 +5,9 @@
 #include <fstream>
 
 #include "capi/src/capi_internal.h"
-#include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/rig/rig_map.h"
 #include "tasks/jobs.h"
-#include "tasks/model_rig.h"
 
 namespace mf::capi {
 namespace {
@@ -36,7 +34,7 @@ std::string rig_map_of(const mf_task_options& o) {
 
 TaskContext task_context(const mf_model* model, const mf_task_options& o) {
   TaskContext ctx;
-  set_models(model, &ctx);
+  if (model) static_cast<ModelSet&>(ctx) = *model;
   ctx.seed = o.seed;
   if (o.progress) {
     const mf_progress_fn fn = o.progress;
@@ -53,58 +51,14 @@ TaskContext task_context(const mf_model* model, const mf_task_options& o) {
   }
   if (o.cancel) ctx.cancel = &o.cancel->flag;
   ctx.rig_map = rig_map_of(o);
+  ctx.rig_map_source = rig_map_file(o);
   return ctx;
-}
-
-void check_model_rig(const mf_model* model, const Skeleton& input, const mf_task_options& o, const TaskContext& ctx) {
-  if (!ctx.model || input.same_as(ctx.model->rig().skeleton)) return;
-  if (!ctx.model_anatomy) {
-    const std::string why = model && !model->anatomy_error.empty()
-                                ? "the model's rig anatomy file did not load: " + model->anatomy_error
-                                : std::string("the model has no rig anatomy to retarget with (") + kRigAnatomyFileName +
-                                      " next to the model file)";
-    throw ApiError(model && !model->anatomy_error.empty() ? MF_ERROR_MODEL : MF_ERROR_INVALID_ARGUMENT,
-                   "the motion has " + std::to_string(input.num_joints()) +
-                       " joints on another rig than the model's (" + std::to_string(ctx.model->rig().num_joints()) +
-                       " joints), and " + why);
-  }
-  try {
-    model_rig_map(input, ctx);
-  } catch (const InputError& e) {
-    const std::string file = rig_map_file(o);
-    throw ApiError(MF_ERROR_INVALID_ARGUMENT, (file.empty() ? "" : file + ": ") + e.what());
-  }
 }
 
 namespace {
 
-// The context of one task call from its options; checks what the C boundary
-// can check before the method runs.
-TaskContext make_context(const mf_model* model, const mf_motion& input, const mf_task_options& o,
-                         std::string* method) {
-  const TaskContext ctx = task_context(model, o);
-  *method = o.method ? o.method : "";
-  const std::string name = method->empty() ? default_method(ctx) : *method;
-  const Method* found = nullptr;
-  std::string list;
-  for (const Method& m : registered_methods()) {
-    list += (list.empty() ? "" : ", ") + m.name;
-    if (m.name == name) found = &m;
-  }
-  if (!found) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "unknown method '" + name + "' (available: " + list + ")");
-  if (found->needs_model) {
-    if (!ctx.model)
-      throw ApiError(MF_ERROR_MODEL, "method '" + name + "' needs a model (the prior), and none was given");
-    check_model_rig(model, input.motion.skeleton, o, ctx);
-  }
-  require_inbetweener(model, name, found->needs_inbetweener);
-  return ctx;
-}
-
-// Called by each task once its arguments are validated: the first progress
-// report, which also honours a cancel token cancelled before the call.
-void start(const TaskContext& ctx) { ctx.report(TaskProgress{}); }
-
+// Runs one task: the C boundary checks what C callers can get wrong (NULL
+// pointers, the options struct); the library validates the request itself.
 template <class Run>
 int run_task(const mf_model* model, const mf_motion* input, const mf_task_options* options, mf_motion** out,
              Run&& run) {
@@ -112,10 +66,9 @@ int run_task(const mf_model* model, const mf_motion* input, const mf_task_option
     require(input, "input");
     require(out, "out");
     const mf_task_options o = read_options(options, "mf_task_options");
-    std::string method;
-    const TaskContext ctx = make_context(model, *input, o, &method);
+    const TaskContext ctx = task_context(model, o);
     apply_num_threads();
-    Motion result = run(input->motion, method, ctx);
+    Motion result = run(input->motion, o.method ? std::string(o.method) : std::string(), ctx);
     *out = derived_motion(std::move(result), *input);
   });
 }
@@ -136,8 +89,6 @@ int mf_inbetween(const mf_model* model, const mf_motion* input, const int32_t* k
                               if (!keyframes && keyframe_count != 0)
                                 throw ApiError(MF_ERROR_INVALID_ARGUMENT, "keyframes is NULL");
                               const std::vector<int> keys(keyframes, keyframes + keyframe_count);
-                              mf::validate_keyframes(keys, in.num_frames());
-                              mf::capi::start(ctx);
                               return mf::run_inbetween(in, keys, method, ctx);
                             });
 }
@@ -146,8 +97,6 @@ int mf_fill(const mf_model* model, const mf_motion* input, int32_t gap_begin, in
             const mf_task_options* options, mf_motion** out) {
   return mf::capi::run_task(model, input, options, out,
                             [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
-                              mf::known_frames_outside_gap(in.num_frames(), gap_begin, gap_end);
-                              mf::capi::start(ctx);
                               return mf::run_fill(in, gap_begin, gap_end, method, ctx);
                             });
 }
@@ -156,10 +105,6 @@ int mf_resample(const mf_model* model, const mf_motion* input, double fps, const
                 mf_motion** out) {
   return mf::capi::run_task(model, input, options, out,
                             [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
-                              if (!(std::isfinite(fps) && fps > 0))
-                                throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the target fps must be finite and positive");
-                              mf::resampled_frame_count(in.num_frames(), in.fps, fps, nullptr);
-                              mf::capi::start(ctx);
                               return mf::run_resample(in, fps, method, nullptr, ctx);
                             });
 }

@@ -284,4 +284,8 @@ std::unique_ptr<InbetweenModel> make_citl(const std::map<std::string, double>& h
   return std::make_unique<CitlModel>(parse_config(hyperparameters), rig);
 }
 
+InbetweenerKind citl_kind() {
+  return {kCitlKind, "CITL transformer", "motionfield-citl.mfm", {{"citl", "CITL transformer"}}, make_citl};
+}
+
 }  // namespace mf

@@ -40,8 +40,12 @@
 
 namespace mf {
 
-/// A freshly initialised CITL model. Missing hyperparameters take the defaults
-/// above; unknown keys or invalid values throw mf::InputError.
+/// A freshly initialised CITL model. Missing hyperparameters take the
+/// defaults above; unknown keys or invalid values throw mf::InputError.
 std::unique_ptr<InbetweenModel> make_citl(const std::map<std::string, double>& hyperparameters, const RigInfo& rig);
+
+/// The kind's entry in the registry (inbetweener_kinds()): name, title, model
+/// file, stages, and make_citl as its factory.
+InbetweenerKind citl_kind();
 
 }  // namespace mf

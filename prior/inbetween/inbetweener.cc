@@ -84,8 +84,10 @@ std::map<std::string, InbetweenFactory>& registry() {
   return r;
 }
 
+// The file kinds load_inbetweener accepts: the product's and the registered.
 std::vector<std::string> known_kinds() {
-  std::vector<std::string> kinds = {kTwoStageKind, kCitlKind};
+  std::vector<std::string> kinds;
+  for (const InbetweenerKind& k : inbetweener_kinds()) kinds.push_back(k.name);
   std::lock_guard<std::mutex> lock(registry_mutex());
   for (const auto& [k, f] : registry()) kinds.push_back(k);
   return kinds;
@@ -192,8 +194,38 @@ void InbetweenModel::set_requires_grad(bool on) {
   for (auto& [name, p] : named_parameters()) p.set_requires_grad(on);
 }
 
+const std::vector<InbetweenerKind>& inbetweener_kinds() {
+  static const std::vector<InbetweenerKind> kinds = {two_stage_kind(), citl_kind()};
+  return kinds;
+}
+
+const InbetweenerKind* find_inbetweener_kind(const std::string& name) {
+  for (const InbetweenerKind& k : inbetweener_kinds()) {
+    if (k.name == name) return &k;
+  }
+  return nullptr;
+}
+
+const InbetweenerKind* find_inbetweener_stage(const std::string& stage, int* index) {
+  for (const InbetweenerKind& k : inbetweener_kinds()) {
+    for (size_t i = 0; i < k.stages.size(); ++i) {
+      if (k.stages[i].name != stage) continue;
+      if (index) *index = static_cast<int>(i);
+      return &k;
+    }
+  }
+  return nullptr;
+}
+
+const InbetweenerKind& inbetweener_kind(const std::string& name) {
+  if (const InbetweenerKind* k = find_inbetweener_kind(name)) return *k;
+  std::string list;
+  for (const InbetweenerKind& k : inbetweener_kinds()) list += (list.empty() ? "" : ", ") + k.name;
+  throw InputError("unknown in-betweener kind '" + name + "' (available: " + list + ")");
+}
+
 void register_inbetweener_kind(const std::string& kind, InbetweenFactory factory) {
-  if (kind == kTwoStageKind || kind == kCitlKind || kind == kNemfKind || kind.empty()) {
+  if (find_inbetweener_kind(kind) || kind == kNemfKind || kind.empty()) {
     throw InputError("register_inbetweener_kind: '" + kind + "' is reserved");
   }
   std::lock_guard<std::mutex> lock(registry_mutex());
@@ -204,24 +236,20 @@ std::unique_ptr<InbetweenModel> make_inbetweener(const std::string& kind,
                                                  const std::map<std::string, double>& hyperparameters,
                                                  const RigInfo& rig) {
   if (rig.num_joints() < 1) throw InputError("in-betweener: the rig has no joints");
-  std::unique_ptr<InbetweenModel> model;
-  if (kind == kTwoStageKind) {
-    model = make_two_stage(hyperparameters, rig);
-  } else if (kind == kCitlKind) {
-    model = make_citl(hyperparameters, rig);
+  InbetweenFactory factory;
+  if (const InbetweenerKind* k = find_inbetweener_kind(kind)) {
+    factory = k->make;
   } else {
-    InbetweenFactory factory;
-    {
-      std::lock_guard<std::mutex> lock(registry_mutex());
-      auto it = registry().find(kind);
-      if (it != registry().end()) factory = it->second;
-    }
-    if (!factory) {
-      throw InputError("unknown in-betweener kind '" + kind + "' (expected '" + kTwoStageKind + "' or '" +
-                       kCitlKind + "')");
-    }
-    model = factory(hyperparameters, rig);
+    std::lock_guard<std::mutex> lock(registry_mutex());
+    auto it = registry().find(kind);
+    if (it != registry().end()) factory = it->second;
   }
+  if (!factory) {
+    std::string list;
+    for (const InbetweenerKind& k : inbetweener_kinds()) list += (list.empty() ? "'" : ", '") + k.name + "'";
+    throw InputError("unknown in-betweener kind '" + kind + "' (expected " + list + ")");
+  }
+  std::unique_ptr<InbetweenModel> model = factory(hyperparameters, rig);
   if (!model) throw InputError("in-betweener: the factory of '" + kind + "' made no model");
   return model;
 }

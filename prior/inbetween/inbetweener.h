@@ -121,8 +121,8 @@ class InbetweenModel {
   InbetweenStats stats_;
 };
 
-/// A freshly initialised model of `kind` (kTwoStageKind, kCitlKind) with the
-/// given hyperparameters (missing ones take the kind's defaults). Throws
+/// A freshly initialised model of `kind` (a product kind or a registered one)
+/// with the given hyperparameters (missing ones take the kind's defaults). Throws
 /// mf::InputError for an unknown kind or invalid hyperparameters.
 std::unique_ptr<InbetweenModel> make_inbetweener(const std::string& kind,
                                                  const std::map<std::string, double>& hyperparameters,
@@ -153,10 +153,46 @@ class HyperparameterReader {
   std::string problems_;
 };
 
-/// Registers another kind for make_inbetweener / load_inbetweener (tests use
-/// it for tiny stand-in models). The built-in kinds are always known.
+/// Makes a fresh model of one kind from its hyperparameters (missing ones take
+/// the kind's defaults; InputError for invalid ones).
 using InbetweenFactory =
     std::function<std::unique_ptr<InbetweenModel>(const std::map<std::string, double>&, const RigInfo&)>;
+
+/// One output stage of a kind, as the product offers it: the stage alone is
+/// the method `name` (one pass), its output encoded by the prior is the
+/// initialiser "<name>-encoder", and the latent solver started there is the
+/// method "nemf-<name>".
+struct InbetweenerStage {
+  std::string name;         ///< "context"; also the model's stage_names() entry
+  std::string description;  ///< "Context Transformer only", in method lists
+};
+
+/// A kind of in-betweener: everything the rest of the product derives from it
+/// (methods, initialisers, the file next to the prior, the trainer's
+/// subcommand, the benchmarks' flags).
+struct InbetweenerKind {
+  std::string name;                      ///< "twostage": the model file's kind
+  std::string title;                     ///< "two-stage transformer", in messages
+  std::string file_name;                 ///< "motionfield-twostage.mfm", next to the prior's file
+  std::vector<InbetweenerStage> stages;  ///< in the model's stage_names() order
+  InbetweenFactory make;
+};
+
+/// The product's kinds, in a fixed order (two-stage, CITL). Adding a kind is
+/// its network's file (which defines its InbetweenerKind) and one line in the
+/// list in inbetweener.cc.
+const std::vector<InbetweenerKind>& inbetweener_kinds();
+/// The product's kind called `name`, or null.
+const InbetweenerKind* find_inbetweener_kind(const std::string& name);
+/// The same; mf::InputError listing the product's kinds when there is none.
+const InbetweenerKind& inbetweener_kind(const std::string& name);
+/// The product kind that has a stage called `stage`, or null; *index (if
+/// non-null) receives the stage's index.
+const InbetweenerKind* find_inbetweener_stage(const std::string& stage, int* index = nullptr);
+
+/// Registers another kind for make_inbetweener / load_inbetweener only (tests
+/// use it for tiny stand-in models); it gets no methods and no file name.
+/// The product's kinds cannot be replaced.
 void register_inbetweener_kind(const std::string& kind, InbetweenFactory factory);
 
 /// The model file (prior/model/model_file.h container: same magic, version,

@@ -318,4 +318,12 @@ std::unique_ptr<InbetweenModel> make_two_stage(const std::map<std::string, doubl
   return std::make_unique<TwoStageModel>(parse_config(hyperparameters), rig);
 }
 
+InbetweenerKind two_stage_kind() {
+  return {kTwoStageKind,
+          "two-stage transformer",
+          "motionfield-twostage.mfm",
+          {{"context", "Context Transformer only"}, {"detail", "Context + Detail Transformer"}},
+          make_two_stage};
+}
+
 }  // namespace mf
