@@ -9,6 +9,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/motion_bvh.h"
 #include "prior/motion/rotations.h"
+#include "prior/rig/mirror.h"
 #include "prior/rig/retarget.h"
 #include "prior/rig/rig_map.h"
 #include "prior/rig/units.h"
@@ -371,6 +372,56 @@ TEST(ModelRig, UnmappableRigAndMissingAnatomyAreClearErrors) {
   EXPECT_THROW(
       complete_on_model_rig(other, {0, 30, 60}, ctx, [](const Motion& m, const std::vector<int>&) { return m; }),
       InputError);
+}
+
+// The training rig (whose joint frames are not world-aligned) mirrors: every
+// joint lands where its counterpart's reflection was, the twists keep the
+// mean local rotations (no bone flipped half a turn), and mirroring twice
+// gives the motion back.
+TEST(Mirror, MotionIsItsCounterpartsReflection) {
+  const Motion& m = sample();
+  const MirrorMap map = mirror_map(m.skeleton, mean_local_rotations({&m}));
+  const Skeleton& s = m.skeleton;
+  EXPECT_EQ(s.names[map.counterpart[s.find("UpperArm_L")]], "UpperArm_R");
+  EXPECT_EQ(s.names[map.counterpart[s.find("Toes_R")]], "Toes_L");
+  EXPECT_EQ(map.counterpart[s.find("Head")], s.find("Head"));
+  EXPECT_LT(map.max_asymmetry, 1e-6);
+  const Motion mirrored = mirror_motion(m, map);
+  const Eigen::Matrix3d M = Eigen::Vector3d(-1, 1, 1).asDiagonal();
+  const GlobalPose a = forward_kinematics(m), b = forward_kinematics(mirrored);
+  double worst = 0.0;
+  for (int f = 0; f < m.num_frames(); ++f)
+    for (int j = 0; j < m.num_joints(); ++j)
+      worst = std::max(worst, (b.position(f, j) - M * a.position(f, map.counterpart[j])).norm());
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GT(max_angle_deg(m, mirrored), 1.0);  // not the identity
+  const std::vector<Eigen::Quaterniond> before = mean_local_rotations({&m}), after = mean_local_rotations({&mirrored});
+  for (int j = 1; j < m.num_joints(); ++j)
+    EXPECT_LT(geodesic_angle(before[j], after[j]) * 180 / M_PI, 45.0) << s.names[j];
+  const Motion twice = mirror_motion(mirrored, map);
+  EXPECT_LT(max_angle_deg(m, twice), 1e-6);
+  EXPECT_LT(max_root_diff(m, twice), 1e-12);
+}
+
+TEST(Mirror, RigsThatCannotBeMirroredAreClearErrors) {
+  Skeleton s = sample().skeleton;
+  s.names[s.find("Hand_R")] = "Palm_R";  // Hand_L has no counterpart now
+  const std::vector<Eigen::Quaterniond> means = mean_local_rotations({&sample()});
+  try {
+    mirror_map(s, means);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'Hand_L' has no right counterpart"), std::string::npos) << e.what();
+  }
+  Skeleton lopsided = sample().skeleton;
+  lopsided.offsets[lopsided.find("LowerLeg_L")] *= 1.5;
+  try {
+    mirror_map(lopsided, means);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("children of 'UpperLeg_L' (LowerLeg_L) are not mirror images"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -319,7 +319,7 @@ InbetweenRun::InbetweenRun(const InbetweenTrainingOptions& o)
     : o_(o),
       t0_(Clock::now()),
       files_(o.out_dir),
-      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, 0.0, o.verbose)),
+      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, 0.0, o.mirror, o.verbose)),
       resuming_(o.resume && files_.has_checkpoint()),
       model_(load_or_make_model(o, data_, files_, resuming_)),
       train_sampler_(data_.train, model_->rig(), model_->window(), o.min_length),

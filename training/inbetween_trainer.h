@@ -57,6 +57,7 @@ struct InbetweenTrainingOptions {
   int validation_windows = 256;
   bool resume = false;              ///< continue from out_dir/last.* when present
   int max_train_clips = 0;          ///< 0 = all
+  bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
   bool verbose = true;
 };
 

@@ -58,6 +58,8 @@ void add_run_options(CLI::App& cmd, Options& o, RunArgs& run) {
   cmd.add_option("--seed", o.seed, "random seed");
   cmd.add_option("--threads", o.threads, "torch intra-op threads");
   cmd.add_option("--max-train-clips", o.max_train_clips, "use at most N training clips (0 = all)");
+  cmd.add_flag("--mirror", o.mirror,
+               "also train on every training clip's left/right mirror (doubles the data; give it again on --resume)");
   cmd.add_flag("--resume", o.resume, "continue from DIR/last.* if present");
   cmd.add_option("--export", run.export_path, "copy the best checkpoint to PATH at the end");
   cmd.add_flag("--quiet", run.quiet, "no progress lines on stderr");

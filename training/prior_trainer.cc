@@ -299,7 +299,7 @@ PriorRun::PriorRun(const PriorTrainingOptions& o)
     : o_(o),
       t0_(Clock::now()),
       files_(o.out_dir),
-      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, o.config.fps, o.verbose)),
+      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, o.config.fps, o.mirror, o.verbose)),
       resuming_(o.resume && files_.has_checkpoint()),
       model_(load_or_make_model(o, data_, files_, resuming_)),
       W_(model_.config().window),

@@ -41,6 +41,7 @@ struct PriorTrainingOptions {
   double kl_warmup = 0.2;
   bool resume = false;              ///< continue from out_dir/last.* when present
   int max_train_clips = 0;          ///< 0 = all (small values for smoke tests)
+  bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
   int max_steps = 0;                ///< 0 = unlimited (for tests)
   bool verbose = true;
 };

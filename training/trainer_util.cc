@@ -4,16 +4,20 @@
 #include <torch/optim/adam.h>
 #include <torch/optim/optimizer.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
 #include "prior/motion/errors.h"
+#include "prior/motion/rotations.h"
+#include "prior/rig/mirror.h"
 
 namespace mf::training {
 
 Dataset load_training_data(const std::string& source, const std::string& cache_dir, int max_train_clips, double fps,
-                           bool verbose) {
+                           bool mirror, bool verbose) {
   DatasetOptions dopt;
   dopt.source = source;
   dopt.cache_dir = cache_dir;
@@ -25,6 +29,31 @@ Dataset load_training_data(const std::string& source, const std::string& cache_d
     if (fps > 0 && std::abs(c.motion.fps - fps) > 1e-3) {
       throw InputError("train: clip " + c.name + " is at " + std::to_string(c.motion.fps) + " fps, the model at " +
                        std::to_string(fps) + " fps");
+    }
+  }
+  if (mirror) {
+    data.train.reserve(2 * data.train.size());  // the pointers below stay valid while the mirrors are added
+    std::vector<const Motion*> motions;
+    for (const Clip& c : data.train) motions.push_back(&c.motion);
+    const MirrorMap map = mirror_map(data.skeleton, mean_local_rotations(motions));
+    const size_t n = data.train.size();
+    for (size_t i = 0; i < n; ++i)
+      data.train.push_back({data.train[i].name + "#mirror", mirror_motion(data.train[i].motion, map)});
+    if (verbose) {
+      // The twists are chosen to keep the mean local rotations; how close they stay says whether they were found.
+      std::vector<const Motion*> mirrored;
+      for (size_t i = n; i < data.train.size(); ++i) mirrored.push_back(&data.train[i].motion);
+      const std::vector<Eigen::Quaterniond> a = mean_local_rotations(motions), b = mean_local_rotations(mirrored);
+      double worst = 0.0;
+      size_t at = 0;
+      for (size_t j = 1; j < a.size(); ++j) {
+        const double d = geodesic_angle(a[j], b[j]) * 180.0 / M_PI;
+        if (d > worst) worst = d, at = j;
+      }
+      std::fprintf(stderr,
+                   "train: %zu mirrored clips added (rest offsets mirror within %.2f cm; mean local rotations "
+                   "within %.1f deg of the originals', the most at %s)\n",
+                   n, map.max_asymmetry * 100.0, worst, data.skeleton.names[at].c_str());
     }
   }
   return data;

@@ -17,10 +17,13 @@ class Optimizer;
 namespace mf::training {
 
 /// Loads `data` (folder or archive) through the cache, keeps at most
-/// `max_train_clips` training clips (0 = all) and checks that every training
-/// clip is at `fps` (when fps > 0). Throws InputError when there is no training clip.
+/// `max_train_clips` training clips (0 = all), checks that every training
+/// clip is at `fps` (when fps > 0) and, with `mirror`, appends each training
+/// clip's left/right mirror (named "<clip>#mirror"; InputError when the rig
+/// cannot be mirrored). The validation split is never mirrored. Throws
+/// InputError when there is no training clip.
 Dataset load_training_data(const std::string& data, const std::string& cache_dir, int max_train_clips, double fps,
-                           bool verbose);
+                           bool mirror, bool verbose);
 
 /// The rig measured from the training clips (as the prior's trainer does).
 RigInfo measure_training_rig(const Dataset& data);

@@ -182,6 +182,32 @@ int name_side(const std::string& name) {
   return split_side(name, &rest);
 }
 
+std::vector<int> mirror_counterparts(const Skeleton& skeleton) {
+  const int J = skeleton.num_joints();
+  std::vector<int> side(J);
+  std::vector<std::vector<std::string>> words(J);
+  for (int j = 0; j < J; ++j) side[j] = split_side(skeleton.names[j], &words[j]);
+  std::vector<int> counterpart(J, -1);
+  for (int j = 0; j < J; ++j) {
+    if (side[j] < 0) {
+      counterpart[j] = j;
+      continue;
+    }
+    for (int k = 0; k < J && counterpart[j] < 0; ++k)
+      if (side[k] == 1 - side[j] && words[k] == words[j]) counterpart[j] = k;
+    if (counterpart[j] < 0)
+      throw InputError("joint '" + skeleton.names[j] + "' has no " + side_name(1 - side[j]) +
+                       " counterpart: the rig cannot be mirrored");
+  }
+  for (int j = 1; j < J; ++j) {
+    const int p = skeleton.parents[j];
+    if (skeleton.parents[counterpart[j]] != counterpart[p])
+      throw InputError("joints '" + skeleton.names[j] + "' and '" + skeleton.names[counterpart[j]] +
+                       "' are counterparts, but their parents are not: the rig cannot be mirrored");
+  }
+  return counterpart;
+}
+
 namespace {
 
 // The steps of find_rig_parts over one skeleton, each filling what it can.

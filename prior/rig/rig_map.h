@@ -61,6 +61,13 @@ RigParts find_rig_parts(const Skeleton& skeleton);
 /// "left"/"right" side of a joint name (0 / 1), or -1 when the name has none.
 int name_side(const std::string& name);
 
+/// Each joint's left/right counterpart by name ("LeftArm" <-> "RightArm",
+/// "hand_l" <-> "hand_r": the same words with the other side), the joint
+/// itself for names without a side. Throws mf::InputError naming a sided
+/// joint without a counterpart, or a counterpart on another side of the
+/// hierarchy (its parent's counterpart is not its parent).
+std::vector<int> mirror_counterparts(const Skeleton& skeleton);
+
 /// The correspondence between a user's skeleton and the model's.
 struct RigMap {
   /// For every model joint: the user joint that plays it, or -1 (the
