@@ -3,6 +3,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "capi/src/capi_internal.h"
 #include "prior/model/nemf.h"
@@ -105,6 +108,8 @@ TaskContext make_context(const mf_model* model, const mf_motion& input, const mf
 // report, which also honours a cancel token cancelled before the call.
 void start(const TaskContext& ctx) { ctx.report(TaskProgress{}); }
 
+// `run(input, method, ctx, warnings)` returns the result and may append
+// warnings for the caller, which the result handle carries.
 template <class Run>
 int run_task(const mf_model* model, const mf_motion* input, const mf_task_options* options, mf_motion** out,
              Run&& run) {
@@ -115,8 +120,11 @@ int run_task(const mf_model* model, const mf_motion* input, const mf_task_option
     std::string method;
     const TaskContext ctx = make_context(model, *input, o, &method);
     apply_num_threads();
-    Motion result = run(input->motion, method, ctx);
-    *out = derived_motion(std::move(result), *input);
+    std::vector<std::string> warnings;
+    Motion result = run(input->motion, method, ctx, &warnings);
+    std::unique_ptr<mf_motion> handle(derived_motion(std::move(result), *input));
+    for (const std::string& w : warnings) handle->warnings += (handle->warnings.empty() ? "" : "\n") + w;
+    *out = handle.release();
   });
 }
 
@@ -132,7 +140,8 @@ extern "C" {
 int mf_inbetween(const mf_model* model, const mf_motion* input, const int32_t* keyframes, size_t keyframe_count,
                  const mf_task_options* options, mf_motion** out) {
   return mf::capi::run_task(model, input, options, out,
-                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
+                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx,
+                                std::vector<std::string>*) {
                               if (!keyframes && keyframe_count != 0)
                                 throw ApiError(MF_ERROR_INVALID_ARGUMENT, "keyframes is NULL");
                               const std::vector<int> keys(keyframes, keyframes + keyframe_count);
@@ -145,7 +154,8 @@ int mf_inbetween(const mf_model* model, const mf_motion* input, const int32_t* k
 int mf_fill(const mf_model* model, const mf_motion* input, int32_t gap_begin, int32_t gap_end,
             const mf_task_options* options, mf_motion** out) {
   return mf::capi::run_task(model, input, options, out,
-                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
+                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx,
+                                std::vector<std::string>*) {
                               mf::known_frames_outside_gap(in.num_frames(), gap_begin, gap_end);
                               mf::capi::start(ctx);
                               return mf::run_fill(in, gap_begin, gap_end, method, ctx);
@@ -155,12 +165,13 @@ int mf_fill(const mf_model* model, const mf_motion* input, int32_t gap_begin, in
 int mf_resample(const mf_model* model, const mf_motion* input, double fps, const mf_task_options* options,
                 mf_motion** out) {
   return mf::capi::run_task(model, input, options, out,
-                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
+                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx,
+                                std::vector<std::string>* warnings) {
                               if (!(std::isfinite(fps) && fps > 0))
                                 throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the target fps must be finite and positive");
                               mf::resampled_frame_count(in.num_frames(), in.fps, fps, nullptr);
                               mf::capi::start(ctx);
-                              return mf::run_resample(in, fps, method, nullptr, ctx);
+                              return mf::run_resample(in, fps, method, warnings, ctx);
                             });
 }
 
