@@ -186,6 +186,8 @@ bad "flag given twice" inbetween --in "$SAMPLE" --keyframes 0,10 --keyframes 0,2
 bad "stray argument" fill --in "$SAMPLE" --gap 1:2 --out "$TMP/bad.bvh" extra
 bad "output directory missing" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/no/such/dir/bad.bvh"
 bad "unknown command" dance --in "$SAMPLE"
+expect_stderr "unknown command 'dance'" "unknown command message"
+bad "diff is a test tool, not a command" diff "$SAMPLE" "$SAMPLE"
 bad "bad --threads" --threads 0 inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh"
 bad "no command"
 
