@@ -182,6 +182,8 @@ bad "unknown method" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.b
 expect_stderr "unknown method 'magic'" "unknown method message"
 bad "missing --keyframes" inbetween --in "$SAMPLE" --out "$TMP/bad.bvh"
 bad "flag without value" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh" --method
+bad "empty --method" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh" --method ""
+bad "empty --model" --model "" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh" --method interp
 bad "flag given twice" inbetween --in "$SAMPLE" --keyframes 0,10 --keyframes 0,20 --out "$TMP/bad.bvh"
 bad "stray argument" fill --in "$SAMPLE" --gap 1:2 --out "$TMP/bad.bvh" extra
 bad "output directory missing" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/no/such/dir/bad.bvh"

@@ -64,6 +64,10 @@ CLI::App* add_command(CLI::App& app, HelpFormatter& help, const std::string& nam
 // A validator whose description stays out of the help's option column.
 CLI::Validator quiet(CLI::Validator check) { return check.description(""); }
 
+// An empty value (--model "") would silently mean the default: refuse it.
+const CLI::Validator kNonEmpty(
+    [](const std::string& value) { return value.empty() ? std::string("needs a value") : std::string(); }, "");
+
 // --in and --out of the task commands.
 void add_task_files(CLI::App* cmd, BatchJob& job, const std::string& in_help) {
   cmd->add_option("--in", job.in, in_help)->required()->type_name("PATH");
@@ -72,7 +76,7 @@ void add_task_files(CLI::App* cmd, BatchJob& job, const std::string& in_help) {
 
 void add_method(CLI::App* cmd, BatchJob& job,
                 const std::string& help = "one of the methods below (default: the best available)") {
-  cmd->add_option("--method", job.method, help)->type_name("M");
+  cmd->add_option("--method", job.method, help)->type_name("M")->check(kNonEmpty);
 }
 
 void define_global_options(CLI::App& app, Settings& s) {
@@ -84,16 +88,21 @@ void define_global_options(CLI::App& app, Settings& s) {
   app.add_option("--model", s.model,
                  "the prior's model file (default: the installed model,\n$MF_MODEL or models/motionfield-prior.mfm, "
                  "if any);\nneeded only by methods that use the prior")
-      ->type_name("PATH");
+      ->type_name("PATH")
+      ->check(kNonEmpty);
   const char* transformer_help =
       "transformer in-betweener files (methods context, detail,\nnemf-context, nemf-detail; citl, nemf-citl); "
       "default:\nmotionfield-twostage.mfm and motionfield-citl.mfm next to\nthe model file, when present";
-  app.add_option("--twostage", s.twostage, transformer_help)->type_name("PATH")->allow_extra_args(false);
-  app.add_option("--citl", s.citl, "the same")->type_name("PATH")->allow_extra_args(false);
+  app.add_option("--twostage", s.twostage, transformer_help)
+      ->type_name("PATH")
+      ->allow_extra_args(false)
+      ->check(kNonEmpty);
+  app.add_option("--citl", s.citl, "the same")->type_name("PATH")->allow_extra_args(false)->check(kNonEmpty);
   app.add_option("--rig-map", s.rig_map,
                  "a JSON map {\"your joint\": \"model joint\" or null} that\noverrides the automatic map of your rig "
                  "onto the model's")
-      ->type_name("FILE");
+      ->type_name("FILE")
+      ->check(kNonEmpty);
   app.add_option("--units", s.units,
                  "the BVH length unit: auto (the default: detected from the\nleg length), cm, m, mm, in, ft, asf or "
                  "metres per unit")
