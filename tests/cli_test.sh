@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # End-to-end tests of the motionfield CLI on the bundled sample.
-#   usage: bash tests/cli_test.sh <path-to-motionfield> <source-dir>
+#   usage: bash tests/cli_test.sh <path-to-motionfield> <source-dir> <path-to-mf_bvh_diff>
 # Checks frame counts and frame times of every subcommand's output, that known
-# frames come back unchanged (with the hidden `motionfield diff` helper), the
+# frames come back unchanged (with the test tool mf_bvh_diff, tests/tools), the
 # exit code 2 of every kind of bad input, and batch mode.
 set -u
 
 MF=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
 SRC=$(cd "$2" && pwd)
+DIFF=$(cd "$(dirname "$3")" && pwd)/$(basename "$3")
 SAMPLE="$SRC/samples/walk_keyframes.bvh"
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/mf-cli-test.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT
@@ -49,11 +50,22 @@ expect_stderr() {  # PATTERN DESCRIPTION
   if grep -q -- "$1" "$TMP/err"; then pass; else fail "$2: stderr lacks '$1'"; sed 's/^/  stderr: /' "$TMP/err"; fi
 }
 
+# in_dir DIR COMMAND...: runs COMMAND (a check) in DIR, in this shell so that
+# its pass or failure counts.
+in_dir() {
+  local dir=$1
+  shift
+  pushd "$dir" >/dev/null || { fail "cannot enter $dir"; return; }
+  "$@"
+  popd >/dev/null || exit 1
+}
+
 expect_absent() {  # FILE
   if [ -e "$1" ]; then fail "$1 was written although the command failed"; else pass; fi
 }
 
 [ -x "$MF" ] || { echo "not executable: $MF"; exit 1; }
+[ -x "$DIFF" ] || { echo "not executable: $DIFF"; exit 1; }
 [ -f "$SAMPLE" ] || { echo "missing sample: $SAMPLE"; exit 1; }
 N=$(frames_of "$SAMPLE")
 FT=$(frame_time_of "$SAMPLE")
@@ -73,7 +85,7 @@ ALL=$(seq -s, 0 $((N - 1)))
 expect_rc 0 "inbetween, every frame a keyframe" -- "$MF" inbetween --in "$SAMPLE" --keyframes "$ALL" --out "$TMP/all.bvh"
 expect_frames "$TMP/all.bvh" "$N"
 expect_frame_time "$TMP/all.bvh" "$FT"
-expect_rc 0 "keeping every frame reproduces the input" -- "$MF" diff "$SAMPLE" "$TMP/all.bvh"
+expect_rc 0 "keeping every frame reproduces the input" -- "$DIFF" "$SAMPLE" "$TMP/all.bvh"
 
 KEYS=0,10,20,30,40,50,60
 for method in interp zerovel; do
@@ -81,9 +93,9 @@ for method in interp zerovel; do
     "$MF" inbetween --in "$SAMPLE" --keyframes "$KEYS" --out "$TMP/kf-$method.bvh" --method "$method"
   expect_frames "$TMP/kf-$method.bvh" "$N"
   expect_frame_time "$TMP/kf-$method.bvh" "$FT"
-  expect_rc 0 "inbetween $method keeps the keyframes" -- "$MF" diff "$SAMPLE" "$TMP/kf-$method.bvh" --frames "$KEYS"
+  expect_rc 0 "inbetween $method keeps the keyframes" -- "$DIFF" "$SAMPLE" "$TMP/kf-$method.bvh" --frames "$KEYS"
   # ...and really changes the others (so the comparison above can fail).
-  expect_rc 3 "inbetween $method changes unknown frames" -- "$MF" diff "$SAMPLE" "$TMP/kf-$method.bvh"
+  expect_rc 3 "inbetween $method changes unknown frames" -- "$DIFF" "$SAMPLE" "$TMP/kf-$method.bvh"
 done
 # --flag=value form, --threads anywhere, and the default method: with the
 # bundled model the measured best method (tasks/jobs.cc default_method(),
@@ -98,9 +110,9 @@ if [ -f "$SRC/models/motionfield-prior.mfm" ]; then
   expect_rc 0 "inbetween --method $default_method" -- \
     "$MF" --threads 1 inbetween --in "$SAMPLE" --keyframes "$KEYS" --out "$TMP/named-default.bvh" --method "$default_method"
   expect_rc 0 "the default method with the model is $default_method" -- \
-    "$MF" diff "$TMP/default.bvh" "$TMP/named-default.bvh" --tol 1e-9
-  expect_rc 0 "the default method keeps the keyframes" -- "$MF" diff "$SAMPLE" "$TMP/default.bvh" --frames "$KEYS"
-  expect_rc 3 "...and is not interp" -- "$MF" diff "$TMP/default.bvh" "$TMP/kf-interp.bvh"
+    "$DIFF" "$TMP/default.bvh" "$TMP/named-default.bvh" --tol 1e-9
+  expect_rc 0 "the default method keeps the keyframes" -- "$DIFF" "$SAMPLE" "$TMP/default.bvh" --frames "$KEYS"
+  expect_rc 3 "...and is not interp" -- "$DIFF" "$TMP/default.bvh" "$TMP/kf-interp.bvh"
 fi
 
 # ------------------------------------------------------------ fill
@@ -109,7 +121,7 @@ for method in interp zerovel; do
   expect_frames "$TMP/fill-$method.bvh" "$N"
   expect_frame_time "$TMP/fill-$method.bvh" "$FT"
   expect_rc 0 "fill $method keeps frames outside the gap" -- \
-    "$MF" diff "$SAMPLE" "$TMP/fill-$method.bvh" --frames "$(seq -s, 0 9),$(seq -s, 40 60)"
+    "$DIFF" "$SAMPLE" "$TMP/fill-$method.bvh" --frames "$(seq -s, 0 9),$(seq -s, 40 60)"
 done
 expect_rc 0 "fill with the widest gap" -- "$MF" fill --in "$SAMPLE" --gap 1:60 --out "$TMP/fill-wide.bvh"
 expect_frames "$TMP/fill-wide.bvh" "$N"
@@ -120,13 +132,13 @@ for method in interp zerovel; do
   expect_frames "$TMP/r60-$method.bvh" $(((N - 1) * 2 + 1))
   expect_frame_time "$TMP/r60-$method.bvh" 0.0166666667
   expect_rc 0 "resample to 60 fps keeps the input frames at even output frames" -- \
-    "$MF" diff "$SAMPLE" "$TMP/r60-$method.bvh" --step 2
+    "$DIFF" "$SAMPLE" "$TMP/r60-$method.bvh" --step 2
   [ -s "$TMP/err" ] && fail "resample to 60 fps printed to stderr" || pass
 done
 expect_rc 0 "resample to 15 fps" -- "$MF" resample --in "$SAMPLE" --fps 15 --out "$TMP/r15.bvh"
 expect_frames "$TMP/r15.bvh" 31
 expect_frame_time "$TMP/r15.bvh" 0.0666666667
-expect_rc 0 "resample to 15 fps keeps even input frames" -- "$MF" diff "$TMP/r15.bvh" "$SAMPLE" --step 2
+expect_rc 0 "resample to 15 fps keeps even input frames" -- "$DIFF" "$TMP/r15.bvh" "$SAMPLE" --step 2
 expect_rc 0 "resample to 24 fps" -- "$MF" resample --in "$SAMPLE" --fps 24 --out "$TMP/r24.bvh"
 expect_frames "$TMP/r24.bvh" 49
 expect_frame_time "$TMP/r24.bvh" 0.0416666667
@@ -170,10 +182,14 @@ bad "unknown method" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.b
 expect_stderr "unknown method 'magic'" "unknown method message"
 bad "missing --keyframes" inbetween --in "$SAMPLE" --out "$TMP/bad.bvh"
 bad "flag without value" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh" --method
+bad "empty --method" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh" --method ""
+bad "empty --model" --model "" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh" --method interp
 bad "flag given twice" inbetween --in "$SAMPLE" --keyframes 0,10 --keyframes 0,20 --out "$TMP/bad.bvh"
 bad "stray argument" fill --in "$SAMPLE" --gap 1:2 --out "$TMP/bad.bvh" extra
 bad "output directory missing" inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/no/such/dir/bad.bvh"
 bad "unknown command" dance --in "$SAMPLE"
+expect_stderr "unknown command 'dance'" "unknown command message"
+bad "diff is a test tool, not a command" diff "$SAMPLE" "$SAMPLE"
 bad "bad --threads" --threads 0 inbetween --in "$SAMPLE" --keyframes 0,10 --out "$TMP/bad.bvh"
 bad "no command"
 
@@ -264,8 +280,8 @@ if [ -n "$TINY" ]; then
   } >"$TMP/renav.jsonl"
   expect_rc 2 "batch renav with one bad line" -- "$MF" --model "$TINY" --threads 1 batch "$TMP/renav.jsonl"
   expect_stderr "at least two points" "batch renav names the bad line's problem"
-  expect_rc 0 "batch renav = renav" -- "$MF" diff "$TMP/b-renav.bvh" "$TMP/renav.bvh" --tol 1e-9
-  expect_rc 0 "batch renav --polyline = renav --polyline" -- "$MF" diff "$TMP/b-renav-poly.bvh" "$TMP/renav-poly.bvh" --tol 1e-9
+  expect_rc 0 "batch renav = renav" -- "$DIFF" "$TMP/b-renav.bvh" "$TMP/renav.bvh" --tol 1e-9
+  expect_rc 0 "batch renav --polyline = renav --polyline" -- "$DIFF" "$TMP/b-renav-poly.bvh" "$TMP/renav-poly.bvh" --tol 1e-9
   expect_absent "$TMP/b-bad.bvh"
 else
   echo "cli_test: no tiny model (mf_capi_tiny_model not built, MF_TEST_MODEL unset): renav runs skipped"
@@ -284,11 +300,11 @@ if [ -x "$HELPER" ] && mkdir -p "$TMP/tr" "$TMP/notr" && "$HELPER" "$TMP/tr/prio
       "$MF" --model "$TMP/tr/prior.mfm" --threads 1 inbetween --in "$SMALL" --keyframes 0,12,39 \
       --out "$TMP/tr-$method.bvh" --method "$method"
     expect_frames "$TMP/tr-$method.bvh" 40
-    expect_rc 0 "$method keeps the keyframes" -- "$MF" diff "$SMALL" "$TMP/tr-$method.bvh" --frames 0,12,39
+    expect_rc 0 "$method keeps the keyframes" -- "$DIFF" "$SMALL" "$TMP/tr-$method.bvh" --frames 0,12,39
   done
   expect_rc 0 "fill --method detail" -- "$MF" --model "$TMP/tr/prior.mfm" --threads 1 fill --in "$SMALL" --gap 10:25 \
     --out "$TMP/tr-fill.bvh" --method detail
-  expect_rc 0 "fill --method detail keeps the known frames" -- "$MF" diff "$SMALL" "$TMP/tr-fill.bvh" --frames 0,9,25,39
+  expect_rc 0 "fill --method detail keeps the known frames" -- "$DIFF" "$SMALL" "$TMP/tr-fill.bvh" --frames 0,9,25,39
   printf '%s\n' "{\"task\": \"inbetween\", \"in\": \"$SMALL\", \"out\": \"$TMP/tr-b1.bvh\", \"keyframes\": [0, 20, 39], \"method\": \"citl\"}" \
     "{\"task\": \"fill\", \"in\": \"$SMALL\", \"out\": \"$TMP/tr-b2.bvh\", \"gap\": [5, 30], \"method\": \"context\"}" >"$TMP/tr-jobs.jsonl"
   expect_rc 0 "batch with transformer methods" -- "$MF" --model "$TMP/tr/prior.mfm" --threads 1 batch "$TMP/tr-jobs.jsonl"
@@ -342,8 +358,8 @@ if [ -f "$SRC/models/motionfield-prior.mfm" ]; then
   expect_frames "$TMP/mix-kf.bvh" "$N"
   grep -q "JOINT mixamorig:LeftForeArm" "$TMP/mix-kf.bvh" && pass || fail "the output has the user's joint names"
   grep -q "OFFSET 0.14 0 0" "$TMP/mix-kf.bvh" && pass || fail "the output is in the input's unit (metres)"
-  expect_rc 0 "known frames kept on another rig" -- "$MF" diff "$MIX" "$TMP/mix-kf.bvh" --frames 0,20,40,60
-  expect_rc 3 "...and the others solved" -- "$MF" diff "$MIX" "$TMP/mix-kf.bvh" --frames 10
+  expect_rc 0 "known frames kept on another rig" -- "$DIFF" "$MIX" "$TMP/mix-kf.bvh" --frames 0,20,40,60
+  expect_rc 3 "...and the others solved" -- "$DIFF" "$MIX" "$TMP/mix-kf.bvh" --frames 10
 
   printf '{"mixamorig:Spine2": "Chest"}\n' >"$TMP/map.json"
   printf '{"mixamorig:Hips": "NoSuchJoint"}\n' >"$TMP/badmap.json"
@@ -384,7 +400,7 @@ cat >"$TMP/batch/jobs.jsonl" <<'EOF'
 {"task": "resample", "in": "walk.bvh", "out": "b3.bvh", "fps": 60, "method": "zerovel", "note": {"any": ["thing"]}}
 {"task": "fill", "in": "walk.bvh", "out": "b4.bvh", "gap": [5, 8], "keyframes": [0, 30, 60]}
 EOF
-(cd "$TMP/batch" && expect_rc 2 "batch with one bad job" -- "$MF" batch jobs.jsonl)
+in_dir "$TMP/batch" expect_rc 2 "batch with one bad job" -- "$MF" batch jobs.jsonl
 expect_frames "$TMP/batch/b1.bvh" 61
 expect_frames "$TMP/batch/b3.bvh" 121
 expect_frames "$TMP/batch/b4.bvh" 61
@@ -393,13 +409,13 @@ expect_stderr "line 3" "batch names the failed job's line"
 expect_stderr "bad-gap" "batch names the failed job's id"
 expect_stderr "touches the first frame" "batch gives the reason"
 if grep -q "line [145]" "$TMP/err"; then fail "batch reported a good job"; else pass; fi
-(cd "$TMP/batch" && expect_rc 0 "fill keyframes are authoritative" -- "$MF" diff walk.bvh b4.bvh --frames 0,30,60)
-(cd "$TMP/batch" && expect_rc 3 "fill keyframes are authoritative (frames 1..29 filled)" -- "$MF" diff walk.bvh b4.bvh --frames 15)
-(cd "$TMP/batch" && expect_rc 0 "batch job keeps its keyframes" -- "$MF" diff walk.bvh b1.bvh --frames 0,20,40,60)
+in_dir "$TMP/batch" expect_rc 0 "fill keyframes are authoritative" -- "$DIFF" walk.bvh b4.bvh --frames 0,30,60
+in_dir "$TMP/batch" expect_rc 3 "fill keyframes are authoritative (frames 1..29 filled)" -- "$DIFF" walk.bvh b4.bvh --frames 15
+in_dir "$TMP/batch" expect_rc 0 "batch job keeps its keyframes" -- "$DIFF" walk.bvh b1.bvh --frames 0,20,40,60
 
 printf '%s\n' '{"task": "inbetween", "in": "walk.bvh", "out": "g1.bvh", "keyframes": [0, 60]}' \
   '{"task": "resample", "in": "walk.bvh", "out": "g2.bvh", "fps": 23.3}' >"$TMP/batch/good.jsonl"
-(cd "$TMP/batch" && expect_rc 0 "batch, all good" -- "$MF" batch good.jsonl)
+in_dir "$TMP/batch" expect_rc 0 "batch, all good" -- "$MF" batch good.jsonl
 expect_frames "$TMP/batch/g1.bvh" 61
 expect_frames "$TMP/batch/g2.bvh" 47
 expect_stderr "line 2: warning: .*rounded down" "batch passes warnings on with the line"
@@ -407,7 +423,7 @@ expect_stderr "line 2: warning: .*rounded down" "batch passes warnings on with t
 printf '%s\n' '{"task": "inbetween", "in": "walk.bvh", "out": "x.bvh", "keyframes": [0, 60],}' \
   '["not", "an", "object"]' '{"task": "inbetween", "in": "missing.bvh", "out": "y.bvh", "keyframes": [0, 1]}' \
   >"$TMP/batch/allbad.jsonl"
-(cd "$TMP/batch" && expect_rc 2 "batch, all bad" -- "$MF" batch allbad.jsonl)
+in_dir "$TMP/batch" expect_rc 2 "batch, all bad" -- "$MF" batch allbad.jsonl
 expect_stderr "line 1: error: invalid JSON: column" "batch names the JSON error's column"
 expect_stderr "line 2: error:" "batch rejects non-objects"
 expect_stderr "line 3: error:" "batch reports a missing input"

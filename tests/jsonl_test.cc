@@ -4,9 +4,9 @@
 
 #include <string>
 
-#include "prior/motion/errors.h"
+#include "capi/cli/input_error.h"
 
-namespace mf::cli {
+namespace motionfield::cli {
 namespace {
 
 // Parses `text`, expects a JsonError and returns its column (0 if none was thrown).
@@ -263,4 +263,4 @@ TEST(JsonlTest, BadJobsNameTheProblem) {
 }
 
 }  // namespace
-}  // namespace mf::cli
+}  // namespace motionfield::cli

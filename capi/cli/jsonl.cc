@@ -1,4 +1,4 @@
-#include "capi/cli/jsonl.h"
+#include "jsonl.h"
 
 #include <nlohmann/json.hpp>
 
@@ -13,9 +13,9 @@
 #include <set>
 #include <utility>
 
-#include "prior/motion/errors.h"
+#include "input_error.h"
 
-namespace mf::cli {
+namespace motionfield::cli {
 
 JsonError::JsonError(int column, const std::string& message)
     : std::runtime_error("column " + std::to_string(column) + ": " + message), column_(column) {}
@@ -418,4 +418,4 @@ BatchJob batch_job_from_json(const JsonValue& line) {
   return job;
 }
 
-}  // namespace mf::cli
+}  // namespace motionfield::cli

@@ -20,7 +20,9 @@
 #include <string>
 #include <vector>
 
-namespace mf::cli {
+#include "input_error.h"
+
+namespace motionfield::cli {
 
 constexpr int kJsonMaxDepth = 64;
 
@@ -111,13 +113,14 @@ struct BatchJob {
   std::string units;               ///< "auto", a unit name or metres per unit as text; empty: the command line's
 };
 
-/// Reads a job from one parsed line. Throws mf::InputError with a message naming
+/// Reads a job from one parsed line. Throws InputError with a message naming
 /// the key when the value is not an object, "task" is missing or unknown, or a
 /// key the task needs is missing or has the wrong type ("in" and "out" non-empty
 /// strings; "keyframes" an array of integers; "gap" an array of two integers;
 /// "fps" a number; "method", "path", "polyline" and "rig_map" strings;
-/// "frames" an integer; "units" a string or a positive number). Range checks (keyframes within the clip,
-/// fps positive, ...) happen later, in tasks/jobs.h, once the input is read.
+/// "frames" an integer; "units" a string or a positive number). Range checks
+/// (keyframes within the clip, fps positive, ...) are the library's, once the
+/// input is read.
 BatchJob batch_job_from_json(const JsonValue& line);
 
-}  // namespace mf::cli
+}  // namespace motionfield::cli

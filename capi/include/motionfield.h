@@ -561,6 +561,15 @@ MF_API int mf_length_unit_scale(const char *unit, double *out);
 MF_API int mf_rig_describe(const mf_model *model, const mf_motion *motion, const char *rig_map_json, char *out,
                            size_t capacity, size_t *needed);
 
+/* ================================================================ warnings */
+
+/** What the task that made `motion` wants its caller to know although it
+ *  succeeded, as sentences for the user, one per line ("" when there is
+ *  nothing, and for motions not made by a task): today mf_resample's "...
+ *  rounded down to N frames ..." when the target frame rate does not give a
+ *  whole number of frames (see mf_resample_frame_count). A string getter. */
+MF_API int mf_motion_get_warnings(const mf_motion *motion, char *out, size_t capacity, size_t *needed);
+
 #ifdef __cplusplus
 }
 #endif

@@ -308,6 +308,10 @@ int mf_motion_get_length_scale(const mf_motion* motion, double* out) {
   });
 }
 
+int mf_motion_get_warnings(const mf_motion* motion, char* out, size_t capacity, size_t* needed) {
+  return guard([&] { mf::capi::write_string(mf::capi::get(motion).warnings, out, capacity, needed); });
+}
+
 int mf_length_unit_scale(const char* unit, double* out) {
   return guard([&] {
     require(unit, "unit");

@@ -3,6 +3,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "capi/src/capi_internal.h"
 #include "prior/motion/errors.h"
@@ -59,6 +62,8 @@ namespace {
 
 // Runs one task: the C boundary checks what C callers can get wrong (NULL
 // pointers, the options struct); the library validates the request itself.
+// `run(input, method, ctx, warnings)` returns the result and may append
+// warnings for the caller, which the result handle carries.
 template <class Run>
 int run_task(const mf_model* model, const mf_motion* input, const mf_task_options* options, mf_motion** out,
              Run&& run) {
@@ -68,8 +73,11 @@ int run_task(const mf_model* model, const mf_motion* input, const mf_task_option
     const mf_task_options o = read_options(options, "mf_task_options");
     const TaskContext ctx = task_context(model, o);
     apply_num_threads();
-    Motion result = run(input->motion, o.method ? std::string(o.method) : std::string(), ctx);
-    *out = derived_motion(std::move(result), *input);
+    std::vector<std::string> warnings;
+    Motion result = run(input->motion, o.method ? std::string(o.method) : std::string(), ctx, &warnings);
+    std::unique_ptr<mf_motion> handle(derived_motion(std::move(result), *input));
+    for (const std::string& w : warnings) handle->warnings += (handle->warnings.empty() ? "" : "\n") + w;
+    *out = handle.release();
   });
 }
 
@@ -85,7 +93,8 @@ extern "C" {
 int mf_inbetween(const mf_model* model, const mf_motion* input, const int32_t* keyframes, size_t keyframe_count,
                  const mf_task_options* options, mf_motion** out) {
   return mf::capi::run_task(model, input, options, out,
-                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
+                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx,
+                                std::vector<std::string>*) {
                               if (!keyframes && keyframe_count != 0)
                                 throw ApiError(MF_ERROR_INVALID_ARGUMENT, "keyframes is NULL");
                               const std::vector<int> keys(keyframes, keyframes + keyframe_count);
@@ -96,7 +105,8 @@ int mf_inbetween(const mf_model* model, const mf_motion* input, const int32_t* k
 int mf_fill(const mf_model* model, const mf_motion* input, int32_t gap_begin, int32_t gap_end,
             const mf_task_options* options, mf_motion** out) {
   return mf::capi::run_task(model, input, options, out,
-                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
+                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx,
+                                std::vector<std::string>*) {
                               return mf::run_fill(in, gap_begin, gap_end, method, ctx);
                             });
 }
@@ -104,8 +114,9 @@ int mf_fill(const mf_model* model, const mf_motion* input, int32_t gap_begin, in
 int mf_resample(const mf_model* model, const mf_motion* input, double fps, const mf_task_options* options,
                 mf_motion** out) {
   return mf::capi::run_task(model, input, options, out,
-                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx) {
-                              return mf::run_resample(in, fps, method, nullptr, ctx);
+                            [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx,
+                                std::vector<std::string>* warnings) {
+                              return mf::run_resample(in, fps, method, warnings, ctx);
                             });
 }
 

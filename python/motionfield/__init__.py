@@ -460,6 +460,13 @@ class Motion(_Handle):
         return self._f64(_c.mf_motion_get_length_scale)
 
     @property
+    def warnings(self):
+        """What the task that made this motion wants the caller to know although
+        it succeeded (e.g. a resampling whose frame count was rounded down), one
+        sentence per line; "" if nothing."""
+        return _read_string(_c.mf_motion_get_warnings, self._live())
+
+    @property
     def frame_time(self):
         """Seconds between frames as a BVH file of this motion says them."""
         return self._f64(_c.mf_motion_get_frame_time)

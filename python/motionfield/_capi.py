@@ -244,6 +244,7 @@ _declare("mf_path_load_csv", _int, _str, _P(_f32), _size, _P(_size))
 _declare("mf_motion_get_length_scale", _int, _motion, _P(_f64))
 _declare("mf_length_unit_scale", _int, _str, _P(_f64))
 _declare("mf_rig_describe", _int, _model, _motion, _str, ctypes.c_char_p, _size, _P(_size))
+_declare("mf_motion_get_warnings", _int, _motion, ctypes.c_char_p, _size, _P(_size))
 
 if mf_abi_version() != ABI_VERSION:  # noqa: F821 (declared above)
     raise ImportError("%s has ABI version %d; this package needs %d" %

@@ -191,6 +191,8 @@ class TaskTest(unittest.TestCase):
         np.testing.assert_array_equal(up.root_positions[::2], self.walk.root_positions)
         self.assertEqual(mf.resample_frame_count(61, 30.0, 23.3), (47, True))
         self.assertEqual(mf.resample_frame_count(61, 30.0, 60.0), (121, False))
+        self.assertEqual(up.warnings, "")
+        self.assertIn("rounded down to 47 frames", mf.resample(self.walk, 23.3).warnings)
 
     def test_progress_and_cancel(self):
         seen = []

@@ -329,6 +329,45 @@ TEST(CApi, InbetweenFillAndResampleWithBaselines) {
   EXPECT_EQ(rounded, 0);
 }
 
+std::string warnings_of(const mf_motion* m) {
+  size_t n = 0;
+  EXPECT_EQ(mf_motion_get_warnings(m, nullptr, 0, &n), MF_OK);
+  std::string text(n, '\0');
+  EXPECT_EQ(mf_motion_get_warnings(m, text.data(), text.size(), &n), MF_OK);
+  text.resize(n - 1);
+  return text;
+}
+
+TEST(CApi, ResampleWarnsWhenItRoundsTheFrameCountDown) {
+  const MotionPtr input = load_sample();
+  EXPECT_EQ(warnings_of(input.get()), "");  // not made by a task
+  mf_motion* exact = nullptr;
+  ASSERT_EQ(mf_resample(nullptr, input.get(), 60.0, nullptr, &exact), MF_OK);
+  const MotionPtr pexact(exact);
+  EXPECT_EQ(warnings_of(exact), "");
+  mf_motion* rounded = nullptr;
+  ASSERT_EQ(mf_resample(nullptr, input.get(), 23.3, nullptr, &rounded), MF_OK);
+  const MotionPtr prounded(rounded);
+  EXPECT_EQ(frame_count(rounded), 47);
+  const std::string w = warnings_of(rounded);
+  EXPECT_NE(w.find("resampling 61 frames from 30 to 23.3 fps"), std::string::npos) << w;
+  EXPECT_NE(w.find("rounded down to 47 frames"), std::string::npos) << w;
+  EXPECT_EQ(w.find('\n'), std::string::npos) << "one warning, one line: " << w;
+  // A motion derived from it (same skeleton, new values) starts without warnings.
+  const std::vector<float> rot = rotations(rounded), pos = root_positions(rounded);
+  int32_t joints = 0;
+  ASSERT_EQ(mf_motion_get_joint_count(rounded, &joints), MF_OK);
+  mf_motion* like = nullptr;
+  ASSERT_EQ(mf_motion_create_like(rounded, joints, 47, 23.3, rot.data(), pos.data(), &like), MF_OK);
+  const MotionPtr plike(like);
+  EXPECT_EQ(warnings_of(like), "");
+  size_t needed = 0;
+  char small[4];
+  EXPECT_EQ(mf_motion_get_warnings(rounded, small, sizeof small, &needed), MF_ERROR_BUFFER_TOO_SMALL);
+  EXPECT_EQ(needed, w.size() + 1);
+  EXPECT_EQ(mf_motion_get_warnings(nullptr, small, sizeof small, &needed), MF_ERROR_INVALID_ARGUMENT);
+}
+
 TEST(CApi, TaskResultsKeepTheInputsLayout) {
   const MotionPtr input = load_sample();
   mf_motion* out = nullptr;

@@ -2,12 +2,14 @@
 # Installs motionfield (the "motionfield" install component) into a temporary
 # prefix and uses it from outside the build tree: the CLI, an external C
 # project (samples/c) built with find_package(motionfield) and with pkg-config,
-# and the Python package.
-#   usage: package_test.sh BUILD_DIR SOURCE_DIR C_COMPILER
+# the C++ sample (samples/cpp, motionfield.hpp) with find_package, and the
+# Python package.
+#   usage: package_test.sh BUILD_DIR SOURCE_DIR C_COMPILER CXX_COMPILER
 set -euo pipefail
 build=$1
 src=$2
 cc=$3
+cxx=$4
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/mf-package.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
 prefix=$tmp/prefix
@@ -21,7 +23,7 @@ cmake --install "$build" --prefix "$prefix" --component motionfield >"$tmp/insta
 lib=$(find "$prefix" -name 'libmotionfield.so.*.*' | head -1)
 [ -n "$lib" ] || { echo "libmotionfield.so.X.Y not installed"; cat "$tmp/install.log"; exit 1; }
 libdir=$(dirname "$lib")
-for f in "$libdir/libmotionfield.so" "$libdir/libmotionfield.so.0" "$prefix/include/motionfield.h" \
+for f in "$libdir/libmotionfield.so" "$libdir/libmotionfield.so.0" "$prefix/include/motionfield.h" "$prefix/include/motionfield.hpp" \
          "$prefix/bin/motionfield" "$libdir/cmake/motionfield/motionfieldConfig.cmake" \
          "$libdir/cmake/motionfield/motionfieldConfigVersion.cmake" "$libdir/cmake/motionfield/motionfieldTargets.cmake" \
          "$libdir/pkgconfig/motionfield.pc" "$prefix/lib/python3/dist-packages/motionfield/__init__.py"; do
@@ -45,6 +47,13 @@ cmake -S "$src/samples/c" -B "$tmp/cmake-build" -DCMAKE_PREFIX_PATH="$prefix" -D
 cmake --build "$tmp/cmake-build" >"$tmp/build.log" || { cat "$tmp/build.log"; exit 1; }
 "$tmp/cmake-build/inbetween" "$sample" "$tmp/cmake.bvh"
 [ "$(awk '/^Frames:/ { print $2 }' "$tmp/cmake.bvh")" = 61 ]
+
+step "an external C++ project on motionfield.hpp: find_package(motionfield)"
+cmake -S "$src/samples/cpp" -B "$tmp/cmake-build-cpp" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_CXX_COMPILER="$cxx" \
+  -DCMAKE_BUILD_TYPE=Release >"$tmp/cmake-cpp.log" || { cat "$tmp/cmake-cpp.log"; exit 1; }
+cmake --build "$tmp/cmake-build-cpp" >"$tmp/build-cpp.log" || { cat "$tmp/build-cpp.log"; exit 1; }
+"$tmp/cmake-build-cpp/inbetween" "$sample" "$tmp/cmake-cpp.bvh"
+[ "$(awk '/^Frames:/ { print $2 }' "$tmp/cmake-cpp.bvh")" = 61 ]
 
 step "an external project with pkg-config"
 export PKG_CONFIG_PATH="$libdir/pkgconfig"

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# Runs the C sample (samples/c/inbetween.c) on the bundled clip and checks its
-# output BVH: 61 frames, the input's frame time and hierarchy.
+# Runs a sample (samples/c/inbetween.c, samples/cpp/inbetween.cc: the same
+# job) on the bundled clip and checks its report and its output BVH: 61
+# frames, the input's frame time and hierarchy.
 #   usage: run_sample.sh SAMPLE_EXECUTABLE SOURCE_DIR
 set -euo pipefail
 exe=$1
 src=$2
-tmp=$(mktemp -d "${TMPDIR:-/tmp}/mf-sample-c.XXXXXX")
+tmp=$(mktemp -d "${TMPDIR:-/tmp}/mf-sample.XXXXXX")
 trap 'rm -rf "$tmp"' EXIT
 "$exe" "$src/samples/walk_keyframes.bvh" "$tmp/out.bvh" | tee "$tmp/log"
 grep -q '^method: ' "$tmp/log"

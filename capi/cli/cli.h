@@ -1,0 +1,50 @@
+// What the parts of the motionfield CLI share: the exit codes, the global
+// settings, and how a failure becomes a message and an exit code.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace motionfield::cli {
+
+constexpr int kExitOk = 0;
+constexpr int kExitInternal = 1;
+constexpr int kExitBadInput = 2;
+
+/// The global options (motionfield --help).
+struct Settings {
+  int threads = 2;
+  bool verbose = false;
+  std::string model;                  ///< --model PATH, "" for the default model
+  std::vector<std::string> twostage;  ///< --twostage PATH (repeatable)
+  std::vector<std::string> citl;      ///< --citl PATH (repeatable)
+  std::string rig_map;                ///< --rig-map FILE, "" for the automatic map
+  std::string units;                  ///< --units, "" = auto
+
+  /// The transformer files to add to the model, --twostage first.
+  std::vector<std::string> transformers() const;
+};
+
+/// A failure as the user sees it: exit code 2 for bad input (InputError, and
+/// the C API's invalid-argument, I/O, model and unsupported statuses), else 1
+/// (internal); the message (for internal errors with the status name).
+struct Failure {
+  int exit_code = kExitInternal;
+  std::string message;
+};
+
+/// The Failure of the exception being handled; call only inside a catch block.
+Failure current_failure();
+
+/// Prints "motionfield: <prefix>error: ..." or "...internal error: ..." on stderr.
+void print_failure(const Failure& failure, const std::string& prefix = "");
+
+/// Prints each line of `warnings` as "motionfield: <prefix>warning: <line>" on stderr.
+void print_warnings(const std::string& warnings, const std::string& prefix = "");
+
+/// Metres per file unit of --units / a batch job's "units": "" or "auto" = 0
+/// (detected), a unit name (mf_length_unit_scale) or a positive number.
+/// `what` names the option in messages.
+double units_scale(const std::string& units, const std::string& what);
+
+}  // namespace motionfield::cli

@@ -1,0 +1,43 @@
+// Which model the CLI's jobs run with.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "motionfield.hpp"
+
+namespace motionfield::cli {
+
+/// The model of the jobs: --model PATH (loaded once, up front, by
+/// load_explicit), else the default model, loaded on first need: when a job
+/// names no method (the default method depends on the model) or one that needs
+/// the model. The C API loads the transformer files next to the model;
+/// `transformers` (--twostage, --citl) add or replace them.
+class Models {
+ public:
+  Models(std::string explicit_path, std::vector<std::string> transformers);
+
+  /// Loads --model, if given (bad input if it does not load).
+  void load_explicit();
+
+  /// The model for a job with `method` ("" = the default method): an empty
+  /// Model when the method needs none and no --model was given.
+  const Model& for_method(const std::string& method);
+
+  /// The model for `what` (a command), which always needs one.
+  const Model& required(const std::string& what);
+
+  /// The loaded model's path ("" before one is loaded).
+  const std::string& path() const { return path_; }
+
+ private:
+  void load_default();
+  void use(Model model, const std::string& path);
+
+  std::string explicit_path_, path_, default_error_;
+  std::vector<std::string> transformers_;
+  bool tried_default_ = false;
+  Model model_;
+};
+
+}  // namespace motionfield::cli

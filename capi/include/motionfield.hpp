@@ -1,0 +1,551 @@
+// motionfield.hpp: a small header-only C++17 layer over motionfield.h.
+//
+// It adds no behaviour of its own: every call is one C call (or a size query
+// and the call), with C++ types around it.
+//   - Handles (Model, Motion, Encoding, CancelToken) own one C handle each and
+//     free it when they go out of scope. They are move-only; a moved-from or
+//     default-constructed handle is empty (get() == nullptr). An empty Model is
+//     "no model", which the tasks accept for methods that do not need one.
+//   - A failed call throws motionfield::Error, carrying the C status
+//     (MF_ERROR_*) and mf_last_error_message(). Nothing else is thrown, except
+//     std::bad_alloc and what a progress callback throws (see TaskOptions).
+//   - Buffers and strings come back as std::vector and std::string, in the
+//     layouts of motionfield.h ("Arrays": row-major, quaternions w, x, y, z,
+//     metres, seconds).
+// The namespace is `motionfield`, so programs may also link motionfield's
+// C++ internals (namespace mf) without a clash. Threads: as motionfield.h says
+// (models and motions may be shared; one call per CancelToken is thread-safe).
+//
+//   motionfield::Model model = motionfield::Model::load_default();
+//   motionfield::Motion walk = motionfield::Motion::load_bvh("walk.bvh");
+//   motionfield::Motion out = motionfield::inbetween(model, walk, {0, 30, 60});
+//   out.save_bvh("out.bvh");
+#ifndef MOTIONFIELD_HPP
+#define MOTIONFIELD_HPP
+
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "motionfield.h"
+
+namespace motionfield {
+
+// ---------------------------------------------------------------- errors
+
+/// A C call that returned a status other than MF_OK.
+class Error : public std::runtime_error {
+ public:
+  Error(int status, const std::string& message) : std::runtime_error(message), status_(status) {}
+  /// The MF_ERROR_* code.
+  int status() const noexcept { return status_; }
+  /// Its name, e.g. "MF_ERROR_IO".
+  const char* status_name() const noexcept { return mf_status_name(status_); }
+
+ private:
+  int status_;
+};
+
+/// Throws Error(status, mf_last_error_message()) unless status is MF_OK.
+inline void check(int status) {
+  if (status != MF_OK) throw Error(status, mf_last_error_message());
+}
+
+namespace detail {
+
+// Owns one C handle; Destroy accepts NULL, as every *_destroy does.
+template <class T, void (*Destroy)(T*)>
+class Handle {
+ public:
+  Handle() noexcept = default;
+  explicit Handle(T* handle) noexcept : handle_(handle) {}
+  Handle(Handle&& other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
+  Handle& operator=(Handle&& other) noexcept {
+    if (this != &other) Destroy(std::exchange(handle_, std::exchange(other.handle_, nullptr)));
+    return *this;
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() { Destroy(handle_); }
+
+  /// The C handle (still owned by this object), or nullptr when empty.
+  T* get() const noexcept { return handle_; }
+  /// Gives up ownership: the caller destroys the returned handle.
+  T* release() noexcept { return std::exchange(handle_, nullptr); }
+  explicit operator bool() const noexcept { return handle_ != nullptr; }
+
+ private:
+  T* handle_ = nullptr;
+};
+
+// A string getter: `get(out, capacity, needed)`, a size query first.
+template <class Get>
+std::string read_string(Get&& get) {
+  size_t needed = 0;
+  check(get(nullptr, 0, &needed));
+  std::string text(needed, '\0');
+  check(get(text.data(), text.size(), &needed));
+  text.resize(needed > 0 ? needed - 1 : 0);
+  return text;
+}
+
+// An array getter: `get(out, capacity, needed)` with capacity in elements.
+template <class T, class Get>
+std::vector<T> read_array(Get&& get) {
+  size_t needed = 0;
+  check(get(nullptr, 0, &needed));
+  std::vector<T> values(needed);
+  check(get(values.data(), values.size(), &needed));
+  return values;
+}
+
+template <class T, class Get>
+T read_value(Get&& get) {
+  T value{};
+  check(get(&value));
+  return value;
+}
+
+}  // namespace detail
+
+// ---------------------------------------------------------------- library
+
+/// mf_version_string(): the loaded library's version, e.g. "0.1.0".
+inline std::string version() { return mf_version_string(); }
+/// mf_abi_version(): the loaded library's ABI major (compare with MF_ABI_VERSION).
+inline uint32_t abi_version() { return mf_abi_version(); }
+/// mf_set_num_threads: intra-op threads of the whole process (1..1024).
+inline void set_num_threads(int32_t threads) { check(mf_set_num_threads(threads)); }
+inline int32_t num_threads() { return detail::read_value<int32_t>(mf_get_num_threads); }
+
+// ---------------------------------------------------------------- handles
+
+/// A loaded model (the prior, with the transformers and rig anatomy next to
+/// it). Empty means "no model".
+class Model : public detail::Handle<mf_model, mf_model_destroy> {
+ public:
+  using Handle::Handle;
+
+  /// mf_model_load(path).
+  static Model load(const std::string& path) {
+    mf_model* m = nullptr;
+    check(mf_model_load(path.c_str(), &m));
+    return Model(m);
+  }
+  /// mf_model_load(NULL): the default model; Error MF_ERROR_IO if none exists.
+  static Model load_default() {
+    mf_model* m = nullptr;
+    check(mf_model_load(nullptr, &m));
+    return Model(m);
+  }
+  /// mf_model_load_from_memory: the bytes of a model file (copied).
+  static Model load_from_memory(const void* data, size_t size) {
+    mf_model* m = nullptr;
+    check(mf_model_load_from_memory(data, size, &m));
+    return Model(m);
+  }
+  /// mf_model_with_inbetweener: a new model with the transformer file at `path`.
+  Model with_inbetweener(const std::string& path) const {
+    mf_model* m = nullptr;
+    check(mf_model_with_inbetweener(get(), path.c_str(), &m));
+    return Model(m);
+  }
+  /// mf_model_has_inbetweener: kind "twostage" or "citl".
+  bool has_inbetweener(const std::string& kind) const {
+    int32_t has = 0;
+    check(mf_model_has_inbetweener(get(), kind.c_str(), &has));
+    return has != 0;
+  }
+
+  int32_t joint_count() const {
+    return detail::read_value<int32_t>([&](int32_t* n) { return mf_model_get_joint_count(get(), n); });
+  }
+  std::vector<std::string> joint_names() const {
+    std::vector<std::string> names;
+    for (int32_t j = 0, n = joint_count(); j < n; ++j)
+      names.push_back(detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+        return mf_model_get_joint_name(get(), j, out, capacity, needed);
+      }));
+    return names;
+  }
+  /// Frame rate of the training data.
+  double fps() const {
+    return detail::read_value<double>([&](double* fps) { return mf_model_get_fps(get(), fps); });
+  }
+  /// Frames per window (one latent code).
+  int32_t window() const {
+    return detail::read_value<int32_t>([&](int32_t* n) { return mf_model_get_window(get(), n); });
+  }
+};
+
+/// mf_model_default_path: "" when no default model exists.
+inline std::string default_model_path() { return detail::read_string(mf_model_default_path); }
+
+/// A skeleton with per-frame local rotations and root positions (immutable).
+class Motion : public detail::Handle<mf_motion, mf_motion_destroy> {
+ public:
+  using Handle::Handle;
+
+  /// mf_motion_load_bvh; length_scale 0 detects the unit (metres per file unit).
+  static Motion load_bvh(const std::string& path, double length_scale = 0.0) {
+    const mf_bvh_options o = bvh_options(length_scale);
+    mf_motion* m = nullptr;
+    check(mf_motion_load_bvh(path.c_str(), &o, &m));
+    return Motion(m);
+  }
+  /// mf_motion_load_bvh_from_memory: BVH text.
+  static Motion load_bvh_from_memory(const std::string& text, double length_scale = 0.0) {
+    const mf_bvh_options o = bvh_options(length_scale);
+    mf_motion* m = nullptr;
+    check(mf_motion_load_bvh_from_memory(text.data(), text.size(), &o, &m));
+    return Motion(m);
+  }
+  /// mf_motion_save_bvh (atomic); length_scale 0 keeps the unit it was read in.
+  void save_bvh(const std::string& path, double length_scale = 0.0) const {
+    const mf_bvh_options o = bvh_options(length_scale);
+    check(mf_motion_save_bvh(get(), path.c_str(), &o));
+  }
+  /// mf_motion_save_bvh_to_memory: the BVH text save_bvh would write.
+  std::string to_bvh(double length_scale = 0.0) const {
+    const mf_bvh_options o = bvh_options(length_scale);
+    return detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+      return mf_motion_save_bvh_to_memory(get(), &o, out, capacity, needed);
+    });
+  }
+
+  int32_t frame_count() const { return value<int32_t>(mf_motion_get_frame_count); }
+  int32_t joint_count() const { return value<int32_t>(mf_motion_get_joint_count); }
+  double fps() const { return value<double>(mf_motion_get_fps); }
+  /// Seconds between frames as a BVH save writes them.
+  double frame_time() const { return value<double>(mf_motion_get_frame_time); }
+  /// Metres per file unit the motion was read with.
+  double length_scale() const { return value<double>(mf_motion_get_length_scale); }
+
+  std::vector<std::string> joint_names() const {
+    std::vector<std::string> names;
+    for (int32_t j = 0, n = joint_count(); j < n; ++j)
+      names.push_back(detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+        return mf_motion_get_joint_name(get(), j, out, capacity, needed);
+      }));
+    return names;
+  }
+  /// [joints] parent indices, -1 for joint 0.
+  std::vector<int32_t> parents() const { return array<int32_t>(mf_motion_get_parents); }
+  /// [joints][3] rest offsets, metres.
+  std::vector<float> offsets() const { return array<float>(mf_motion_get_offsets); }
+  /// [frames][joints][4] local rotations (w, x, y, z).
+  std::vector<float> rotations() const { return array<float>(mf_motion_get_rotations); }
+  /// [frames][3] root positions, metres.
+  std::vector<float> root_positions() const { return array<float>(mf_motion_get_root_positions); }
+  /// [frames][joints][3] global joint positions, metres.
+  std::vector<float> global_positions() const { return array<float>(mf_motion_get_global_positions); }
+  /// mf_motion_get_warnings: what the task that made this motion wants the
+  /// user to know, one sentence per line; "" if nothing.
+  std::string warnings() const {
+    return detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+      return mf_motion_get_warnings(get(), out, capacity, needed);
+    });
+  }
+
+ private:
+  static mf_bvh_options bvh_options(double length_scale) {
+    mf_bvh_options o;
+    check(mf_bvh_options_init(&o));
+    o.length_scale = length_scale;
+    return o;
+  }
+  template <class T, class Get>
+  T value(Get get_value) const {
+    return detail::read_value<T>([&](T* out) { return get_value(get(), out); });
+  }
+  template <class T, class Get>
+  std::vector<T> array(Get get_array) const {
+    return detail::read_array<T>(
+        [&](T* out, size_t capacity, size_t* needed) { return get_array(get(), out, capacity, needed); });
+  }
+};
+
+/// A flag that stops running tasks; cancel() may be called from any thread.
+class CancelToken : public detail::Handle<mf_cancel_token, mf_cancel_token_destroy> {
+ public:
+  using Handle::Handle;
+
+  /// A new, not cancelled token.
+  static CancelToken create() {
+    mf_cancel_token* t = nullptr;
+    check(mf_cancel_token_create(&t));
+    return CancelToken(t);
+  }
+  void cancel() { check(mf_cancel_token_cancel(get())); }
+  void reset() { check(mf_cancel_token_reset(get())); }
+  bool is_cancelled() const {
+    return detail::read_value<int32_t>([&](int32_t* out) { return mf_cancel_token_is_cancelled(get(), out); }) != 0;
+  }
+};
+
+// ---------------------------------------------------------------- methods
+
+/// A registered method (mf_method_get).
+struct MethodInfo {
+  std::string name, description;
+  uint32_t flags = 0;  ///< MF_METHOD_* bits
+  bool needs_model() const { return (flags & MF_METHOD_NEEDS_MODEL) != 0; }
+  bool completes() const { return (flags & MF_METHOD_COMPLETES) != 0; }
+  bool resamples() const { return (flags & MF_METHOD_RESAMPLES) != 0; }
+};
+
+namespace detail {
+inline MethodInfo method_at(int32_t index) {
+  const char* name = nullptr;
+  const char* description = nullptr;
+  uint32_t flags = 0;
+  check(mf_method_get(index, &name, &description, &flags));
+  return {name, description, flags};
+}
+}  // namespace detail
+
+/// Every registered method, in the library's order.
+inline std::vector<MethodInfo> methods() {
+  std::vector<MethodInfo> all;
+  for (int32_t i = 0, n = detail::read_value<int32_t>(mf_method_count); i < n; ++i) all.push_back(detail::method_at(i));
+  return all;
+}
+/// The method named `name`; Error MF_ERROR_INVALID_ARGUMENT (listing the
+/// methods) if there is none.
+inline MethodInfo find_method(const std::string& name) {
+  int32_t index = 0;
+  check(mf_method_find(name.c_str(), &index));
+  return detail::method_at(index);
+}
+/// mf_default_method: the in-betweening method used when none is named.
+inline std::string default_method(const Model& model) {
+  const char* name = nullptr;
+  check(mf_default_method(model.get(), &name));
+  return name;
+}
+
+// ---------------------------------------------------------------- tasks
+
+/// mf_task_options in C++ types.
+struct TaskOptions {
+  TaskOptions() = default;
+  /// Only a method: `inbetween(model, motion, keys, {"interp"})`.
+  TaskOptions(std::string method_name) : method(std::move(method_name)) {}
+
+  std::string method;  ///< "" = the default method
+  uint64_t seed = 0;
+  /// Called with each progress report; return false to cancel. An exception
+  /// it throws cancels the task and is rethrown from the task's call.
+  std::function<bool(const mf_progress&)> progress;
+  CancelToken* cancel = nullptr;  ///< optional; must outlive the call
+  std::string rig_map;            ///< JSON text; "" = automatic
+  std::string rig_map_path;       ///< a JSON file; "" = none
+};
+
+/// mf_renav_options in C++ types.
+struct RenavOptions {
+  int32_t path_kind = MF_PATH_PER_FRAME;  ///< or MF_PATH_POLYLINE
+  int32_t frame_count = 0;                ///< polyline: output frames (0 = from the speed)
+  double fps = 0.0;                       ///< 0 = the reference's
+};
+
+namespace detail {
+
+// One task call: the C options (pointing into `options`) and the progress
+// trampoline, which keeps exceptions from crossing the C boundary.
+class TaskCall {
+ public:
+  explicit TaskCall(const TaskOptions& options) : options_(options) {
+    check(mf_task_options_init(&c_));
+    c_.method = options.method.empty() ? nullptr : options.method.c_str();
+    c_.seed = options.seed;
+    c_.cancel = options.cancel ? options.cancel->get() : nullptr;
+    c_.rig_map = options.rig_map.empty() ? nullptr : options.rig_map.c_str();
+    c_.rig_map_path = options.rig_map_path.empty() ? nullptr : options.rig_map_path.c_str();
+    if (options.progress) {
+      c_.progress = &TaskCall::on_progress;
+      c_.user_data = this;
+    }
+  }
+  TaskCall(const TaskCall&) = delete;
+  TaskCall& operator=(const TaskCall&) = delete;
+
+  const mf_task_options* options() const { return &c_; }
+
+  // The result of the C call that returned `status` and `out`.
+  Motion finish(int status, mf_motion* out) {
+    Motion result(out);
+    if (error_) std::rethrow_exception(error_);
+    check(status);
+    return result;
+  }
+
+ private:
+  static int on_progress(void* self, const mf_progress* progress) noexcept {
+    TaskCall* call = static_cast<TaskCall*>(self);
+    try {
+      return call->options_.progress(*progress) ? 0 : 1;
+    } catch (...) {
+      call->error_ = std::current_exception();
+      return 1;
+    }
+  }
+
+  const TaskOptions& options_;
+  mf_task_options c_;
+  std::exception_ptr error_;
+};
+
+}  // namespace detail
+
+/// mf_inbetween: keeps `keyframes` (strictly increasing, at least two) and
+/// produces every other frame.
+inline Motion inbetween(const Model& model, const Motion& input, const std::vector<int32_t>& keyframes,
+                        const TaskOptions& options = {}) {
+  detail::TaskCall call(options);
+  mf_motion* out = nullptr;
+  const int status = mf_inbetween(model.get(), input.get(), keyframes.data(), keyframes.size(), call.options(), &out);
+  return call.finish(status, out);
+}
+
+/// mf_fill: frames gap_begin..gap_end-1 are unknown.
+inline Motion fill(const Model& model, const Motion& input, int32_t gap_begin, int32_t gap_end,
+                   const TaskOptions& options = {}) {
+  detail::TaskCall call(options);
+  mf_motion* out = nullptr;
+  const int status = mf_fill(model.get(), input.get(), gap_begin, gap_end, call.options(), &out);
+  return call.finish(status, out);
+}
+
+/// mf_resample to `fps`, keeping the time span (see Motion::warnings()).
+inline Motion resample(const Model& model, const Motion& input, double fps, const TaskOptions& options = {}) {
+  detail::TaskCall call(options);
+  mf_motion* out = nullptr;
+  const int status = mf_resample(model.get(), input.get(), fps, call.options(), &out);
+  return call.finish(status, out);
+}
+
+/// mf_renav along `path_xz` ([points][2] floats, metres).
+inline Motion renav(const Model& model, const Motion& reference, const std::vector<float>& path_xz,
+                    const RenavOptions& renav_options = {}, const TaskOptions& options = {}) {
+  mf_renav_options r;
+  check(mf_renav_options_init(&r));
+  r.path_kind = renav_options.path_kind;
+  r.frame_count = renav_options.frame_count;
+  r.fps = renav_options.fps;
+  detail::TaskCall call(options);
+  mf_motion* out = nullptr;
+  const int status =
+      mf_renav(model.get(), reference.get(), path_xz.data(), path_xz.size() / 2, &r, call.options(), &out);
+  return call.finish(status, out);
+}
+
+/// mf_resample_frame_count: the output frame count and whether it was rounded down.
+struct ResampledFrameCount {
+  int32_t frames = 0;
+  bool rounded = false;
+};
+inline ResampledFrameCount resample_frame_count(int32_t frames, double fps_in, double fps_out) {
+  int32_t n = 0, rounded = 0;
+  check(mf_resample_frame_count(frames, fps_in, fps_out, &n, &rounded));
+  return {n, rounded != 0};
+}
+
+/// mf_path_load_csv: [points][2] floats (x, z, metres).
+inline std::vector<float> load_path_csv(const std::string& path) {
+  return detail::read_array<float>([&](float* out, size_t capacity, size_t* needed) {
+    return mf_path_load_csv(path.c_str(), out, capacity, needed);
+  });
+}
+
+/// mf_length_unit_scale: metres per unit of "cm", "m", "mm", "in", "ft", "asf".
+inline double length_unit_scale(const std::string& unit) {
+  return detail::read_value<double>([&](double* out) { return mf_length_unit_scale(unit.c_str(), out); });
+}
+
+/// mf_rig_describe: how `motion`'s rig maps onto `model`'s, as JSON text.
+inline std::string rig_describe(const Model& model, const Motion& motion, const std::string& rig_map_json = "") {
+  return detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+    return mf_rig_describe(model.get(), motion.get(), rig_map_json.c_str(), out, capacity, needed);
+  });
+}
+
+// ---------------------------------------------------------------- encode, decode
+
+/// mf_codec_options in C++ types.
+struct CodecOptions {
+  int32_t hop = 0;                           ///< encoding: 0 = window / 2
+  int32_t root_source = MF_ROOT_FROM_PRIOR;  ///< decoding: or MF_ROOT_FROM_INPUT
+};
+
+namespace detail {
+inline mf_codec_options codec_options(const CodecOptions& options) {
+  mf_codec_options o;
+  check(mf_codec_options_init(&o));
+  o.hop = options.hop;
+  o.root_source = options.root_source;
+  return o;
+}
+}  // namespace detail
+
+/// A motion encoded by a model as window latents (immutable).
+class Encoding : public detail::Handle<mf_encoding, mf_encoding_destroy> {
+ public:
+  using Handle::Handle;
+
+  int32_t window_count() const {
+    return detail::read_value<int32_t>([&](int32_t* n) { return mf_encoding_get_window_count(get(), n); });
+  }
+  /// Seconds from the first to the last encoded frame.
+  double duration() const {
+    return detail::read_value<double>([&](double* d) { return mf_encoding_get_duration(get(), d); });
+  }
+  std::vector<double> window_times() const { return array<double>(mf_encoding_get_window_times); }
+  std::vector<float> local_latents() const { return array<float>(mf_encoding_get_local_latents); }
+  std::vector<float> global_latents() const { return array<float>(mf_encoding_get_global_latents); }
+  /// mf_encoding_with_latents; an empty vector keeps that part.
+  Encoding with_latents(const std::vector<float>& local, const std::vector<float>& global) const {
+    mf_encoding* e = nullptr;
+    check(mf_encoding_with_latents(get(), local.empty() ? nullptr : local.data(), local.size(),
+                                   global.empty() ? nullptr : global.data(), global.size(), &e));
+    return Encoding(e);
+  }
+  /// mf_decode at i / fps; frame_count 0 = the frames that fit the encoded span.
+  Motion decode(double fps, int32_t frame_count = 0, const CodecOptions& options = {}) const {
+    const mf_codec_options o = detail::codec_options(options);
+    mf_motion* m = nullptr;
+    check(mf_decode(get(), fps, frame_count, &o, &m));
+    return Motion(m);
+  }
+  /// mf_decode_times: one frame per time (seconds).
+  Motion decode_times(const std::vector<double>& times, double fps, const CodecOptions& options = {}) const {
+    const mf_codec_options o = detail::codec_options(options);
+    mf_motion* m = nullptr;
+    check(mf_decode_times(get(), times.data(), times.size(), fps, &o, &m));
+    return Motion(m);
+  }
+
+ private:
+  template <class T, class Get>
+  std::vector<T> array(Get get_array) const {
+    return detail::read_array<T>(
+        [&](T* out, size_t capacity, size_t* needed) { return get_array(get(), out, capacity, needed); });
+  }
+};
+
+/// mf_encode: `input` (on the model's skeleton) as window latents.
+inline Encoding encode(const Model& model, const Motion& input, const CodecOptions& options = {}) {
+  const mf_codec_options o = detail::codec_options(options);
+  mf_encoding* e = nullptr;
+  check(mf_encode(model.get(), input.get(), &o, &e));
+  return Encoding(e);
+}
+
+}  // namespace motionfield
+
+#endif  // MOTIONFIELD_HPP
