@@ -550,11 +550,23 @@ TEST(CApi, ResampleWithThePrior) {
   EXPECT_EQ(frame_count(out), 79);
 }
 
+// The destroy functions accept NULL (a crash fails the test's process) and,
+// like every destroy, leave the thread's last error as it was.
 TEST(CApi, DestroyAcceptsNull) {
+  mf_motion* m = nullptr;
+  ASSERT_EQ(mf_motion_load_bvh("/nonexistent/destroy-null.bvh", nullptr, &m), MF_ERROR_IO);
+  const std::string message = mf_last_error_message();
+  ASSERT_NE(message.find("destroy-null.bvh"), std::string::npos) << message;
   mf_model_destroy(nullptr);
   mf_motion_destroy(nullptr);
   mf_encoding_destroy(nullptr);
   mf_cancel_token_destroy(nullptr);
+  EXPECT_EQ(mf_last_error_message(), message);
+  mf_cancel_token* token = nullptr;
+  ASSERT_EQ(mf_cancel_token_create(&token), MF_OK);
+  mf_cancel_token_destroy(token);
+  mf_motion_destroy(load_sample().release());
+  EXPECT_EQ(mf_last_error_message(), message);
 }
 
 }  // namespace
