@@ -21,17 +21,6 @@
 namespace mf {
 namespace {
 
-NemfConfig tiny_config() { return test::tiny_nemf_config(); }
-
-NemfModel tiny_model() {
-  Skeleton s = test::small_skeleton();
-  Motion m = test::random_motion(s, 60, 30.0, 3);
-  at::manual_seed(11);
-  NemfModel model(tiny_config(), measure_rig(s, {&m}));
-  model.set_requires_grad(false);
-  return model;
-}
-
 EnergyWeights all_terms() {
   EnergyWeights w;
   w.latent_prior = 0.0;
@@ -88,7 +77,7 @@ double term(const EnergyTerms& e, const std::string& name) {
 
 TEST(Energies, ZeroAtAPerfectFitAndPositiveOtherwise) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  NemfModel model = test::tiny_prior(11);
   at::manual_seed(5);
   at::Tensor zl = at::randn({1, 8}), zg = at::randn({1, 4});
   WindowProblem p = problem_from_decode(model, zl, zg, {2, 10, 20}, 24);
@@ -122,7 +111,7 @@ TEST(Energies, ZeroAtAPerfectFitAndPositiveOtherwise) {
 
 TEST(Energies, GradientsFlowToTheLatentsOnly) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  NemfModel model = test::tiny_prior(11);
   at::manual_seed(6);
   at::Tensor zl0 = at::randn({1, 8}), zg0 = at::randn({1, 4});
   WindowProblem p = problem_from_decode(model, zl0, zg0, {0, 12, 23}, 24);
@@ -148,7 +137,7 @@ TEST(Energies, KeysOnlyDecodeMatchesDenseDecode) {
   // Without dense terms only the key frames are decoded; the keyed terms must
   // not depend on which path computed them.
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  NemfModel model = test::tiny_prior(11);
   at::manual_seed(7);
   at::Tensor zl = at::randn({1, 8}), zg = at::randn({1, 4});
   WindowProblem p = problem_from_decode(model, zl, zg, {1, 7, 15}, 20);
@@ -165,7 +154,7 @@ TEST(Energies, KeysOnlyDecodeMatchesDenseDecode) {
 }
 
 TEST(Energies, WindowProblemReadsOnlyConstrainedValues) {
-  NemfModel model = tiny_model();
+  NemfModel model = test::tiny_prior(11);
   const RigInfo& rig = model.rig();
   Motion m = test::random_motion(rig.skeleton, 20, 30.0, 4);
   MotionConstraints c;
@@ -211,7 +200,7 @@ TEST(Energies, WindowProblemReadsOnlyConstrainedValues) {
 
 TEST(Energies, PartialKeysIgnoreUnconstrainedJoints) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  NemfModel model = test::tiny_prior(11);
   at::manual_seed(8);
   at::Tensor zl = at::randn({1, 8}), zg = at::randn({1, 4});
   WindowProblem p = problem_from_decode(model, zl, zg, {0, 8, 16}, 20);
@@ -258,7 +247,7 @@ TEST(Energies, ConstraintValidation) {
 
 TEST(Initializers, InterpolationEncoderMatchesEncodingTheInterpolatedWindow) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  NemfModel model = test::tiny_prior(11);
   Motion m = test::random_motion(model.rig().skeleton, 24, 30.0, 6);
   MotionConstraints c = MotionConstraints::full_pose({0, 11, 23});
   InitRequest r;

@@ -29,23 +29,26 @@ NemfConfig tiny_config() {
   return c;
 }
 
-// A tiny random prior whose global motion predictor stands still at 0.9 m
-// (its output layer zeroed, the height mean set): a random GMP walks off in
-// random directions, which no window could agree on. Its root faces +Z.
-NemfModel tiny_model() {
-  Skeleton s = test::small_skeleton();
-  Motion m = test::random_motion(s, 60, 30.0, 3);
-  RigInfo rig = measure_rig(s, {&m});
-  rig.root_forward = Eigen::Vector3d::UnitZ();  // the gentle motions below face +Z
-  at::manual_seed(11);
-  NemfModel model(tiny_config(), rig);
-  model.set_requires_grad(false);
+// A tiny random prior on `rig` whose global motion predictor stands still at
+// 0.9 m (its output layer zeroed, the height mean set): a random GMP walks off
+// in random directions, which no window could agree on. With `contact_logit`,
+// it reports that foot-contact logit everywhere.
+NemfModel standing_prior(const RigInfo& rig, float contact_logit = 0.0f) {
+  NemfModel model = test::tiny_prior(11, tiny_config(), rig);
   at::NoGradGuard no_grad;
   for (auto& p : model.named_parameters()) {
     if (p.first.rfind("gmp.output.", 0) == 0) p.second.zero_();
+    if (p.first == "gmp.output.bias") p.second.narrow(0, 4, 2).fill_(contact_logit);
   }
   model.stats().gmp_out_mean[3] = 0.9f;
   return model;
+}
+
+// The standing prior on the small test skeleton, its root facing +Z.
+NemfModel tiny_model() {
+  RigInfo rig = test::tiny_rig();
+  rig.root_forward = Eigen::Vector3d::UnitZ();  // the gentle motions below face +Z
+  return standing_prior(rig);
 }
 
 LatentSolverOptions quick(SolverMethod method) {
@@ -324,16 +327,7 @@ LeggedModel legged_model(float contact_logit, bool arm = false) {
   RigInfo rig = measure_rig(s, {&m});
   rig.root_forward = Eigen::Vector3d::UnitZ();
   rig.foot_thresholds = {10.0, 10.0};  // every height counts as low
-  at::manual_seed(11);
-  out.model = std::make_unique<NemfModel>(tiny_config(), rig);
-  NemfModel& model = *out.model;
-  model.set_requires_grad(false);
-  at::NoGradGuard no_grad;
-  for (auto& p : model.named_parameters()) {
-    if (p.first.rfind("gmp.output.", 0) == 0) p.second.zero_();
-    if (p.first == "gmp.output.bias") p.second.narrow(0, 4, 2).fill_(contact_logit);
-  }
-  model.stats().gmp_out_mean[3] = 0.9f;
+  out.model = std::make_unique<NemfModel>(standing_prior(rig, contact_logit));
   return out;
 }
 

@@ -19,17 +19,6 @@
 namespace mf {
 namespace {
 
-NemfConfig tiny_config() { return test::tiny_nemf_config(); }
-
-std::shared_ptr<const NemfModel> tiny_model() {
-  at::manual_seed(0);
-  Skeleton s = test::small_skeleton();
-  Motion m = test::random_motion(s, 60, 30.0, 3);
-  auto model = std::make_shared<NemfModel>(tiny_config(), measure_rig(s, {&m}));
-  model->set_requires_grad(false);
-  return model;
-}
-
 bool all_unit_and_finite(const Motion& m) {
   for (const auto& q : m.rotations) {
     if (!std::isfinite(q.w()) || std::abs(q.norm() - 1.0) > 1e-9) return false;
@@ -82,7 +71,7 @@ TEST(PriorCodec, BlendWeightsSumToOneAndAreContinuous) {
 }
 
 TEST(PriorCodec, EncodeSplitsLongClipsIntoWindows) {
-  auto model = tiny_model();
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   Motion m = test::random_motion(model->rig().skeleton, 100, 30.0, 7);
   EncodedMotion code = encode_motion(*model, m);
   EXPECT_EQ(code.frames, 100);
@@ -108,7 +97,7 @@ TEST(PriorCodec, EncodeSplitsLongClipsIntoWindows) {
 }
 
 TEST(PriorCodec, ShortClipsAndOtherFrameRatesEncodeAsOneShortWindow) {
-  auto model = tiny_model();
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   const Skeleton& s = model->rig().skeleton;
   EncodedMotion a = encode_motion(*model, test::random_motion(s, 2, 30.0, 1));
   ASSERT_EQ(a.windows.size(), 1u);
@@ -129,7 +118,7 @@ TEST(PriorCodec, ShortClipsAndOtherFrameRatesEncodeAsOneShortWindow) {
 }
 
 TEST(PriorCodec, DecodesAtAnyFrameRate) {
-  auto model = tiny_model();
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   Motion m = test::random_motion(model->rig().skeleton, 70, 30.0, 11);
   EncodedMotion code = encode_motion(*model, m);
   for (double fps : {24.0, 30.0, 60.0, 120.0, 240.0}) {
@@ -147,7 +136,7 @@ TEST(PriorCodec, DecodesAtAnyFrameRate) {
 }
 
 TEST(PriorCodec, SingleWindowDecodeIsTheModelsDecodeInTheWorldFrame) {
-  auto model = tiny_model();
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   Motion m = test::random_motion(model->rig().skeleton, 25, 30.0, 5);
   EncodedMotion code = encode_motion(*model, m);
   ASSERT_EQ(code.windows.size(), 1u);
@@ -174,7 +163,7 @@ TEST(PriorCodec, SingleWindowDecodeIsTheModelsDecodeInTheWorldFrame) {
 }
 
 TEST(PriorCodec, OverlapBlendIsTheWeightedMeanOfTheWindows) {
-  auto model = tiny_model();
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   Motion m = test::random_motion(model->rig().skeleton, 48, 30.0, 8);
   EncodedMotion code = encode_motion(*model, m);  // windows [0, 31] and [16, 47]
   ASSERT_EQ(code.windows.size(), 2u);
@@ -202,7 +191,7 @@ TEST(PriorCodec, OverlapBlendIsTheWeightedMeanOfTheWindows) {
 }
 
 TEST(PriorCodec, InputRootPathIsInterpolated) {
-  auto model = tiny_model();
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   Motion m = test::random_motion(model->rig().skeleton, 20, 15.0, 12);
   EncodedMotion code = encode_motion(*model, m);
   Motion out = decode_motion(*model, code, 30.0, 39, DecodeOptions{RootSource::kInput});
@@ -214,7 +203,7 @@ TEST(PriorCodec, InputRootPathIsInterpolated) {
 }
 
 TEST(PriorCodec, ResampleKeepsInputFramesExactly) {
-  auto model = tiny_model();
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   TaskContext ctx;
   ctx.model = model;
   const Skeleton& s = model->rig().skeleton;
@@ -246,7 +235,7 @@ TEST(PriorCodec, ResampleKeepsInputFramesExactly) {
 TEST(PriorCodec, ResidualMakesTheReconstructionExactAtInputFrames) {
   // Without the copy of coinciding frames, the residual alone reproduces the
   // input: check through times that sit 1e-4 frames off the input frames.
-  auto model = tiny_model();
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   TaskContext ctx;
   ctx.model = model;
   Motion m = test::random_motion(model->rig().skeleton, 30, 30.0, 4);
@@ -266,7 +255,7 @@ TEST(PriorCodec, ResidualMakesTheReconstructionExactAtInputFrames) {
 }
 
 TEST(PriorCodec, RejectsBadInput) {
-  auto model = tiny_model();
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   TaskContext none;
   Motion m = test::random_motion(model->rig().skeleton, 10, 30.0, 2);
   EXPECT_THROW(resample_with_prior(m, 60.0, 19, none), InputError);

@@ -140,27 +140,8 @@ TEST(PriorEval, JointLimitsCountFramesBeyondThePercentile) {
   EXPECT_THROW(compute_joint_limits({}), InputError);
 }
 
-std::shared_ptr<NemfModel> tiny_model() {
-  at::manual_seed(0);
-  NemfConfig c;
-  c.window = 32;
-  c.decoder_width = 16;
-  c.decoder_layers = 2;
-  c.zl = 8;
-  c.zg = 4;
-  c.zg_layers = 1;
-  c.encoder_channels = 4;
-  c.gmp_width = 8;
-  c.gmp_blocks = 1;
-  const Skeleton s = test::small_skeleton();
-  const Motion m = test::random_motion(s, 60, 30.0, 3);
-  auto model = std::make_shared<NemfModel>(c, measure_rig(s, {&m}));
-  model->set_requires_grad(false);
-  return model;
-}
-
 TEST(PriorEval, TasksRunOnATinyModel) {
-  const auto model = tiny_model();
+  const auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   const Skeleton s = test::small_skeleton();
   std::vector<Clip> train = {make_clip("t1", test::random_motion(s, 120, 30.0, 11)),
                              make_clip("t2", test::random_motion(s, 90, 30.0, 12))};

@@ -19,8 +19,8 @@
 namespace mf {
 namespace {
 
-NemfConfig tiny_config() { return test::tiny_nemf_config(); }
-RigInfo tiny_rig() { return test::tiny_rig(); }
+using test::tiny_nemf_config;
+using test::tiny_rig;
 
 TEST(PriorModel, RigFindsFeetAndForward) {
   RigInfo rig = tiny_rig();
@@ -64,7 +64,7 @@ TEST(PriorModel, GmpTargetsIntegrateBackToTheRootPath) {
 TEST(PriorModel, EncodeDecodeShapesShortWindowsAndContinuousTime) {
   at::manual_seed(0);
   RigInfo rig = tiny_rig();
-  NemfModel model(tiny_config(), rig);
+  NemfModel model(tiny_nemf_config(), rig);
   Motion m = test::random_motion(rig.skeleton, 20, 30.0, 1);
   WindowTensors w = window_tensors(m, 0, 20, rig, 0);  // shorter than the 32-frame window
   NemfLatent z = model.encode(w.local_rotations, at::ones({1, 20}));
@@ -82,7 +82,7 @@ TEST(PriorModel, EncodeDecodeShapesShortWindowsAndContinuousTime) {
 TEST(PriorModel, GradientsReachTheLatentThroughAFrozenNetwork) {
   at::manual_seed(0);
   RigInfo rig = tiny_rig();
-  NemfModel model(tiny_config(), rig);
+  NemfModel model(tiny_nemf_config(), rig);
   model.set_requires_grad(false);
   at::Tensor zl = at::zeros({1, 8}).set_requires_grad(true);
   at::Tensor zg = at::zeros({1, 4}).set_requires_grad(true);
@@ -102,7 +102,7 @@ class ModelFile : public ::testing::Test {
     at::manual_seed(0);
     dir_ = test::scratch_dir("model_file");
     path_ = dir_ + "/m.mfm";
-    NemfModel model(tiny_config(), tiny_rig());
+    NemfModel model(tiny_nemf_config(), tiny_rig());
     save_nemf(model, path_);
     bytes_ = serialize_nemf(model);
   }
@@ -120,7 +120,7 @@ class ModelFile : public ::testing::Test {
 
 TEST_F(ModelFile, RoundTripGivesTheSameOutputs) {
   at::manual_seed(0);
-  NemfModel a(tiny_config(), tiny_rig());
+  NemfModel a(tiny_nemf_config(), tiny_rig());
   a.stats().feature_mean.fill_(0.25);
   save_nemf(a, path_);
   NemfModel b = load_nemf(path_);
@@ -164,7 +164,7 @@ TEST(PriorTraining, AFewStepsRunCheckpointAndResume) {
   o.data = dir;
   o.cache_dir = dir + "/cache";
   o.out_dir = dir + "/run";
-  o.config = tiny_config();
+  o.config = tiny_nemf_config();
   o.batch = 4;
   o.stride = 16;
   o.max_epochs = 2;

@@ -202,26 +202,6 @@ TEST(ProtocolTest, StatsTableListsJointsAndFeet) {
   EXPECT_NE(t.find("| Foot_L | 10.0 | 12.0 | 0.0 | 50.0 | 5.0 | 10.0 | 11.74 | 8 |"), std::string::npos) << t;
 }
 
-// A tiny untrained prior on the small test skeleton, frozen like the benchmark's.
-std::shared_ptr<const NemfModel> tiny_prior() {
-  at::manual_seed(0);
-  NemfConfig c;
-  c.window = 32;
-  c.decoder_width = 16;
-  c.decoder_layers = 2;
-  c.zl = 8;
-  c.zg = 4;
-  c.zg_layers = 1;
-  c.encoder_channels = 4;
-  c.gmp_width = 8;
-  c.gmp_blocks = 1;
-  const Skeleton s = test::small_skeleton();
-  const Motion m = test::random_motion(s, 60, 30.0, 3);
-  auto model = std::make_shared<NemfModel>(c, measure_rig(s, {&m}));
-  model->set_requires_grad(false);
-  return model;
-}
-
 TEST(ProtocolTest, TheContextReachesMethodsThatNeedTheModel) {
   const EvalStats stats = small_stats();
   std::vector<Clip> val = {make_clip("v", test::random_motion(test::small_skeleton(), 110, 30.0, 50))};
@@ -232,7 +212,7 @@ TEST(ProtocolTest, TheContextReachesMethodsThatNeedTheModel) {
   // Without a model in the context the prior's method refuses to run.
   EXPECT_THROW(run_resampling(val, stats, "prior"), InputError);
   TaskContext ctx;
-  ctx.model = tiny_prior();
+  ctx.model = std::make_shared<const NemfModel>(test::tiny_prior());
   const TaskResult r = run_task(Task::Resample, val, stats, "prior", ProtocolOptions{}, ctx);
   ASSERT_EQ(r.rows.size(), 1u);
   EXPECT_EQ(r.rows[0].metrics.windows, 2);  // 65-frame windows at 0 and 40

@@ -1,5 +1,7 @@
 #include "tests/test_util.h"
 
+#include <ATen/ATen.h>
+
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -60,6 +62,20 @@ RigInfo tiny_rig() {
   Skeleton s = small_skeleton();
   Motion m = random_motion(s, 60, 30.0, 3);
   return measure_rig(s, {&m});
+}
+
+NemfModel tiny_prior(uint64_t seed, const NemfConfig& config, const RigInfo& rig) {
+  at::manual_seed(seed);
+  NemfModel model(config, rig);
+  model.set_requires_grad(false);
+  return model;
+}
+
+std::unique_ptr<InbetweenModel> tiny_transformer(const std::string& kind, const RigInfo& rig, uint64_t seed) {
+  at::manual_seed(seed);
+  std::map<std::string, double> hp = {{"width", 16}, {"layers", 1}, {"heads", 2}, {"ffn", 32}, {"window", 32}};
+  if (kind == kCitlKind) hp["time_dim"] = 4;
+  return make_inbetweener(kind, hp, rig);
 }
 
 std::string scratch_dir(const std::string& name) {

@@ -2,8 +2,10 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <string>
 
+#include "prior/inbetween/inbetweener.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/motion.h"
 
@@ -19,6 +21,13 @@ Motion random_motion(const Skeleton& skeleton, int frames, double fps, uint32_t 
 NemfConfig tiny_nemf_config();
 /// The rig of small_skeleton(), measured from one random motion.
 RigInfo tiny_rig();
+/// A tiny random prior, frozen (no gradients), its weights drawn after
+/// at::manual_seed(seed).
+NemfModel tiny_prior(uint64_t seed = 0, const NemfConfig& config = tiny_nemf_config(),
+                     const RigInfo& rig = tiny_rig());
+/// A tiny random transformer in-betweener of `kind` (kTwoStageKind or
+/// kCitlKind; width 16, one layer, window 32), drawn after at::manual_seed(seed).
+std::unique_ptr<InbetweenModel> tiny_transformer(const std::string& kind, const RigInfo& rig, uint64_t seed = 0);
 
 /// A fresh empty directory under the build tree's test scratch area.
 std::string scratch_dir(const std::string& name);

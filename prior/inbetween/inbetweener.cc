@@ -163,6 +163,7 @@ InbetweenModel::Normalisation InbetweenModel::checked_normalisation(const Inbetw
   n.mean = stats().pose_mean.defined() ? stats().pose_mean.to(n.options) : at::zeros({D}, n.options);
   n.scale = stats().pose_std.defined() ? stats().pose_std.to(n.options) : at::ones({D}, n.options);
   if (n.mean.numel() != D || n.scale.numel() != D) throw InputError(name + ": statistics do not match the pose size");
+  n.scale = n.scale.clamp_min(1e-6);  // a constant channel (std 0) must not turn the input into inf/NaN
   return n;
 }
 

@@ -293,9 +293,8 @@ class TwoStageModel final : public InbetweenModel {
   InbetweenOutput forward(const InbetweenBatch& batch) const override {
     const Normalisation n = checked_normalisation(batch, config_.window, "twostage");
     const int64_t D = pose_size();
-    // A constant channel (std 0) must not turn the input into inf/NaN.
     return net_->forward(batch.pose.to(at::kFloat), batch.known.to(n.options), batch.valid.to(n.options),
-                         n.mean.reshape({D}), n.scale.reshape({D}).clamp_min(1e-6));
+                         n.mean.reshape({D}), n.scale.reshape({D}));
   }
 
   std::vector<std::pair<std::string, at::Tensor>> named_parameters() const override {

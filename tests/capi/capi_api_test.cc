@@ -435,45 +435,52 @@ TEST(CApi, ProgressCallbackAndCancelToken) {
   mf_motion_destroy(out);
 }
 
-// A solver that reports progress, cancelled from another thread while it runs.
+// A solver that reports progress, cancelled from another thread while it runs:
+// the third progress call waits until the other thread has cancelled the token,
+// so the cancel always lands in the middle of the solve.
 TEST(CApi, CancelFromAnotherThreadStopsASolver) {
   const std::vector<std::string> solvers = methods_with(MF_METHOD_NEEDS_MODEL | MF_METHOD_COMPLETES);
-  if (solvers.empty()) GTEST_SKIP() << "no registered method solves with the prior yet";
+  ASSERT_FALSE(solvers.empty()) << "no registered method solves with the prior";
   const ModelPtr model = load_tiny_model();
   const MotionPtr input = random_capi_motion(30, 30.0, 5);  // within one window of the tiny model
   mf_cancel_token* raw = nullptr;
   ASSERT_EQ(mf_cancel_token_create(&raw), MF_OK);
   const TokenPtr token(raw);
-  struct Seen {
+  struct Rendezvous {
     std::atomic<int> calls{0};
-  } seen;
+    std::atomic<bool> asked{false}, cancelled{false};
+  } rv;
   mf_task_options options;
   mf_task_options_init(&options);
   options.method = solvers.front().c_str();
   options.cancel = raw;
-  options.user_data = &seen;
+  options.user_data = &rv;
   options.progress = [](void* user_data, const mf_progress*) {
-    static_cast<Seen*>(user_data)->calls++;
-    std::this_thread::sleep_for(std::chrono::milliseconds(2));  // keep the solve running until cancelled
+    auto* r = static_cast<Rendezvous*>(user_data);
+    if (++r->calls == 3) {
+      r->asked = true;
+      while (!r->cancelled.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
     return 0;
   };
   int status = -1;
-  std::atomic<bool> done{false};
+  mf_motion* out = reinterpret_cast<mf_motion*>(0x1234);
   std::thread solver([&] {
     const int32_t keys[] = {0, 29};
-    mf_motion* out = nullptr;
     status = mf_inbetween(model.get(), input.get(), keys, 2, &options, &out);
-    mf_motion_destroy(out);
-    done = true;
   });
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (seen.calls.load() < 3 && !done.load() && std::chrono::steady_clock::now() < deadline)
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (!rv.asked.load() && std::chrono::steady_clock::now() < deadline)
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
-  ASSERT_EQ(mf_cancel_token_cancel(raw), MF_OK);
+  const bool reached = rv.asked.load();
+  EXPECT_EQ(mf_cancel_token_cancel(raw), MF_OK);
+  rv.cancelled = true;
   solver.join();
-  if (seen.calls.load() < 3 && status == MF_OK)
-    GTEST_SKIP() << solvers.front() << " finished before it could be cancelled";
+  const MotionPtr produced(status == MF_OK ? out : nullptr);
+  ASSERT_TRUE(reached) << solvers.front() << " made " << rv.calls.load() << " progress calls, expected at least 3";
   EXPECT_EQ(status, MF_ERROR_CANCELLED) << describe(status);
+  EXPECT_EQ(out, reinterpret_cast<mf_motion*>(0x1234)) << "a cancelled task produced a motion";
+  EXPECT_EQ(rv.calls.load(), 3) << "the solve went on after the cancel";
 }
 
 TEST(CApi, EncodeAndDecodeAtAnyTimes) {
@@ -570,7 +577,7 @@ TEST(CApi, EncodeAndDecodeAtAnyTimes) {
 
 TEST(CApi, ResampleWithThePrior) {
   const std::vector<std::string> prior = methods_with(MF_METHOD_NEEDS_MODEL | MF_METHOD_RESAMPLES);
-  if (prior.empty()) GTEST_SKIP() << "no registered method resamples with the prior";
+  ASSERT_FALSE(prior.empty()) << "no registered method resamples with the prior";
   const ModelPtr model = load_tiny_model();
   const MotionPtr input = random_capi_motion(40, 30.0, 13);
   mf_task_options options;
@@ -582,11 +589,23 @@ TEST(CApi, ResampleWithThePrior) {
   EXPECT_EQ(frame_count(out), 79);
 }
 
+// The destroy functions accept NULL (a crash fails the test's process) and,
+// like every destroy, leave the thread's last error as it was.
 TEST(CApi, DestroyAcceptsNull) {
+  mf_motion* m = nullptr;
+  ASSERT_EQ(mf_motion_load_bvh("/nonexistent/destroy-null.bvh", nullptr, &m), MF_ERROR_IO);
+  const std::string message = mf_last_error_message();
+  ASSERT_NE(message.find("destroy-null.bvh"), std::string::npos) << message;
   mf_model_destroy(nullptr);
   mf_motion_destroy(nullptr);
   mf_encoding_destroy(nullptr);
   mf_cancel_token_destroy(nullptr);
+  EXPECT_EQ(mf_last_error_message(), message);
+  mf_cancel_token* token = nullptr;
+  ASSERT_EQ(mf_cancel_token_create(&token), MF_OK);
+  mf_cancel_token_destroy(token);
+  mf_motion_destroy(load_sample().release());
+  EXPECT_EQ(mf_last_error_message(), message);
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 // transformers written with the C++ model code; no trained file).
 #include <unistd.h>
 
-#include <ATen/ATen.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -39,12 +38,8 @@ struct ModelDir {
   }
   // A tiny random transformer of `kind` on the prior's rig, written as `file`.
   std::string write(const std::string& kind, const std::string& file) const {
-    at::manual_seed(1);
-    const NemfModel prior_model = load_nemf(prior);
-    std::map<std::string, double> hp = {{"width", 16}, {"layers", 1}, {"heads", 2}, {"ffn", 32}, {"window", 32}};
-    if (kind == kCitlKind) hp["time_dim"] = 4;
     const std::string path = dir + "/" + file;
-    save_inbetweener(*make_inbetweener(kind, hp, prior_model.rig()), path);
+    save_inbetweener(*test::tiny_transformer(kind, load_nemf(prior).rig(), 1), path);
     return path;
   }
 };

@@ -2,19 +2,13 @@
 
 #include <unistd.h>
 
-#include <ATen/ATen.h>
-
 #include <filesystem>
 
 #include "prior/model/model_file.h"
-#include "prior/model/nemf.h"
-#include "prior/model/representation.h"
 #include "tests/test_util.h"
 
 namespace mf::capi_test {
 namespace {
-
-NemfConfig tiny_config() { return test::tiny_nemf_config(); }
 
 // The model file, in a directory of this process removed at exit (ctest runs
 // every test in its own process, several at once).
@@ -22,10 +16,7 @@ struct TinyModelFile {
   std::string dir, path;
   std::vector<uint8_t> bytes;
   TinyModelFile() {
-    at::manual_seed(0);
-    const Skeleton s = test::small_skeleton();
-    const Motion m = test::random_motion(s, 60, 30.0, 3);
-    const NemfModel model(tiny_config(), measure_rig(s, {&m}));
+    const NemfModel model = test::tiny_prior();
     dir = test::scratch_dir("capi-" + std::to_string(::getpid()));
     path = dir + "/tiny.mfm";
     save_nemf(model, path);

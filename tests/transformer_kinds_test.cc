@@ -1,0 +1,341 @@
+// The transformer in-betweeners (prior/inbetween/two_stage.h, citl.h): what
+// every kind guarantees, as one suite over the kinds, then what only one kind
+// does.
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+#include <torch/optim/adam.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include "prior/inbetween/citl.h"
+#include "prior/inbetween/two_stage.h"
+#include "prior/motion/errors.h"
+#include "tests/test_util.h"
+
+namespace mf {
+namespace {
+
+constexpr int kWindow = 16;
+
+using Factory = std::function<std::unique_ptr<InbetweenModel>(const std::map<std::string, double>&, const RigInfo&)>;
+
+struct Kind {
+  std::string name;
+  Factory make;
+  std::map<std::string, double> tiny;      // the hyperparameters of the tests' models
+  std::map<std::string, double> defaults;  // what an empty map gives
+  std::vector<std::string> stages;
+  bool contacts;
+  std::string described;                       // found in describe() of the tiny model
+  std::vector<std::string> parameter_names;    // the first one first, then some others
+  std::vector<std::pair<std::string, double>> bad_for_kind;  // rejected besides the shared ones
+  int overfit_steps;
+  float overfit_ratio;  // the loss after overfit_steps, relative to the first
+};
+
+Kind two_stage_kind() {
+  return {kTwoStageKind,
+          make_two_stage,
+          {{"width", 32}, {"layers", 1}, {"heads", 2}, {"ffn", 48}, {"window", kWindow}, {"fps", 30}},
+          {{"width", 64}, {"layers", 2}, {"heads", 4}, {"ffn", 128}, {"window", 128}, {"fps", 30}},
+          {"context", "detail"},
+          true,
+          "context 1x32",
+          {"context.input.fc1.weight", "context.layers.0.attn.q.weight"},
+          {},
+          60,
+          0.75f};
+}
+
+Kind citl_kind() {
+  return {kCitlKind,
+          make_citl,
+          {{"width", 32}, {"layers", 1}, {"heads", 2}, {"ffn", 64}, {"time_dim", 8}, {"window", kWindow}, {"fps", 30}},
+          {{"width", 64}, {"layers", 2}, {"heads", 4}, {"ffn", 256}, {"time_dim", 16}, {"window", 128}, {"fps", 30}},
+          {"citl"},
+          false,
+          "citl",
+          {"input.weight"},
+          {{"time_dim", 7}, {"time_dim", 32}},  // odd; not below width
+          40,
+          0.6f};
+}
+
+std::unique_ptr<InbetweenModel> tiny(const Kind& kind, uint64_t seed) {
+  at::manual_seed(seed);
+  auto model = kind.make(kind.tiny, test::tiny_rig());
+  const int64_t D = model->pose_size();
+  model->stats().pose_mean = at::randn({D}) * 0.1;
+  model->stats().pose_std = at::rand({D}) + 0.5;
+  return model;
+}
+
+// Two windows: sample 0 uses all 16 frames with full keys at 0, 5 and 15;
+// sample 1 has 10 valid frames, full keys at 0 and 9, a partial key at 3 (two
+// joints, no root position) and a root-position-only key at 6. Unknown entries
+// of pose are zero.
+InbetweenBatch two_windows(const InbetweenModel& model) {
+  const int64_t J = model.rig().num_joints(), D = model.pose_size();
+  InbetweenBatch b;
+  b.known = at::zeros({2, kWindow, J + 1});
+  b.valid = at::zeros({2, kWindow});
+  for (int t : {0, 5, 15}) b.known[0][t].fill_(1.0);
+  for (int t : {0, 9}) b.known[1][t].fill_(1.0);
+  b.known[1][3][1] = 1.0;
+  b.known[1][3][2] = 1.0;
+  b.known[1][6][J] = 1.0;
+  b.valid[0].fill_(1.0);
+  b.valid[1].narrow(0, 0, 10).fill_(1.0);
+  b.pose = at::randn({2, kWindow, D}) * known_channel_mask(b.known, static_cast<int>(J));
+  return b;
+}
+
+// Every output tensor: the stages, then the contact logits if the kind has them.
+std::vector<at::Tensor> outputs(const InbetweenModel& model, const InbetweenBatch& batch) {
+  InbetweenOutput out = model.forward(batch);
+  std::vector<at::Tensor> all = out.stages;
+  if (out.contact_logits.defined()) all.push_back(out.contact_logits);
+  return all;
+}
+
+at::Tensor final_stage(const InbetweenModel& model, const InbetweenBatch& batch) {
+  return model.forward(batch).stages.back();
+}
+
+// CTest names the cases .../<kind> (gtest_discover_tests prints the parameter).
+void PrintTo(const Kind& kind, std::ostream* os) { *os << kind.name; }
+
+class TransformerKind : public ::testing::TestWithParam<Kind> {};
+
+TEST_P(TransformerKind, ShapesAndKind) {
+  const Kind& kind = GetParam();
+  auto model = tiny(kind, 0);
+  EXPECT_EQ(model->kind(), kind.name);
+  EXPECT_EQ(model->stage_names(), kind.stages);
+  EXPECT_EQ(model->window(), kWindow);
+  EXPECT_EQ(model->fps(), 30.0);
+  ASSERT_GT(model->rig().num_feet(), 0);
+  InbetweenBatch b = two_windows(*model);
+  InbetweenOutput out = model->forward(b);
+  ASSERT_EQ(out.stages.size(), kind.stages.size());
+  for (const at::Tensor& s : out.stages) {
+    EXPECT_EQ(s.sizes(), (at::IntArrayRef{2, kWindow, model->pose_size()}));
+    EXPECT_TRUE(at::isfinite(s).all().item<bool>());
+  }
+  ASSERT_EQ(out.contact_logits.defined(), kind.contacts);
+  if (kind.contacts) EXPECT_EQ(out.contact_logits.sizes(), (at::IntArrayRef{2, kWindow, model->rig().num_feet()}));
+  // Shorter windows than `window` are accepted; longer ones and bad shapes are not.
+  InbetweenBatch shorter{b.pose.narrow(1, 0, 6), b.known.narrow(1, 0, 6), b.valid.narrow(1, 0, 6)};
+  EXPECT_EQ(final_stage(*model, shorter).size(1), 6);
+  InbetweenBatch one{b.pose.narrow(1, 0, 1), b.known.narrow(1, 0, 1), b.valid.narrow(1, 0, 1)};
+  EXPECT_TRUE(at::isfinite(final_stage(*model, one)).all().item<bool>());
+  InbetweenBatch longer{at::cat({b.pose, b.pose}, 1), at::cat({b.known, b.known}, 1), at::cat({b.valid, b.valid}, 1)};
+  EXPECT_THROW(model->forward(longer), InputError);
+  EXPECT_THROW(model->forward(InbetweenBatch{b.pose, b.known.narrow(-1, 0, 3), b.valid}), InputError);
+  EXPECT_THROW(model->forward(InbetweenBatch{b.pose.narrow(-1, 0, 7), b.known, b.valid}), InputError);
+  EXPECT_THROW(model->forward(InbetweenBatch{b.pose, b.known, at::Tensor()}), InputError);
+}
+
+TEST_P(TransformerKind, UnknownValuesDoNotChangeTheOutput) {
+  auto model = tiny(GetParam(), 1);
+  InbetweenBatch b = two_windows(*model);
+  const std::vector<at::Tensor> reference = outputs(*model, b);
+  at::Tensor mask = known_channel_mask(b.known, model->rig().num_joints());
+  InbetweenBatch perturbed = b;
+  perturbed.pose = b.pose + at::randn(b.pose.sizes()) * 10.0 * (1.0 - mask);
+  const std::vector<at::Tensor> out = outputs(*model, perturbed);
+  ASSERT_EQ(out.size(), reference.size());
+  for (size_t i = 0; i < out.size(); ++i) EXPECT_TRUE(at::equal(out[i], reference[i])) << "output " << i;
+}
+
+TEST_P(TransformerKind, KnownValuesDoChangeTheOutput) {
+  auto model = tiny(GetParam(), 2);
+  InbetweenBatch b = two_windows(*model);
+  at::Tensor reference = final_stage(*model, b);
+  InbetweenBatch changed = b;
+  changed.pose = b.pose.clone();
+  changed.pose[0][5].mul_(-1.0);  // a full key in the middle of sample 0
+  at::Tensor out = final_stage(*model, changed);
+  EXPECT_FALSE(at::allclose(out[0], reference[0]));
+  EXPECT_TRUE(at::allclose(out[1], reference[1], 1e-5, 1e-6));  // samples are independent
+}
+
+TEST_P(TransformerKind, PaddingFramesDoNotChangeValidFrames) {
+  auto model = tiny(GetParam(), 3);
+  InbetweenBatch b = two_windows(*model);
+  const std::vector<at::Tensor> reference = outputs(*model, b);
+  // Garbage in the padding of sample 1: values, known flags, everything.
+  InbetweenBatch garbage = b;
+  garbage.pose = b.pose.clone();
+  garbage.known = b.known.clone();
+  garbage.pose[1].narrow(0, 10, kWindow - 10).normal_(0.0, 5.0);
+  garbage.known[1].narrow(0, 10, kWindow - 10).fill_(1.0);
+  const std::vector<at::Tensor> out = outputs(*model, garbage);
+  // The same window alone, unpadded, and the other sample alone.
+  InbetweenBatch alone{b.pose.narrow(0, 1, 1).narrow(1, 0, 10), b.known.narrow(0, 1, 1).narrow(1, 0, 10),
+                       b.valid.narrow(0, 1, 1).narrow(1, 0, 10)};
+  InbetweenBatch first{b.pose.narrow(0, 0, 1), b.known.narrow(0, 0, 1), b.valid.narrow(0, 0, 1)};
+  const std::vector<at::Tensor> single = outputs(*model, alone), other = outputs(*model, first);
+  ASSERT_EQ(out.size(), reference.size());
+  for (size_t i = 0; i < out.size(); ++i) {
+    const at::Tensor valid = reference[i][1].narrow(0, 0, 10);
+    EXPECT_TRUE(at::allclose(out[i][0], reference[i][0], 1e-5, 1e-6)) << "output " << i;
+    EXPECT_TRUE(at::allclose(out[i][1].narrow(0, 0, 10), valid, 1e-5, 1e-6)) << "output " << i;
+    EXPECT_TRUE(at::allclose(single[i][0], valid, 1e-4, 1e-5)) << "output " << i;
+    EXPECT_TRUE(at::allclose(other[i][0], reference[i][0], 1e-4, 1e-5)) << "output " << i;
+  }
+}
+
+TEST_P(TransformerKind, ArbitraryKeySetsIncludingOneOrNone) {
+  auto model = tiny(GetParam(), 4);
+  const int64_t J = model->rig().num_joints(), D = model->pose_size();
+  InbetweenBatch b;
+  b.known = at::zeros({3, kWindow, J + 1});
+  b.known[0][0].fill_(1.0);                  // one key
+  b.known[1].narrow(0, 0, 12).fill_(1.0);    // dense context, then a gap to the end
+  b.known[2][7].narrow(0, 0, 1).fill_(1.0);  // only the root rotation of frame 7
+  b.valid = at::ones({3, kWindow});
+  b.pose = at::randn({3, kWindow, D}) * known_channel_mask(b.known, static_cast<int>(J));
+  EXPECT_TRUE(at::isfinite(final_stage(*model, b)).all().item<bool>());
+  // No key at all: still finite (no NaN from fully masked rows), whatever the values.
+  b.known.zero_();
+  EXPECT_TRUE(at::isfinite(final_stage(*model, b)).all().item<bool>());
+  b.pose.zero_();
+  EXPECT_TRUE(at::isfinite(final_stage(*model, b)).all().item<bool>());
+}
+
+TEST_P(TransformerKind, GradientsReachEveryParameter) {
+  auto model = tiny(GetParam(), 5);
+  model->train(true);
+  InbetweenBatch b = two_windows(*model);
+  at::Tensor loss = at::zeros({});
+  for (const at::Tensor& out : outputs(*model, b)) loss = loss + out.pow(2).sum();
+  loss.backward();
+  for (const auto& [name, p] : model->named_parameters()) {
+    ASSERT_TRUE(p.grad().defined()) << name;
+    EXPECT_GT(p.grad().abs().sum().item<float>(), 0.0f) << name;
+  }
+}
+
+TEST_P(TransformerKind, HyperparametersRoundTrip) {
+  const Kind& kind = GetParam();
+  EXPECT_EQ(kind.make({}, test::tiny_rig())->hyperparameters(), kind.defaults);
+  auto model = tiny(kind, 0);
+  auto copy = kind.make(model->hyperparameters(), model->rig());
+  EXPECT_EQ(copy->hyperparameters(), model->hyperparameters());
+  EXPECT_EQ(copy->describe(), model->describe());
+  EXPECT_NE(model->describe().find(kind.described), std::string::npos) << model->describe();
+  auto a = model->named_parameters(), c = copy->named_parameters();
+  ASSERT_EQ(a.size(), c.size());
+  std::vector<std::string> names;
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].first, c[i].first);
+    EXPECT_EQ(a[i].second.sizes(), c[i].second.sizes()) << a[i].first;
+    names.push_back(a[i].first);
+  }
+  // Stable, readable parameter names.
+  EXPECT_EQ(names.front(), kind.parameter_names.front());
+  for (const std::string& n : kind.parameter_names)
+    EXPECT_NE(std::find(names.begin(), names.end(), n), names.end()) << n;
+  auto factory = make_inbetweener(kind.name, model->hyperparameters(), model->rig());
+  EXPECT_EQ(factory->kind(), kind.name);
+  EXPECT_EQ(factory->num_parameters(), model->num_parameters());
+}
+
+TEST_P(TransformerKind, ModelFileRoundTripGivesTheSameOutputs) {
+  const Kind& kind = GetParam();
+  auto model = tiny(kind, 7);
+  model->train(false);
+  model->stats().pose_std[3] = 0.0;  // a constant channel stays finite
+  InbetweenBatch b = two_windows(*model);
+  const std::vector<at::Tensor> reference = outputs(*model, b);
+  EXPECT_TRUE(at::isfinite(reference.front()).all().item<bool>());
+  std::vector<uint8_t> bytes = serialize_inbetweener(*model);
+  const std::string path = test::scratch_dir("transformer_model_file_" + kind.name) + "/model.mfm";
+  save_inbetweener(*model, path);
+  std::vector<std::unique_ptr<InbetweenModel>> loaded_models;
+  loaded_models.push_back(deserialize_inbetweener(bytes.data(), bytes.size(), "memory"));
+  loaded_models.push_back(load_inbetweener(path));
+  for (const auto& loaded : loaded_models) {
+    EXPECT_EQ(loaded->kind(), kind.name);
+    EXPECT_EQ(loaded->hyperparameters(), model->hyperparameters());
+    const std::vector<at::Tensor> out = outputs(*loaded, b);
+    ASSERT_EQ(out.size(), reference.size());
+    for (size_t i = 0; i < out.size(); ++i) EXPECT_TRUE(at::equal(out[i], reference[i])) << "output " << i;
+  }
+}
+
+TEST_P(TransformerKind, BadHyperparametersThrow) {
+  const Kind& kind = GetParam();
+  const RigInfo rig = test::tiny_rig();
+  auto with = [&](const std::string& key, double v) {
+    auto h = kind.tiny;
+    h[key] = v;
+    return h;
+  };
+  std::vector<std::pair<std::string, double>> bad = {
+      {"heads", 3},  // does not divide 32
+      {"heads", 0},  {"width", 0},    {"layers", 1.5},          {"layers", 0},
+      {"ffn", -4},   {"window", 1},   {"fps", -30},             {"fps", std::nan("")},
+      {"dropout", 0.1},  // unknown key
+  };
+  bad.insert(bad.end(), kind.bad_for_kind.begin(), kind.bad_for_kind.end());
+  for (const auto& [key, value] : bad) EXPECT_THROW(kind.make(with(key, value), rig), InputError) << key << " " << value;
+  EXPECT_NO_THROW(kind.make(with("heads", 4), rig));
+}
+
+TEST_P(TransformerKind, OverfitsOneBatch) {
+  const Kind& kind = GetParam();
+  auto model = tiny(kind, 6);
+  model->train(true);
+  InbetweenBatch b = two_windows(*model);
+  at::Tensor target = at::randn(b.pose.sizes()) * 0.5;
+  at::Tensor mask = known_channel_mask(b.known, model->rig().num_joints());
+  b.pose = target * mask;
+  at::Tensor weight = b.valid.unsqueeze(-1) * (1.0 - mask);
+  torch::optim::Adam optimizer(model->parameters(), torch::optim::AdamOptions(3e-3));
+  auto loss_of = [&] {
+    at::Tensor loss = at::zeros({});
+    for (const at::Tensor& stage : model->forward(b).stages)
+      loss = loss + ((stage - target).abs() * weight).sum() / weight.sum();
+    return loss;
+  };
+  const float initial = loss_of().item<float>();
+  for (int step = 0; step < kind.overfit_steps; ++step) {
+    optimizer.zero_grad();
+    at::Tensor loss = loss_of();
+    loss.backward();
+    optimizer.step();
+  }
+  EXPECT_LT(loss_of().item<float>(), kind.overfit_ratio * initial);
+}
+
+INSTANTIATE_TEST_SUITE_P(Kinds, TransformerKind, ::testing::Values(two_stage_kind(), citl_kind()));
+
+// CITL alone keeps the known values of valid frames exactly, partial keys included.
+TEST(Citl, KnownValuesComeBackExactly) {
+  auto model = tiny(citl_kind(), 0);
+  InbetweenBatch b = two_windows(*model);
+  at::Tensor mask = known_channel_mask(b.known * b.valid.unsqueeze(-1), model->rig().num_joints());
+  EXPECT_TRUE(at::equal(final_stage(*model, b) * mask, b.pose * mask));
+}
+
+// CITL re-centres each sequence on its keys: moving every known root position
+// moves the output by as much.
+TEST(Citl, SequenceRecentringMakesTheOutputFollowTranslations) {
+  auto model = tiny(citl_kind(), 4);
+  InbetweenBatch b = two_windows(*model);
+  at::Tensor reference = final_stage(*model, b);
+  const int64_t D = model->pose_size();
+  at::Tensor delta = at::zeros({D});
+  delta.narrow(0, D - 3, 3).copy_(at::tensor({1.5f, -0.25f, 3.0f}));
+  InbetweenBatch moved = b;
+  at::Tensor root_known = b.known.narrow(-1, model->rig().num_joints(), 1);
+  moved.pose = b.pose + delta * root_known;
+  EXPECT_TRUE(at::allclose(final_stage(*model, moved) - delta, reference, 1e-4, 1e-4));
+}
+
+}  // namespace
+}  // namespace mf
