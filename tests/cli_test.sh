@@ -284,14 +284,14 @@ if [ -n "$TINY" ]; then
   expect_rc 0 "batch renav --polyline = renav --polyline" -- "$DIFF" "$TMP/b-renav-poly.bvh" "$TMP/renav-poly.bvh" --tol 1e-9
   expect_absent "$TMP/b-bad.bvh"
 else
-  echo "cli_test: no tiny model (mf_capi_tiny_model not built, MF_TEST_MODEL unset): renav runs skipped"
+  fail "no tiny model (mf_capi_tiny_model not built, MF_TEST_MODEL unset): the renav runs could not run"
 fi
 bad "renav without a path" renav --in "$SMALL" --out "$TMP/bad.bvh"
 MF_MODEL="$TMP/none.mfm" bad "renav without a model" renav --in "$SMALL" --path "$TMP/path50.csv" --out "$TMP/bad.bvh"
 
 # ------------------------------------------------------------ transformer methods
 # Tiny random transformers next to a tiny prior (mf_capi_tiny_model --transformers),
-# so no trained file is needed; skipped when the helper is not built.
+# so no trained file is needed; a missing helper is a failure (CTest builds it).
 HELPER="$(dirname "$MF")/mf_capi_tiny_model"
 if [ -x "$HELPER" ] && mkdir -p "$TMP/tr" "$TMP/notr" && "$HELPER" "$TMP/tr/prior.mfm" --transformers &&
    "$HELPER" "$TMP/notr/prior.mfm"; then
@@ -322,7 +322,7 @@ if [ -x "$HELPER" ] && mkdir -p "$TMP/tr" "$TMP/notr" && "$HELPER" "$TMP/tr/prio
     --keyframes 0,39 --out "$TMP/bad.bvh" --method citl
   expect_stderr "frames apart" "long-gap message"
 else
-  echo "cli_test: mf_capi_tiny_model not built: transformer method runs skipped"
+  fail "mf_capi_tiny_model not built or failed: the transformer method runs could not run"
 fi
 
 # ------------------------------------------------------------ other rigs
@@ -387,7 +387,7 @@ if [ -f "$SRC/models/motionfield-prior.mfm" ]; then
   expect_absent "$TMP/mix-b2.bvh"
   expect_stderr "line 2: error: .*badmap.json: rig map" "batch names the job's bad map file"
 else
-  echo "cli_test: no bundled model: other-rig runs skipped"
+  fail "no bundled model (models/motionfield-prior.mfm is in the repository): the other-rig runs could not run"
 fi
 
 # ------------------------------------------------------------ batch

@@ -4,7 +4,8 @@
         /usr/bin/python3 -m unittest discover -s python/tests -v
 
 The model tests need a model file: $MF_TEST_MODEL (CTest writes a tiny random
-one with mf_capi_tiny_model); they are skipped without it.
+one with mf_capi_tiny_model) and the bundled model (in the repository); they
+fail without them, so that a broken set-up cannot pass by skipping.
 """
 
 import json
@@ -235,8 +236,12 @@ class TaskTest(unittest.TestCase):
             np.testing.assert_array_equal(a, b)
 
 
-@unittest.skipUnless(os.environ.get("MF_TEST_MODEL"), "set MF_TEST_MODEL to a (tiny) model file")
 class ModelTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        if not os.environ.get("MF_TEST_MODEL"):
+            raise AssertionError("set MF_TEST_MODEL to a (tiny) model file (CTest does)")
+
     def test_model_and_codec(self):
         model = mf.Model(os.environ["MF_TEST_MODEL"])
         self.assertGreater(model.joint_count, 0)
@@ -318,10 +323,11 @@ class UnitsTest(unittest.TestCase):
             mf.Motion.load_bvh(SAMPLE, units="m", length_scale=1.0)
 
 
-@unittest.skipUnless(os.path.exists(DEFAULT_MODEL), "no bundled model")
 class OtherRigTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
+        if not os.path.exists(DEFAULT_MODEL):
+            raise AssertionError(DEFAULT_MODEL + " is missing (it is in the repository)")
         cls.model = mf.Model(DEFAULT_MODEL)
         cls.method = "detail" if cls.model.has_inbetweener("twostage") else "nemf"
         cm = mf.Motion.from_bvh_text(mixamo_sample_text())
