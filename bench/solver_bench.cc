@@ -210,7 +210,8 @@ std::string describe(const mf::LatentSolverOptions& o) {
   s << (o.method == mf::SolverMethod::Adam ? "Adam" : "L-BFGS") << ", max iterations "
     << (o.max_iterations ? std::to_string(o.max_iterations) : std::string("default"));
   if (o.method == mf::SolverMethod::Lbfgs)
-    s << ", ftol " << o.function_tolerance << ", rank " << o.lbfgs_rank << ", keys-only stage " << o.keyed_iterations;
+    s << ", ftol " << o.function_tolerance << ", rank " << o.lbfgs_rank << ", keys-only stage "
+      << (o.keyed_iterations >= 0 ? std::to_string(o.keyed_iterations) : std::string("default"));
   s << "; weights: rotation " << w.rotation << ", position " << w.position << ", root orientation "
     << w.root_orientation << ", root translation " << w.root_translation << ", latent prior " << w.latent_prior
     << ", foot skating " << w.foot_skating << ", smoothness " << w.smoothness << "; penalty "

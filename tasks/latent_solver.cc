@@ -29,28 +29,23 @@ double ms_since(Clock::time_point t0) {
 
 int default_iterations(SolverMethod m) { return m == SolverMethod::Adam ? 600 : 40; }
 
-// L-BFGS cap for one window when the options leave it open: 40, or 60 when
-// the window has end-effector targets or 40+ frames in a row without a key
-// (every task keeps improving up to 40 iterations, long gaps and effectors up to
-// 60; docs/BENCHMARKS.md, "Iteration caps").
-int window_iterations(const LatentSolverOptions& o, const MotionConstraints& wc, int T) {
-  if (o.max_iterations > 0) return o.max_iterations;
-  if (o.method == SolverMethod::Adam) return default_iterations(o.method);
-  int longest = 0, previous = -1;
-  for (const PoseKey& k : wc.keys) {
-    longest = std::max(longest, k.frame - previous - 1);
-    previous = k.frame;
-  }
-  longest = std::max(longest, T - previous - 1);
-  return (!wc.effectors.empty() || longest >= 40) ? 60 : default_iterations(o.method);
+// A keys-only stage only pays where a dense term is left for the second stage.
+bool has_dense_term(const EnergyWeights& w) {
+  return w.root_translation > 0 || w.effector > 0 || w.foot_skating > 0 || w.smoothness > 0;
 }
 
-// Iterations of the keys-only first stage of solve_latents(); 0 when it does
-// not run (Adam, no keyed_iterations, or no dense term to save).
-int keyed_stage_iterations(const LatentSolverOptions& o) {
-  const EnergyWeights& w = o.weights;
-  const bool dense = w.root_translation > 0 || w.effector > 0 || w.foot_skating > 0 || w.smoothness > 0;
-  return o.method == SolverMethod::Lbfgs && o.keyed_iterations > 0 && dense ? o.keyed_iterations : 0;
+std::vector<int> key_frames_of(const MotionConstraints& c) {
+  std::vector<int> frames;
+  for (const PoseKey& k : c.keys) frames.push_back(k.frame);
+  return frames;
+}
+
+std::vector<int> key_frames_of(const WindowProblem& p) {
+  std::vector<int> frames;
+  if (p.num_keys() == 0) return frames;
+  const at::Tensor f = p.key_frames.contiguous();
+  for (int64_t k = 0; k < f.numel(); ++k) frames.push_back(static_cast<int>(f.data_ptr<int64_t>()[k]));
+  return frames;
 }
 
 // The energy of a window's problem as a function of the codes.
@@ -158,7 +153,7 @@ struct WindowPlan {
   /// with full-pose keys at the shared frames (what the window is solved under).
   MotionConstraints user, constraints;
   int anchor = 0;      ///< window frame of the first key that fixes the root
-  int iterations = 0;  ///< the window's cap (window_iterations())
+  WindowCaps caps;     ///< the window's iteration caps (window_caps())
 };
 
 // Full-pose keys at window frames [begin, end) merged into `user`'s keys (a
@@ -225,7 +220,7 @@ std::vector<WindowPlan> plan_windows(int W, int N, const MotionConstraints& cons
       throw InputError("frames " + std::to_string(p.start) + ".." + std::to_string(p.start + p.length - 1) +
                        " hold no key that fixes the root");  // cannot happen after validation
     }
-    p.iterations = window_iterations(options, p.constraints, p.length);
+    p.caps = window_caps(options, key_frames_of(p.constraints), !p.constraints.effectors.empty(), p.length);
     std::fill(solved.begin() + p.start, solved.begin() + p.start + p.length, 1);
     plan.push_back(std::move(p));
   }
@@ -290,7 +285,7 @@ SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const st
   std::shared_ptr<const LatentInitializer> init = options.initializer;
   if (!init) init = std::make_shared<InterpolationEncoderInitializer>();
   int total = 0;
-  for (const WindowPlan& w : plan) total += w.iterations + keyed_stage_iterations(options);
+  for (const WindowPlan& w : plan) total += w.caps.keyed + w.caps.full;
 
   SolvedMotion out{Motion::identity(input.skeleton, N, input.fps), std::vector<float>(static_cast<size_t>(N) * F, 0.0f),
                    std::vector<char>(N, 0)};
@@ -306,7 +301,8 @@ SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const st
     request.context = &ctx;
     const InitialGuess start = init->initialize(request);
     LatentSolverOptions window_options = options;
-    window_options.max_iterations = w.iterations;
+    window_options.keyed_iterations = w.caps.keyed;
+    window_options.max_iterations = w.caps.full;
     LatentSolution sol = solve_latents(model, problem, start, window_options, ctx, iterations, total);
     iterations += sol.summary.iterations;
     rep->windows.push_back(sol.summary);
@@ -340,11 +336,36 @@ void make_known_values_exact(const RigInfo& rig, const Motion& input, const Moti
 
 }  // namespace
 
+WindowCaps window_caps(const LatentSolverOptions& o, const std::vector<int>& key_frames, bool has_effectors, int T) {
+  WindowCaps caps;
+  if (o.method == SolverMethod::Adam) {
+    caps.full = o.max_iterations > 0 ? o.max_iterations : default_iterations(o.method);
+    return caps;
+  }
+  std::vector<int> frames = key_frames;
+  std::sort(frames.begin(), frames.end());
+  int longest = 0, previous = -1;
+  for (int f : frames) {
+    longest = std::max(longest, f - previous - 1);
+    previous = f;
+  }
+  longest = std::max(longest, T - previous - 1);
+  const bool long_window = has_effectors || longest >= 40;
+  caps.keyed = o.keyed_iterations >= 0 ? o.keyed_iterations : (long_window ? 0 : 30);
+  if (!has_dense_term(o.weights)) caps.keyed = 0;
+  if (o.max_iterations > 0) {
+    caps.full = o.max_iterations;
+  } else {
+    caps.full = long_window ? 60 : caps.keyed > 0 ? 20 : default_iterations(o.method);
+  }
+  return caps;
+}
+
 std::string LatentSolverOptions::validate() const {
   std::ostringstream e;
   e << LatentOptimizerSettings::validate();
   if (overlap < 1) e << "overlap must be >= 1; ";
-  if (keyed_iterations < 0) e << "keyed_iterations must be >= 0; ";
+  if (keyed_iterations < -1) e << "keyed_iterations must be >= 0, or -1 for the default; ";
   const EnergyWeights& w = weights;
   for (double v : {w.rotation, w.position, w.root_orientation, w.root_translation, w.effector, w.latent_prior,
                    w.foot_skating, w.smoothness}) {
@@ -373,25 +394,25 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
   const auto t0 = Clock::now();
   const FlatLatentEnergy energy(window_energy(model, problem, options.weights), zl, zg);
   const at::Tensor x0 = energy.join(start.z_l, start.z_g);
-  const int cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.method);
-  const int total = iteration_total > 0 ? iteration_total : cap;
+  const WindowCaps caps = window_caps(options, key_frames_of(problem), problem.num_effectors() > 0, problem.length);
+  const int total = iteration_total > 0 ? iteration_total : caps.keyed + caps.full;
 
   LatentSolution out;
   SolveSummary& s = out.summary;
   s.initial_terms = energy.terms(x0, &s.initial_energy);
   at::Tensor x = x0;
-  if (const int keyed_cap = keyed_stage_iterations(options); keyed_cap > 0) {
+  if (caps.keyed > 0) {
     EnergyWeights keyed = options.weights;
     keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
     const FlatLatentEnergy cheap(window_energy(model, problem, keyed), zl, zg);
     LatentOptimizerStats first;
-    x = minimize_latent(cheap.total(), x, options.method, options.capped(keyed_cap), ctx, &first, iteration_offset,
+    x = minimize_latent(cheap.total(), x, options.method, options.capped(caps.keyed), ctx, &first, iteration_offset,
                         total);
     s.keyed_iterations = first.iterations;
     s.evaluations += first.evaluations;
   }
   LatentOptimizerStats main;
-  x = minimize_latent(energy.total(), x, options.method, options.capped(cap), ctx, &main,
+  x = minimize_latent(energy.total(), x, options.method, options.capped(caps.full), ctx, &main,
                       iteration_offset + s.keyed_iterations, total);
   s.iterations = s.keyed_iterations + main.iterations;
   s.evaluations += main.evaluations;

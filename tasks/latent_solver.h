@@ -16,7 +16,8 @@
 // step is random: the seed is handed to initialisers that sample).
 //
 // Defaults (docs/BENCHMARKS.md, "Latent solvers", has the measurements):
-// L-BFGS, at most 40 iterations (60 with long gaps or end-effector targets),
+// L-BFGS: 30 keys-only iterations then at most 20 full ones (a single stage of
+// 60 with long gaps or end-effector targets; window_caps()),
 // function tolerance 1e-3; weights rotation 1,
 // position 10, root orientation 1, root translation 10 (the GMP path), no
 // prior, skating or smoothness term (they bought nothing measurable with the
@@ -82,10 +83,8 @@ using SolverMethod = LatentOptimizer;
 /// function tolerance 1e-3, gradient tolerance 1e-8, parameter tolerance
 /// 1e-6, L-BFGS rank 20; Adam lr 0.1, x0.7 every 200 iterations, stopping when
 /// the best energy improves by less than 1e-4 over 100 iterations).
-/// max_iterations is the cap per window; 0 means the method's default: Adam
-/// 600; L-BFGS 40, or 60 for a window with end-effector targets or with 40 or
-/// more frames in a row without a key (measured: quality keeps improving up
-/// to 40 iterations everywhere, to 60 on long gaps; docs/BENCHMARKS.md).
+/// max_iterations is the cap per window (of the full-energy stage); 0 means
+/// the method's default (window_caps()).
 struct LatentSolverOptions : LatentOptimizerSettings {
   SolverMethod method = SolverMethod::Lbfgs;
   EnergyWeights weights;
@@ -93,8 +92,9 @@ struct LatentSolverOptions : LatentOptimizerSettings {
   /// L-BFGS only: first up to this many iterations on the terms that need
   /// only the key frames decoded (rotation, position, root orientation, latent
   /// prior), which cost a fraction of a dense evaluation, then the full energy
-  /// (max_iterations). 0 = a single stage.
-  int keyed_iterations = 0;
+  /// (max_iterations). 0 = a single stage; -1 = the solver's choice per window
+  /// (window_caps()).
+  int keyed_iterations = -1;
 
   /// Null means InterpolationEncoderInitializer.
   std::shared_ptr<const LatentInitializer> initializer;
@@ -119,6 +119,25 @@ struct LatentSolverOptions : LatentOptimizerSettings {
   /// Empty when valid, else what is wrong (Ceres' Options::IsValid style).
   std::string validate() const;
 };
+
+/// The iteration caps of one window: `keyed` iterations of the keys-only
+/// first stage (0: none), then at most `full` on the whole energy.
+struct WindowCaps {
+  int keyed = 0, full = 0;
+};
+
+/// The caps a window is solved with: the options' where they set them, else
+/// the defaults. Adam: 600, a single stage. L-BFGS: a window with end-effector
+/// targets or with 40 or more frames in a row without a key (long gaps) gets a
+/// single stage of 60 iterations; any other window 30 keys-only iterations,
+/// then 20 on the whole energy (without a keys-only stage: 40). Measured in
+/// docs/BENCHMARKS.md ("Iteration caps", "A keys-only first stage"): the
+/// keys-only stage costs a fraction of a dense iteration and leaves the full
+/// stage less to do on short gaps and sparse keys, while long gaps keep
+/// improving up to 60 full iterations. `key_frames` are the window's key
+/// frames (any order); T its length.
+WindowCaps window_caps(const LatentSolverOptions& options, const std::vector<int>& key_frames, bool has_effectors,
+                       int T);
 
 /// The options of the registered methods: "nemf" (L-BFGS) and "nemf-adam".
 LatentSolverOptions default_solver_options(SolverMethod method = SolverMethod::Lbfgs);
