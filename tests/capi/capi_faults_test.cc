@@ -10,8 +10,8 @@
 #include <fstream>
 #include <string>
 
-#include "capi_test_util.h"
-#include "test_util.h"
+#include "tests/capi/capi_test_util.h"
+#include "tests/test_util.h"
 
 namespace mf::capi_test {
 namespace {
