@@ -290,7 +290,10 @@ SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const st
   SolvedMotion out{Motion::identity(input.skeleton, N, input.fps), std::vector<float>(static_cast<size_t>(N) * F, 0.0f),
                    std::vector<char>(N, 0)};
   int iterations = 0;
+  TaskContext window_ctx = ctx;  // reports carry the window
+  window_ctx.window_count = static_cast<int>(plan.size());
   for (const WindowPlan& w : plan) {
+    window_ctx.window = static_cast<int>(&w - plan.data());
     const Motion src = window_source(input, out.motion, w);
     const WindowProblem problem = make_window_problem(rig, src, 0, w.length, w.constraints, w.anchor);
     InitRequest request;
@@ -303,7 +306,7 @@ SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const st
     LatentSolverOptions window_options = options;
     window_options.keyed_iterations = w.caps.keyed;
     window_options.max_iterations = w.caps.full;
-    LatentSolution sol = solve_latents(model, problem, start, window_options, ctx, iterations, total);
+    LatentSolution sol = solve_latents(model, problem, start, window_options, window_ctx, iterations, total);
     iterations += sol.summary.iterations;
     rep->windows.push_back(sol.summary);
     rep->window_starts.push_back(w.start);

@@ -10,6 +10,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "prior/util/binary_io.h"
 #include "tasks/baselines.h"
 #include "tasks/residuals.h"
 
@@ -59,11 +60,8 @@ std::shared_ptr<const RigAnatomy> load_rig_anatomy_next_to(const std::string& pr
   const std::filesystem::path path = std::filesystem::path(prior_file).parent_path() / kRigAnatomyFileName;
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return nullptr;
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in) throw InputError(path.string() + ": cannot read the rig anatomy file");
-  return std::make_shared<const RigAnatomy>(RigAnatomy::from_json(text.str(), model, path.string()));
+  const std::string text = read_file_limited(path.string(), "rig anatomy file", kMaxTextFileBytes);
+  return std::make_shared<const RigAnatomy>(RigAnatomy::from_json(text, model, path.string()));
 }
 
 bool needs_model_rig(const Motion& input, const TaskContext& ctx) {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "prior/motion/errors.h"
+#include "prior/util/binary_io.h"
 #include "tasks/ground_path.h"
 
 namespace mf {
@@ -79,12 +80,7 @@ std::vector<Eigen::Vector2d> parse_path_csv(const std::string& text, const std::
 }
 
 std::vector<Eigen::Vector2d> read_path_csv(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError(path + ": cannot open the path file");
-  std::ostringstream text;
-  text << file.rdbuf();
-  if (file.bad()) throw InputError(path + ": cannot read the path file");
-  return parse_path_csv(text.str(), path);
+  return parse_path_csv(read_file_limited(path, "path file", kMaxTextFileBytes), path);
 }
 
 }  // namespace mf

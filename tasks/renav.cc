@@ -472,10 +472,13 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
   RenavReport rep;
   Motion out = Motion::identity(reference.skeleton, M, fm);
   int iterations = 0;
+  TaskContext window_ctx = ctx;  // reports carry the window
+  window_ctx.window_count = windows;
   for (int k = 0; k < windows; ++k) {
     const auto tw = Clock::now();
     const RenavSpan& span = spans[k];
-    ctx.report({iterations, cap * windows, 0.0});
+    window_ctx.window = k;
+    window_ctx.report({iterations, cap * windows, 0.0});
     const RenavWindow window = make_renav_window(model, ref_m, span.ref_begin, span.ref_length, path_m, span.begin,
                                                  span.length, k > 0 ? &out : nullptr, span.shared);
     RenavWindowSummary sum;
@@ -486,7 +489,7 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
     const at::Tensor x0 = initial_codes(model, window, energy, inits, ctx.seed, k, &sum);
     sum.initial_terms = energy.terms(x0, &sum.initial_energy);
     LatentOptimizerStats stats;
-    const at::Tensor x = minimize_latent(energy.total(), x0, options.solver, options.capped(cap), ctx, &stats,
+    const at::Tensor x = minimize_latent(energy.total(), x0, options.solver, options.capped(cap), window_ctx, &stats,
                                          iterations, cap * windows);
     sum.iterations = stats.iterations;
     sum.evaluations = stats.evaluations;

@@ -25,6 +25,11 @@ struct TaskProgress {
   int iteration = 0;
   int max_iterations = 0;
   double energy = 0.0;
+  /// The window being solved (0-based) and the window count; 0 and 0 when
+  /// the method does not work window by window. TaskContext::report fills
+  /// them from the context.
+  int window = 0;
+  int window_count = 0;
 };
 
 /// Thrown when a progress callback or the cancel flag stops a method.
@@ -76,9 +81,16 @@ struct TaskContext : ModelSet {
   std::function<bool(const TaskProgress&)> progress;
   /// Non-zero cancels (thread-safe; set from any thread).
   const std::atomic<int>* cancel = nullptr;
+  /// The window a windowed solver is on, and how many it has (0: not
+  /// windowed): set on a copy of the context per window, passed on in reports.
+  int window = 0;
+  int window_count = 0;
 
-  /// Calls `progress` and checks `cancel`; throws CancelledError when asked to stop.
-  void report(const TaskProgress& p) const {
+  /// Calls `progress` (with this context's window) and checks `cancel`;
+  /// throws CancelledError when asked to stop.
+  void report(TaskProgress p) const {
+    p.window = window;
+    p.window_count = window_count;
     if ((cancel && cancel->load() != 0) || (progress && !progress(p))) throw CancelledError();
   }
 };

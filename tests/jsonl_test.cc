@@ -239,6 +239,19 @@ TEST(JsonlTest, EveryJobTakesARigMapAndUnits) {
                   "a unit name or a number"));
 }
 
+// Issue 18, item 4: a NUL would silently cut a file name ("a.bvh\u0000.evil" would read a.bvh).
+TEST(JsonlTest, NulInAStringIsRefused) {
+  EXPECT_EQ(job_error(R"({"task": "inbetween", "in": "a.bvh\u0000.evil", "out": "b", "keyframes": [0, 1]})"),
+            "\"in\" contains a NUL character (\\u0000), which no file name or value can hold");
+  EXPECT_NE(job_error(R"({"task": "inbetween", "in": "a", "out": "b\u0000", "keyframes": [0, 1]})").find("\"out\" contains a NUL"),
+            std::string::npos);
+  EXPECT_NE(job_error(R"({"task": "renav", "in": "a", "out": "b", "path": "p\u0000.csv"})").find("\"path\" contains a NUL"),
+            std::string::npos);
+  EXPECT_NE(job_error(R"({"task": "fill", "in": "a", "out": "b", "gap": [1, 2], "rig_map": "m\u0000"})")
+                .find("\"rig_map\" contains a NUL"),
+            std::string::npos);
+}
+
 TEST(JsonlTest, BadJobsNameTheProblem) {
   auto has = [](const std::string& m, const std::string& part) { return m.find(part) != std::string::npos; };
   EXPECT_TRUE(has(job_error("[1, 2]"), "JSON object"));

@@ -70,8 +70,12 @@ const CLI::Validator kNonEmpty(
 
 // --in and --out of the task commands.
 void add_task_files(CLI::App* cmd, BatchJob& job, const std::string& in_help) {
-  cmd->add_option("--in", job.in, in_help)->required()->type_name("PATH");
-  cmd->add_option("--out", job.out, "output BVH (written atomically)")->required()->type_name("PATH");
+  cmd->add_option("-i,--in", job.in, in_help + "; - reads standard input")->required()->type_name("PATH");
+  cmd->add_option("-o,--out", job.out,
+                  "output BVH (a file is replaced atomically; a device or\nFIFO is written in place); - writes "
+                  "standard output")
+      ->required()
+      ->type_name("PATH");
 }
 
 void add_method(CLI::App* cmd, BatchJob& job,
@@ -79,7 +83,7 @@ void add_method(CLI::App* cmd, BatchJob& job,
   cmd->add_option("--method", job.method, help)->type_name("M")->check(kNonEmpty);
 }
 
-void define_global_options(CLI::App& app, Settings& s) {
+void define_global_options(CLI::App& app, Settings& s, bool& version_flag) {
   app.option_defaults()->group("global options");
   app.set_help_flag("-h,--help", "this help; `motionfield <command> --help` for a command");
   app.add_option("--threads", s.threads, "intra-op threads for the solvers (default 2)")
@@ -103,13 +107,17 @@ void define_global_options(CLI::App& app, Settings& s) {
                  "onto the model's")
       ->type_name("FILE")
       ->check(kNonEmpty);
-  app.add_option("--units", s.units,
+  app.add_option("--units,--length-scale", s.units,
                  "the BVH length unit: auto (the default: detected from the\nleg length), cm, m, mm, in, ft, asf or "
-                 "metres per unit")
+                 "metres per unit\n(--length-scale 0.01 = --units cm)")
       ->type_name("U");
   app.add_flag("-v,--verbose", s.verbose, "print what runs and how long it takes (stderr)");
-  app.set_version_flag(
-      "--version", [] { return "motionfield " + version(); }, "print the version");
+  app.add_flag("-q,--quiet", s.quiet, "no progress bar and no warnings (errors are still printed)");
+  app.add_flag("--json", s.json,
+               "print a JSON summary of each job on stdout, one object per\nline (method, frames, timings, "
+               "warnings; rig: the\ndescription)");
+  app.add_flag("--version", version_flag, "print the versions of the program, the library, its ABI\nand the "
+                                           "model (--model or the default one)");
 }
 
 void define_inbetween(CLI::App& app, HelpFormatter& help, Arguments& a) {
@@ -199,6 +207,8 @@ void define_batch(CLI::App& app, HelpFormatter& help, Arguments& a) {
       "--units for that job. Keys a job does not need (\"id\", frame counts, ...) are\n"
       "ignored; blank lines are skipped; relative paths are relative to the current\n"
       "directory. The model (--model) is loaded once for all jobs.\n"
+      "A job may not write the output of an earlier line, nor its own input; \"-\"\n"
+      "(standard input or output) is for single commands only.\n"
       "A failed job is reported on stderr (line number, id, reason) and the others\n"
       "still run. Exit code: 0 if every job succeeded, 1 if any job hit an internal\n"
       "error, otherwise 2 if any job had bad input. Progress is shown on stderr when\n"
@@ -217,7 +227,6 @@ void define_rig(CLI::App& app, HelpFormatter& help, Arguments& a) {
                               "interpolate them between known frames). --rig-map FILE entries replace what\n"
                               "was found. A rig that cannot be mapped gives the reason (exit 2).");
   cmd->add_option("in", a.file, "the BVH file")->required()->type_name("IN.bvh");
-  cmd->add_flag("--json", a.json, "the description as JSON (the C API's mf_rig_describe)");
   cmd->footer(kGlobalOptionsNote);
 }
 
@@ -230,11 +239,11 @@ void define_command_line(CLI::App& app, Arguments& args) {
   help->set_text(
       &app,
       "motionfield [--threads N] [--model PATH] [--twostage PATH] [--citl PATH] [--verbose]\n"
-      "                   [--rig-map FILE] [--units U] <command> [options]",
+      "                   [--quiet] [--json] [--rig-map FILE] [--units U] <command> [options]",
       "motionfield " + version() + ": motion in-betweening, gap filling, resampling and re-navigation of BVH clips");
   // Global options may come anywhere, also after the command.
   app.fallthrough();
-  define_global_options(app, args.settings);
+  define_global_options(app, args.settings, args.version);
   define_inbetween(app, *help, args);
   define_fill(app, *help, args);
   define_resample(app, *help, args);
@@ -246,6 +255,9 @@ void define_command_line(CLI::App& app, Arguments& args) {
       "model retarget it to the model's rig and back (`motionfield rig IN.bvh` shows\n"
       "the map). Output BVH files keep the input's skeleton, channel layout, unit and\n"
       "frame time.\n"
+      "A progress bar (iterations, windows, time left) is drawn on stderr when it is a\n"
+      "terminal, unless --quiet. Messages quote file names and input with control\n"
+      "characters escaped.\n"
       "Exit codes: 0 ok, 2 bad input (message on stderr), 1 internal error.");
 }
 

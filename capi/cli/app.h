@@ -21,7 +21,7 @@ struct Arguments {
   std::string path;       ///< renav --path
   std::string polyline;   ///< renav --polyline
   std::string file;       ///< rig IN.bvh, batch JOBS.jsonl
-  bool json = false;      ///< rig --json
+  bool version = false;   ///< --version
 };
 
 /// Defines the command line on `app` (named "motionfield"), storing into `args`.

@@ -11,6 +11,7 @@
 #include "job.h"
 #include "models.h"
 #include "motionfield.hpp"
+#include "progress.h"
 
 namespace motionfield::cli {
 namespace {
@@ -63,43 +64,84 @@ BatchJob task_job(const std::string& command, const Arguments& a) {
 }
 
 int command_task(const BatchJob& job, const Settings& settings) {
+  if (settings.json && job.out == "-")
+    throw InputError("--json and --out - would both write to standard output: name an output file");
   Models models(settings.model, settings.transformers());
   models.load_explicit();
-  print_warnings(run_job(job, settings, models));
+  ProgressLine progress(ProgressLine::stderr_is_terminal() && !settings.quiet);
+  progress.start(job.task + " " + job.in);
+  JobReport report;
+  try {
+    report = run_job(job, settings, models, progress);
+  } catch (...) {
+    progress.clear();
+    if (settings.json) {
+      Failure failure = current_failure();
+      failure.message = printable(failure.message);
+      std::printf("%s\n", job_json(job, nullptr, &failure).c_str());
+    }
+    throw;
+  }
+  if (!settings.quiet) print_warnings(report.warnings);
+  if (settings.json) std::printf("%s\n", job_json(job, &report, nullptr).c_str());
   return kExitOk;
 }
 
-std::string read_text_file(const std::string& path, const std::string& what) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the " + what);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) throw InputError(path + ": cannot read the " + what);
-  return text.str();
+// motionfield --version: the program's, the library's and the ABI's versions,
+// and the model's when one is found (--model or the default one).
+int command_version(const Settings& settings) {
+  std::printf("motionfield %s\n", MF_VERSION_STRING);
+  std::printf("library %s, ABI %u (this program was built against %s, ABI %d)\n", version().c_str(),
+              static_cast<unsigned>(abi_version()), MF_VERSION_STRING, MF_ABI_VERSION);
+  const std::string path = settings.model.empty() ? default_model_path() : settings.model;
+  if (path.empty()) {
+    std::printf("model: none found (--model PATH, $MF_MODEL or models/motionfield-prior.mfm)\n");
+    return kExitOk;
+  }
+  try {
+    Model model = Model::load(path);
+    for (const std::string& file : settings.transformers()) model = model.with_inbetweener(file);
+    const JsonValue d = parse_json(model.describe());
+    std::string transformers;
+    const JsonValue& kinds = *d.find("inbetweeners");
+    for (size_t i = 0; i < kinds.keys().size(); ++i)
+      if (kinds.values()[i].find("loaded")->as_bool()) transformers += (transformers.empty() ? "" : ", ") + kinds.keys()[i];
+    std::printf("%s\n", printable("model " + path + ": format " +
+                                   std::to_string(static_cast<int>(d.find("format_version")->as_number())) + ", " +
+                                   std::to_string(static_cast<int>(d.find("joints")->as_number())) + " joints at " +
+                                   std::to_string(static_cast<int>(d.find("fps")->as_number())) + " fps, window " +
+                                   std::to_string(static_cast<int>(d.find("window")->as_number())) +
+                                   "; transformers: " + (transformers.empty() ? "none" : transformers))
+                             .c_str());
+    if (!settings.quiet) print_warnings(Models::load_warnings_of(model));
+  } catch (const Error& e) {
+    std::printf("%s\n", printable("model " + path + ": does not load: " + e.what()).c_str());
+  }
+  return kExitOk;
 }
 
-// The text form of mf_rig_describe's JSON.
+// The text form of mf_rig_describe's JSON (names from the file printable).
 void print_rig(const std::string& in, const JsonValue& d, const std::string& model_path, bool units_given) {
   const bool detected = d.find("unit_detected")->as_bool();
   const char* unit_how = units_given ? "given" : detected ? "detected from the leg length" : "no legs found: assumed";
-  std::printf("%s: %d joints, unit %s (%s; %g m per file unit)\n", in.c_str(),
+  std::printf("%s: %d joints, unit %s (%s; %g m per file unit)\n", printable(in).c_str(),
               static_cast<int>(d.find("joints")->as_number()), d.find("unit")->as_string().c_str(), unit_how,
               d.find("length_scale")->as_number());
-  std::printf("mapped onto %s (%zu joints): user joint -> model joint, found by\n", model_path.c_str(),
+  std::printf("mapped onto %s (%zu joints): user joint -> model joint, found by\n", printable(model_path).c_str(),
               d.find("model_joints")->as_array().size());
   const JsonValue& map = *d.find("map");
   const JsonValue& how = *d.find("how");
   size_t width = 0;
-  for (const std::string& user : map.keys()) width = std::max(width, user.size());
+  for (const std::string& user : map.keys()) width = std::max(width, printable(user).size());
   for (size_t i = 0; i < map.keys().size(); ++i) {
     const std::string& model_joint = map.values()[i].as_string();
-    std::printf("  %-*s -> %-14s %s\n", static_cast<int>(width), map.keys()[i].c_str(), model_joint.c_str(),
+    std::printf("  %-*s -> %-14s %s\n", static_cast<int>(width), printable(map.keys()[i]).c_str(), model_joint.c_str(),
                 how.find(model_joint)->as_string().c_str());
   }
   std::string left;
   for (const JsonValue& j : d.find("unmapped_user_joints")->as_array())
     left += (left.empty() ? "" : ", ") + j.as_string();
-  std::printf("user joints left out: %s\n", left.empty() ? "none" : left.c_str());
+  std::printf("user joints left out: %s\n", left.empty() ? "none" : printable(left).c_str());
   if (!d.find("retargeting")->as_bool())
     std::printf(
         "note: the model has no rig anatomy (motionfield-rig.json next to it): "
@@ -121,7 +163,7 @@ int command_rig(const std::string& in, bool json, const Settings& settings) {
     throw;
   }
   if (json) {
-    std::printf("%s\n", text.c_str());
+    std::printf("%s\n", text.c_str());  // JSON: control characters are escaped
   } else {
     print_rig(in, parse_json(text), models.path(), length_scale > 0);
   }
@@ -132,6 +174,7 @@ int command_rig(const std::string& in, bool json, const Settings& settings) {
 
 int run_command(const CLI::App& app, const Arguments& args) {
   const Settings& settings = args.settings;
+  if (args.version) return command_version(settings);
   units_scale(settings.units, "--units");
   const std::vector<CLI::App*> chosen = app.get_subcommands();
   if (chosen.empty()) {
@@ -143,7 +186,7 @@ int run_command(const CLI::App& app, const Arguments& args) {
 
   const std::string command = chosen.front()->get_name();
   if (command == "batch") return command_batch(args.file, settings);
-  if (command == "rig") return command_rig(args.file, args.json, settings);
+  if (command == "rig") return command_rig(args.file, settings.json, settings);
   return command_task(task_job(command, args), settings);
 }
 

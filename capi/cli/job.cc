@@ -1,9 +1,14 @@
 #include "job.h"
 
+#include <nlohmann/json.hpp>
+
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <sstream>
 #include <system_error>
 
 #include "input_error.h"
@@ -13,10 +18,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+constexpr char kStdio[] = "-";
+
 // Fails before any work when the output cannot be written (the C API would
 // only find out after the solve).
 void check_output_path(const std::string& out) {
   namespace fs = std::filesystem;
+  if (out == kStdio) return;
   const fs::path p(out);
   std::error_code ec;
   if (fs::is_directory(p, ec)) throw InputError("cannot write " + out + ": it is a directory");
@@ -25,8 +33,23 @@ void check_output_path(const std::string& out) {
     throw InputError("cannot write " + out + ": directory " + dir.string() + " does not exist");
 }
 
+// Refuses an output that is one of the job's input files (same file by
+// device and inode: a.bvh, ./a.bvh and a hard link all match).
+void check_output_is_not_an_input(const BatchJob& job, const Settings& settings) {
+  if (job.out == kStdio) return;
+  const std::string rig_map = job.rig_map.empty() ? settings.rig_map : job.rig_map;
+  const std::pair<const std::string*, const char*> inputs[] = {
+      {&job.in, "input"}, {&job.path_file, "path file"}, {&rig_map, "rig map file"}};
+  for (const auto& [file, role] : inputs) {
+    std::error_code ec;
+    if (!file->empty() && *file != kStdio && std::filesystem::equivalent(*file, job.out, ec))
+      throw InputError("the output " + job.out + " is the " + role + " " + *file +
+                       ": refusing to overwrite it (name another output file)");
+  }
+}
+
 // What a job checks before reading anything: its method exists, re-navigation's numbers, the output path.
-void check_job(const BatchJob& job) {
+void check_job(const BatchJob& job, const Settings& settings) {
   const bool renav = job.task == "renav";
   // Re-navigation has methods of its own, checked by mf_renav.
   if (!job.method.empty() && !renav) find_method(job.method);
@@ -36,11 +59,14 @@ void check_job(const BatchJob& job) {
       throw InputError("renav: the frame count must be at least 2");
   }
   check_output_path(job.out);
+  check_output_is_not_an_input(job, settings);
 }
 
-Motion solve(const BatchJob& job, const Settings& settings, const Model& model, const Motion& input) {
+Motion solve(const BatchJob& job, const Settings& settings, const Model& model, const Motion& input,
+             ProgressLine& progress) {
   TaskOptions options(job.method);
   options.rig_map_path = job.rig_map.empty() ? settings.rig_map : job.rig_map;
+  if (progress.enabled()) options.progress = [&progress](const mf_progress& p) { return progress.update(p); };
   if (job.task == "inbetween" || (job.task == "fill" && job.has_keyframes))
     return inbetween(model, input, std::vector<int32_t>(job.keyframes.begin(), job.keyframes.end()), options);
   if (job.task == "fill") return fill(model, input, job.gap_begin, job.gap_end, options);
@@ -55,38 +81,97 @@ Motion solve(const BatchJob& job, const Settings& settings, const Model& model, 
   throw InputError("unknown task '" + job.task + "'");
 }
 
-// The method that ran, for --verbose.
+// The method that ran.
 std::string method_name(const BatchJob& job, const Model& model) {
   if (!job.method.empty()) return job.method;
-  if (job.task == "resample") return "default";
+  if (job.task == "resample") return model ? "prior" : "interp";
   if (job.task == "renav") return "nemf";
   return default_method(model);
 }
 
+// Writes the BVH text on standard output; InputError with the reason when it fails (a closed pipe, a full disk).
+void write_stdout(const Motion& result) {
+  const std::string text = result.to_bvh();
+  errno = 0;
+  const bool ok = std::fwrite(text.data(), 1, text.size(), stdout) == text.size() && std::fflush(stdout) == 0;
+  if (!ok) throw Error(MF_ERROR_IO, std::string("cannot write the standard output: ") + std::strerror(errno));
+}
+
+double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+
 }  // namespace
 
-std::string run_job(const BatchJob& job, const Settings& settings, Models& models) {
+JobReport run_job(const BatchJob& job, const Settings& settings, Models& models, ProgressLine& progress) {
   const auto t0 = Clock::now();
-  check_job(job);
+  check_job(job, settings);
   // Re-navigation always needs the prior, whatever the method.
   const Model& model = models.for_method(job.task == "renav" && job.method.empty() ? "nemf" : job.method);
-  const Motion input = Motion::load_bvh(job.in, units_scale(job.units.empty() ? settings.units : job.units, "--units"));
+  JobReport report;
+  if (job.method.empty()) report.warnings = models.load_warnings();  // what the default method lost
+  // Standard input through its device file: the library reads pipes and
+  // redirected files with its size limit, and refuses a terminal.
+  const Motion input = Motion::load_bvh(job.in == kStdio ? "/dev/stdin" : job.in,
+                                        units_scale(job.units.empty() ? settings.units : job.units, "--units"));
   const auto t1 = Clock::now();
-  const Motion result = solve(job, settings, model, input);
+  const Motion result = solve(job, settings, model, input, progress);
+  progress.clear();
   const auto t2 = Clock::now();
-  result.save_bvh(job.out);
+  if (job.out == kStdio)
+    write_stdout(result);
+  else
+    result.save_bvh(job.out);
   const auto t3 = Clock::now();
 
+  report.method = method_name(job, model);
+  report.model = model ? models.path() : "";
+  report.frames_in = input.frame_count();
+  report.frames_out = result.frame_count();
+  report.read_ms = ms(t1 - t0);
+  report.solve_ms = ms(t2 - t1);
+  report.write_ms = ms(t3 - t2);
+  report.warnings += result.warnings();
   if (settings.verbose) {
-    auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
-    std::fprintf(stderr,
-                 "motionfield: %s %s -> %s: %d -> %d frames, method %s, model %s, %d threads; read %.1f ms, "
-                 "solve %.1f ms, write %.1f ms\n",
-                 job.task.c_str(), job.in.c_str(), job.out.c_str(), input.frame_count(), result.frame_count(),
-                 method_name(job, model).c_str(), model ? models.path().c_str() : "none", settings.threads, ms(t1 - t0),
-                 ms(t2 - t1), ms(t3 - t2));
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  ": %d -> %d frames, method %s, %d threads; read %.1f ms, solve %.1f ms, write %.1f ms",
+                  report.frames_in, report.frames_out, report.method.c_str(), settings.threads, report.read_ms,
+                  report.solve_ms, report.write_ms);
+    std::fprintf(stderr, "motionfield: %s\n",
+                 printable(job.task + " " + job.in + " -> " + job.out + ", model " +
+                           (report.model.empty() ? std::string("none") : report.model) + line)
+                     .c_str());
   }
-  return result.warnings();
+  return report;
+}
+
+std::string job_json(const BatchJob& job, const JobReport* report, const Failure* failure, size_t line) {
+  nlohmann::ordered_json j;
+  if (line > 0) j["line"] = line;
+  if (!job.id.empty()) j["id"] = job.id;
+  j["task"] = job.task;
+  j["in"] = job.in;
+  j["out"] = job.out;
+  if (failure) {
+    j["status"] = "error";
+    j["exit_code"] = failure->exit_code;
+    j["error"] = failure->message;
+  } else if (report) {
+    j["status"] = "ok";
+    j["method"] = report->method;
+    j["model"] = report->model;
+    j["frames_in"] = report->frames_in;
+    j["frames_out"] = report->frames_out;
+    j["timings_ms"] = {{"read", report->read_ms},
+                       {"solve", report->solve_ms},
+                       {"write", report->write_ms},
+                       {"total", report->read_ms + report->solve_ms + report->write_ms}};
+    nlohmann::ordered_json warnings = nlohmann::ordered_json::array();
+    std::istringstream lines(report->warnings);
+    for (std::string w; std::getline(lines, w);) warnings.push_back(w);
+    j["warnings"] = warnings;
+  }
+  // Invalid UTF-8 in a file name becomes U+FFFD rather than failing the summary.
+  return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace motionfield::cli

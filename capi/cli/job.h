@@ -1,5 +1,5 @@
 // One job of the CLI, from the command line or a batch line, end to end:
-// read, solve, write.
+// read, solve, write; and its summary for --json.
 #pragma once
 
 #include <string>
@@ -7,12 +7,32 @@
 #include "cli.h"
 #include "jsonl.h"
 #include "models.h"
+#include "progress.h"
 
 namespace motionfield::cli {
 
-/// Runs `job` with the model `models` gives for its method. Returns the
-/// warnings of the task (Motion::warnings(), one per line; "" if none). With
-/// settings.verbose, prints what ran and how long each step took (stderr).
-std::string run_job(const BatchJob& job, const Settings& settings, Models& models);
+/// What a job did, for --verbose and --json.
+struct JobReport {
+  std::string method;    ///< the method that ran (the default one resolved)
+  std::string model;     ///< the model file, "" when none was used
+  int frames_in = 0, frames_out = 0;
+  double read_ms = 0, solve_ms = 0, write_ms = 0;
+  std::string warnings;  ///< the task's warnings (Motion::warnings()) and the CLI's, one per line
+};
+
+/// Runs `job` with the model `models` gives for its method, showing the
+/// solver's progress on `progress`. "-" as the input reads standard input, as
+/// the output writes standard output. Refuses, before reading anything, an
+/// output that is the job's input (or path or rig map file), by inode, so
+/// ./a.bvh and a.bvh match. With settings.verbose, prints what ran and how
+/// long each step took (stderr).
+JobReport run_job(const BatchJob& job, const Settings& settings, Models& models, ProgressLine& progress);
+
+/// The --json summary of one job: {"task", "in", "out", "status": "ok" |
+/// "error", "method", "model", "frames_in", "frames_out", "timings_ms":
+/// {"read", "solve", "write", "total"}, "warnings": [...]} when it ran, or
+/// {"task", "in", "out", "status": "error", "exit_code", "error"} when it
+/// failed; batch jobs add "line" and "id" (when given). One line of JSON.
+std::string job_json(const BatchJob& job, const JobReport* report, const Failure* failure, size_t line = 0);
 
 }  // namespace motionfield::cli

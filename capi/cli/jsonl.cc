@@ -303,6 +303,10 @@ const JsonValue& required(const JsonValue& obj, const std::string& key, const st
 std::string string_value(const JsonValue& v, const std::string& key, bool allow_empty) {
   if (!v.is_string()) throw InputError(where(key) + " must be a string, not " + json_type_name(v.type()));
   if (!allow_empty && v.as_string().empty()) throw InputError(where(key) + " must not be empty");
+  // A file name cannot hold a NUL: the system would silently cut it there
+  // ("a.bvh\u0000.evil" would name a.bvh).
+  if (v.as_string().find('\0') != std::string::npos)
+    throw InputError(where(key) + " contains a NUL character (\\u0000), which no file name or value can hold");
   return v.as_string();
 }
 

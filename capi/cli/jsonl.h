@@ -118,7 +118,8 @@ struct BatchJob {
 /// key the task needs is missing or has the wrong type ("in" and "out" non-empty
 /// strings; "keyframes" an array of integers; "gap" an array of two integers;
 /// "fps" a number; "method", "path", "polyline" and "rig_map" strings;
-/// "frames" an integer; "units" a string or a positive number). Range checks
+/// "frames" an integer; "units" a string or a positive number; no string
+/// may contain a NUL, "\u0000", which would cut a file name). Range checks
 /// (keyframes within the clip, fps positive, ...) are the library's, once the
 /// input is read.
 BatchJob batch_job_from_json(const JsonValue& line);

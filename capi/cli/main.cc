@@ -4,10 +4,12 @@
 // the library's internals (the build gives it no path to them).
 //   app.cc       the command line (CLI11): options and help texts
 //   commands.cc  the commands; batch.cc the batch command
-//   job.cc       one job end to end; models.cc which model it runs with
+//   job.cc       one job end to end (and its --json summary); models.cc which
+//                model it runs with; progress.cc the progress bar
 //   jsonl.cc     the batch file's JSON lines
 // Exit codes: 0 ok, 2 bad input, 1 internal error; every message goes to
-// stderr, prefixed with "motionfield: ".
+// stderr, prefixed with "motionfield: ", with control characters escaped
+// (cli.h printable).
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <string>

@@ -3,6 +3,7 @@
 #include <utility>
 
 #include "input_error.h"
+#include "jsonl.h"
 
 namespace motionfield::cli {
 
@@ -54,6 +55,27 @@ void Models::load_default() {
     throw InputError(default_error_);
   }
   use(std::move(model), path);
+}
+
+std::string Models::load_warnings_of(const Model& model) {
+  if (!model) return "";
+  std::string out;
+  const JsonValue d = parse_json(model.describe());
+  const JsonValue& kinds = *d.find("inbetweeners");
+  for (size_t i = 0; i < kinds.keys().size(); ++i) {
+    const JsonValue& k = kinds.values()[i];
+    const std::string& error = k.find("error")->as_string();
+    if (!error.empty())
+      out += k.find("file")->as_string() + " next to the model did not load, so the methods that need it cannot run "
+             "and the default method does without it: " + error + "\n";
+  }
+  return out;
+}
+
+std::string Models::load_warnings() {
+  if (warned_ || !model_) return "";
+  warned_ = true;
+  return load_warnings_of(model_);
 }
 
 void Models::use(Model model, const std::string& path) {

@@ -30,6 +30,15 @@ class Models {
   /// The loaded model's path ("" before one is loaded).
   const std::string& path() const { return path_; }
 
+  /// The transformer files next to the model that were there but did not
+  /// load (a truncated file: the default method then quietly runs without
+  /// it), one warning per line naming the file and the reason; given once
+  /// per process ("" afterwards, and when everything loaded).
+  std::string load_warnings();
+
+  /// Those warnings of `model` (mf_model_describe), every time.
+  static std::string load_warnings_of(const Model& model);
+
  private:
   void load_default();
   void use(Model model, const std::string& path);
@@ -37,6 +46,7 @@ class Models {
   std::string explicit_path_, path_, default_error_;
   std::vector<std::string> transformers_;
   bool tried_default_ = false;
+  bool warned_ = false;
   Model model_;
 };
 

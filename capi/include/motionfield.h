@@ -148,6 +148,22 @@ MF_API const char *mf_last_error_message(void);
  *  for a code this library does not define). Never NULL. */
 MF_API const char *mf_status_name(int status);
 
+/** The longest message the library records, in bytes (without the NUL). */
+#define MF_MESSAGE_MAX_BYTES 4096
+
+/* Messages (mf_last_error_message) quote file names and bytes of the input;
+ * the library records them in a form that is safe to
+ * print on a terminal: bytes that are not printable UTF-8 (control characters
+ * and escape sequences, invalid UTF-8, C1 controls, bidirectional overrides)
+ * are escaped as \n, \t, \r, \xNN or \uNNNN (a backslash itself is kept),
+ * and text longer than MF_MESSAGE_MAX_BYTES keeps its start and its end around
+ * "... (N bytes left out) ...". Applying the form twice changes nothing. */
+
+/** `text` (`length` bytes, NULs allowed) in that form, for clients that print
+ *  messages of their own with file names or input in them. A string getter
+ *  (see "Arrays"); text == NULL is allowed with length 0. */
+MF_API int mf_printable_text(const char *text, size_t length, char *out, size_t capacity, size_t *needed);
+
 /* ================================================================ threads */
 
 /** Sets the number of intra-op threads of the numeric work in this process
@@ -180,6 +196,12 @@ typedef struct mf_progress {
   int32_t max_iterations;
   /** The solver's current energy (0 for methods without one). */
   double energy;
+  /** Since 0.1 (appended): the window being solved (0-based) and the number
+   *  of windows of a long clip solved window by window (iterations and
+   *  max_iterations are summed over the windows); 0 and 0 for methods that
+   *  do not work in windows. */
+  int32_t window;
+  int32_t window_count;
 } mf_progress;
 
 /** Progress callback: called on the task's thread before the work starts and
@@ -256,6 +278,19 @@ MF_API int mf_model_with_inbetweener(const mf_model *model, const char *path, mf
 /** *out = 1 if `model` has the transformer of `kind` ("twostage" or "citl"),
  *  else 0. MF_ERROR_INVALID_ARGUMENT for any other kind. */
 MF_API int mf_model_has_inbetweener(const mf_model *model, const char *kind, int32_t *out);
+
+/** What a model handle holds and what did not load with it, as JSON text (a
+ *  string getter, UTF-8):
+ *    {"format_version": 1,            (of the prior's model file)
+ *     "joints": 21, "fps": 30, "window": 128,
+ *     "inbetweeners": {"twostage": {"file": "motionfield-twostage.mfm",
+ *                                   "loaded": true, "error": ""}, ...},
+ *     "rig_anatomy": true, "rig_anatomy_error": ""}
+ *  One entry per transformer kind: "loaded" false with "error" "" when its
+ *  file was absent, with the reason when a file was there but did not load
+ *  (a truncated file, another skeleton): mf_model_load goes on without it, and
+ *  the default method (mf_default_method) is then chosen without it. */
+MF_API int mf_model_describe(const mf_model *model, char *out, size_t capacity, size_t *needed);
 
 /** The model's skeleton: joint count, names, parent indices (-1 for the root,
  *  joint 0) and rest offsets [joints][3] in metres. */

@@ -119,6 +119,13 @@ T read_value(Get&& get) {
 inline std::string version() { return mf_version_string(); }
 /// mf_abi_version(): the loaded library's ABI major (compare with MF_ABI_VERSION).
 inline uint32_t abi_version() { return mf_abi_version(); }
+/// mf_printable_text: `text` as the library records messages (non-printable
+/// bytes escaped, at most MF_MESSAGE_MAX_BYTES), for messages of your own.
+inline std::string printable_text(const std::string& text) {
+  return detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+    return mf_printable_text(text.data(), text.size(), out, capacity, needed);
+  });
+}
 /// mf_set_num_threads: intra-op threads of the whole process (1..1024).
 inline void set_num_threads(int32_t threads) { check(mf_set_num_threads(threads)); }
 inline int32_t num_threads() { return detail::read_value<int32_t>(mf_get_num_threads); }
@@ -160,6 +167,13 @@ class Model : public detail::Handle<mf_model, mf_model_destroy> {
     int32_t has = 0;
     check(mf_model_has_inbetweener(get(), kind.c_str(), &has));
     return has != 0;
+  }
+
+  /// mf_model_describe: the format version, the transformers and what did
+  /// not load next to the prior, as JSON text.
+  std::string describe() const {
+    return detail::read_string(
+        [&](char* out, size_t capacity, size_t* needed) { return mf_model_describe(get(), out, capacity, needed); });
   }
 
   int32_t joint_count() const {

@@ -59,7 +59,12 @@ class ApiError : public std::runtime_error {
   int status_;
 };
 
-/// Records `message` as this thread's last error and returns `status`.
+/// `text` in the printable, bounded form every message is recorded in (see
+/// MF_MESSAGE_MAX_BYTES in motionfield.h): the one place that makes it.
+std::string printable_text(const std::string& text, size_t max_bytes = MF_MESSAGE_MAX_BYTES);
+
+/// Records `message` (in printable_text's form) as this thread's last error
+/// and returns `status`.
 int fail(int status, const char* message) noexcept;
 
 /// Maps the exception being handled to a status code and records its message.

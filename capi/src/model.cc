@@ -3,6 +3,8 @@
 // skeleton/config queries.
 #include <dlfcn.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cerrno>
 #include <cstdlib>
 #include <filesystem>
@@ -15,6 +17,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/rig/retarget.h"
+#include "prior/util/binary_io.h"
 #include "tasks/inbetweener_files.h"
 #include "tasks/model_rig.h"
 
@@ -66,15 +69,7 @@ std::unique_ptr<mf_model> load_bytes(const uint8_t* data, size_t size, const std
 }
 
 // The bytes of a file; MF_ERROR_IO when it cannot be read.
-std::vector<uint8_t> read_file(const std::string& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw ApiError(MF_ERROR_IO, "cannot open model file " + file + ": " + std::strerror(errno));
-  std::error_code ec;
-  if (fs::is_directory(file, ec)) throw ApiError(MF_ERROR_IO, "cannot read model file " + file + ": it is a directory");
-  std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw ApiError(MF_ERROR_IO, "cannot read model file " + file);
-  return bytes;
-}
+std::vector<uint8_t> read_file(const std::string& file) { return read_file_bytes(file); }  // FileError: MF_ERROR_IO
 
 // The in-betweener file `file` for the prior of `model`: MF_ERROR_IO when
 // unreadable, MF_ERROR_MODEL when it is not an in-betweener or not on the
@@ -167,6 +162,28 @@ int mf_model_has_inbetweener(const mf_model* model, const char* kind, int32_t* o
     require(kind, "kind");
     require(out, "out");
     *out = model->inbetweener(mf::inbetweener_kind(kind).name) ? 1 : 0;
+  });
+}
+
+int mf_model_describe(const mf_model* model, char* out, size_t capacity, size_t* needed) {
+  return guard([&] {
+    const mf::NemfModel& m = mf::capi::get(model);
+    nlohmann::ordered_json j;
+    j["format_version"] = mf::kModelFormatVersion;
+    j["joints"] = m.rig().num_joints();
+    j["fps"] = m.config().fps;
+    j["window"] = m.config().window;
+    nlohmann::ordered_json kinds = nlohmann::ordered_json::object();
+    for (const mf::InbetweenerKind& kind : mf::inbetweener_kinds()) {
+      const auto error = model->inbetweener_errors.find(kind.name);
+      kinds[kind.name] = {{"file", kind.file_name},
+                          {"loaded", model->inbetweener(kind.name) != nullptr},
+                          {"error", error == model->inbetweener_errors.end() ? "" : error->second}};
+    }
+    j["inbetweeners"] = kinds;
+    j["rig_anatomy"] = model->model_anatomy != nullptr;
+    j["rig_anatomy_error"] = model->model_anatomy_error;
+    mf::capi::write_string(j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace), out, capacity, needed);
   });
 }
 

@@ -12,6 +12,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/motion_bvh.h"
 #include "prior/rig/units.h"
+#include "prior/util/binary_io.h"
 
 namespace mf::capi {
 namespace {
@@ -228,13 +229,7 @@ int mf_motion_load_bvh(const char* path, const mf_bvh_options* options, mf_motio
     require(path, "path");
     require(out, "out");
     mf::capi::length_scale_of(options);
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-      throw ApiError(MF_ERROR_IO, std::string(path) + ": cannot read: it is a directory");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw ApiError(MF_ERROR_IO, std::string(path) + ": cannot open: " + std::strerror(errno));
-    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw ApiError(MF_ERROR_IO, std::string(path) + ": read error");
+    const std::string text = mf::read_file_limited(path, "BVH file", mf::kMaxBvhFileBytes);  // FileError: MF_ERROR_IO
     *out = mf::capi::motion_from_document(mf::parse_bvh(text, path), options, path);
   });
 }
@@ -255,13 +250,7 @@ int mf_motion_save_bvh(const mf_motion* motion, const char* path, const mf_bvh_o
     require(path, "path");
     if (!*path) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the output path is empty");
     const mf::BvhDocument doc = mf::capi::document_of(m, mf::capi::units_of(options, m.length_scale));
-    try {
-      mf::write_bvh_file(path, doc);
-    } catch (const mf::InputError&) {  // the document does not validate
-      throw;
-    } catch (const std::exception& e) {
-      throw ApiError(MF_ERROR_IO, std::string("cannot write ") + path + ": " + e.what());
-    }
+    mf::write_bvh_file(path, doc);  // FileError "cannot write <path>: <reason>": MF_ERROR_IO
   });
 }
 

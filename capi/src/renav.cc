@@ -68,11 +68,7 @@ int mf_renav(const mf_model* model, const mf_motion* reference, const float* pat
 int mf_path_load_csv(const char* path, float* out, size_t capacity, size_t* needed) {
   return guard([&] {
     require(path, "path");
-    std::error_code ec;
-    if (std::filesystem::is_directory(path, ec))
-      throw ApiError(MF_ERROR_IO, std::string(path) + ": cannot read: it is a directory");
-    if (!std::ifstream(path, std::ios::binary)) throw ApiError(MF_ERROR_IO, std::string(path) + ": cannot open the path file");
-    const std::vector<Eigen::Vector2d> points = mf::read_path_csv(path);
+    const std::vector<Eigen::Vector2d> points = mf::read_path_csv(path);  // FileError: MF_ERROR_IO
     std::vector<float> flat(points.size() * 2);
     for (size_t i = 0; i < points.size(); ++i) {
       const float x = static_cast<float>(points[i].x()), z = static_cast<float>(points[i].y());

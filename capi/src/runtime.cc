@@ -1,10 +1,12 @@
 // Version, status codes and messages, threads, cancel tokens, methods.
 #include <ATen/Parallel.h>
 
+#include <cstdio>
 #include <new>
 
 #include "capi/src/capi_internal.h"
 #include "prior/motion/errors.h"
+#include "prior/util/binary_io.h"
 #include "tasks/jobs.h"
 #include "prior/util/threads.h"
 
@@ -16,11 +18,107 @@ thread_local const char* t_message_ptr = "";
 
 std::atomic<int> g_num_threads{0};
 
+// The code point of the valid UTF-8 sequence at s[i] (0x80 and up) and its
+// length in *n; -1 when the bytes there are not valid UTF-8 (overlong,
+// surrogate, beyond U+10FFFF, truncated).
+long utf8_at(const std::string& s, size_t i, size_t* n) {
+  const unsigned char c = static_cast<unsigned char>(s[i]);
+  size_t len = 0;
+  long cp = 0, min = 0;
+  if (c >= 0xC2 && c <= 0xDF) {
+    len = 2;
+    cp = c & 0x1F;
+    min = 0x80;
+  } else if (c >= 0xE0 && c <= 0xEF) {
+    len = 3;
+    cp = c & 0x0F;
+    min = 0x800;
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    len = 4;
+    cp = c & 0x07;
+    min = 0x10000;
+  } else {
+    return -1;
+  }
+  if (i + len > s.size()) return -1;
+  for (size_t k = 1; k < len; ++k) {
+    const unsigned char d = static_cast<unsigned char>(s[i + k]);
+    if ((d & 0xC0) != 0x80) return -1;
+    cp = (cp << 6) | (d & 0x3F);
+  }
+  if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return -1;
+  *n = len;
+  return cp;
+}
+
+// Code points a terminal acts on rather than shows: C1 controls, the
+// bidirectional overrides and isolates, line and paragraph separators.
+bool unprintable(long cp) {
+  return (cp >= 0x80 && cp <= 0x9F) || (cp >= 0x202A && cp <= 0x202E) || (cp >= 0x2066 && cp <= 0x2069) ||
+         cp == 0x2028 || cp == 0x2029 || cp == 0x200E || cp == 0x200F || cp == 0x061C;
+}
+
+std::string escaped(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  char buf[16];
+  for (size_t i = 0; i < s.size();) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if (c >= 0x20 && c < 0x7F) {
+      out += static_cast<char>(c);
+      ++i;
+    } else if (c == '\n' || c == '\t' || c == '\r') {
+      out += c == '\n' ? "\\n" : c == '\t' ? "\\t" : "\\r";
+      ++i;
+    } else if (c < 0x80) {
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+      ++i;
+    } else {
+      size_t n = 0;
+      const long cp = utf8_at(s, i, &n);
+      if (cp < 0) {
+        std::snprintf(buf, sizeof buf, "\\x%02x", c);
+        out += buf;
+        ++i;
+      } else if (unprintable(cp)) {
+        std::snprintf(buf, sizeof buf, "\\u%04lx", cp);
+        out += buf;
+        i += n;
+      } else {
+        out.append(s, i, n);
+        i += n;
+      }
+    }
+  }
+  return out;
+}
+
+// Moves a cut at `at` back to the start of a UTF-8 sequence (for the head).
+size_t char_boundary(const std::string& s, size_t at) {
+  while (at > 0 && at < s.size() && (static_cast<unsigned char>(s[at]) & 0xC0) == 0x80) --at;
+  return at;
+}
+
 }  // namespace
+
+std::string printable_text(const std::string& text, size_t max_bytes) {
+  std::string out = escaped(text);
+  if (out.size() <= max_bytes) return out;
+  // Keep the start (the file and what was wrong) and the end (the reason),
+  // the result never longer than max_bytes, so applying it again keeps it.
+  const std::string note = "... (" + std::to_string(out.size()) + " bytes left out) ...";  // >= the final note
+  const size_t room = max_bytes > note.size() ? max_bytes - note.size() : 0;
+  const size_t head = char_boundary(out, room * 3 / 4);
+  size_t tail_start = out.size() - (room - room * 3 / 4);
+  while (tail_start < out.size() && (static_cast<unsigned char>(out[tail_start]) & 0xC0) == 0x80) ++tail_start;
+  const size_t left_out = tail_start - head;
+  return out.substr(0, head) + "... (" + std::to_string(left_out) + " bytes left out) ..." + out.substr(tail_start);
+}
 
 int fail(int status, const char* message) noexcept {
   try {
-    t_message = message;
+    t_message = printable_text(message);
     t_message_ptr = t_message.c_str();
   } catch (...) {
     t_message_ptr = "out of memory (while recording an error message)";
@@ -37,6 +135,8 @@ int fail_current_exception() noexcept {
     return fail(MF_ERROR_CANCELLED, "cancelled");
   } catch (const ModelMissingError& e) {
     return fail(MF_ERROR_MODEL, e.what());
+  } catch (const FileError& e) {
+    return fail(MF_ERROR_IO, e.what());
   } catch (const InputError& e) {
     return fail(MF_ERROR_INVALID_ARGUMENT, e.what());
   } catch (const std::bad_alloc&) {
@@ -94,6 +194,14 @@ uint32_t mf_version_number(void) { return MF_VERSION_NUMBER; }
 const char* mf_version_string(void) { return MF_VERSION_STRING; }
 
 const char* mf_last_error_message(void) { return mf::capi::t_message_ptr; }
+
+int mf_printable_text(const char* text, size_t length, char* out, size_t capacity, size_t* needed) {
+  return guard([&] {
+    if (!text && length != 0) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "text is NULL");
+    mf::capi::write_string(mf::capi::printable_text(text ? std::string(text, length) : std::string()), out, capacity,
+                           needed);
+  });
+}
 
 const char* mf_status_name(int status) {
   switch (status) {

@@ -27,10 +27,7 @@ std::string rig_map_of(const mf_task_options& o) {
     throw ApiError(MF_ERROR_INVALID_ARGUMENT, "mf_task_options: give rig_map or rig_map_path, not both");
   if (text) return o.rig_map;
   if (file.empty()) return "";
-  std::error_code ec;
-  if (std::filesystem::is_directory(file, ec) || !std::ifstream(file, std::ios::binary))
-    throw ApiError(MF_ERROR_IO, file + ": cannot open the rig map file");
-  return read_rig_map_file(file);
+  return read_rig_map_file(file);  // FileError: MF_ERROR_IO
 }
 
 }  // namespace
@@ -49,6 +46,8 @@ TaskContext task_context(const mf_model* model, const mf_task_options& o) {
       cp.iteration = p.iteration;
       cp.max_iterations = p.max_iterations;
       cp.energy = p.energy;
+      cp.window = p.window;
+      cp.window_count = p.window_count;
       return fn(user_data, &cp) == 0;
     };
   }

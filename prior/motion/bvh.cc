@@ -1,18 +1,15 @@
 #include "prior/motion/bvh.h"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <cctype>
 #include <charconv>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <string_view>
 #include <system_error>
 #include <unordered_set>
+
+#include "prior/util/binary_io.h"
 
 namespace mf {
 namespace {
@@ -499,12 +496,7 @@ void BvhDocument::validate() const {
 BvhDocument parse_bvh(const std::string& text, const std::string& source) { return Parser(text, source).parse(); }
 
 BvhDocument read_bvh_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw BvhError(path + ": cannot open file");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw BvhError(path + ": read error");
-  return parse_bvh(buffer.str(), path);
+  return parse_bvh(read_file_limited(path, "BVH file", kMaxBvhFileBytes), path);
 }
 
 std::string format_bvh(const BvhDocument& doc) {
@@ -515,30 +507,8 @@ std::string format_bvh(const BvhDocument& doc) {
 }
 
 void write_bvh_file(const std::string& path, const BvhDocument& doc) {
-  namespace fs = std::filesystem;
   const std::string text = format_bvh(doc);
-  static std::atomic<unsigned> counter{0};
-  const fs::path target(path);
-  fs::path temp = target;
-  temp += ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot create " + temp.string());
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    out.close();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(temp, ignored);
-      throw std::runtime_error("cannot write " + temp.string());
-    }
-  }
-  std::error_code ec;
-  fs::rename(temp, target, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-    throw std::runtime_error("cannot rename " + temp.string() + " to " + path + ": " + ec.message());
-  }
+  write_file_atomically(path, text.data(), text.size());
 }
 
 }  // namespace mf

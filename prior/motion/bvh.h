@@ -77,8 +77,9 @@ constexpr long long kBvhMaxValues = 200'000'000;
 /// Joint names are single tokens and must be unique; only one ROOT is allowed.
 /// Numbers too small for a double read as 0.
 BvhDocument parse_bvh(const std::string& text, const std::string& source);
-/// Reads and parses a file; throws BvhError ("<path>: cannot open ...") if it
-/// cannot be opened.
+/// Reads (at most kMaxBvhFileBytes, prior/util/binary_io.h) and parses a file;
+/// throws FileError ("cannot open BVH file <path>: <reason>") if it cannot be
+/// read, BvhError if it does not parse.
 BvhDocument read_bvh_file(const std::string& path);
 
 /// Writes BVH text: tabs for indentation, values with 9 significant digits
@@ -87,8 +88,9 @@ BvhDocument read_bvh_file(const std::string& path);
 /// End Site. Throws mf::InputError if validate() fails, num_frames < 1 or
 /// frame_time <= 0 (the reader would reject the output).
 std::string format_bvh(const BvhDocument& doc);
-/// Writes to `path` through a temporary file and a rename, so a failure never
-/// leaves a half-written file; throws std::runtime_error on I/O failure.
+/// Writes to `path` with write_file_atomically (prior/util/binary_io.h: a
+/// temporary file and a rename, or in place for devices and FIFOs); throws
+/// FileError "cannot write <path>: <reason>" on I/O failure.
 void write_bvh_file(const std::string& path, const BvhDocument& doc);
 
 }  // namespace mf

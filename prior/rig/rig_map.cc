@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "prior/motion/errors.h"
+#include "prior/util/binary_io.h"
 
 namespace mf {
 namespace {
@@ -561,12 +562,7 @@ std::string RigMap::to_json(const Skeleton& user, const Skeleton& model) const {
 }
 
 std::string read_rig_map_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open the rig map file");
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (text.str().size() > (1u << 20)) throw InputError(path + ": a rig map file is at most 1 MiB");
-  return text.str();
+  return read_file_limited(path, "rig map file", kMaxRigMapFileBytes);
 }
 
 }  // namespace mf

@@ -1,40 +1,97 @@
 #include "prior/util/binary_io.h"
 
-#include <cerrno>
-#include <cstdio>
-#include <fstream>
-#include <stdexcept>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstring>
 
 namespace mf {
 
-std::vector<uint8_t> read_file_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open for reading");
-  in.seekg(0, std::ios::end);
-  std::streamoff size = in.tellg();
-  if (size < 0) throw InputError(path + ": cannot determine the size");
-  in.seekg(0);
-  std::vector<uint8_t> bytes(static_cast<size_t>(size));
-  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), size)) throw InputError(path + ": read failed");
-  return bytes;
+namespace {
+
+std::string mib(size_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
+
+// Writes all of `data` to `fd`; 0 or the errno of the failure.
+int write_all(int fd, const char* data, size_t size) {
+  while (size > 0) {
+    const ssize_t n = ::write(fd, data, size);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return errno;
+    }
+    if (n == 0) return EIO;
+    data += n;
+    size -= static_cast<size_t>(n);
+  }
+  return 0;
 }
 
-void write_file_atomically(const std::string& path, const std::vector<uint8_t>& bytes) {
-  std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error(path + ": cannot open for writing");
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw std::runtime_error(path + ": write failed");
+}  // namespace
+
+std::string read_file_limited(const std::string& path, const std::string& what, size_t max_bytes) {
+  struct stat st;
+  if (::stat(path.c_str(), &st) != 0) throw FileError("cannot open " + what + " " + path + ": " + std::strerror(errno));
+  const std::string cannot = "cannot read " + what + " " + path + ": ";
+  if (S_ISDIR(st.st_mode)) throw FileError(cannot + "it is a directory");
+  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) throw FileError(cannot + "it is a device, not a file");
+  const std::string too_large = cannot + "larger than the limit of " + mib(max_bytes) + " for a " + what;
+  if (S_ISREG(st.st_mode) && static_cast<uint64_t>(st.st_size) > max_bytes) throw FileError(too_large);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw FileError("cannot open " + what + " " + path + ": " + std::strerror(errno));
+  std::string text;
+  if (S_ISREG(st.st_mode)) text.reserve(static_cast<size_t>(st.st_size));
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int error = errno;
+      ::close(fd);
+      throw FileError(cannot + std::strerror(error));
     }
+    if (n == 0) break;
+    if (text.size() + static_cast<size_t>(n) > max_bytes) {
+      ::close(fd);
+      throw FileError(too_large);
+    }
+    text.append(buffer, static_cast<size_t>(n));
   }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    throw std::runtime_error(path + ": cannot rename the temporary file into place");
+  ::close(fd);
+  return text;
+}
+
+std::vector<uint8_t> read_file_bytes(const std::string& path) {
+  const std::string text = read_file_limited(path, "model file", kMaxModelFileBytes);
+  return std::vector<uint8_t>(text.begin(), text.end());
+}
+
+void write_file_atomically(const std::string& path, const void* data, size_t size) {
+  const std::string cannot = "cannot write " + path + ": ";
+  const char* bytes = static_cast<const char*>(data);
+  struct stat st;
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    // A device (/dev/null, /dev/full, a terminal) or a FIFO: written in place, never replaced.
+    if (S_ISDIR(st.st_mode)) throw FileError(cannot + "it is a directory");
+    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (fd < 0) throw FileError(cannot + std::strerror(errno));
+    int error = write_all(fd, bytes, size);
+    if (::close(fd) != 0 && error == 0) error = errno;
+    if (error != 0) throw FileError(cannot + std::strerror(error));
+    return;
+  }
+  static std::atomic<unsigned> counter{0};
+  const std::string temp = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) throw FileError(cannot + std::strerror(errno) + " (creating " + temp + ")");
+  int error = write_all(fd, bytes, size);
+  if (::close(fd) != 0 && error == 0) error = errno;
+  if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0) error = errno;
+  if (error != 0) {
+    ::unlink(temp.c_str());
+    throw FileError(cannot + std::strerror(error));
   }
 }
 

@@ -94,9 +94,40 @@ inline uint64_t fnv1a64_bytes(const uint8_t* data, size_t n, uint64_t h = 0xcbf2
   return h;
 }
 
-/// Reads a whole file; throws InputError naming the path if it cannot.
+/// A file that cannot be opened, read or written (the C API's MF_ERROR_IO);
+/// the message names the file and the reason (strerror).
+class FileError : public InputError {
+ public:
+  explicit FileError(const std::string& message) : InputError(message) {}
+};
+
+/// The size limits of input files (docs/RELIABILITY.md, "Bad input and
+/// faults"): a file is checked against its limit before it is read (regular
+/// files by their size, pipes while reading).
+constexpr size_t kMiB = size_t{1} << 20;
+constexpr size_t kMaxBvhFileBytes = 512 * kMiB;    ///< BVH: an hour at 120 fps on a 70-joint rig
+constexpr size_t kMaxModelFileBytes = 2048 * kMiB; ///< model files (.mfm)
+constexpr size_t kMaxTextFileBytes = 64 * kMiB;    ///< path CSVs, rig anatomy
+constexpr size_t kMaxRigMapFileBytes = 1 * kMiB;   ///< rig map files
+
+/// Reads a whole file of at most `max_bytes`. Throws FileError
+/// "cannot read the <what> <path>: <reason>" when it cannot be opened or read,
+/// is a directory or a device (/dev/zero, a terminal: not a file), or is
+/// larger than `max_bytes`. Regular files, pipes and FIFOs are read.
+std::string read_file_limited(const std::string& path, const std::string& what, size_t max_bytes);
+
+/// Reads a whole model-sized file (read_file_limited, kMaxModelFileBytes).
 std::vector<uint8_t> read_file_bytes(const std::string& path);
-/// Writes through a temporary file and a rename; throws std::runtime_error on failure.
-void write_file_atomically(const std::string& path, const std::vector<uint8_t>& bytes);
+
+/// Writes `size` bytes to `path`. A regular file (or a new one) is replaced
+/// through a temporary file in its directory and a rename, so a failure never
+/// leaves a half-written file; anything else that exists (a character device
+/// like /dev/null or /dev/stdout, a FIFO) is written directly, never replaced.
+/// Throws FileError "cannot write <path>: <reason>" (strerror: "No space left
+/// on device", "Permission denied", ...).
+void write_file_atomically(const std::string& path, const void* data, size_t size);
+inline void write_file_atomically(const std::string& path, const std::vector<uint8_t>& bytes) {
+  write_file_atomically(path, bytes.data(), bytes.size());
+}
 
 }  // namespace mf

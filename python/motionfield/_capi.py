@@ -58,6 +58,8 @@ class MfProgress(ctypes.Structure):
         ("iteration", ctypes.c_int32),
         ("max_iterations", ctypes.c_int32),
         ("energy", ctypes.c_double),
+        ("window", ctypes.c_int32),
+        ("window_count", ctypes.c_int32),
     ]
 
 
@@ -171,6 +173,7 @@ _declare("mf_version_number", _u32)
 _declare("mf_version_string", _str)
 _declare("mf_last_error_message", _str)
 _declare("mf_status_name", _str, _int)
+_declare("mf_printable_text", _int, ctypes.c_char_p, _size, ctypes.c_char_p, _size, _P(_size))
 _declare("mf_set_num_threads", _int, _i32)
 _declare("mf_get_num_threads", _int, _P(_i32))
 
@@ -191,6 +194,7 @@ _declare("mf_model_load_from_memory", _int, ctypes.c_void_p, _size, _P(_model))
 _declare("mf_model_destroy", None, _model)
 _declare("mf_model_with_inbetweener", _int, _model, _str, _P(_model))
 _declare("mf_model_has_inbetweener", _int, _model, _str, _P(_i32))
+_declare("mf_model_describe", _int, _model, ctypes.c_char_p, _size, _P(_size))
 _declare("mf_model_get_joint_count", _int, _model, _P(_i32))
 _declare("mf_model_get_joint_name", _int, _model, _i32, ctypes.c_char_p, _size, _P(_size))
 _declare("mf_model_get_parents", _int, _model, _P(_i32), _size, _P(_size))

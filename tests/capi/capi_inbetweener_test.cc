@@ -153,5 +153,34 @@ TEST(CApiInbetweener, WithInbetweenerFromAnExplicitPath) {
   EXPECT_EQ(v, 7);
 }
 
+// A transformer file next to the prior that does not load (issue 18, item 6)
+// is named with its reason by mf_model_describe, so a client can warn that the
+// default method runs without it.
+TEST(CApiInbetweener, DescribeNamesTheFileThatDidNotLoad) {
+  ModelDir d("describe");
+  d.write(kCitlKind, "motionfield-citl.mfm");
+  {
+    std::ofstream(d.dir + "/motionfield-twostage.mfm") << "MFIB truncated";
+  }
+  const ModelPtr model = load(d.prior);
+  ASSERT_TRUE(model);
+  size_t needed = 0;
+  ASSERT_EQ(mf_model_describe(model.get(), nullptr, 0, &needed), MF_OK);
+  std::string text(needed, '\0');
+  ASSERT_EQ(mf_model_describe(model.get(), text.data(), text.size(), &needed), MF_OK);
+  text.resize(needed - 1);
+  EXPECT_NE(text.find("\"format_version\":1"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"twostage\":{\"file\":\"motionfield-twostage.mfm\",\"loaded\":false,\"error\":\""),
+            std::string::npos)
+      << text;
+  EXPECT_EQ(text.find("\"error\":\"\"},\"citl\""), std::string::npos) << "the twostage error is empty: " << text;
+  EXPECT_NE(text.find("\"citl\":{\"file\":\"motionfield-citl.mfm\",\"loaded\":true,\"error\":\"\"}"),
+            std::string::npos)
+      << text;
+  const char* default_method = nullptr;
+  ASSERT_EQ(mf_default_method(model.get(), &default_method), MF_OK);
+  EXPECT_STREQ(default_method, "nemf");  // what the CLI's warning explains
+}
+
 }  // namespace
 }  // namespace mf::capi_test

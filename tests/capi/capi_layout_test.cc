@@ -13,11 +13,13 @@ namespace {
 static_assert(sizeof(void*) == 8, "these layouts are frozen for LP64 platforms");
 
 TEST(CApiLayout, Progress) {
-  EXPECT_EQ(sizeof(mf_progress), 24u);
+  EXPECT_EQ(sizeof(mf_progress), 32u);  // window, window_count appended
   EXPECT_EQ(offsetof(mf_progress, struct_size), 0u);
   EXPECT_EQ(offsetof(mf_progress, iteration), 4u);
   EXPECT_EQ(offsetof(mf_progress, max_iterations), 8u);
   EXPECT_EQ(offsetof(mf_progress, energy), 16u);
+  EXPECT_EQ(offsetof(mf_progress, window), 24u);
+  EXPECT_EQ(offsetof(mf_progress, window_count), 28u);
 }
 
 TEST(CApiLayout, BvhOptions) {
