@@ -221,7 +221,7 @@ class TaskTest(unittest.TestCase):
         self.assertEqual(mf.resample(self.walk, 60.0, cancel=token).frame_count, 121)
 
     def test_threads_give_the_same_results(self):
-        keys = [[0, 30, 60], [0, 10, 60], [0, 45, 60], [0, 5, 20, 60]]
+        keys = [[0, 30, 60], [0, 10, 60], [0, 5, 20, 60]]  # the default method: nemf-detail
         sequential = [mf.inbetween(self.walk, k).rotations for k in keys]
         results = [None] * len(keys)
 

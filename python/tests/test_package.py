@@ -86,7 +86,7 @@ class DocumentationTest(unittest.TestCase):
                 self.assertRegex(documented, r"(^|\n|, )%s\b" % re.escape(p.name), "%s: %s not documented" % (name, p.name))
             self.assertNotIn("{task_", doc, name)
             checked += 1
-        self.assertGreater(checked, 40)
+        self.assertGreater(checked, 35)
 
 
 class ArgumentOrderTest(unittest.TestCase):

@@ -57,10 +57,14 @@ mf.set_num_threads(2)
 walk = mf.Motion.load_bvh(os.path.join(src, "samples", "walk_keyframes.bvh"))
 clip = mf.Motion.from_arrays(walk.rotations[:21], walk.root_positions[:21], walk.fps, like=walk)
 keys = [0, 10, 20]
-out = mf.inbetween(clip, keys)
+# The two-stage transformer from the bundled files (the default method,
+# nemf-detail, starts from it; test_same_as_cli.py runs that one).
+assert mf.default_method() == "nemf-detail", mf.default_method()
+out = mf.inbetween(clip, keys, method="detail")
 assert out.frame_count == 21
 assert (out.rotations[keys] == clip.rotations[keys]).all()
-print("venv: motionfield %s, %s, model %s, method %s: %d frames" % (
-    mf.__version__, mf.library_path(), mf.default_model_path(), mf.default_method(), out.frame_count))
+assert not (out.rotations[5] == mf.inbetween(clip, keys, method="interp").rotations[5]).all()
+print("venv: motionfield %s, %s, model %s: %d frames" % (
+    mf.__version__, mf.library_path(), mf.default_model_path(), out.frame_count))
 PY
 echo "venv test ok"
