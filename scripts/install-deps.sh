@@ -14,6 +14,7 @@ packages=(
   libarchive-dev        # libarchive: reads the training archives (.tar, .tar.xz, .tar.gz) without spawning tar
   libopenblas0-pthread  # BLAS for libtorch and Eigen: ~3x faster than ATLAS here (docs/BLAS.md)
   python3 python3-numpy # the Python binding's tests
+  python3-venv python3-pip python3-setuptools python3-wheel  # `pip install ./python` into a venv without network (README, capi_python_venv test)
 )
 
 missing=()

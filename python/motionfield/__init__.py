@@ -15,87 +15,143 @@ Example::
 
     import motionfield as mf
     walk = mf.Motion.load_bvh("samples/walk_keyframes.bvh")
-    filled = mf.inbetween(walk, [0, 15, 30, 45, 60], method="interp")
+    filled = mf.inbetween(walk, [0, 15, 30, 45, 60])   # the CLI's default method
     mf.resample(filled, 60.0).save_bvh("walk60.bvh")
+
+Every task takes the motion first and everything else by keyword. Without
+``model=`` a task uses the default model, exactly as the CLI does without
+``--model``: ``$MF_MODEL``, else the model installed next to the library
+(``<prefix>/share/motionfield/motionfield-prior.mfm``; for a bundled library
+that is inside this package), else the source tree's
+``models/motionfield-prior.mfm``; the transformer in-betweeners next to it
+are loaded with it. It is loaded once, on first use, and only when the
+method is the default one or needs a model. Without ``method=`` a task uses
+the CLI's default method (``default_method()``: "nemf-detail" with the
+bundled model), so ``inbetween(motion, keys)`` gives what ``motionfield
+inbetween --in ... --keyframes ...`` gives.
 
 Any humanoid rig works with every task, in its own unit (detected from the leg
 length, or ``Motion.load_bvh(path, units="m")``) and frame rate: methods that
-need the model retarget it to the model's rig and back. ``describe_rig(motion,
-model)`` shows the map found; ``rig_map=`` (a dict, a JSON file or JSON text)
-on the tasks overrides it.
+need the model retarget it to the model's rig and back. ``describe_rig(motion)``
+shows the map found; ``rig_map=`` (a dict, a JSON file or JSON text) on the
+tasks overrides it.
 
-The library is found through $MOTIONFIELD_LIBRARY, then next to this package,
-then a build tree of the source checkout, then the system's library path.
-Tasks release the GIL: several Python threads may run them at once on one
-shared Model.
+The library is found through ``$MOTIONFIELD_LIBRARY``, then inside this
+package (a bundled copy), then the CMake install tree this package was
+installed with, then a build tree of the source checkout, then the system's
+library path (see ``library_path()``). Tasks release the GIL: several Python
+threads may run them at once on one shared Model.
 """
 
+from __future__ import annotations
+
 import ctypes
+import functools
+import inspect
 import json
 import os
-from collections import namedtuple
+import threading
+import warnings
+from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple, TypeVar, Union
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _capi as _c
 
 __all__ = [
+    "__version__",
     "Error", "InvalidArgumentError", "BufferTooSmallError", "FileError", "ModelError", "CancelledError",
     "InternalError", "UnsupportedError", "OutOfMemoryError",
     "version", "abi_version", "library_path", "set_num_threads", "get_num_threads",
-    "Method", "methods", "default_method", "default_model_path",
+    "Method", "methods", "default_method", "default_model_path", "default_model",
     "Model", "Motion", "CancelToken", "Progress", "Encoding",
     "inbetween", "fill", "resample", "resample_frame_count", "encode",
     "renav", "load_path_csv", "describe_rig",
 ]
 
+#: A file path: a string or an os.PathLike.
+PathLike = Union[str, "os.PathLike[str]"]
+#: A rig_map= argument: a dict {user joint: model joint or None}, a JSON file's path or JSON text.
+RigMap = Union[Dict[str, Optional[str]], str, "os.PathLike[str]"]
+#: A progress callback: gets a Progress, returns True to cancel the task.
+ProgressCallback = Callable[["Progress"], Optional[bool]]
+FloatArray = npt.NDArray[np.float32]
+
+_F = TypeVar("_F", bound=Callable[..., Any])
+
 # ------------------------------------------------------------------ errors
 
 
 class Error(Exception):
-    """A motionfield call failed; ``status`` is the C status code."""
+    """A motionfield call failed.
 
-    status = None
+    Attributes
+    ----------
+    status : int
+        The C status code (MF_ERROR_*).
+    status_name : str
+        Its name, e.g. "MF_ERROR_INVALID_ARGUMENT".
+    """
 
-    def __init__(self, message, status=None):
+    status: Optional[int] = None
+
+    def __init__(self, message: str, status: Optional[int] = None) -> None:
         super().__init__(message)
         if status is not None:
             self.status = status
 
     @property
-    def status_name(self):
+    def status_name(self) -> str:
+        """The name of the status code, e.g. "MF_ERROR_IO"."""
         return _c.mf_status_name(self.status).decode()
 
 
 class InvalidArgumentError(Error, ValueError):
+    """Bad input (MF_ERROR_INVALID_ARGUMENT); also a ValueError."""
+
     status = _c.ERROR_INVALID_ARGUMENT
 
 
 class BufferTooSmallError(Error):
+    """MF_ERROR_BUFFER_TOO_SMALL (the package sizes its buffers, so only on a bug)."""
+
     status = _c.ERROR_BUFFER_TOO_SMALL
 
 
 class FileError(Error, OSError):
+    """A file cannot be read or written (MF_ERROR_IO); also an OSError."""
+
     status = _c.ERROR_IO
 
 
 class ModelError(Error):
+    """The model is missing, not a model file, or lacks what the method needs (MF_ERROR_MODEL)."""
+
     status = _c.ERROR_MODEL
 
 
 class CancelledError(Error):
+    """The task was cancelled by its progress callback or its CancelToken (MF_ERROR_CANCELLED)."""
+
     status = _c.ERROR_CANCELLED
 
 
 class InternalError(Error):
+    """A bug in the library (MF_ERROR_INTERNAL)."""
+
     status = _c.ERROR_INTERNAL
 
 
 class UnsupportedError(Error):
+    """The operation is not supported (MF_ERROR_UNSUPPORTED)."""
+
     status = _c.ERROR_UNSUPPORTED
 
 
 class OutOfMemoryError(Error, MemoryError):
+    """MF_ERROR_OUT_OF_MEMORY; also a MemoryError."""
+
     status = _c.ERROR_OUT_OF_MEMORY
 
 
@@ -103,7 +159,7 @@ _ERRORS = {cls.status: cls for cls in (InvalidArgumentError, BufferTooSmallError
                                        CancelledError, InternalError, UnsupportedError, OutOfMemoryError)}
 
 
-def _check(status):
+def _check(status: int) -> None:
     if status == _c.OK:
         return
     message = _c.mf_last_error_message().decode("utf-8", "replace")
@@ -113,11 +169,11 @@ def _check(status):
 # ------------------------------------------------------------------ helpers
 
 
-def _f32_ptr(a):
+def _f32_ptr(a: np.ndarray) -> Any:
     return a.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
 
 
-def _read_floats(getter, handle, shape):
+def _read_floats(getter: Any, handle: Any, shape: Tuple[int, ...]) -> FloatArray:
     needed = ctypes.c_size_t(0)
     _check(getter(handle, None, 0, ctypes.byref(needed)))
     out = np.empty(needed.value, dtype=np.float32)
@@ -125,7 +181,7 @@ def _read_floats(getter, handle, shape):
     return out.reshape(shape)
 
 
-def _read_string(getter, *args):
+def _read_string(getter: Any, *args: Any) -> str:
     needed = ctypes.c_size_t(0)
     _check(getter(*args, None, 0, ctypes.byref(needed)))
     buf = ctypes.create_string_buffer(needed.value)
@@ -133,7 +189,7 @@ def _read_string(getter, *args):
     return buf.value.decode("utf-8")
 
 
-def _float_array(a, shape_tail, what):
+def _float_array(a: npt.ArrayLike, shape_tail: Tuple[int, ...], what: str) -> FloatArray:
     a = np.ascontiguousarray(a, dtype=np.float32)
     if a.ndim != 1 + len(shape_tail) or tuple(a.shape[1:]) != tuple(shape_tail):
         raise InvalidArgumentError("%s must have shape [N, %s], not %s" %
@@ -141,7 +197,7 @@ def _float_array(a, shape_tail, what):
     return a
 
 
-def _bvh_options(length_scale):
+def _bvh_options(length_scale: Optional[float]) -> Any:
     o = _c.MfBvhOptions()
     _check(_c.mf_bvh_options_init(ctypes.byref(o)))
     if length_scale is not None:
@@ -149,7 +205,7 @@ def _bvh_options(length_scale):
     return o
 
 
-def _units_scale(units, length_scale):
+def _units_scale(units: Union[str, float, None], length_scale: Optional[float]) -> Optional[float]:
     """Metres per file unit for reading: None or "auto" -> None (detected), a
     unit name ("cm", "m", "mm", "in", "ft", "asf") or a number."""
     if length_scale is not None:
@@ -165,7 +221,7 @@ def _units_scale(units, length_scale):
     return float(units)
 
 
-def _rig_map_args(rig_map):
+def _rig_map_args(rig_map: Optional[RigMap]) -> Tuple[Optional[str], Optional[str]]:
     """(JSON text, file path) of a rig_map= argument: None, a dict {user joint:
     model joint or None}, a path to a JSON file, or JSON text."""
     if rig_map is None:
@@ -180,39 +236,170 @@ def _rig_map_args(rig_map):
                                type(rig_map).__name__)
 
 
+def _keywords_after(*old_order: str) -> Callable[[_F], _F]:
+    """Makes the arguments after the positional ones keyword-only while still
+    accepting, with a DeprecationWarning, the old call that gave them by
+    position (in `old_order`)."""
+
+    def wrap(fn: _F) -> _F:
+        params = inspect.signature(fn).parameters.values()
+        positional = sum(1 for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD))
+
+        @functools.wraps(fn)
+        def call(*args: Any, **kwargs: Any) -> Any:
+            if len(args) > positional:
+                extra = args[positional:]
+                if len(extra) > len(old_order):
+                    raise TypeError("%s() takes at most %d positional arguments (%d given)" %
+                                    (fn.__name__, positional + len(old_order), len(args)))
+                names = old_order[:len(extra)]
+                for name in names:
+                    if name in kwargs:
+                        raise TypeError("%s() got multiple values for argument '%s'" % (fn.__name__, name))
+                warnings.warn("%s(): giving %s by position is deprecated; pass %s" %
+                              (fn.__name__, ", ".join(names), ", ".join(n + "=..." for n in names)),
+                              DeprecationWarning, stacklevel=2)
+                kwargs.update(zip(names, extra))
+                args = args[:positional]
+            return fn(*args, **kwargs)
+
+        return call  # type: ignore[return-value]
+
+    return wrap
+
+
 # ------------------------------------------------------------------ library-wide
 
 
-def version():
-    """The library's version string, e.g. "0.1.0"."""
+def version() -> str:
+    """The library's version.
+
+    Returns
+    -------
+    str
+        MF_VERSION_STRING of the loaded libmotionfield.so, e.g. "0.1.0" (the
+        project's version in CMakeLists.txt; ``__version__`` is the same).
+
+    Raises
+    ------
+    None
+    """
     return _c.mf_version_string().decode()
 
 
-def abi_version():
+#: The package's version: the loaded library's (one source of truth, CMakeLists.txt's project(VERSION)).
+__version__: str = version()
+
+
+def abi_version() -> int:
+    """The loaded library's ABI version (the SONAME's number).
+
+    Returns
+    -------
+    int
+        MF_ABI_VERSION of the library (this package needs 0).
+
+    Raises
+    ------
+    None
+    """
     return int(_c.mf_abi_version())
 
 
-def library_path():
-    """Path of the loaded libmotionfield.so."""
+def library_path() -> str:
+    """Path of the loaded libmotionfield.so.
+
+    Found through ``$MOTIONFIELD_LIBRARY``, then ``motionfield/lib/`` inside
+    this package (a bundled copy), then the CMake install tree, then the
+    source checkout's ``build*/capi``, then the system's library path.
+
+    Returns
+    -------
+    str
+        The path the library was loaded from.
+
+    Raises
+    ------
+    None
+    """
     return _c.library_path
 
 
-def set_num_threads(n):
-    """Intra-op threads of the numeric work, for the whole process (1..1024)."""
+def set_num_threads(n: int) -> None:
+    """Sets the intra-op threads of the numeric work, for the whole process.
+
+    Parameters
+    ----------
+    n : int
+        Number of threads, 1..1024 (the CLI's default is 2).
+
+    Returns
+    -------
+    None
+
+    Raises
+    ------
+    InvalidArgumentError
+        If `n` is out of range.
+    """
     _check(_c.mf_set_num_threads(int(n)))
 
 
-def get_num_threads():
+def get_num_threads() -> int:
+    """The intra-op threads of the numeric work.
+
+    Returns
+    -------
+    int
+        The thread count set by set_num_threads(), else the library's default.
+
+    Raises
+    ------
+    Error
+        Never in practice.
+    """
     n = ctypes.c_int32(0)
     _check(_c.mf_get_num_threads(ctypes.byref(n)))
     return n.value
 
 
-Method = namedtuple("Method", "name description needs_model completes resamples")
+class Method(NamedTuple):
+    """A registered method (see methods()).
+
+    Attributes
+    ----------
+    name : str
+        What to pass as ``method=``.
+    description : str
+        One line about it.
+    needs_model : bool
+        It runs only with a Model.
+    completes : bool
+        It does in-betweening and gap filling.
+    resamples : bool
+        It does resampling.
+    """
+
+    name: str
+    description: str
+    needs_model: bool
+    completes: bool
+    resamples: bool
 
 
-def methods():
-    """Every registered method, as Method tuples."""
+def methods() -> List[Method]:
+    """Every registered method.
+
+    Returns
+    -------
+    list of Method
+        In the library's order ("interp", "zerovel", the prior's, ...).
+
+    Raises
+    ------
+    Error
+        Never in practice.
+    """
     count = ctypes.c_int32(0)
     _check(_c.mf_method_count(ctypes.byref(count)))
     out = []
@@ -225,126 +412,308 @@ def methods():
     return out
 
 
-def default_method(model=None):
-    """The method used when none is named (it may depend on the model)."""
-    name = ctypes.c_char_p()
-    _check(_c.mf_default_method(model._handle if model is not None else None, ctypes.byref(name)))
-    return name.value.decode()
+@functools.lru_cache(maxsize=None)
+def _methods_by_name() -> Dict[str, Method]:
+    return {m.name: m for m in methods()}
 
 
-def default_model_path():
-    """Path of the default model, or None if there is none."""
+def default_model_path() -> Optional[str]:
+    """Path of the default model (the CLI's, mf_model_default_path).
+
+    ``$MF_MODEL`` if set; else ``share/motionfield/motionfield-prior.mfm``
+    installed next to the library (``<prefix>/share/motionfield`` of a CMake
+    install, ``motionfield/share/motionfield`` of a package that bundles the
+    library); else the source tree's ``models/motionfield-prior.mfm``.
+
+    Returns
+    -------
+    str or None
+        The path, or None when there is no default model.
+
+    Raises
+    ------
+    Error
+        Never in practice.
+    """
     path = _read_string(_c.mf_model_default_path)
     return path or None
+
+
+_default_models: Dict[str, "Model"] = {}
+_default_models_lock = threading.Lock()
+
+
+def default_model() -> Optional["Model"]:
+    """The default model, loaded on first use and then shared.
+
+    What the tasks use without ``model=`` (and what the CLI uses without
+    ``--model``): the file at default_model_path() with the transformer
+    in-betweeners and the rig anatomy found next to it.
+
+    Returns
+    -------
+    Model or None
+        The shared Model, or None when there is no default model.
+
+    Raises
+    ------
+    FileError, ModelError
+        If the default model exists but cannot be loaded (the message names it).
+    """
+    path = default_model_path()
+    if path is None:
+        return None
+    with _default_models_lock:
+        model = _default_models.get(path)
+        if model is None:
+            try:
+                model = Model(path)
+            except Error as e:
+                raise type(e)("cannot load the default model: %s" % e, e.status) from None
+            _default_models[path] = model
+    return model
+
+
+@_keywords_after("model")
+def default_method(*, model: Optional["Model"] = None) -> str:
+    """The in-betweening and gap-filling method used when none is named.
+
+    The best measured method that can run with the model (mf_default_method):
+    "nemf-detail" when it has the two-stage transformer, "nemf" with the
+    prior alone, "interp" without a model. Resampling without a method uses
+    "prior" with a model and "interp" without; re-navigation uses "nemf".
+
+    Parameters
+    ----------
+    model : Model, optional
+        The model; by default the default model (see default_model()), as the
+        tasks and the CLI use it.
+
+    Returns
+    -------
+    str
+        The method's name.
+
+    Raises
+    ------
+    FileError, ModelError
+        If the default model exists but cannot be loaded.
+    """
+    if model is None:
+        model = default_model()
+    name = ctypes.c_char_p()
+    _check(_c.mf_default_method(model._live() if model is not None else None, ctypes.byref(name)))
+    return name.value.decode()
 
 
 # ------------------------------------------------------------------ handles
 
 
 class _Handle:
-    _destroy = None
+    _destroy: Any = None
+    _handle: Any
 
-    def __init__(self, handle):
+    def __init__(self, handle: Any) -> None:
         self._handle = handle
 
-    def close(self):
-        """Frees the C object now (otherwise when garbage-collected)."""
+    def close(self) -> None:
+        """Frees the C object now (otherwise when garbage-collected).
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        None
+        """
         if getattr(self, "_handle", None):
             type(self)._destroy(self._handle)
             self._handle = None
 
-    def __del__(self):
+    def __del__(self) -> None:
         try:
             self.close()
         except Exception:
             pass
 
-    def __enter__(self):
+    def __enter__(self) -> Any:
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: Any) -> None:
         self.close()
 
-    def _live(self):
+    def _live(self) -> Any:
         if not self._handle:
             raise InvalidArgumentError("%s is closed" % type(self).__name__)
         return self._handle
 
 
 class Model(_Handle):
-    """A loaded prior. Immutable; share one between threads."""
+    """A loaded prior. Immutable; share one between threads.
+
+    Parameters
+    ----------
+    path : str or os.PathLike, optional
+        A model file (.mfm); None loads the default model file (see
+        default_model_path(); default_model() shares one instead). The
+        transformer in-betweeners (motionfield-twostage.mfm,
+        motionfield-citl.mfm) and the rig anatomy (motionfield-rig.json) next
+        to it are loaded too.
+
+    Raises
+    ------
+    FileError
+        If the file cannot be read, or `path` is None and there is no default model.
+    ModelError
+        If it is not a valid model file.
+
+    Attributes
+    ----------
+    joint_count : int
+    joint_names : list of str
+    parents : numpy.ndarray
+        [joints] int32, -1 for the root.
+    offsets : numpy.ndarray
+        [joints, 3] float32, metres.
+    fps : float
+        The frame rate the model works at.
+    window : int
+        Frames per window.
+    latent_sizes : tuple of int
+        (local_size, global_size).
+    """
 
     _destroy = staticmethod(_c.mf_model_destroy)
 
-    def __init__(self, path=None):
-        """Loads a model file; path None loads the default model."""
+    def __init__(self, path: Optional[PathLike] = None) -> None:
         handle = ctypes.POINTER(_c.MfModel)()
-        _check(_c.mf_model_load(None if path is None else str(path).encode(), ctypes.byref(handle)))
+        _check(_c.mf_model_load(None if path is None else os.fspath(path).encode(), ctypes.byref(handle)))
         super().__init__(handle)
 
     @classmethod
-    def from_bytes(cls, data):
-        data = bytes(data)
-        handle = ctypes.POINTER(_c.MfModel)()
-        _check(_c.mf_model_load_from_memory(data, len(data), ctypes.byref(handle)))
+    def _wrap(cls, handle: Any) -> "Model":
         self = cls.__new__(cls)
         _Handle.__init__(self, handle)
         return self
 
-    def with_inbetweener(self, path):
-        """A new Model: this one's prior and transformers plus the transformer
-        in-betweener file at `path` (kind "twostage" or "citl", read from the
-        file). Model(path) already loads motionfield-twostage.mfm and
-        motionfield-citl.mfm found next to the prior's file."""
-        handle = ctypes.POINTER(_c.MfModel)()
-        _check(_c.mf_model_with_inbetweener(self._live(), str(path).encode(), ctypes.byref(handle)))
-        model = type(self).__new__(type(self))
-        _Handle.__init__(model, handle)
-        return model
+    @classmethod
+    def from_bytes(cls, data: bytes) -> "Model":
+        """A model from the bytes of a model file.
 
-    def has_inbetweener(self, kind):
-        """True when the transformer of `kind` ("twostage": methods context,
-        detail, nemf-context, nemf-detail; "citl": citl, nemf-citl) is loaded."""
+        No transformer and no rig anatomy are loaded with it: it serves only
+        motions on the model's own skeleton (see with_inbetweener()).
+
+        Parameters
+        ----------
+        data : bytes-like
+            The file's contents (copied).
+
+        Returns
+        -------
+        Model
+
+        Raises
+        ------
+        ModelError
+            If it is not a valid model file.
+        """
+        data = bytes(data)
+        handle = ctypes.POINTER(_c.MfModel)()
+        _check(_c.mf_model_load_from_memory(data, len(data), ctypes.byref(handle)))
+        return cls._wrap(handle)
+
+    def with_inbetweener(self, path: PathLike) -> "Model":
+        """This model plus a transformer in-betweener file.
+
+        Model(path) already loads motionfield-twostage.mfm and
+        motionfield-citl.mfm found next to the prior's file.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            A transformer file of kind "twostage" or "citl" (read from the file).
+
+        Returns
+        -------
+        Model
+            A new Model: this one's prior and transformers plus that one.
+
+        Raises
+        ------
+        FileError
+            If the file cannot be read.
+        ModelError
+            If it is not a transformer file or does not fit the prior.
+        """
+        handle = ctypes.POINTER(_c.MfModel)()
+        _check(_c.mf_model_with_inbetweener(self._live(), os.fspath(path).encode(), ctypes.byref(handle)))
+        return type(self)._wrap(handle)
+
+    def has_inbetweener(self, kind: str) -> bool:
+        """Whether a transformer in-betweener is loaded.
+
+        Parameters
+        ----------
+        kind : str
+            "twostage" (methods context, detail, nemf-context, nemf-detail) or
+            "citl" (citl, nemf-citl).
+
+        Returns
+        -------
+        bool
+
+        Raises
+        ------
+        InvalidArgumentError
+            If `kind` is neither.
+        """
         v = ctypes.c_int32(0)
         _check(_c.mf_model_has_inbetweener(self._live(), str(kind).encode(), ctypes.byref(v)))
         return v.value != 0
 
-    def _i32(self, getter):
+    def _i32(self, getter: Any) -> int:
         v = ctypes.c_int32(0)
         _check(getter(self._live(), ctypes.byref(v)))
         return v.value
 
     @property
-    def joint_count(self):
+    def joint_count(self) -> int:
+        """Number of joints of the model's skeleton."""
         return self._i32(_c.mf_model_get_joint_count)
 
     @property
-    def joint_names(self):
+    def joint_names(self) -> List[str]:
+        """Joint names of the model's skeleton."""
         return [_read_string(_c.mf_model_get_joint_name, self._live(), j) for j in range(self.joint_count)]
 
     @property
-    def parents(self):
+    def parents(self) -> npt.NDArray[np.int32]:
+        """[joints] int32 parent indices, -1 for the root."""
         n = self.joint_count
         out = (ctypes.c_int32 * n)()
         _check(_c.mf_model_get_parents(self._live(), out, n, None))
         return np.array(out, dtype=np.int32)
 
     @property
-    def offsets(self):
+    def offsets(self) -> FloatArray:
+        """[joints, 3] float32 bone offsets, metres."""
         return _read_floats(_c.mf_model_get_offsets, self._live(), (-1, 3))
 
     @property
-    def fps(self):
+    def fps(self) -> float:
+        """The frame rate the model works at."""
         v = ctypes.c_double(0)
         _check(_c.mf_model_get_fps(self._live(), ctypes.byref(v)))
         return v.value
 
     @property
-    def window(self):
+    def window(self) -> int:
+        """Frames per window."""
         return self._i32(_c.mf_model_get_window)
 
     @property
-    def latent_sizes(self):
+    def latent_sizes(self) -> Tuple[int, int]:
         """(local_size, global_size)."""
         zl, zg = ctypes.c_int32(0), ctypes.c_int32(0)
         _check(_c.mf_model_get_latent_sizes(self._live(), ctypes.byref(zl), ctypes.byref(zg)))
@@ -352,26 +721,87 @@ class Model(_Handle):
 
 
 class Motion(_Handle):
-    """A skeleton with per-frame local rotations and root positions. Immutable."""
+    """A skeleton with per-frame local rotations and root positions. Immutable.
+
+    Made by Motion.from_arrays(), Motion.load_bvh(), Motion.from_bvh_text()
+    and the tasks.
+
+    Raises
+    ------
+    TypeError
+        When called directly: Motion() makes nothing.
+
+    Attributes
+    ----------
+    frame_count, joint_count : int
+    fps : float
+    frame_time : float
+        Seconds between frames as a BVH file of this motion says them.
+    length_scale : float
+        Metres per file unit the motion was read with.
+    joint_names : list of str
+    parents : numpy.ndarray
+        [joints] int32.
+    offsets : numpy.ndarray
+        [joints, 3] float32, metres.
+    rotations : numpy.ndarray
+        [frames, joints, 4] float32 local rotations (w, x, y, z).
+    root_positions : numpy.ndarray
+        [frames, 3] float32, metres.
+    global_positions : numpy.ndarray
+        [frames, joints, 3] float32, metres.
+    warnings : str
+        What the task that made this motion wants the caller to know.
+    """
 
     _destroy = staticmethod(_c.mf_motion_destroy)
 
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         raise TypeError("use Motion.from_arrays, Motion.load_bvh or Motion.from_bvh_text")
 
     @classmethod
-    def _wrap(cls, handle):
+    def _wrap(cls, handle: Any) -> "Motion":
         self = cls.__new__(cls)
         _Handle.__init__(self, handle)
         return self
 
     @classmethod
-    def from_arrays(cls, rotations, root_positions, fps, joint_names=None, parents=None, offsets=None, model=None,
-                    like=None):
-        """A motion from arrays: rotations [F, J, 4] (w, x, y, z), root_positions
-        [F, 3] in metres, on the skeleton given by joint_names/parents/offsets
-        ([J, 3], metres), by a Model (`model`) or by another Motion (`like`,
-        whose BVH layout the new motion also keeps)."""
+    @_keywords_after("joint_names", "parents", "offsets", "model", "like")
+    def from_arrays(cls, rotations: npt.ArrayLike, root_positions: npt.ArrayLike, fps: float, *,
+                    joint_names: Optional[Sequence[str]] = None, parents: Optional[Sequence[int]] = None,
+                    offsets: Optional[npt.ArrayLike] = None, model: Optional[Model] = None,
+                    like: Optional["Motion"] = None) -> "Motion":
+        """A motion from arrays, on a skeleton given one of three ways.
+
+        Parameters
+        ----------
+        rotations : array_like
+            [frames, joints, 4] local rotations (w, x, y, z), unit quaternions.
+        root_positions : array_like
+            [frames, 3] root positions, metres.
+        fps : float
+            Frame rate.
+        joint_names : sequence of str, optional
+            The skeleton's joint names (with `parents` and `offsets`).
+        parents : sequence of int, optional
+            Parent index of each joint, -1 for the root.
+        offsets : array_like, optional
+            [joints, 3] bone offsets, metres.
+        model : Model, optional
+            Use the model's skeleton instead.
+        like : Motion, optional
+            Use another motion's skeleton (and BVH layout) instead.
+
+        Returns
+        -------
+        Motion
+
+        Raises
+        ------
+        InvalidArgumentError
+            If the shapes disagree, a quaternion is not finite and non-zero, or
+            not exactly one skeleton is given.
+        """
         rot = np.ascontiguousarray(rotations, dtype=np.float32)
         if rot.ndim != 3 or rot.shape[2] != 4:
             raise InvalidArgumentError("rotations must have shape [frames, joints, 4], not %s" % list(rot.shape))
@@ -390,6 +820,7 @@ class Motion(_Handle):
             _check(_c.mf_motion_create_like(like._live(), joints, frames, float(fps), _f32_ptr(rot), _f32_ptr(root),
                                             ctypes.byref(out)))
         else:
+            assert joint_names is not None
             if parents is None or offsets is None:
                 raise InvalidArgumentError("joint_names needs parents and offsets")
             if len(joint_names) != joints or len(parents) != joints:
@@ -404,134 +835,265 @@ class Motion(_Handle):
         return cls._wrap(out)
 
     @classmethod
-    def load_bvh(cls, path, units=None, length_scale=None):
-        """Reads a BVH file. units: None or "auto" (detected from the leg
-        length; centimetres when no legs are found), "cm", "m", "mm", "in",
-        "ft", "asf" or metres per file unit (a number; length_scale= is the
-        same). The motion remembers it (length_scale) and writes in it."""
+    def load_bvh(cls, path: PathLike, units: Union[str, float, None] = None,
+                 length_scale: Optional[float] = None) -> "Motion":
+        """Reads a BVH file.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+        units : str or float, optional
+            None or "auto" (detected from the leg length; centimetres when no
+            legs are found), "cm", "m", "mm", "in", "ft", "asf", or metres per
+            file unit. The motion remembers it (length_scale) and writes in it.
+        length_scale : float, optional
+            Metres per file unit (the same as a number for `units`).
+
+        Returns
+        -------
+        Motion
+
+        Raises
+        ------
+        FileError
+            If the file cannot be read.
+        InvalidArgumentError
+            If it is not valid BVH (the message says where), or the unit is unknown.
+        """
         out = ctypes.POINTER(_c.MfMotion)()
         o = _bvh_options(_units_scale(units, length_scale))
-        _check(_c.mf_motion_load_bvh(str(path).encode(), ctypes.byref(o), ctypes.byref(out)))
+        _check(_c.mf_motion_load_bvh(os.fspath(path).encode(), ctypes.byref(o), ctypes.byref(out)))
         return cls._wrap(out)
 
     @classmethod
-    def from_bvh_text(cls, text, units=None, length_scale=None):
+    def from_bvh_text(cls, text: Union[str, bytes], units: Union[str, float, None] = None,
+                      length_scale: Optional[float] = None) -> "Motion":
+        """Reads BVH from a string.
+
+        Parameters
+        ----------
+        text : str or bytes
+            The BVH text.
+        units, length_scale
+            As in load_bvh().
+
+        Returns
+        -------
+        Motion
+
+        Raises
+        ------
+        InvalidArgumentError
+            If it is not valid BVH ("<memory>:LINE: ..."), or the unit is unknown.
+        """
         data = text.encode() if isinstance(text, str) else bytes(text)
         out = ctypes.POINTER(_c.MfMotion)()
         o = _bvh_options(_units_scale(units, length_scale))
         _check(_c.mf_motion_load_bvh_from_memory(data, len(data), ctypes.byref(o), ctypes.byref(out)))
         return cls._wrap(out)
 
-    def save_bvh(self, path, length_scale=None):
-        """Writes BVH (atomically), keeping the layout of the BVH it came from."""
-        o = _bvh_options(length_scale)
-        _check(_c.mf_motion_save_bvh(self._live(), str(path).encode(), ctypes.byref(o)))
+    def save_bvh(self, path: PathLike, length_scale: Optional[float] = None) -> None:
+        """Writes BVH (atomically), keeping the layout of the BVH it came from.
 
-    def to_bvh_text(self, length_scale=None):
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+        length_scale : float, optional
+            Metres per file unit to write in; by default the motion's.
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        FileError
+            If the file cannot be written.
+        """
+        o = _bvh_options(length_scale)
+        _check(_c.mf_motion_save_bvh(self._live(), os.fspath(path).encode(), ctypes.byref(o)))
+
+    def to_bvh_text(self, length_scale: Optional[float] = None) -> str:
+        """The BVH text save_bvh() would write.
+
+        Parameters
+        ----------
+        length_scale : float, optional
+            Metres per file unit to write in; by default the motion's.
+
+        Returns
+        -------
+        str
+
+        Raises
+        ------
+        InvalidArgumentError
+            If `length_scale` is not positive.
+        """
         o = _bvh_options(length_scale)
         return _read_string(_c.mf_motion_save_bvh_to_memory, self._live(), ctypes.byref(o))
 
-    def _i32(self, getter):
+    def _i32(self, getter: Any) -> int:
         v = ctypes.c_int32(0)
         _check(getter(self._live(), ctypes.byref(v)))
         return v.value
 
-    def _f64(self, getter):
+    def _f64(self, getter: Any) -> float:
         v = ctypes.c_double(0)
         _check(getter(self._live(), ctypes.byref(v)))
         return v.value
 
     @property
-    def frame_count(self):
+    def frame_count(self) -> int:
+        """Number of frames."""
         return self._i32(_c.mf_motion_get_frame_count)
 
     @property
-    def joint_count(self):
+    def joint_count(self) -> int:
+        """Number of joints."""
         return self._i32(_c.mf_motion_get_joint_count)
 
     @property
-    def fps(self):
+    def fps(self) -> float:
+        """Frame rate."""
         return self._f64(_c.mf_motion_get_fps)
 
     @property
-    def length_scale(self):
+    def length_scale(self) -> float:
         """Metres per file unit the motion was read with (given or detected);
         0.01 for motions from arrays. Task results keep their input's."""
         return self._f64(_c.mf_motion_get_length_scale)
 
     @property
-    def warnings(self):
+    def warnings(self) -> str:
         """What the task that made this motion wants the caller to know although
         it succeeded (e.g. a resampling whose frame count was rounded down), one
         sentence per line; "" if nothing."""
         return _read_string(_c.mf_motion_get_warnings, self._live())
 
     @property
-    def frame_time(self):
+    def frame_time(self) -> float:
         """Seconds between frames as a BVH file of this motion says them."""
         return self._f64(_c.mf_motion_get_frame_time)
 
     @property
-    def joint_names(self):
+    def joint_names(self) -> List[str]:
+        """Joint names."""
         return [_read_string(_c.mf_motion_get_joint_name, self._live(), j) for j in range(self.joint_count)]
 
     @property
-    def parents(self):
+    def parents(self) -> npt.NDArray[np.int32]:
+        """[joints] int32 parent indices, -1 for the root."""
         n = self.joint_count
         out = (ctypes.c_int32 * n)()
         _check(_c.mf_motion_get_parents(self._live(), out, n, None))
         return np.array(out, dtype=np.int32)
 
     @property
-    def offsets(self):
+    def offsets(self) -> FloatArray:
+        """[joints, 3] float32 bone offsets, metres."""
         return _read_floats(_c.mf_motion_get_offsets, self._live(), (-1, 3))
 
     @property
-    def rotations(self):
+    def rotations(self) -> FloatArray:
         """[frames, joints, 4] float32 local rotations (w, x, y, z)."""
         return _read_floats(_c.mf_motion_get_rotations, self._live(), (self.frame_count, self.joint_count, 4))
 
     @property
-    def root_positions(self):
+    def root_positions(self) -> FloatArray:
         """[frames, 3] float32 root positions, metres."""
         return _read_floats(_c.mf_motion_get_root_positions, self._live(), (-1, 3))
 
     @property
-    def global_positions(self):
+    def global_positions(self) -> FloatArray:
         """[frames, joints, 3] float32 joint positions (forward kinematics), metres."""
         return _read_floats(_c.mf_motion_get_global_positions, self._live(),
                             (self.frame_count, self.joint_count, 3))
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         if not self._handle:
             return "<motionfield.Motion (closed)>"
         return "<motionfield.Motion %d frames at %g fps, %d joints>" % (self.frame_count, self.fps, self.joint_count)
 
 
 class CancelToken(_Handle):
-    """Stops a running task from any thread: token.cancel()."""
+    """Stops a running task from any thread: ``token.cancel()``.
+
+    Pass it as ``cancel=`` to a task; the task then raises CancelledError.
+
+    Raises
+    ------
+    OutOfMemoryError
+        If it cannot be made.
+
+    Attributes
+    ----------
+    cancelled : bool
+        Whether cancel() was called (and reset() not since).
+    """
 
     _destroy = staticmethod(_c.mf_cancel_token_destroy)
 
-    def __init__(self):
+    def __init__(self) -> None:
         handle = ctypes.POINTER(_c.MfCancelToken)()
         _check(_c.mf_cancel_token_create(ctypes.byref(handle)))
         super().__init__(handle)
 
-    def cancel(self):
+    def cancel(self) -> None:
+        """Cancels the tasks running with this token, and those started with it later.
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        InvalidArgumentError
+            If the token is closed.
+        """
         _check(_c.mf_cancel_token_cancel(self._live()))
 
-    def reset(self):
+    def reset(self) -> None:
+        """Makes the token usable again after cancel().
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        InvalidArgumentError
+            If the token is closed.
+        """
         _check(_c.mf_cancel_token_reset(self._live()))
 
     @property
-    def cancelled(self):
+    def cancelled(self) -> bool:
+        """Whether cancel() was called (and reset() not since)."""
         v = ctypes.c_int32(0)
         _check(_c.mf_cancel_token_is_cancelled(self._live(), ctypes.byref(v)))
         return bool(v.value)
 
 
-Progress = namedtuple("Progress", "iteration max_iterations energy")
+class Progress(NamedTuple):
+    """What a progress callback is given.
+
+    Attributes
+    ----------
+    iteration : int
+        Iterations done.
+    max_iterations : int
+        The most there will be.
+    energy : float
+        The solver's current energy (0 for methods without one).
+    """
+
+    iteration: int
+    max_iterations: int
+    energy: float
+
 
 # ------------------------------------------------------------------ tasks
 
@@ -540,7 +1102,8 @@ class _TaskCall:
     """The options struct of one task call, and its progress callback (kept
     alive for the call; exceptions it raises cancel the task and are re-raised)."""
 
-    def __init__(self, method, seed, progress, cancel, rig_map=None):
+    def __init__(self, method: Optional[str], seed: int, progress: Optional[ProgressCallback],
+                 cancel: Optional[CancelToken], rig_map: Optional[RigMap] = None) -> None:
         self.options = _c.MfTaskOptions()
         _check(_c.mf_task_options_init(ctypes.byref(self.options)))
         self._method = method.encode() if method else None
@@ -549,9 +1112,9 @@ class _TaskCall:
         self._rig_map = (text.encode() if text else None, path.encode() if path else None)
         self.options.rig_map, self.options.rig_map_path = self._rig_map
         self.options.seed = int(seed)
-        self.error = None
+        self.error: Optional[BaseException] = None
         if progress is not None:
-            def trampoline(_user_data, p):
+            def trampoline(_user_data: Any, p: Any) -> int:
                 try:
                     return 1 if progress(Progress(p.contents.iteration, p.contents.max_iterations,
                                                   p.contents.energy)) else 0
@@ -563,7 +1126,7 @@ class _TaskCall:
         if cancel is not None:
             self.options.cancel = cancel._live()
 
-    def run(self, fn, *args):
+    def run(self, fn: Any, *args: Any) -> Motion:
         out = ctypes.POINTER(_c.MfMotion)()
         status = fn(*args, ctypes.byref(self.options), ctypes.byref(out))
         if self.error is not None:
@@ -572,51 +1135,212 @@ class _TaskCall:
         return Motion._wrap(out)
 
 
-def _model_handle(model):
+def _task_model(model: Optional[Model], method: Optional[str]) -> Any:
+    """The model handle a task runs with, chosen as the CLI chooses it: the
+    given model; else the default model when no method is named or the method
+    needs a model (None when there is none: the default method is then one
+    without a model); else none."""
+    if model is None and (not method or _needs_model(method)):
+        model = default_model()
     return model._live() if model is not None else None
 
 
-def inbetween(motion, keyframes, method=None, model=None, seed=0, progress=None, cancel=None, rig_map=None):
-    """Keyframe in-betweening: the frames in `keyframes` (0-based, strictly
-    increasing, at least two) are kept, every other frame is produced.
+def _needs_model(method: str) -> bool:
+    m = _methods_by_name().get(method)
+    return m is not None and m.needs_model  # unknown names: the library says so
 
-    progress(Progress) is called now and then; returning True cancels (the
-    call then raises CancelledError). cancel: a CancelToken. rig_map: for a
-    motion on another rig than the model's, a dict {user joint: model joint or
-    None}, a JSON file's path or JSON text overriding the automatic map (see
-    describe_rig)."""
+
+def _required_model(model: Optional[Model], what: str) -> Model:
+    if model is None:
+        model = default_model()
+        if model is None:
+            raise ModelError("%s needs the model, and there is no default model (pass model=, or set MF_MODEL)" % what,
+                             _c.ERROR_MODEL)
+    return model
+
+
+_TASK_OPTIONS = ("method", "model", "seed", "progress", "cancel", "rig_map")
+
+_TASK_PARAMETERS_DOC = """\
+    method : str, optional
+        A method name (see methods()); by default the CLI's default, the best
+        one that can run with the model (see default_method()).
+    model : Model, optional
+        By default the default model (see default_model()), loaded when no
+        method is named or the method needs one, as the CLI does without
+        ``--model``.
+    seed : int, optional
+        Seed of the method's random choices; equal seeds give equal results.
+    progress : callable, optional
+        Called now and then with a Progress; returning True cancels the task.
+        An exception it raises cancels the task and is re-raised.
+    cancel : CancelToken, optional
+        Cancels the task from another thread.
+    rig_map : dict, str or os.PathLike, optional
+        For a motion on another rig than the model's: a dict {user joint:
+        model joint or None}, a JSON file's path or JSON text overriding the
+        automatic map (see describe_rig())."""
+
+_TASK_RAISES_DOC = """\
+    InvalidArgumentError
+        If an argument is out of range or the method is unknown (the message says which).
+    ModelError
+        If the method needs a model and there is none, or the model lacks a
+        transformer the method needs (the message names the file).
+    CancelledError
+        If the progress callback or the cancel token cancelled the task.
+    FileError
+        If the rig map file cannot be read."""
+
+
+def _task_doc(fn: _F) -> _F:
+    fn.__doc__ = (fn.__doc__ or "").replace("    {task_parameters}", _TASK_PARAMETERS_DOC).replace(
+        "    {task_raises}", _TASK_RAISES_DOC)
+    return fn
+
+
+@_task_doc
+@_keywords_after(*_TASK_OPTIONS)
+def inbetween(motion: Motion, keyframes: Sequence[int], *, method: Optional[str] = None,
+              model: Optional[Model] = None, seed: int = 0, progress: Optional[ProgressCallback] = None,
+              cancel: Optional[CancelToken] = None, rig_map: Optional[RigMap] = None) -> Motion:
+    """Keyframe in-betweening: the keyframes are kept, every other frame is produced.
+
+    ``inbetween(motion, keys)`` gives what ``motionfield inbetween --in ...
+    --keyframes ...`` gives (same default model, same default method).
+
+    Parameters
+    ----------
+    motion : Motion
+        The input (its non-key frames are never read).
+    keyframes : sequence of int
+        0-based frame indices, strictly increasing, at least two.
+    {task_parameters}
+
+    Returns
+    -------
+    Motion
+        On the input's skeleton and BVH layout, with its length and frame rate.
+
+    Raises
+    ------
+    {task_raises}
+    """
     keys = np.ascontiguousarray(keyframes, dtype=np.int32).reshape(-1)
     call = _TaskCall(method, seed, progress, cancel, rig_map)
-    return call.run(_c.mf_inbetween, _model_handle(model), motion._live(),
+    return call.run(_c.mf_inbetween, _task_model(model, method), motion._live(),
                     keys.ctypes.data_as(ctypes.POINTER(ctypes.c_int32)), keys.size)
 
 
-def fill(motion, gap_begin, gap_end, method=None, model=None, seed=0, progress=None, cancel=None, rig_map=None):
-    """Gap filling: frames gap_begin..gap_end-1 are produced, the others kept."""
+@_task_doc
+@_keywords_after(*_TASK_OPTIONS)
+def fill(motion: Motion, gap_begin: int, gap_end: int, *, method: Optional[str] = None,
+         model: Optional[Model] = None, seed: int = 0, progress: Optional[ProgressCallback] = None,
+         cancel: Optional[CancelToken] = None, rig_map: Optional[RigMap] = None) -> Motion:
+    """Gap filling: frames gap_begin..gap_end-1 are produced, the others kept.
+
+    Parameters
+    ----------
+    motion : Motion
+        The input (the gap's frames are never read).
+    gap_begin, gap_end : int
+        The unknown frames, 1 <= gap_begin < gap_end <= frames - 1.
+    {task_parameters}
+
+    Returns
+    -------
+    Motion
+        On the input's skeleton and BVH layout, with its length and frame rate.
+
+    Raises
+    ------
+    {task_raises}
+    """
     call = _TaskCall(method, seed, progress, cancel, rig_map)
-    return call.run(_c.mf_fill, _model_handle(model), motion._live(), int(gap_begin), int(gap_end))
+    return call.run(_c.mf_fill, _task_model(model, method), motion._live(), int(gap_begin), int(gap_end))
 
 
-def resample(motion, fps, method=None, model=None, seed=0, progress=None, cancel=None, rig_map=None):
-    """Resampling to `fps`, keeping the time span (see resample_frame_count)."""
+@_task_doc
+@_keywords_after(*_TASK_OPTIONS)
+def resample(motion: Motion, fps: float, *, method: Optional[str] = None, model: Optional[Model] = None,
+             seed: int = 0, progress: Optional[ProgressCallback] = None, cancel: Optional[CancelToken] = None,
+             rig_map: Optional[RigMap] = None) -> Motion:
+    """Resampling to another frame rate, keeping the time span.
+
+    Without a method: "prior" with a model (the default one unless given),
+    "interp" without, as the CLI does.
+
+    Parameters
+    ----------
+    motion : Motion
+        The input.
+    fps : float
+        The output's frame rate; output frame i sits at i / fps seconds.
+    {task_parameters}
+
+    Returns
+    -------
+    Motion
+        resample_frame_count() frames; its ``warnings`` say when the count was
+        rounded down.
+
+    Raises
+    ------
+    {task_raises}
+    """
     call = _TaskCall(method, seed, progress, cancel, rig_map)
-    return call.run(_c.mf_resample, _model_handle(model), motion._live(), float(fps))
+    return call.run(_c.mf_resample, _task_model(model, method), motion._live(), float(fps))
 
 
-def resample_frame_count(frames, fps_in, fps_out):
-    """(frame count, rounded): (frames - 1) * fps_out / fps_in + 1, rounded
-    down (rounded=True) unless within 1e-5 relative of an integer."""
+def resample_frame_count(frames: int, fps_in: float, fps_out: float) -> Tuple[int, bool]:
+    """How many frames resample() makes.
+
+    Parameters
+    ----------
+    frames : int
+        The input's frame count.
+    fps_in, fps_out : float
+        The input's and the output's frame rates.
+
+    Returns
+    -------
+    (int, bool)
+        (frames - 1) * fps_out / fps_in + 1, rounded down unless within 1e-5
+        relative of an integer; and whether it was rounded.
+
+    Raises
+    ------
+    InvalidArgumentError
+        If an argument is out of range.
+    """
     n, rounded = ctypes.c_int32(0), ctypes.c_int32(0)
     _check(_c.mf_resample_frame_count(int(frames), float(fps_in), float(fps_out), ctypes.byref(n),
                                       ctypes.byref(rounded)))
     return n.value, bool(rounded.value)
 
 
-def load_path_csv(path):
-    """Reads a path CSV (one "x,z" pair per line, metres; an optional header
-    "x,z"; blank lines and lines starting with # skipped) into a float32 array
-    [points, 2]."""
-    name = str(path).encode()
+def load_path_csv(path: PathLike) -> FloatArray:
+    """Reads a ground path for renav() from a CSV file.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        One "x,z" pair per line, metres; an optional header "x,z"; blank lines
+        and lines starting with # skipped.
+
+    Returns
+    -------
+    numpy.ndarray
+        [points, 2] float32.
+
+    Raises
+    ------
+    FileError
+        If the file cannot be read.
+    InvalidArgumentError
+        If a line is not an x,z pair (the message says which).
+    """
+    name = os.fspath(path).encode()
     needed = ctypes.c_size_t(0)
     _check(_c.mf_path_load_csv(name, None, 0, ctypes.byref(needed)))
     out = np.empty(needed.value, dtype=np.float32)
@@ -624,35 +1348,86 @@ def load_path_csv(path):
     return out.reshape(-1, 2)
 
 
-def renav(reference, path, model, method=None, polyline=False, frames=0, fps=0.0, seed=0, progress=None,
-          cancel=None, rig_map=None):
-    """Re-navigation: a motion in the style of `reference` (on any humanoid
-    rig; rig_map as in inbetween()) whose root follows `path`, an array
-    [points, 2] of ground (x, z) positions in metres. By default one point per output frame at `fps` (0:
-    the reference's frame rate); with polyline=True the points are the
-    vertices of a polyline walked at constant speed, in `frames` frames (0:
-    at the reference's mean ground speed). method: "nemf" (L-BFGS, the
-    default) or "nemf-adam". Needs a Model. progress/cancel as in inbetween()."""
+@_task_doc
+@_keywords_after("model", "method", "polyline", "frames", "fps", "seed", "progress", "cancel", "rig_map")
+def renav(reference: Motion, path: npt.ArrayLike, *, model: Optional[Model] = None, method: Optional[str] = None,
+          polyline: bool = False, frames: int = 0, fps: float = 0.0, seed: int = 0,
+          progress: Optional[ProgressCallback] = None, cancel: Optional[CancelToken] = None,
+          rig_map: Optional[RigMap] = None) -> Motion:
+    """Re-navigation: a motion in the style of `reference` whose root follows `path`.
+
+    Always needs a model (the default one unless given). Methods: "nemf"
+    (L-BFGS, the default) or "nemf-adam" (NeMF's Adam reference, slower).
+
+    Parameters
+    ----------
+    reference : Motion
+        The style reference, on any humanoid rig.
+    path : array_like
+        [points, 2] ground (x, z) positions, metres (see load_path_csv()).
+    polyline : bool, optional
+        False: one point per output frame at `fps`. True: the points are the
+        vertices of a polyline walked at constant speed in `frames` frames.
+    frames : int, optional
+        With polyline=True, the output's frame count (0: at the reference's
+        mean ground speed).
+    fps : float, optional
+        The output's frame rate (0: the reference's).
+    {task_parameters}
+
+    Returns
+    -------
+    Motion
+        On the reference's skeleton and BVH layout.
+
+    Raises
+    ------
+    {task_raises}
+    """
     xz = np.ascontiguousarray(path, dtype=np.float32)
     if xz.ndim != 2 or xz.shape[1] != 2:
         raise InvalidArgumentError("path must have shape [points, 2], not %s" % list(xz.shape))
+    handle = _required_model(model, "re-navigation")._live()
     o = _c.MfRenavOptions()
     _check(_c.mf_renav_options_init(ctypes.byref(o)))
     o.path_kind = _c.PATH_POLYLINE if polyline else _c.PATH_PER_FRAME
     o.frame_count = int(frames)
     o.fps = float(fps)
     call = _TaskCall(method, seed, progress, cancel, rig_map)
-    return call.run(lambda *args: _c.mf_renav(*args[:4], ctypes.byref(o), *args[4:]), _model_handle(model),
+    return call.run(lambda *args: _c.mf_renav(*args[:4], ctypes.byref(o), *args[4:]), handle,
                     reference._live(), _f32_ptr(xz), xz.shape[0])
 
 
-def describe_rig(motion, model, rig_map=None):
-    """How `motion`'s rig is read and mapped onto `model`'s, as a dict:
-    {"unit", "length_scale", "unit_detected", "joints", "map": {user joint:
-    model joint}, "how": {model joint: "name" | "shape" | "map file"},
-    "unmapped_user_joints", "model_joints", "retargeting"} (mf_rig_describe).
-    rig_map as in inbetween(). Raises InvalidArgumentError with the reason
-    when the rig cannot be mapped."""
+@_keywords_after("model", "rig_map")
+def describe_rig(motion: Motion, *, model: Optional[Model] = None, rig_map: Optional[RigMap] = None) -> Dict[str, Any]:
+    """How `motion`'s rig is read and mapped onto the model's (mf_rig_describe).
+
+    Parameters
+    ----------
+    motion : Motion
+        A motion on any humanoid rig.
+    model : Model, optional
+        By default the default model.
+    rig_map : dict, str or os.PathLike, optional
+        As in inbetween().
+
+    Returns
+    -------
+    dict
+        {"unit", "length_scale", "unit_detected", "joints", "map": {user joint:
+        model joint}, "how": {model joint: "name" | "shape" | "map file"},
+        "unmapped_user_joints", "model_joints", "retargeting"}.
+
+    Raises
+    ------
+    InvalidArgumentError
+        With the reason, when the rig cannot be mapped or the map is not valid.
+    ModelError
+        If no model is given and there is no default model.
+    FileError
+        If the rig map file cannot be read.
+    """
+    model = _required_model(model, "describe_rig()")
     text, path = _rig_map_args(rig_map)
     if path is not None:
         with open(path, encoding="utf-8") as f:
@@ -671,7 +1446,7 @@ def describe_rig(motion, model, rig_map=None):
 _ROOTS = {"prior": _c.ROOT_FROM_PRIOR, "input": _c.ROOT_FROM_INPUT}
 
 
-def _codec_options(hop=0, root="prior"):
+def _codec_options(hop: int = 0, root: str = "prior") -> Any:
     o = _c.MfCodecOptions()
     _check(_c.mf_codec_options_init(ctypes.byref(o)))
     o.hop = int(hop)
@@ -682,34 +1457,53 @@ def _codec_options(hop=0, root="prior"):
 
 
 class Encoding(_Handle):
-    """A motion encoded by a model as window latents (see encode())."""
+    """A motion encoded by a model as window latents (made by encode()).
+
+    Raises
+    ------
+    TypeError
+        When called directly: Encoding() makes nothing.
+
+    Attributes
+    ----------
+    window_count : int
+    duration : float
+        Seconds from the first to the last frame of the encoded motion.
+    window_times : numpy.ndarray
+        [windows] float64 start time of each window, seconds.
+    local_latents : numpy.ndarray
+        [windows, local_size] float32.
+    global_latents : numpy.ndarray
+        [windows, global_size] float32.
+    """
 
     _destroy = staticmethod(_c.mf_encoding_destroy)
 
-    def __init__(self, *args, **kwargs):
-        raise TypeError("use motionfield.encode(model, motion)")
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        raise TypeError("use motionfield.encode(motion, model=model)")
 
     @classmethod
-    def _wrap(cls, handle):
+    def _wrap(cls, handle: Any) -> "Encoding":
         self = cls.__new__(cls)
         _Handle.__init__(self, handle)
         return self
 
     @property
-    def window_count(self):
+    def window_count(self) -> int:
+        """Number of windows."""
         v = ctypes.c_int32(0)
         _check(_c.mf_encoding_get_window_count(self._live(), ctypes.byref(v)))
         return v.value
 
     @property
-    def duration(self):
+    def duration(self) -> float:
         """Seconds from the first to the last frame of the encoded motion."""
         v = ctypes.c_double(0)
         _check(_c.mf_encoding_get_duration(self._live(), ctypes.byref(v)))
         return v.value
 
     @property
-    def window_times(self):
+    def window_times(self) -> npt.NDArray[np.float64]:
         """[windows] float64 start time of each window, seconds."""
         n = self.window_count
         out = np.empty(n, dtype=np.float64)
@@ -718,18 +1512,37 @@ class Encoding(_Handle):
         return out
 
     @property
-    def local_latents(self):
+    def local_latents(self) -> FloatArray:
         """[windows, local_size] float32."""
         return _read_floats(_c.mf_encoding_get_local_latents, self._live(), (self.window_count, -1))
 
     @property
-    def global_latents(self):
+    def global_latents(self) -> FloatArray:
         """[windows, global_size] float32."""
         return _read_floats(_c.mf_encoding_get_global_latents, self._live(), (self.window_count, -1))
 
-    def with_latents(self, local=None, global_=None):
-        """A copy with other latents (arrays shaped like local_latents / global_latents)."""
-        args, keep = [], []
+    def with_latents(self, local: Optional[npt.ArrayLike] = None,
+                     global_: Optional[npt.ArrayLike] = None) -> "Encoding":
+        """A copy with other latents.
+
+        Parameters
+        ----------
+        local : array_like, optional
+            Shaped like local_latents; None keeps them.
+        global_ : array_like, optional
+            Shaped like global_latents; None keeps them.
+
+        Returns
+        -------
+        Encoding
+
+        Raises
+        ------
+        InvalidArgumentError
+            If a size is wrong or a value is not finite.
+        """
+        args: List[Any] = []
+        keep = []
         for z in (local, global_):
             if z is None:
                 args += [None, 0]
@@ -741,15 +1554,55 @@ class Encoding(_Handle):
         _check(_c.mf_encoding_with_latents(self._live(), *args, ctypes.byref(out)))
         return Encoding._wrap(out)
 
-    def decode(self, fps, frame_count=0, root="prior"):
-        """Frames at times i / fps, i < frame_count (0: the encoded time span)."""
+    def decode(self, fps: float, frame_count: int = 0, root: str = "prior") -> Motion:
+        """Decodes frames at times i / fps.
+
+        Parameters
+        ----------
+        fps : float
+            The output's frame rate.
+        frame_count : int, optional
+            Frames i < frame_count (0: the encoded time span).
+        root : {"prior", "input"}, optional
+            Root positions decoded by the prior, or the encoded motion's.
+
+        Returns
+        -------
+        Motion
+            On the model's skeleton.
+
+        Raises
+        ------
+        InvalidArgumentError
+            If an argument is out of range.
+        """
         o = _codec_options(root=root)
         out = ctypes.POINTER(_c.MfMotion)()
         _check(_c.mf_decode(self._live(), float(fps), int(frame_count), ctypes.byref(o), ctypes.byref(out)))
         return Motion._wrap(out)
 
-    def decode_times(self, times, fps, root="prior"):
-        """One frame per time (seconds from the first frame, any order)."""
+    def decode_times(self, times: npt.ArrayLike, fps: float, root: str = "prior") -> Motion:
+        """Decodes one frame per time.
+
+        Parameters
+        ----------
+        times : array_like
+            Seconds from the first frame, any order.
+        fps : float
+            The frame rate the output says it has.
+        root : {"prior", "input"}, optional
+            As in decode().
+
+        Returns
+        -------
+        Motion
+            One frame per time, on the model's skeleton.
+
+        Raises
+        ------
+        InvalidArgumentError
+            If a time is not finite or an argument is out of range.
+        """
         t = np.ascontiguousarray(times, dtype=np.float64).reshape(-1)
         o = _codec_options(root=root)
         out = ctypes.POINTER(_c.MfMotion)()
@@ -758,9 +1611,45 @@ class Encoding(_Handle):
         return Motion._wrap(out)
 
 
-def encode(model, motion, hop=0):
-    """Encodes `motion` (on the model's skeleton, >= 2 frames, any fps) into
-    window latents; hop: model frames between windows (0: window / 2)."""
+def encode(motion: Motion, *args: Any, model: Optional[Model] = None, hop: int = 0) -> Encoding:
+    """Encodes a motion into window latents of the model.
+
+    The old form ``encode(model, motion[, hop])`` still works, with a
+    DeprecationWarning.
+
+    Parameters
+    ----------
+    motion : Motion
+        On the model's skeleton, at least 2 frames, any frame rate.
+    model : Model, optional
+        By default the default model.
+    hop : int, optional
+        Model frames between windows (0: window / 2).
+
+    Returns
+    -------
+    Encoding
+
+    Raises
+    ------
+    InvalidArgumentError
+        If the motion is not on the model's skeleton or too short.
+    ModelError
+        If no model is given and there is no default model.
+    TypeError
+        If called with other positional arguments than the old form's.
+    """
+    if isinstance(motion, Model):
+        if model is not None or not 1 <= len(args) <= 2:
+            raise TypeError("encode() takes the motion and keywords: encode(motion, model=..., hop=...)")
+        warnings.warn("encode(model, motion) is deprecated; use encode(motion, model=model)", DeprecationWarning,
+                      stacklevel=2)
+        model, motion = motion, args[0]
+        if len(args) == 2:
+            hop = args[1]
+    elif args:
+        raise TypeError("encode() takes 1 positional argument (the motion) and keywords, not %d" % (1 + len(args)))
+    model = _required_model(model, "encode()")
     o = _codec_options(hop=hop)
     out = ctypes.POINTER(_c.MfEncoding)()
     _check(_c.mf_encode(model._live(), motion._live(), ctypes.byref(o), ctypes.byref(out)))

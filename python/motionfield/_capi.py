@@ -2,9 +2,18 @@
 
 Every function's argtypes and restype is set here, once; the rest of the
 package calls only what this module declares. The library is found by
-``library_path()``: $MOTIONFIELD_LIBRARY, then next to this package (an
-installed tree), then a build tree of the source checkout, then the system's
-library path.
+``_candidates()``, first found wins:
+
+1. ``$MOTIONFIELD_LIBRARY`` (a path; nothing else is tried when it is set);
+2. bundled in the package: ``motionfield/lib/libmotionfield.so.0`` (what
+   ``pip install ./python`` puts there when it finds a built library), or
+   ``motionfield/libmotionfield.so.0``;
+3. the CMake install tree: ``cmake --install`` puts this package in
+   ``<prefix>/lib/python3/dist-packages/motionfield`` and the library in
+   ``<prefix>/<libdir>`` (``lib``, ``lib/<multiarch>`` or ``lib64``);
+4. the source checkout's build trees (``python/motionfield`` ->
+   ``<root>/build/capi``, then other ``<root>/build*/capi``, newest first);
+5. the system's library path (``ldconfig``).
 """
 
 import ctypes
@@ -106,25 +115,46 @@ class MfRenavOptions(ctypes.Structure):
 _LIB_NAMES = ("libmotionfield.so.0", "libmotionfield.so")
 
 
+def _package_dir():
+    return os.path.dirname(os.path.abspath(__file__))
+
+
+def _bundled_dirs(here):
+    """Where a wheel or an install bundles the library inside the package."""
+    return [os.path.join(here, "lib"), here]
+
+
+def _install_tree_dirs(here):
+    """<prefix>/<libdir> of a CMake install (capi/CMakeLists.txt): the package
+    in <prefix>/lib/python3/dist-packages/motionfield."""
+    site = os.path.dirname(here)
+    if os.path.basename(site) not in ("dist-packages", "site-packages"):
+        return []
+    prefix = os.path.normpath(os.path.join(site, "..", "..", ".."))
+    dirs = [os.path.join(prefix, "lib")]
+    dirs += sorted(glob.glob(os.path.join(prefix, "lib", "*-linux-gnu")))
+    dirs += [os.path.join(prefix, "lib64")]
+    return dirs
+
+
+def _build_tree_dirs(here):
+    """<root>/build*/capi of the source checkout (python/motionfield)."""
+    root = os.path.normpath(os.path.join(here, "..", ".."))
+    if not os.path.isfile(os.path.join(root, "capi", "include", "motionfield.h")):
+        return []
+    builds = [os.path.join(root, "build")] + sorted(
+        (d for d in glob.glob(os.path.join(root, "build*")) if os.path.basename(d) != "build"),
+        key=lambda d: -os.path.getmtime(d))
+    return [os.path.join(b, "capi") for b in builds]
+
+
 def _candidates():
     env = os.environ.get("MOTIONFIELD_LIBRARY")
     if env:
         yield env
         return
-    here = os.path.dirname(os.path.abspath(__file__))
-    # Next to the package: inside it, beside it, or an installed prefix
-    # (<prefix>/lib/python3/dist-packages/motionfield -> <prefix>/lib[/<multiarch>]).
-    prefix = os.path.normpath(os.path.join(here, "..", "..", "..", ".."))
-    dirs = [here, os.path.dirname(here), os.path.join(prefix, "lib")]
-    dirs += sorted(glob.glob(os.path.join(prefix, "lib", "*-linux-gnu")))
-    dirs += [os.path.join(prefix, "lib64")]
-    # The source checkout's build trees (python/motionfield -> <root>/build*/capi).
-    root = os.path.normpath(os.path.join(here, "..", ".."))
-    builds = [os.path.join(root, "build")] + sorted(
-        (d for d in glob.glob(os.path.join(root, "build*")) if os.path.basename(d) != "build"),
-        key=lambda d: -os.path.getmtime(d))
-    dirs += [os.path.join(b, "capi") for b in builds]
-    for d in dirs:
+    here = _package_dir()
+    for d in _bundled_dirs(here) + _install_tree_dirs(here) + _build_tree_dirs(here):
         for name in _LIB_NAMES:
             path = os.path.join(d, name)
             if os.path.isfile(path):

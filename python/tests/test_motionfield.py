@@ -89,8 +89,10 @@ class LibraryTest(unittest.TestCase):
         self.assertIn("zerovel", names)
         self.assertTrue(names["interp"].completes and names["interp"].resamples)
         self.assertFalse(names["interp"].needs_model)
+        # Like the CLI: the default model's best method (see test_same_as_cli.py).
         self.assertIn(mf.default_method(), names)
-        self.assertFalse(names[mf.default_method()].needs_model)
+        self.assertTrue(names[mf.default_method()].needs_model)
+        self.assertTrue(names[mf.default_method()].completes)
 
 
 class MotionTest(unittest.TestCase):
@@ -160,10 +162,8 @@ class MotionTest(unittest.TestCase):
             mf.inbetween(walk, [0, 30, 61])
         with self.assertRaisesRegex(mf.InvalidArgumentError, "unknown method 'magic'"):
             mf.inbetween(walk, [0, 60], method="magic")
-        for m in mf.methods():
-            if m.needs_model and m.resamples:
-                with self.assertRaisesRegex(mf.ModelError, "needs a model"):
-                    mf.resample(walk, 60.0, method=m.name)
+        # (Without model=, a method that needs one runs with the default model,
+        # as in the CLI: see test_package.py.)
         walk.close()
         with self.assertRaisesRegex(mf.InvalidArgumentError, "closed"):
             walk.frame_count
@@ -186,13 +186,14 @@ class TaskTest(unittest.TestCase):
         out = mf.fill(self.walk, 10, 40, method="zerovel")
         np.testing.assert_array_equal(out.root_positions[:10], self.walk.root_positions[:10])
         np.testing.assert_array_equal(out.root_positions[10:40], np.repeat(self.walk.root_positions[9:10], 30, 0))
-        up = mf.resample(self.walk, 60.0)
+        up = mf.resample(self.walk, 60.0, method="interp")
         self.assertEqual(up.frame_count, 121)
         self.assertEqual(up.fps, 60.0)
         np.testing.assert_array_equal(up.root_positions[::2], self.walk.root_positions)
         self.assertEqual(mf.resample_frame_count(61, 30.0, 23.3), (47, True))
         self.assertEqual(mf.resample_frame_count(61, 30.0, 60.0), (121, False))
         self.assertEqual(up.warnings, "")
+        self.assertIn("rounded down to 47 frames", mf.resample(self.walk, 23.3, method="interp").warnings)
         self.assertIn("rounded down to 47 frames", mf.resample(self.walk, 23.3).warnings)
 
     def test_progress_and_cancel(self):
@@ -220,7 +221,7 @@ class TaskTest(unittest.TestCase):
         self.assertEqual(mf.resample(self.walk, 60.0, cancel=token).frame_count, 121)
 
     def test_threads_give_the_same_results(self):
-        keys = [[0, 30, 60], [0, 10, 60], [0, 45, 60], [0, 5, 20, 60]]
+        keys = [[0, 30, 60], [0, 10, 60], [0, 5, 20, 60]]  # the default method: nemf-detail
         sequential = [mf.inbetween(self.walk, k).rotations for k in keys]
         results = [None] * len(keys)
 
@@ -256,7 +257,7 @@ class ModelTest(unittest.TestCase):
         root = np.zeros((40, 3), np.float32)
         root[:, 1] = 0.9
         m = mf.Motion.from_arrays(rot, root, 30.0, model=model)
-        code = mf.encode(model, m)
+        code = mf.encode(m, model=model)
         self.assertEqual(code.local_latents.shape, (code.window_count, zl))
         self.assertEqual(code.global_latents.shape, (code.window_count, zg))
         self.assertAlmostEqual(code.duration, 39 / 30.0)
@@ -334,7 +335,7 @@ class OtherRigTest(unittest.TestCase):
         cls.user = mf.Motion.from_bvh_text(cm.to_bvh_text(length_scale=1.0))  # in metres
 
     def test_describe_rig(self):
-        d = mf.describe_rig(self.user, self.model)
+        d = mf.describe_rig(self.user, model=self.model)
         self.assertEqual(d["unit"], "m")
         self.assertTrue(d["unit_detected"])
         self.assertEqual(d["joints"], 21)
@@ -343,10 +344,10 @@ class OtherRigTest(unittest.TestCase):
         self.assertEqual(d["unmapped_user_joints"], [])
         self.assertEqual(d["model_joints"], self.model.joint_names)
         self.assertTrue(d["retargeting"])
-        given = mf.describe_rig(self.user, self.model, rig_map={"mixamorig:Spine2": "Chest"})
+        given = mf.describe_rig(self.user, model=self.model, rig_map={"mixamorig:Spine2": "Chest"})
         self.assertEqual(given["how"]["Chest"], "map file")
         with self.assertRaisesRegex(mf.InvalidArgumentError, "rig map: not valid JSON"):
-            mf.describe_rig(self.user, self.model, rig_map="{oops")
+            mf.describe_rig(self.user, model=self.model, rig_map="{oops")
 
     def test_tasks_on_another_rig(self):
         keys = [0, 20, 40, 60]

@@ -67,10 +67,15 @@ echo "motionfield $(pkg-config --modversion motionfield): $(pkg-config --cflags 
 [ "$(awk '/^Frames:/ { print $2 }' "$tmp/pc.bvh")" = 61 ]
 
 step "the installed Python package (no MOTIONFIELD_LIBRARY: the library next to it)"
-(cd "$tmp" && PYTHONPATH="$prefix/lib/python3/dist-packages" PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 - "$sample" "$lib" <<'PY'
+(cd "$tmp" && PYTHONPATH="$prefix/lib/python3/dist-packages" PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 - "$sample" "$lib" "$prefix" <<'PY'
 import os, sys
 import motionfield as mf
 assert os.path.realpath(mf.library_path()) == os.path.realpath(sys.argv[2]), (mf.library_path(), sys.argv[2])
+assert os.path.isfile(os.path.join(os.path.dirname(mf.__file__), "py.typed"))
+# The default model is the installed one (the CLI's too).
+installed = os.path.join(sys.argv[3], "share", "motionfield", "motionfield-prior.mfm")
+if os.path.isfile(installed):
+    assert os.path.realpath(mf.default_model_path()) == os.path.realpath(installed), mf.default_model_path()
 m = mf.Motion.load_bvh(sys.argv[1])
 out = mf.resample(m, 60.0)
 assert out.frame_count == 121, out.frame_count
