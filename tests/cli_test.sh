@@ -283,6 +283,19 @@ if [ -n "$TINY" ]; then
   expect_rc 0 "batch renav = renav" -- "$DIFF" "$TMP/b-renav.bvh" "$TMP/renav.bvh" --tol 1e-9
   expect_rc 0 "batch renav --polyline = renav --polyline" -- "$DIFF" "$TMP/b-renav-poly.bvh" "$TMP/renav-poly.bvh" --tol 1e-9
   expect_absent "$TMP/b-bad.bvh"
+  # --jobs 2: the same files bit for bit and the same messages and --json lines, in line order.
+  "$MF" --model "$TINY" --threads 1 --json batch "$TMP/renav.jsonl" >"$TMP/serial.json" 2>"$TMP/serial.err"
+  sed "s|b-renav|p-renav|g" "$TMP/renav.jsonl" >"$TMP/renav-par.jsonl"
+  expect_rc 2 "batch --jobs 2 with one bad line" -- "$MF" --model "$TINY" --threads 1 --json batch --jobs 2 "$TMP/renav-par.jsonl"
+  cmp -s "$TMP/p-renav.bvh" "$TMP/b-renav.bvh" && pass || fail "batch --jobs 2 output differs from the serial run's"
+  cmp -s "$TMP/p-renav-poly.bvh" "$TMP/b-renav-poly.bvh" && pass || fail "batch --jobs 2 output (polyline) differs"
+  sed "s|p-renav|b-renav|g; s|renav-par.jsonl|renav.jsonl|g" "$TMP/out" >"$TMP/par.json"
+  awk '{ gsub(/"timings_ms":\{[^}]*\}/, ""); print }' "$TMP/par.json" >"$TMP/par.cut"
+  awk '{ gsub(/"timings_ms":\{[^}]*\}/, ""); print }' "$TMP/serial.json" >"$TMP/serial.cut"
+  cmp -s "$TMP/par.cut" "$TMP/serial.cut" && pass || fail "batch --jobs 2 --json lines differ from the serial run's"
+  sed "s|renav-par.jsonl|renav.jsonl|g" "$TMP/err" | cmp -s - "$TMP/serial.err" && pass ||
+    fail "batch --jobs 2 messages differ from the serial run's"
+  bad "batch --jobs 0" batch --jobs 0 "$TMP/renav.jsonl"
 else
   fail "no tiny model (mf_capi_tiny_model not built, MF_TEST_MODEL unset): the renav runs could not run"
 fi

@@ -193,7 +193,8 @@ void define_renav(CLI::App& app, HelpFormatter& help, Arguments& a) {
 
 void define_batch(CLI::App& app, HelpFormatter& help, Arguments& a) {
   CLI::App* cmd = add_command(
-      app, help, "batch", "run many jobs from a JSON Lines file in one process", "motionfield batch JOBS.jsonl",
+      app, help, "batch", "run many jobs from a JSON Lines file in one process",
+      "motionfield batch JOBS.jsonl [--jobs N]",
       "Runs one job per line of JOBS.jsonl, each a JSON object:\n"
       "  {\"task\": \"inbetween\", \"in\": \"a.bvh\", \"out\": \"b.bvh\", \"keyframes\": [0, 10, 20]}\n"
       "  {\"task\": \"fill\", \"in\": \"a.bvh\", \"out\": \"c.bvh\", \"gap\": [10, 20]}\n"
@@ -212,8 +213,14 @@ void define_batch(CLI::App& app, HelpFormatter& help, Arguments& a) {
       "A failed job is reported on stderr (line number, id, reason) and the others\n"
       "still run. Exit code: 0 if every job succeeded, 1 if any job hit an internal\n"
       "error, otherwise 2 if any job had bad input. Progress is shown on stderr when\n"
-      "it is a terminal.");
+      "it is a terminal (with --jobs 1).\n"
+      "--jobs N runs N jobs at once on the one model (threads; each job still uses\n"
+      "--threads intra-op threads): the outputs and messages are those of a serial\n"
+      "run, in line order.");
   cmd->add_option("jobs", a.file, "the jobs, one JSON object per line")->required()->type_name("JOBS.jsonl");
+  cmd->add_option("-j,--jobs", a.settings.jobs, "jobs run at once (default 1)")
+      ->check(CLI::Range(1, 256))
+      ->type_name("N");
   cmd->footer(kGlobalOptionsNote);
 }
 

@@ -1,11 +1,15 @@
-// `motionfield batch JOBS.jsonl`: one job per line, each failure reported
-// with its line, the others still run.
+// `motionfield batch JOBS.jsonl [--jobs N]`: one job per line, each failure
+// reported with its line, the others still run; N jobs at once on one model.
+#include <algorithm>
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <mutex>
 #include <sstream>
 #include <string>
 #include <system_error>
+#include <thread>
 #include <vector>
 
 #include "commands.h"
@@ -66,44 +70,109 @@ BatchJob parse_line(const std::string& line, std::string* label) {
   return job;
 }
 
+// One line's job once run: its report, or why it failed.
+struct Outcome {
+  std::string label;
+  BatchJob job;
+  bool ok = false;
+  JobReport report;
+  Failure failure;
+};
+
+// Prints what a finished line says (warnings or the failure; its --json line).
+void print_outcome(const Outcome& o, size_t line, const Settings& settings) {
+  if (o.ok) {
+    if (!settings.quiet) print_warnings(o.report.warnings, o.label + ": ");
+    if (settings.json) std::printf("%s\n", job_json(o.job, &o.report, nullptr, line).c_str());
+  } else {
+    print_failure(o.failure, o.label + ": ");
+    if (settings.json) {
+      Failure shown = o.failure;
+      shown.message = printable(o.failure.message);
+      std::printf("%s\n", job_json(o.job, nullptr, &shown, line).c_str());
+    }
+  }
+  if (settings.json) std::fflush(stdout);
+}
+
 }  // namespace
 
 int command_batch(const std::string& path, const Settings& settings) {
   const std::vector<std::string> lines = read_lines(path);
   Models models(settings.model, settings.transformers());
   models.load_explicit();
-  int total = 0;
-  for (const std::string& l : lines) total += blank(l) ? 0 : 1;
-  ProgressLine progress(ProgressLine::stderr_is_terminal() && !settings.quiet);
+
+  // Every line parsed and its output claimed first, in line order (so that
+  // which of two jobs writing one file is refused does not depend on timing);
+  // the model a job needs is loaded here too, once, before any worker runs.
+  std::vector<size_t> line_of;
+  std::vector<Outcome> outcomes;
+  std::vector<char> runnable;
   Outputs outputs;
-  int done = 0, bad = 0, internal = 0;
   for (size_t i = 0; i < lines.size(); ++i) {
     if (blank(lines[i])) continue;
-    std::string label = path + " line " + std::to_string(i + 1);
-    progress.start("[" + std::to_string(done + 1) + "/" + std::to_string(total) + "] line " + std::to_string(i + 1));
-    BatchJob job;
+    Outcome o;
+    o.label = path + " line " + std::to_string(i + 1);
+    bool ready = false;
     try {
-      job = parse_line(lines[i], &label);
-      outputs.claim(job.out, i + 1);
-      const JobReport report = run_job(job, settings, models, progress);
-      progress.clear();
-      if (!settings.quiet) print_warnings(report.warnings, label + ": ");
-      if (settings.json) std::printf("%s\n", job_json(job, &report, nullptr, i + 1).c_str());
+      o.job = parse_line(lines[i], &o.label);
+      outputs.claim(o.job.out, i + 1);
+      if (settings.jobs > 1) models.for_method(o.job.task == "renav" && o.job.method.empty() ? "nemf" : o.job.method);
+      ready = true;
     } catch (...) {
-      const Failure failure = current_failure();
-      ++(failure.exit_code == kExitBadInput ? bad : internal);
-      progress.clear();
-      print_failure(failure, label + ": ");
-      if (settings.json) {
-        Failure shown = failure;
-        shown.message = printable(failure.message);
-        std::printf("%s\n", job_json(job, nullptr, &shown, i + 1).c_str());
-      }
+      o.failure = current_failure();
     }
-    if (settings.json) std::fflush(stdout);
-    ++done;
+    line_of.push_back(i + 1);
+    outcomes.push_back(std::move(o));
+    runnable.push_back(ready ? 1 : 0);
+  }
+  const int total = static_cast<int>(outcomes.size());
+
+  ProgressLine progress(settings.jobs == 1 && ProgressLine::stderr_is_terminal() && !settings.quiet);
+  const auto run = [&](size_t k, ProgressLine& line) {
+    if (!runnable[k]) return;
+    try {
+      outcomes[k].report = run_job(outcomes[k].job, settings, models, line);
+      outcomes[k].ok = true;
+    } catch (...) {
+      outcomes[k].failure = current_failure();
+    }
+    line.clear();
+  };
+  if (settings.jobs <= 1) {
+    for (size_t k = 0; k < outcomes.size(); ++k) {
+      progress.start("[" + std::to_string(k + 1) + "/" + std::to_string(total) + "] line " + std::to_string(line_of[k]));
+      run(k, progress);
+      print_outcome(outcomes[k], line_of[k], settings);
+    }
+  } else {
+    // Workers share the model (the C API's tasks are thread-safe on one model);
+    // each line's messages are printed in line order as soon as every earlier
+    // line has finished, so the output is the serial run's.
+    std::atomic<size_t> next{0};
+    std::mutex mutex;
+    std::vector<char> finished(outcomes.size(), 0);
+    size_t printed = 0;
+    const auto worker = [&] {
+      ProgressLine silent(false);
+      for (size_t k; (k = next++) < outcomes.size();) {
+        run(k, silent);
+        const std::lock_guard<std::mutex> lock(mutex);
+        finished[k] = 1;
+        for (; printed < outcomes.size() && finished[printed]; ++printed)
+          print_outcome(outcomes[printed], line_of[printed], settings);
+      }
+    };
+    std::vector<std::thread> pool;
+    const int n = std::min(settings.jobs, std::max(total, 1));
+    for (int w = 0; w < n; ++w) pool.emplace_back(worker);
+    for (std::thread& t : pool) t.join();
   }
   progress.clear();
+
+  int bad = 0, internal = 0;
+  for (const Outcome& o : outcomes)
+    if (!o.ok) ++(o.failure.exit_code == kExitBadInput ? bad : internal);
   const int failed = bad + internal;
   if (failed > 0 || settings.verbose || (progress.enabled() && !settings.quiet))
     std::fprintf(stderr, "motionfield: %s\n",

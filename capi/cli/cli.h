@@ -17,6 +17,7 @@ struct Settings {
   bool verbose = false;
   bool quiet = false;                 ///< --quiet: no progress bar, no warnings
   bool json = false;                  ///< --json: a JSON summary of each job on stdout
+  int jobs = 1;                       ///< batch --jobs: jobs run at once
   std::string model;                  ///< --model PATH, "" for the default model
   std::vector<std::string> twostage;  ///< --twostage PATH (repeatable)
   std::vector<std::string> citl;      ///< --citl PATH (repeatable)

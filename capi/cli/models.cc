@@ -73,8 +73,7 @@ std::string Models::load_warnings_of(const Model& model) {
 }
 
 std::string Models::load_warnings() {
-  if (warned_ || !model_) return "";
-  warned_ = true;
+  if (!model_ || warned_.exchange(true)) return "";
   return load_warnings_of(model_);
 }
 

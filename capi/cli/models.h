@@ -1,6 +1,7 @@
 // Which model the CLI's jobs run with.
 #pragma once
 
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -33,7 +34,8 @@ class Models {
   /// The transformer files next to the model that were there but did not
   /// load (a truncated file: the default method then quietly runs without
   /// it), one warning per line naming the file and the reason; given once
-  /// per process ("" afterwards, and when everything loaded).
+  /// per process ("" afterwards, and when everything loaded). Thread-safe once
+  /// the model is loaded (batch --jobs loads it before the workers start).
   std::string load_warnings();
 
   /// Those warnings of `model` (mf_model_describe), every time.
@@ -46,7 +48,7 @@ class Models {
   std::string explicit_path_, path_, default_error_;
   std::vector<std::string> transformers_;
   bool tried_default_ = false;
-  bool warned_ = false;
+  std::atomic<bool> warned_{false};  // batch workers ask concurrently
   Model model_;
 };
 
