@@ -64,8 +64,8 @@ wait || true
   printf '%-22s %14s %10s %8s %s\n' target executions exec/s seconds result
   for t in "${TARGETS[@]}"; do
     log="$BUILD/fuzz-logs/$t.log"
-    execs=$(grep -o 'stat::number_of_executed_units: [0-9]*' "$log" | tail -1 | awk '{print $2}')
-    speed=$(grep -o 'stat::average_exec_per_sec: [0-9]*' "$log" | tail -1 | awk '{print $2}')
+    execs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | tail -1 | awk '{print $2}')
+    speed=$(grep -o 'stat::average_exec_per_sec: *[0-9]*' "$log" | tail -1 | awk '{print $2}')
     result=ok
     grep -qE '^==[0-9]+==ERROR|^SUMMARY|deadly signal|fuzz check failed|out-of-memory|timeout after' "$log" && result=FINDING
     printf '%-22s %14s %10s %8s %s\n' "$t" "${execs:-?}" "${speed:-?}" "$SECONDS_PER_TARGET" "$result"
