@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 DEMO_OUT ?= out
 
-.PHONY: all deps configure build test demo bench clean
+.PHONY: all deps configure build test demo bench clean asan fuzz
 
 all: build
 
@@ -23,6 +23,17 @@ test: build
 
 demo: build
 	@bash scripts/demo.sh $(BUILD) $(DEMO_OUT)
+
+# AddressSanitizer + UBSan build in build-asan and the test suite under it
+# (docs/RELIABILITY.md, "Sanitizers"); CTest arguments in ASAN_CTEST_ARGS.
+asan: deps
+	@JOBS=$(JOBS) bash scripts/asan.sh $(ASAN_CTEST_ARGS)
+
+# The libFuzzer targets (clang) in build-fuzz, each run FUZZ_SECONDS seconds
+# (docs/RELIABILITY.md, "Fuzzing").
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	@bash scripts/fuzz.sh $(FUZZ_SECONDS)
 
 clean:
 	rm -rf $(BUILD)

@@ -134,7 +134,9 @@ int resampled_frame_count(int frames, double fps_in, double fps_out, bool* round
   // within 1e-5 relative of an integer count is taken as that integer.
   const bool integral = std::abs(exact - nearest) <= 1e-5 * std::max(1.0, exact);
   const double count = integral ? nearest : std::floor(exact);
-  if (count > kMaxResampledFrames) {
+  // Not `count > max`: a ratio fps_out / fps_in that overflows makes `exact`
+  // infinite, or NaN for one frame (0 * inf), and NaN must not reach the cast.
+  if (!(count <= kMaxResampledFrames)) {
     std::ostringstream msg;
     msg << "resampling " << frames << " frames from " << fps_in << " to " << fps_out << " fps would give more than "
         << static_cast<long long>(kMaxResampledFrames) << " frames";

@@ -111,6 +111,9 @@ TEST(JobsTest, ResampledFrameCountRejectsBadRates) {
   }
   EXPECT_THROW(resampled_frame_count(0, 30, 60, nullptr), InputError);
   EXPECT_TRUE(contains(input_error([] { resampled_frame_count(1000000, 30, 3000, nullptr); }), "10000000 frames"));
+  // A ratio that overflows (found by fuzz_capi_motion): infinite, or NaN for one frame.
+  EXPECT_THROW(resampled_frame_count(1, 1e-300, 1e300, nullptr), InputError);
+  EXPECT_THROW(resampled_frame_count(2, 1e-300, 1e300, nullptr), InputError);
 }
 
 TEST(JobsTest, RunInbetweenDispatchesByMethod) {

@@ -152,6 +152,24 @@ TEST_F(ModelFile, ErrorsSayWhatIsWrong) {
   EXPECT_THROW(load_nemf(dir_ + "/missing.mfm"), InputError);
 }
 
+// Found by fuzz_model_file: hyperparameters outside int's range were cast
+// (undefined), and the GMP's width had no upper bound (2e9 asked for 200 GB).
+TEST(PriorModel, HyperparametersAreBoundedBeforeTheNetworkIsBuilt) {
+  std::map<std::string, double> values = tiny_nemf_config().to_map();
+  for (double bad : {1e300, -1e300, std::nan(""), 0.5}) {
+    std::map<std::string, double> v = values;
+    v["window"] = bad;
+    EXPECT_THROW(NemfConfig::from_map(v), InputError) << bad;
+  }
+  NemfConfig c = tiny_nemf_config();
+  c.gmp_width = 2000000000;
+  EXPECT_NE(c.validate(), "");
+  c = tiny_nemf_config();
+  c.window = 1 << 20;
+  EXPECT_NE(c.validate(), "");
+  EXPECT_EQ(tiny_nemf_config().validate(), "");
+}
+
 TEST(PriorTraining, AFewStepsRunCheckpointAndResume) {
   namespace fs = std::filesystem;
   std::string dir = test::scratch_dir("prior_training");

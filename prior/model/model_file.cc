@@ -162,7 +162,10 @@ std::map<std::string, at::Tensor> read_tensors(ByteReader& p) {
     for (auto& d : dims) {
       d = p.pod<int64_t>();
       if (d < 0 || d > (int64_t(1) << 32)) p.fail("tensor '" + name + "' has a bad dimension");
-      numel *= static_cast<uint64_t>(d);
+      // Dimensions of 2^32 wrap the product to 0, which need_items() accepts
+      // and at::empty() refuses with a c10::Error (found by fuzz_model_file).
+      if (__builtin_mul_overflow(numel, static_cast<uint64_t>(d), &numel))
+        p.fail("tensor '" + name + "' has too many elements");
     }
     p.need_items(numel, sizeof(float));
     at::Tensor t = at::empty(dims, at::kFloat);

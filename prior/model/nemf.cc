@@ -8,6 +8,8 @@
 #include <ATen/ATen.h>
 
 #include <cmath>
+#include <limits>
+#include <type_traits>
 #include <sstream>
 
 #include "prior/motion/errors.h"
@@ -188,7 +190,12 @@ std::string NemfConfig::validate() const {
   if (zl < 1 || zl > 4096 || zg < 1 || zg > 4096) e << "latent sizes must be in [1, 4096]; ";
   if (zg_layers < 1 || zg_layers > decoder_layers) e << "zg_layers must be in [1, decoder_layers]; ";
   if (encoder_channels < 1 || encoder_channels > 256) e << "encoder_channels must be in [1, 256]; ";
-  if (gmp_width < 4 || gmp_kernel < 1 || gmp_kernel % 2 == 0 || gmp_blocks < 0) e << "bad GMP sizes; ";
+  // Upper bounds too: a model file's hyperparameters size the network built
+  // before its weights are read (a fuzzed gmp_width of 2e9 asked for 200 GB).
+  if (window > 4096) e << "window must be at most 4096; ";
+  if (gmp_width < 4 || gmp_width > 4096 || gmp_kernel < 1 || gmp_kernel > 63 || gmp_kernel % 2 == 0 ||
+      gmp_blocks < 0 || gmp_blocks > 64)
+    e << "bad GMP sizes (width in [4, 4096], odd kernel in [1, 63], blocks in [0, 64]); ";
   return e.str();
 }
 
@@ -221,7 +228,15 @@ NemfConfig NemfConfig::from_map(const std::map<std::string, double>& v) {
   auto get = [&](const char* k, auto& field) {
     auto it = v.find(k);
     if (it == v.end()) throw InputError(std::string("model hyperparameter '") + k + "' is missing");
-    field = static_cast<std::remove_reference_t<decltype(field)>>(it->second);
+    using Field = std::remove_reference_t<decltype(field)>;
+    if constexpr (std::is_integral_v<Field>) {
+      // Casting a double outside int's range (or NaN) is undefined; validate()
+      // checks the ranges of the values that fit.
+      const double d = it->second;
+      if (!(d == std::floor(d) && d >= std::numeric_limits<Field>::min() && d <= std::numeric_limits<Field>::max()))
+        throw InputError(std::string("model hyperparameter '") + k + "' must be an integer");
+    }
+    field = static_cast<Field>(it->second);
   };
   get("window", c.window);
   get("fps", c.fps);

@@ -42,7 +42,9 @@ class ByteReader {
   ByteReader(const uint8_t* data, size_t size, std::string what) : data_(data), size_(size), what_(std::move(what)) {}
   void bytes(void* out, size_t n) {
     need(n);
-    std::memcpy(out, data_ + pos_, n);
+    // An empty tensor's data pointer may be null, and memcpy's may never be
+    // (UBSan nonnull-attribute; found by fuzz_model_file).
+    if (n != 0) std::memcpy(out, data_ + pos_, n);
     pos_ += n;
   }
   template <class T>
