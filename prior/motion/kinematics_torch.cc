@@ -8,7 +8,6 @@
 #include <vector>
 
 #include "prior/motion/errors.h"
-#include "prior/motion/rotations_torch.h"
 #include "prior/motion/skeleton.h"
 
 namespace mf {
