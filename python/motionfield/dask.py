@@ -43,13 +43,17 @@ def _arguments(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     where = p.add_mutually_exclusive_group()
     where.add_argument("--workers", type=int, default=2, metavar="N",
                        help="worker processes of the local cluster, one thread each (default 2)")
-    where.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler, e.g. tcp://host:8786")
+    where.add_argument("--scheduler", type=_non_empty, metavar="ADDRESS",
+                       help="an existing Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--threads", type=int, default=2, metavar="N",
                    help="intra-op threads of each worker process (default 2, as the CLI's --threads)")
-    p.add_argument("--model", default="", metavar="PATH", help="the prior's model file (default: the default model)")
-    p.add_argument("--twostage", action="append", default=[], metavar="PATH", help="a two-stage transformer file")
-    p.add_argument("--citl", action="append", default=[], metavar="PATH", help="a CITL transformer file")
-    p.add_argument("--rig-map", default="", metavar="FILE", help="a JSON rig map for every job without its own")
+    p.add_argument("--model", type=_non_empty, metavar="PATH",
+                   help="the prior's model file (default: the default model)")
+    p.add_argument("--twostage", action="append", default=[], type=_non_empty, metavar="PATH",
+                   help="a two-stage transformer file (repeatable)")
+    p.add_argument("--citl", action="append", default=[], type=_non_empty, metavar="PATH",
+                   help="a CITL transformer file (repeatable)")
+    p.add_argument("--rig-map", type=_non_empty, metavar="FILE", help="a JSON rig map for every job without its own")
     p.add_argument("--units", "--length-scale", default="", metavar="U",
                    help="the BVH length unit of every job without its own (default auto)")
     p.add_argument("--json", action="store_true", help="a JSON summary of each job on stdout, in line order")
@@ -60,10 +64,14 @@ def _arguments(argv: Optional[Sequence[str]]) -> argparse.Namespace:
         p.error("--workers must be 1 to 256")
     if not 1 <= args.threads <= 1024:
         p.error("--threads must be 1 to 1024")
-    for name in ("model", "rig_map"):
-        if getattr(args, name) == "" and ("--" + name.replace("_", "-")) in (argv or sys.argv[1:]):
-            p.error("--%s needs a value" % name.replace("_", "-"))
     return args
+
+
+def _non_empty(value: str) -> str:
+    """An option's value; an empty one (--model "") would silently mean the default: refused, as by the CLI."""
+    if not value:
+        raise argparse.ArgumentTypeError("needs a value")
+    return value
 
 
 class _ProgressLine:
@@ -186,8 +194,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     """
     args = _arguments(argv)
     settings = mfb.Settings(threads=args.threads, verbose=args.verbose, quiet=args.quiet, json=args.json,
-                            model=args.model, twostage=tuple(args.twostage), citl=tuple(args.citl),
-                            rig_map=args.rig_map, units=args.units)
+                            model=args.model or "", twostage=tuple(args.twostage), citl=tuple(args.citl),
+                            rig_map=args.rig_map or "", units=args.units)
     try:
         import motionfield as mf
 
