@@ -146,6 +146,7 @@ def _run(args: argparse.Namespace, settings: mfb.Settings) -> int:
     if runnable:
         import distributed
 
+        progress.draw(0, 0)
         client, cluster = _client(args)
         try:
             futures = {client.submit(mfb.run_job_in_process, entries[k].job, settings, pure=False,
