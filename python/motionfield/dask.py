@@ -98,8 +98,17 @@ class _ProgressLine:
             self.drawn = False
 
 
+def _distributed():  # type: ignore[no-untyped-def]
+    try:
+        import distributed
+    except ImportError as e:
+        raise mfb.InputError("python3 -m motionfield.dask needs Dask's distributed package (Debian: "
+                             "python3-distributed; `make deps` installs it): %s" % e) from None
+    return distributed
+
+
 def _client(args: argparse.Namespace):  # type: ignore[no-untyped-def]
-    import distributed
+    distributed = _distributed()
 
     if args.scheduler:
         return distributed.Client(args.scheduler), None
@@ -144,8 +153,7 @@ def _run(args: argparse.Namespace, settings: mfb.Settings) -> int:
     printer = _Printer(entries, settings, progress)
     runnable = [k for k, e in enumerate(entries) if e.runnable]
     if runnable:
-        import distributed
-
+        distributed = _distributed()
         progress.draw(0, 0)
         client, cluster = _client(args)
         try:
