@@ -4,7 +4,8 @@ A LocalCluster of 2 worker processes (one thread each) runs a small jobs file:
 a few short jobs of every task, good and bad (bad lines the parser refuses,
 and jobs that fail on the worker: a missing input, a missing directory, an
 unknown method, an output that is the input, a keyframe out of range, an
-unknown unit). The outputs must be byte-identical to the CLI's on the same
+unknown unit, a re-navigation method that does not exist, a missing and a bad
+rig map, a negative frame rate). The outputs must be byte-identical to the CLI's on the same
 file, and the messages (stderr lines, --json summaries without the timings)
 the same, in line order, with the same exit code. Lines that are not JSON
 are compared up to "invalid JSON: column" (Python's parser words the syntax
@@ -62,6 +63,10 @@ WORKER_FAILURES = [
     {"id": "far", "task": "inbetween", "in": "walk.bvh", "out": "out/k.bvh", "keyframes": [0, 100],
      "method": "interp"},
     {"task": "resample", "in": "walk.bvh", "out": "out/u2.bvh", "fps": 30, "units": "furlong"},
+    {"task": "renav", "in": "walk.bvh", "out": "out/r1.bvh", "path": "path.csv", "method": "interp"},
+    {"task": "fill", "in": "walk.bvh", "out": "out/f1.bvh", "gap": [2, 5], "rig_map": "missing-map.json"},
+    {"task": "fill", "in": "walk.bvh", "out": "out/f2.bvh", "gap": [2, 5], "rig_map": "notamap.json", "method": "nemf"},
+    {"task": "resample", "in": "walk.bvh", "out": "out/s.bvh", "fps": -5},
 ]
 
 
@@ -76,6 +81,8 @@ def set_up_dir(path):
     shutil.copy(SAMPLE, os.path.join(path, "walk.bvh"))
     with open(os.path.join(path, "path.csv"), "w") as f:
         f.write("x,z\n" + "".join("%.4f,%.4f\n" % (0.3 * (i / 30.0) ** 2, 0.04 * i) for i in range(30)))
+    with open(os.path.join(path, "notamap.json"), "w") as f:
+        f.write('{"a": 1}\n')
     with open(os.path.join(path, "jobs.jsonl"), "w") as f:
         f.write(jobs_text())
 
