@@ -29,6 +29,7 @@ import logging
 import os
 import sys
 import time
+import uuid
 from typing import Dict, List, Optional, Sequence
 
 from . import batch as mfb
@@ -157,8 +158,9 @@ def _run(args: argparse.Namespace, settings: mfb.Settings) -> int:
         progress.draw(0, 0)
         client, cluster = _client(args)
         try:
+            run = uuid.uuid4().hex[:12]  # task keys unique to this run: a shared scheduler merges equal keys
             futures = {client.submit(mfb.run_job_in_process, entries[k].job, settings, pure=False,
-                                     key="motionfield-line-%d" % entries[k].line): k for k in runnable}
+                                     key="motionfield-%s-line-%d" % (run, entries[k].line)): k for k in runnable}
             for k, e in enumerate(entries):
                 if not e.runnable:
                     printer.finish(k, mfb.Outcome(failure=e.failure))
