@@ -114,14 +114,7 @@ class DaskBatchTest(unittest.TestCase):
         set_up_dir(cls.cli_dir)
         set_up_dir(cls.dask_dir)
         # --jobs 2: the CLI loads the model before the jobs, as the Dask workers do.
-        cls.cli_run = subprocess.run([cls.cli, "--threads", THREADS, "--json", "batch", "--jobs", "2", "jobs.jsonl"],
-                                     cwd=cls.cli_dir, capture_output=True, text=True, timeout=300)
-        env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in [os.path.dirname(os.path.dirname(mf.__file__)),
-                                                                        os.environ.get("PYTHONPATH")] if p),
-                   MOTIONFIELD_LIBRARY=mf.library_path())
-        cls.dask_run = subprocess.run([sys.executable, "-m", "motionfield.dask", "--workers", "2", "--threads", THREADS,
-                                       "--json", "jobs.jsonl"], cwd=cls.dask_dir, capture_output=True, text=True,
-                                      timeout=300, env=env)
+        cls.cli_run, cls.dask_run = run_both(cls.cli, cls.tmp, ["--json"], ["--jobs", "2"])
 
     @classmethod
     def tearDownClass(cls):
@@ -159,6 +152,57 @@ class DaskBatchTest(unittest.TestCase):
     def test_same_messages_as_the_cli(self):
         self.assertEqual(without_timings(self.dask_run.stdout), without_timings(self.cli_run.stdout))
         self.assertEqual(comparable_stderr(self.dask_run.stderr), comparable_stderr(self.cli_run.stderr))
+
+
+def run_both(cli, directory, options, cli_batch_options=()):
+    """(CLI run, Dask run) of jobs.jsonl with the global `options`, in directory/cli and directory/dask:
+    `motionfield --threads 1 OPTIONS batch CLI_BATCH_OPTIONS jobs.jsonl` and
+    `python3 -m motionfield.dask --workers 2 --threads 1 OPTIONS jobs.jsonl`."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join(p for p in [os.path.dirname(os.path.dirname(mf.__file__)),
+                                                                    os.environ.get("PYTHONPATH")] if p),
+               MOTIONFIELD_LIBRARY=mf.library_path())
+    cli_run = subprocess.run([cli, "--threads", THREADS] + list(options) + ["batch"] + list(cli_batch_options)
+                             + ["jobs.jsonl"], cwd=os.path.join(directory, "cli"), capture_output=True, text=True,
+                             timeout=300)
+    dask_run = subprocess.run([sys.executable, "-m", "motionfield.dask", "--workers", "2", "--threads", THREADS]
+                              + list(options) + ["jobs.jsonl"], cwd=os.path.join(directory, "dask"),
+                              capture_output=True, text=True, timeout=300, env=env)
+    return cli_run, dask_run
+
+
+class LoadWarningTest(unittest.TestCase):
+    """A transformer file next to the model that does not load: the CLI warns
+    once, on the first job that names no method; so does the Dask run."""
+
+    def test_the_load_warning_goes_to_the_first_job_without_a_method(self):
+        cli = os.environ.get("MF_CLI") or os.path.join(SOURCE, "build", "capi", "motionfield")
+        models = os.path.join(SOURCE, "models")
+        tmp = tempfile.mkdtemp(prefix="mf-dask-warn-")
+        self.addCleanup(shutil.rmtree, tmp, True)
+        for side in ("cli", "dask"):
+            d = os.path.join(tmp, side)
+            os.makedirs(os.path.join(d, "m"))
+            os.makedirs(os.path.join(d, "out"))
+            shutil.copy(SAMPLE, os.path.join(d, "walk.bvh"))
+            for name in ("motionfield-prior.mfm", "motionfield-rig.json"):
+                shutil.copy(os.path.join(models, name), os.path.join(d, "m", name))
+            with open(os.path.join(models, "motionfield-twostage.mfm"), "rb") as f, \
+                    open(os.path.join(d, "m", "motionfield-twostage.mfm"), "wb") as g:
+                g.write(f.read(1000))  # truncated
+            with open(os.path.join(d, "jobs.jsonl"), "w") as f:
+                f.write('{"task": "fill", "in": "walk.bvh", "out": "out/a.bvh", "gap": [2, 5], "method": "interp"}\n'
+                        '{"task": "fill", "in": "walk.bvh", "out": "out/b.bvh", "gap": [2, 5]}\n'
+                        '{"task": "fill", "in": "walk.bvh", "out": "out/c.bvh", "gap": [2, 8]}\n')
+        cli_run, dask_run = run_both(cli, tmp, ["--model", "m/motionfield-prior.mfm"])
+        self.assertEqual((cli_run.returncode, dask_run.returncode), (0, 0), cli_run.stderr + dask_run.stderr)
+        self.assertRegex(dask_run.stderr, r"^motionfield: jobs.jsonl line 2: warning: motionfield-twostage.mfm next to "
+                                          r"the model did not load.*truncated")
+        self.assertEqual(dask_run.stderr.count("warning"), 1, dask_run.stderr)
+        self.assertEqual(dask_run.stderr, cli_run.stderr)
+        for name in ("a.bvh", "b.bvh", "c.bvh"):
+            with open(os.path.join(tmp, "cli", "out", name), "rb") as a, \
+                    open(os.path.join(tmp, "dask", "out", name), "rb") as b:
+                self.assertTrue(a.read() == b.read(), "out/%s differs from the CLI's" % name)
 
 
 class JobFormatTest(unittest.TestCase):
