@@ -64,10 +64,11 @@ __all__ = [
     "Error", "InvalidArgumentError", "BufferTooSmallError", "FileError", "ModelError", "CancelledError",
     "InternalError", "UnsupportedError", "OutOfMemoryError",
     "version", "abi_version", "library_path", "set_num_threads", "get_num_threads",
-    "Method", "methods", "default_method", "default_model_path", "default_model",
+    "Method", "methods", "find_method", "default_method", "default_model_path", "default_model",
+    "printable_text",
     "Model", "Motion", "CancelToken", "Progress", "Encoding",
     "inbetween", "fill", "resample", "resample_frame_count", "encode",
-    "renav", "load_path_csv", "describe_rig",
+    "renav", "load_path_csv", "describe_rig", "length_unit_scale",
 ]
 
 #: A file path: a string or an os.PathLike.
@@ -215,9 +216,7 @@ def _units_scale(units: Union[str, float, None], length_scale: Optional[float]) 
     if units is None or units == "auto":
         return None
     if isinstance(units, str):
-        v = ctypes.c_double(0)
-        _check(_c.mf_length_unit_scale(units.encode(), ctypes.byref(v)))
-        return v.value
+        return length_unit_scale(units)
     return float(units)
 
 
@@ -410,6 +409,63 @@ def methods() -> List[Method]:
         out.append(Method(name.value.decode(), description.value.decode(), bool(f & _c.METHOD_NEEDS_MODEL),
                           bool(f & _c.METHOD_COMPLETES), bool(f & _c.METHOD_RESAMPLES)))
     return out
+
+
+def find_method(name: str) -> Method:
+    """The method called `name` (mf_method_find), or the library's error.
+
+    The check the CLI makes of a job's method before reading anything
+    (``motionfield batch`` and ``python3 -m motionfield.dask``).
+
+    Parameters
+    ----------
+    name : str
+        A method name, e.g. "interp" or "nemf".
+
+    Returns
+    -------
+    Method
+        Its name, description and flags.
+
+    Raises
+    ------
+    InvalidArgumentError
+        If no method has that name (the library's message lists the names).
+    """
+    index = ctypes.c_int32(0)
+    _check(_c.mf_method_find(name.encode(), ctypes.byref(index)))
+    return methods()[index.value]
+
+
+def printable_text(text: Union[str, bytes]) -> str:
+    """`text` as the library prints messages (mf_printable_text).
+
+    Control bytes and terminal escape sequences are escaped and the text is cut
+    at MF_MESSAGE_MAX_BYTES: what the CLI does to every message that quotes a
+    file name or input before printing it.
+
+    Parameters
+    ----------
+    text : str or bytes
+        The text (str is encoded as UTF-8, lone surrogates as "surrogateescape"
+        bytes).
+
+    Returns
+    -------
+    str
+        The printable text (invalid UTF-8 left in it is decoded with U+FFFD).
+
+    Raises
+    ------
+    OutOfMemoryError
+        Never in practice.
+    """
+    data = text if isinstance(text, bytes) else text.encode("utf-8", "surrogateescape")
+    needed = ctypes.c_size_t(0)
+    _check(_c.mf_printable_text(data, len(data), None, 0, ctypes.byref(needed)))
+    buf = ctypes.create_string_buffer(needed.value)
+    _check(_c.mf_printable_text(data, len(data), buf, needed.value, ctypes.byref(needed)))
+    return buf.value.decode("utf-8", "replace")
 
 
 @functools.lru_cache(maxsize=None)
@@ -711,6 +767,25 @@ class Model(_Handle):
     def window(self) -> int:
         """Frames per window."""
         return self._i32(_c.mf_model_get_window)
+
+    def describe(self) -> Dict[str, Any]:
+        """What the model holds and what did not load with it (mf_model_describe).
+
+        Returns
+        -------
+        dict
+            {"format_version", "joints", "fps", "window", "inbetweeners":
+            {kind: {"file", "loaded", "error"}}, "rig_anatomy",
+            "rig_anatomy_error"}: a transformer file next to the model that
+            was there but did not load has "loaded" False and the reason in
+            "error" (the default method then runs without it).
+
+        Raises
+        ------
+        InvalidArgumentError
+            If the model is closed.
+        """
+        return json.loads(_read_string(_c.mf_model_describe, self._live()))
 
     @property
     def latent_sizes(self) -> Tuple[int, int]:
@@ -1317,6 +1392,29 @@ def resample_frame_count(frames: int, fps_in: float, fps_out: float) -> Tuple[in
     _check(_c.mf_resample_frame_count(int(frames), float(fps_in), float(fps_out), ctypes.byref(n),
                                       ctypes.byref(rounded)))
     return n.value, bool(rounded.value)
+
+
+def length_unit_scale(unit: str) -> float:
+    """Metres per unit of a BVH length unit name (mf_length_unit_scale).
+
+    Parameters
+    ----------
+    unit : str
+        "cm", "m", "mm", "in", "ft" or "asf".
+
+    Returns
+    -------
+    float
+        Metres per unit, e.g. 0.01 for "cm".
+
+    Raises
+    ------
+    InvalidArgumentError
+        If the name is not a known unit (the message lists them).
+    """
+    v = ctypes.c_double(0)
+    _check(_c.mf_length_unit_scale(unit.encode(), ctypes.byref(v)))
+    return v.value
 
 
 def load_path_csv(path: PathLike) -> FloatArray:
