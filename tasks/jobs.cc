@@ -94,6 +94,21 @@ void warn_missed_targets(const Motion& out, const MotionConstraints& c, std::vec
   }
 }
 
+// Warnings for contact pins the output lets slide by more than half a centimetre.
+void warn_sliding_pins(const Motion& out, const MotionConstraints& c, std::vector<std::string>* warnings) {
+  for (const ContactPin& p : c.contacts) {
+    MotionConstraints one;
+    one.contacts = {p};
+    const double cm = contact_error(out, one).max_cm;
+    if (cm <= 0.5) continue;
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << "the contact of joint '" << out.skeleton.names[p.joint] << "' on frames " << p.first << ".." << p.last
+        << " slides up to " << cm << " cm (the body moves beyond the limb's reach, or keys move the joint)";
+    warnings->push_back(msg.str());
+  }
+}
+
 }  // namespace
 
 const std::vector<Method>& registered_methods() {
@@ -227,6 +242,7 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
     for (int v = 0; v <= alternatives; ++v)
       result.motions.push_back(m.complete_constrained(input, constraints, v, ctx, &result.warnings));
     warn_missed_targets(result.motions.front(), constraints, &result.warnings);
+    warn_sliding_pins(result.motions.front(), constraints, &result.warnings);
   }
   for (const Motion& out : result.motions) result.reports.push_back(measure_constraints(input, constraints, out));
   return result;
