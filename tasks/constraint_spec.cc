@@ -128,6 +128,23 @@ int joint_index(const Skeleton& skel, const std::string& name, const std::string
   throw InputError(where + ": unknown joint '" + name + "' (the motion's joints: " + names + ")");
 }
 
+// Two keys at one frame: what either constrains (a whole pose covers all).
+void merge_key(const PoseKey& k, PoseKey* into) {
+  const bool whole_k = k.rotations && k.joints.empty(), whole_into = into->rotations && into->joints.empty();
+  if (whole_k || whole_into) {
+    into->joints.clear();
+    into->rotations = true;
+  } else if (k.rotations) {
+    std::vector<int> joints = into->joints;
+    joints.insert(joints.end(), k.joints.begin(), k.joints.end());
+    std::sort(joints.begin(), joints.end());
+    joints.erase(std::unique(joints.begin(), joints.end()), joints.end());
+    into->joints = joints;
+    into->rotations = true;
+  }
+  into->root_position = into->root_position || k.root_position;
+}
+
 }  // namespace
 
 ConstraintSpec ConstraintSpec::parse_json(const std::string& text, const std::string& source) {
@@ -185,10 +202,15 @@ MotionConstraints ConstraintSpec::resolve(const Skeleton& skel, double length_sc
     c.keys.push_back(key);
   }
   std::stable_sort(c.keys.begin(), c.keys.end(), [](const PoseKey& a, const PoseKey& b) { return a.frame < b.frame; });
-  for (size_t i = 1; i < c.keys.size(); ++i) {
-    if (c.keys[i].frame == c.keys[i - 1].frame)
-      throw InputError("frame " + std::to_string(c.keys[i].frame) + " is keyed twice: give one key per frame");
+  std::vector<PoseKey> merged;
+  for (const PoseKey& k : c.keys) {
+    if (merged.empty() || merged.back().frame != k.frame) {
+      merged.push_back(k);
+    } else {
+      merge_key(k, &merged.back());
+    }
   }
+  c.keys = std::move(merged);
   for (const TargetSpec& t : targets) {
     EffectorTarget e;
     e.frame = t.frame;

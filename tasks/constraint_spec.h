@@ -55,9 +55,10 @@ struct ConstraintSpec {
   void add_whole_pose_keys(const std::vector<int>& frames);
 
   /// The constraints on `skeleton`, positions scaled by `length_scale` (metres
-  /// per input unit), keys sorted by frame. Throws mf::InputError on an
-  /// unknown joint name (listing the skeleton's) or a frame keyed twice; the
-  /// rest is checked by MotionConstraints::validate().
+  /// per input unit), keys sorted by frame; keys at one frame are merged into
+  /// one that constrains what either does (a whole pose covers everything).
+  /// Throws mf::InputError on an unknown joint name (listing the skeleton's);
+  /// the rest is checked by MotionConstraints::validate().
   MotionConstraints resolve(const Skeleton& skeleton, double length_scale) const;
 
   /// The same description as JSON text (parse_json() reads it back).

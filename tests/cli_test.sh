@@ -550,5 +550,51 @@ expect_stderr "line 2: error:" "batch rejects non-objects"
 expect_stderr "line 3: error:" "batch reports a missing input"
 expect_rc 2 "batch file missing" -- "$MF" batch "$TMP/batch/none.jsonl"
 
+# ------------------------------------------------------------ constraints (issue 16, docs/CONSTRAINTS.md)
+cat >"$TMP/c.json" <<'JSON'
+{"keys": [{"frame": 30, "joints": ["UpperArm_L", "LowerArm_L"]}, {"frame": 45, "root": "position"}],
+ "targets": [{"frame": 20, "joint": "Hand_R", "position": [20, 110, 30]}],
+ "contacts": [{"joint": "Foot_L", "first": 50, "last": 55}]}
+JSON
+expect_rc 0 "inbetween --constraints (interp)" -- "$MF" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/c.bvh" \
+  --constraints "$TMP/c.json" --method interp --report "$TMP/c-report.json"
+expect_rc 0 "constraints keep the whole-pose keys" -- "$DIFF" "$SAMPLE" "$TMP/c.bvh" --frames 0,60
+grep -q '"targets"' "$TMP/c-report.json" && pass || fail "--report writes the constraint report"
+grep -q '"rotations": 44' "$TMP/c-report.json" && pass || fail "the report counts the whole and partial key rotations"
+expect_rc 0 "fill --constraints" -- "$MF" fill -i "$SAMPLE" --gap 10:40 -o "$TMP/cf.bvh" --method interp \
+  --constraints "$TMP/c.json" --json
+grep -q '"constraints":{' "$TMP/out" && pass || fail "--json carries the constraint report"
+expect_rc 0 "inbetween --alternatives 1 (nemf)" -- "$MF" --threads 1 inbetween -i "$SAMPLE" --keyframes 0,60 \
+  -o "$TMP/alt.bvh" --alternatives 1 --method nemf
+expect_frames "$TMP/alt_1.bvh" "$N"
+expect_rc 0 "an alternative keeps the keys" -- "$DIFF" "$SAMPLE" "$TMP/alt_1.bvh" --frames 0,60
+cmp -s "$TMP/alt.bvh" "$TMP/alt_1.bvh" && fail "the alternative equals the default solution" || pass
+printf '%s\n' "{\"task\": \"inbetween\", \"in\": \"$SAMPLE\", \"out\": \"$TMP/bc.bvh\", \"keyframes\": [0, 60], \"method\": \"interp\", \"constraints\": $(tr -d '\n' <"$TMP/c.json"), \"report\": \"$TMP/bc-report.json\"}" \
+  "{\"task\": \"inbetween\", \"in\": \"$SAMPLE\", \"out\": \"$TMP/bc2.bvh\", \"keyframes\": [0, 60], \"method\": \"interp\", \"constraints\": \"$TMP/c.json\"}" \
+  "{\"task\": \"inbetween\", \"in\": \"$SAMPLE\", \"out\": \"$TMP/bc3.bvh\", \"keyframes\": [0, 60], \"constraints\": 3}" \
+  >"$TMP/cjobs.jsonl"
+expect_rc 2 "batch with constraints (one bad line)" -- "$MF" batch "$TMP/cjobs.jsonl"
+expect_stderr 'line 3: error: "constraints" must be a file name or an object' "batch names a bad constraints value"
+cmp -s "$TMP/bc.bvh" "$TMP/c.bvh" && pass || fail "batch inline constraints = --constraints"
+cmp -s "$TMP/bc2.bvh" "$TMP/c.bvh" && pass || fail "batch constraints file = --constraints"
+cmp -s "$TMP/bc-report.json" "$TMP/c-report.json" && pass || fail "batch report = --report"
+echo '{"keys": [{"frame": 30, "joints": ["Tail"]}]}' >"$TMP/c-bad.json"
+bad "constraints: unknown joint" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --constraints "$TMP/c-bad.json" --method interp
+expect_stderr "unknown joint 'Tail'" "unknown joint message"
+echo '{"contacts": [{"joint": "Foot_L", "first": 5, "last": 20}, {"joint": "Foot_L", "first": 10, "last": 30}]}' >"$TMP/c-bad.json"
+bad "constraints: overlapping contacts" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --constraints "$TMP/c-bad.json" --method interp
+expect_stderr "overlaps contact 5..20" "overlapping contacts message"
+echo '{"targets": [{"frame": 99, "joint": "Hand_R", "position": [0, 0, 0]}]}' >"$TMP/c-bad.json"
+bad "constraints: frame out of range" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --constraints "$TMP/c-bad.json" --method interp
+echo '{"keys": [{"frame": 3, "joints": "Head"}]}' >"$TMP/c-bad.json"
+bad "constraints: joints not an array" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --constraints "$TMP/c-bad.json" --method interp
+bad "constraints file missing" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --constraints "$TMP/none.json"
+bad "constraints with a method that takes whole poses only" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --constraints "$TMP/c.json" --method zerovel
+expect_stderr "takes whole-pose keys only" "whole-pose-only method message"
+bad "--alternatives 17" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --alternatives 17
+bad "--alternatives with interp" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --alternatives 1 --method interp
+expect_stderr "single solution" "interp alternatives message"
+expect_rc 2 "--alternatives to standard output" -- "$MF" inbetween -i "$SAMPLE" --keyframes 0,60 -o - --alternatives 1
+
 echo "cli_test: $((checks - failures)) of $checks checks passed"
 [ "$failures" -eq 0 ]

@@ -615,8 +615,8 @@ MF_API int mf_motion_get_warnings(const mf_motion *motion, char *out, size_t cap
  * input's world frame and its own length unit (mf_motion_get_length_scale).
  * mf_solve runs it and can return several distinct solutions. Names and frames
  * are checked against the input when mf_solve runs (unknown joints, frames out
- * of range, a frame keyed twice, overlapping pins: MF_ERROR_INVALID_ARGUMENT
- * naming the item). */
+ * of range, overlapping pins: MF_ERROR_INVALID_ARGUMENT naming the item); keys
+ * at one frame merge into one (a whole pose covers everything). */
 
 /** A set of constraints (not thread-safe while being built; const use is). */
 typedef struct mf_constraints mf_constraints;
