@@ -1566,11 +1566,14 @@ class Solution(NamedTuple):
         {"unit", "solutions": [{"index", "keys", "targets", "contacts"}], "warnings"}).
     warnings : list of str
         Constraints that could not hold exactly, with the frames involved.
+    report_json : str
+        The report as the library formats it (what ``--report FILE`` holds).
     """
 
     motions: List[Motion]
     report: Dict[str, Any]
     warnings: List[str]
+    report_json: str
 
     @property
     def motion(self) -> Motion:
@@ -1657,10 +1660,11 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
             m = ctypes.POINTER(_c.MfMotion)()
             _check(_c.mf_solution_get_motion(handle, i, ctypes.byref(m)))
             motions.append(Motion._wrap(m))
-        report = json.loads(_read_string(_c.mf_solution_get_report_json, handle))
+        text = _read_string(_c.mf_solution_get_report_json, handle)
     finally:
         _c.mf_solution_destroy(handle)
-    return Solution(motions, report, list(report.get("warnings", [])))
+    report = json.loads(text)
+    return Solution(motions, report, list(report.get("warnings", [])), text)
 
 
 def resample_frame_count(frames: int, fps_in: float, fps_out: float) -> Tuple[int, bool]:

@@ -89,6 +89,15 @@ class BatchJob:
     frames: int = 0
     rig_map: str = ""
     units: str = ""
+    constraints_file: str = ""  # inbetween, fill: a constraints file
+    constraints_json: str = ""  # ... or the same inline (JSON text)
+    alternatives: int = 0
+    report_file: str = ""
+
+    @property
+    def constrained(self) -> bool:
+        """Whether the job goes through solve() (constraints, alternatives or a report)."""
+        return bool(self.constraints_file or self.constraints_json or self.alternatives or self.report_file)
 
 
 @dataclasses.dataclass
@@ -112,6 +121,8 @@ class JobReport:
     write_ms: float = 0.0
     warnings: str = ""
     verbose_line: str = ""     # the --verbose line of the job ("" without --verbose)
+    constraints: str = ""      # the constraint report (JSON text), "" when not asked for
+    alternatives: List[str] = dataclasses.field(default_factory=list)
 
 
 @dataclasses.dataclass
@@ -422,7 +433,26 @@ def _read_units(line: Dict[str, Any], job: BatchJob) -> None:
         raise InputError('"units" must be a unit name or a number, not ' + json_type_name(u))
 
 
+def _read_constraints(line: Dict[str, Any], job: BatchJob) -> None:
+    if "constraints" in line:
+        c = line["constraints"]
+        if isinstance(c, dict):
+            job.constraints_json = dump(c)  # as the CLI's JsonValue::dump writes it (25, not 25.0)
+        elif isinstance(c, str):
+            job.constraints_file = _string_value(c, "constraints", False)
+        else:
+            raise InputError('"constraints" must be a file name or an object, not ' + json_type_name(c))
+    if "alternatives" in line:
+        job.alternatives = _int_value(line["alternatives"], '"alternatives"')
+        if not 0 <= job.alternatives <= 16:
+            raise InputError('"alternatives" must be between 0 and 16, not ' + dump(line["alternatives"]))
+    if "report" in line:
+        job.report_file = _string_value(line["report"], "report", False)
+
+
 def _read_task_keys(line: Dict[str, Any], job: BatchJob) -> None:
+    if job.task in ("inbetween", "fill"):
+        _read_constraints(line, job)
     if job.task == "inbetween":
         job.keyframes = _int_array(_required(line, "keyframes", job.task), "keyframes")
         job.has_keyframes = True
@@ -752,22 +782,34 @@ class _FilePath(os.PathLike):  # type: ignore[type-arg]
         return self._path
 
 
-def _check_output(job: BatchJob, settings: Settings) -> None:
-    out = job.out_path
+def _check_path(out: str) -> None:
     if os.path.isdir(out):
         raise InputError("cannot write %s: it is a directory" % out)
     parent = os.path.dirname(out)
     if parent and not os.path.isdir(parent):
         raise InputError("cannot write %s: directory %s does not exist" % (out, parent))
+
+
+def _check_output(job: BatchJob, settings: Settings) -> None:
+    if job.out_path == _STDIO and job.alternatives > 0:
+        raise InputError("--alternatives writes OUT_1.bvh .. beside the output: name an output file, not -")
+    _check_path(job.out_path)
+    if job.report_file:
+        _check_path(job.report_file)
     rig_map = job.rig_map or settings.rig_map
-    for file, role in ((job.in_path, "input"), (job.path_file, "path file"), (rig_map, "rig map file")):
-        try:
-            same = bool(file) and file != _STDIO and os.path.samefile(file, out)
-        except OSError:
-            same = False
-        if same:
-            raise InputError("the output %s is the %s %s: refusing to overwrite it (name another output file)"
-                             % (out, role, file))
+    outputs = [job.out_path] + [alternative_path(job.out_path, i) for i in range(1, job.alternatives + 1)]
+    if job.report_file:
+        outputs.append(job.report_file)
+    for out in outputs:
+        for file, role in ((job.in_path, "input"), (job.path_file, "path file"), (rig_map, "rig map file"),
+                           (job.constraints_file, "constraints file")):
+            try:
+                same = bool(file) and file != _STDIO and os.path.samefile(file, out)
+            except OSError:
+                same = False
+            if same:
+                raise InputError("the output %s is the %s %s: refusing to overwrite it (name another output file)"
+                                 % (out, role, file))
 
 
 def check_job(job: BatchJob, settings: Settings) -> None:
@@ -784,10 +826,28 @@ def check_job(job: BatchJob, settings: Settings) -> None:
     _check_output(job, settings)
 
 
-def _solve(job: BatchJob, settings: Settings, model: Optional[mf.Model], motion: mf.Motion) -> mf.Motion:
+def _solve_constrained(job: BatchJob, options: Dict[str, Any], motion: mf.Motion) -> "mf.Solution":
+    """The CLI's constrained path: the job's constraints plus its known frames as whole-pose keys."""
+    constraints = (mf.Constraints.load(job.constraints_file) if job.constraints_file
+                   else mf.Constraints(job.constraints_json) if job.constraints_json else mf.Constraints())
+    if job.task == "inbetween" or job.has_keyframes:
+        keys = job.keyframes
+    else:
+        n = motion.frame_count
+        if not 1 <= job.gap_begin < job.gap_end <= n - 1:
+            raise InputError("gap %d:%d must satisfy 1 <= A < B <= frames - 1 (the input has %d frames)" %
+                             (job.gap_begin, job.gap_end, n))
+        keys = [f for f in range(n) if f < job.gap_begin or f >= job.gap_end]
+    constraints.add_keys(keys)
+    return mf.solve(motion, constraints=constraints, alternatives=job.alternatives, **options)
+
+
+def _solve(job: BatchJob, settings: Settings, model: Optional[mf.Model], motion: mf.Motion) -> Any:
     rig_map = job.rig_map or settings.rig_map
     options: Dict[str, Any] = dict(method=job.method or None, model=model,
                                    rig_map=_FilePath(rig_map) if rig_map else None)
+    if job.constrained:
+        return _solve_constrained(job, options, motion)
     if job.task == "inbetween" or (job.task == "fill" and job.has_keyframes):
         return mf.inbetween(motion, job.keyframes, **options)
     if job.task == "fill":
@@ -807,6 +867,26 @@ def _method_name(job: BatchJob, model: Optional[mf.Model]) -> str:
     if job.task == "renav":
         return "nemf"
     return mf.default_method(model=model)
+
+
+def alternative_path(out: str, index: int) -> str:
+    """Where alternative `index` (1..) of output `out` goes: OUT_1.bvh for OUT.bvh (the CLI's)."""
+    stem, ext = os.path.splitext(os.path.basename(out))
+    return os.path.join(os.path.dirname(out), "%s_%d%s" % (stem, index, ext))
+
+
+def _write_atomically(path: str, text: str) -> None:
+    tmp = path + ".tmp"
+    try:
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(text)
+        os.replace(tmp, path)
+    except OSError:
+        try:
+            os.remove(tmp)
+        except OSError:
+            pass
+        raise mf.FileError("cannot write " + path, None)
 
 
 def run_job(job: BatchJob, settings: Settings, models: Models) -> Outcome:
@@ -840,13 +920,23 @@ def run_job(job: BatchJob, settings: Settings, models: Models) -> Outcome:
             outcome.load_warnings = models.load_warnings()
         motion = mf.Motion.load_bvh(job.in_path, units=units_scale(job.units or settings.units, "--units"))
         t1 = time.perf_counter()
-        result = _solve(job, settings, model, motion)
+        solved = _solve(job, settings, model, motion)
+        result = solved.motion if isinstance(solved, mf.Solution) else solved
         t2 = time.perf_counter()
         result.save_bvh(job.out_path)  # atomic: a temporary file in the same directory, then a rename
+        alternatives: List[str] = []
+        if isinstance(solved, mf.Solution):
+            for i, m in enumerate(solved.motions[1:], 1):
+                alternatives.append(alternative_path(job.out_path, i))
+                m.save_bvh(alternatives[-1])
+            if job.report_file:
+                _write_atomically(job.report_file, solved.report_json + "\n")
         t3 = time.perf_counter()
         r = JobReport(method=_method_name(job, model), model=models.path if model is not None else "",
                       frames_in=motion.frame_count, frames_out=result.frame_count, read_ms=(t1 - t0) * 1e3,
-                      solve_ms=(t2 - t1) * 1e3, write_ms=(t3 - t2) * 1e3, warnings=result.warnings)
+                      solve_ms=(t2 - t1) * 1e3, write_ms=(t3 - t2) * 1e3, warnings=result.warnings,
+                      constraints=solved.report_json if isinstance(solved, mf.Solution) else "",
+                      alternatives=alternatives)
         if settings.verbose:
             r.verbose_line = "motionfield: %s\n" % printable(
                 "%s %s -> %s, model %s: %d -> %d frames, method %s, %d threads; read %.1f ms, solve %.1f ms, "
@@ -915,6 +1005,8 @@ def job_json(job: BatchJob, report: Optional[JobReport], failure: Optional[Failu
                  timings_ms={"read": report.read_ms, "solve": report.solve_ms, "write": report.write_ms,
                              "total": report.read_ms + report.solve_ms + report.write_ms},
                  warnings=getlines(report.warnings))
+        if report.constraints:
+            j.update(alternatives=report.alternatives, constraints=json.loads(report.constraints))
     return json.dumps(j, ensure_ascii=False, separators=(",", ":"))
 
 

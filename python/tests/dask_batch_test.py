@@ -40,7 +40,12 @@ GOOD = [
     {"task": "renav", "in": "walk.bvh", "out": "out/renav.bvh", "path": "path.csv"},   # "nemf"
     {"id": 5, "task": "fill", "in": "walk.bvh", "out": "out/fill-keys.bvh", "keyframes": [0, 30, 60],
      "method": "zerovel", "units": "cm"},
+    {"task": "fill", "in": "walk.bvh", "out": "out/constrained.bvh", "gap": [10, 40], "method": "interp",
+     "constraints": {"keys": [{"frame": 25, "joints": ["Head"]}], "contacts": [{"joint": "Foot_L", "first": 30,
+                                                                               "last": 35}]},
+     "report": "out/constrained-report.json"},                                       # docs/CONSTRAINTS.md
 ]
+REPORTS = ["constrained-report.json"]
 BAD_LINES = [
     '{"id": 7, "task": "fill", "in": "walk.bvh", "out": "out/bad-gap.bvh", "gap": [10]}',
     '{"task": "fill",}',
@@ -54,6 +59,8 @@ BAD_LINES = [
     '{"task": "fill", "in": "walk.bvh", "out": "z.bvh", "gap": [1, 5], "gap": [2, 6]}',
     '{"task": "fill", "in": "walk.bvh", "out": "z.bvh", "gap": [1e400, 5]}',
     '{"task": "inbetween", "in": "walk.bvh", "out": "z.bvh", "keyframes": [0, 3000000000]}',
+    '{"task": "inbetween", "in": "walk.bvh", "out": "z.bvh", "keyframes": [0, 60], "constraints": 3}',
+    '{"task": "inbetween", "in": "walk.bvh", "out": "z.bvh", "keyframes": [0, 60], "alternatives": 17}',
 ]
 WORKER_FAILURES = [
     {"task": "fill", "in": "missing.bvh", "out": "out/missing.bvh", "gap": [1, 5]},
@@ -67,6 +74,8 @@ WORKER_FAILURES = [
     {"task": "fill", "in": "walk.bvh", "out": "out/f1.bvh", "gap": [2, 5], "rig_map": "missing-map.json"},
     {"task": "fill", "in": "walk.bvh", "out": "out/f2.bvh", "gap": [2, 5], "rig_map": "notamap.json", "method": "nemf"},
     {"task": "resample", "in": "walk.bvh", "out": "out/s.bvh", "fps": -5},
+    {"task": "inbetween", "in": "walk.bvh", "out": "out/c.bvh", "keyframes": [0, 60], "method": "interp",
+     "constraints": {"keys": [{"frame": 30, "joints": ["Tail"]}]}},
 ]
 
 
@@ -126,7 +135,7 @@ class DaskBatchTest(unittest.TestCase):
 
     def test_outputs_are_byte_identical(self):
         written = sorted(os.listdir(os.path.join(self.cli_dir, "out")))
-        self.assertEqual(written, sorted(os.path.basename(j["out"]) for j in GOOD))
+        self.assertEqual(written, sorted([os.path.basename(j["out"]) for j in GOOD] + REPORTS))
         self.assertEqual(sorted(os.listdir(os.path.join(self.dask_dir, "out"))), written)
         for name in written:
             with open(os.path.join(self.cli_dir, "out", name), "rb") as a, \
@@ -142,9 +151,9 @@ class DaskBatchTest(unittest.TestCase):
                          ["ok"] * len(GOOD) + ["error"] * (len(BAD_LINES) + len(WORKER_FAILURES)))
         self.assertEqual([s["line"] for s in summaries[:4]], [1, 2, 4, 5])  # line 3 is blank
         self.assertEqual(summaries[0]["method"], mf.default_method())
-        self.assertIn('motionfield: jobs.jsonl line 7 (id 7): error: "gap" must be an array of two integers',
+        self.assertIn('motionfield: jobs.jsonl line 8 (id 7): error: "gap" must be an array of two integers',
                       self.dask_run.stderr)
-        self.assertIn("jobs.jsonl line 20: error: cannot write nodir/x.bvh: directory nodir does not exist",
+        self.assertIn("jobs.jsonl line 23: error: cannot write nodir/x.bvh: directory nodir does not exist",
                       self.dask_run.stderr)
         self.assertTrue(self.dask_run.stderr.endswith("motionfield: batch jobs.jsonl: %d jobs, %d ok, %d failed\n" % (
             len(summaries), len(GOOD), len(summaries) - len(GOOD))), self.dask_run.stderr)
