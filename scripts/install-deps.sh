@@ -15,6 +15,7 @@ packages=(
   libopenblas0-pthread  # BLAS for libtorch and Eigen: ~3x faster than ATLAS here (docs/BLAS.md)
   python3 python3-numpy # the Python binding's tests
   python3-venv python3-pip python3-setuptools python3-wheel  # `pip install ./python` into a venv without network (README, capi_python_venv test)
+  blender               # the Blender add-on's headless tests (capi_blender_addon*, integrations/blender); Debian's 3.4 runs on the system python3
 )
 
 missing=()
