@@ -18,16 +18,14 @@ import math
 import os
 import sys
 import tempfile
-import threading
 import time
-import traceback
 
 import bpy
-from mathutils import Matrix, Quaternion, Vector
+from mathutils import Quaternion, Vector
 
 sys.path.insert(0, os.environ["MF_BLENDER_ADDON_DIR"])
 import motionfield_blender as addon  # noqa: E402
-from motionfield_blender import animation, convert, engine  # noqa: E402
+from motionfield_blender import convert, engine  # noqa: E402
 
 FAILURES = []
 T0 = time.time()
@@ -391,6 +389,33 @@ check(abs(first.x - start.x) < 1e-3 and abs(first.y - start.y) < 1e-3,
       "follow path starts at the path's first point: %s vs %s" % (tuple(first), tuple(start)))
 check(max_jump(A, NAMES, frames[0], frames[-1]) > 0.05, "follow path: the new frames move")
 log("follow path", len(frames), "frames")
+
+# ------------------------------------------------------------------ ranges (C: preview range, selected keys)
+C = build_armature("C", NAMES, 'QUATERNION')
+for k in WALK_KEYS:
+    key_pose(C, NAMES, 1 + k, k)
+bpy.context.view_layer.objects.active = C
+s.method, s.range_mode = "interp", 'PREVIEW'
+scene.use_preview_range, scene.frame_preview_start, scene.frame_preview_end = True, 10, 35
+check(operator("inbetween") == {'FINISHED'}, "in-between in the preview range finished")
+
+
+def hips_frames(obj):
+    fc = obj.animation_data.action.fcurves.find('pose.bones["Hips"].rotation_quaternion', index=0)
+    return sorted(int(k.co[0]) for k in fc.keyframe_points)
+
+
+check(hips_frames(C) == [1] + list(range(16, 32)) + [46, 61], "preview range 10..35: frames 17..30 only: %s"
+      % hips_frames(C))
+scene.use_preview_range = False
+s.range_mode = 'SELECTED'
+for fc in C.animation_data.action.fcurves:
+    for k in fc.keyframe_points:
+        k.select_control_point = int(k.co[0]) in (46, 61)
+check(operator("inbetween") == {'FINISHED'}, "in-between of the selected keys finished")
+check(hips_frames(C) == [1] + list(range(16, 32)) + list(range(46, 62)), "selected keys 46, 61: frames 47..60 only")
+s.range_mode = 'SCENE'
+log("ranges")
 
 # ------------------------------------------------------------------ errors, progress, cancel
 E = build_armature("E", NAMES, 'QUATERNION')
