@@ -110,6 +110,9 @@ class MotionfieldSettings(bpy.types.PropertyGroup):
                               description="The bone whose translation moves the character; its tree is "
                                           "converted. Empty: the armature's root bone")
     seed: IntProperty(name="Seed", min=0, default=0)
+    max_iterations: IntProperty(name="Iterations", min=0, default=0,
+                                description="Iteration budget of the solvers (per window of the full solve); "
+                                            "0: each method's own (mf_task_options.max_iterations)")
     range_mode: EnumProperty(name="Range", default='SCENE', items=[
         ('SCENE', "Scene", "Every frame between keys in the scene's frame range"),
         ('PREVIEW', "Preview", "Within the preview range (the scene range when off)"),
@@ -157,7 +160,8 @@ class _TaskOperator:
         s = context.scene.motionfield
         m = _method_arg(method)
         needs = m is None or any(x.name == m and x.needs_model for x in self.mf.methods())
-        kw = {"method": m, "seed": s.seed, "model": engine.model(bpy.path.abspath(s.model_path)) if needs else None}
+        kw = {"method": m, "seed": s.seed, "max_iterations": s.max_iterations,
+              "model": engine.model(bpy.path.abspath(s.model_path)) if needs else None}
         if s.rig_map:
             kw["rig_map"] = bpy.path.abspath(s.rig_map)
         return kw
@@ -419,6 +423,7 @@ class MOTIONFIELD_PT_panel(bpy.types.Panel):
         if obj is not None and obj.type == 'ARMATURE':
             col.prop_search(s, "root_bone", obj.data, "bones")
         col.prop(s, "seed")
+        col.prop(s, "max_iterations")
         box = layout.box()
         box.prop(s, "method")
         box.prop(s, "range_mode")

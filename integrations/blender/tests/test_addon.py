@@ -62,6 +62,7 @@ WALK_KEYS = [0, 15, 30, 45, 60]
 # The methods that refine with the prior are smooth across keys (the
 # transformers alone, e.g. "detail", jump by up to 0.6-0.9 m at the keys).
 METHOD = "nemf-detail"
+BUDGET = 8  # iterations per window (the add-on's "Iterations"): a faster test
 full = mf.inbetween(walk, WALK_KEYS, method=METHOD)
 NAMES, PARENTS = full.joint_names, [int(p) for p in full.parents]
 GROT = []  # [frame][joint] global rotation (motion space)
@@ -256,14 +257,15 @@ check(mf.describe_rig(motion, rig_map=rig_map_path)["map"]["bone_05"] == NAMES[5
 
 # ------------------------------------------------------------------ in-between (A)
 s = scene.motionfield
-s.method, s.root_bone, s.range_mode, s.seed = METHOD, "", 'SCENE', 3
+s.method, s.root_bone, s.range_mode, s.seed, s.max_iterations = METHOD, "", 'SCENE', 3, BUDGET
 bpy.context.view_layer.objects.active = A
 keys_a = [1 + k for k in WALK_KEYS]
 before_keys = fcurve_snapshot(A.animation_data.action)
 before_pose = poses(A, keys_a)
 other = cube_state()
 rig_a, expected = library_result(A, "", list(range(1, 62)),
-                                 lambda m: mf.inbetween(m, WALK_KEYS, method=METHOD, seed=3))
+                                 lambda m: mf.inbetween(m, WALK_KEYS, method=METHOD, seed=3,
+                                                       max_iterations=BUDGET))
 bpy.ops.ed.undo_push(message="before in-between")
 check(operator("inbetween") == {'FINISHED'}, "in-between finished")
 A = bpy.data.objects["A"]
@@ -308,7 +310,8 @@ before_keys = fcurve_snapshot(B.animation_data.action)
 before_pose = poses(B, B_KEYED)
 other = cube_state()
 rig_b, expected = library_result(B, "bone_00", list(range(1, 62)),
-                                 lambda m: mf.fill(m, 20, 40, method=METHOD, seed=3, rig_map=rig_map_path))
+                                 lambda m: mf.fill(m, 20, 40, method=METHOD, seed=3, rig_map=rig_map_path,
+                                                   max_iterations=BUDGET))
 scene.frame_set(30)
 bpy.ops.ed.undo_push(message="before fill")
 check(operator("fill") == {'FINISHED'}, "fill finished")
@@ -448,6 +451,48 @@ while job.progress == (0, 0) and not job.done:
 job.cancel()
 job.join()
 check(isinstance(job.error, mf.CancelledError), "cancel token (Esc) cancels the thread: %r" % job.error)
+
+# The interactive path (invoke -> modal on a timer) needs a window, which
+# background mode has not: its modal() runs here on stand-ins of the window
+# manager, the workspace and the events.
+class _Stub:
+    def __init__(self):
+        self.calls = []
+
+    def __getattr__(self, name):
+        return lambda *a: self.calls.append((name,) + a)
+
+
+class _Event:
+    def __init__(self, kind):
+        self.type = kind
+
+
+def run_modal(press_esc):
+    op = type("Op", (addon._TaskOperator,), {"bl_label": "In-between"})()
+    op.mf, op._timer, reports = mf, None, []
+    op.report = lambda kind, message: reports.append(message)
+    op._finish = lambda context, result: "%d frames" % result.frame_count
+    op._job = engine.Job(lambda progress, cancel: mf.inbetween(full, WALK_KEYS, method="nemf", progress=progress,
+                                                                cancel=cancel, max_iterations=BUDGET))
+    ctx = type("Ctx", (), {"window_manager": _Stub(), "workspace": _Stub()})()
+    op._job.start()
+    state, deadline = {'RUNNING_MODAL'}, time.time() + 60
+    while state == {'RUNNING_MODAL'} and time.time() < deadline:
+        if press_esc and op._job.progress != (0, 0):
+            op.modal(ctx, _Event('ESC'))
+            press_esc = False
+        state = op.modal(ctx, _Event('TIMER'))
+        time.sleep(0.01)
+    return state, reports, ctx
+
+
+state, reports, ctx = run_modal(press_esc=False)
+check(state == {'FINISHED'} and reports == ["motionfield: 61 frames"], "modal run: %s %s" % (state, reports))
+check(any(c[0] == "progress_update" for c in ctx.window_manager.calls), "modal run shows progress")
+check(("status_text_set", None) in ctx.workspace.calls, "modal run clears the status text")
+state, reports, ctx = run_modal(press_esc=True)
+check(state == {'CANCELLED'} and any("cancelled" in r for r in reports), "Esc cancels: %s %s" % (state, reports))
 
 addon.unregister()
 log("done,", len(FAILURES), "failures")
