@@ -42,11 +42,12 @@ class MOTIONFIELD_AP_preferences(bpy.types.AddonPreferences):
     python_dir: StringProperty(
         name="Python package folder", subtype='DIR_PATH',
         description="Folder holding the motionfield Python package (e.g. <checkout>/python); "
-                    "empty: $MOTIONFIELD_PYTHON, an installed package, or next to the add-on")
+                    "empty: $MOTIONFIELD_PYTHON, an installed package, or next to the add-on. "
+                    "Read once: a change takes effect after restarting Blender")
     library: StringProperty(
         name="Library", subtype='FILE_PATH',
         description="libmotionfield.so to use (sets $MOTIONFIELD_LIBRARY before the first use); "
-                    "empty: the package finds it")
+                    "empty: the package finds it. A change takes effect after restarting Blender")
 
     def draw(self, context):
         self.layout.prop(self, "python_dir")
