@@ -162,10 +162,15 @@ def mat_diff(a, b):
 
 
 def cube_state():
+    """What an operator on the active armature must not change: the cube, the
+    other armatures' actions, the set of objects."""
     cube = bpy.data.objects["Cube"]
     scene.frame_set(10)
+    active = bpy.context.view_layer.objects.active
+    others = {o.name: fcurve_snapshot(o.animation_data.action) for o in bpy.data.objects
+              if o.type == 'ARMATURE' and o != active and o.animation_data and o.animation_data.action}
     return (fcurve_snapshot(cube.animation_data.action), [tuple(v) for v in cube.matrix_world],
-            sorted(o.name for o in bpy.data.objects))
+            sorted(o.name for o in bpy.data.objects), others)
 
 
 def operator(name):
@@ -290,7 +295,7 @@ check(max_jump(A, NAMES, 2, 14) > 0.05, "in-between: the new frames move")
 # and more next to the keys; the walk's fastest joint moves < 0.2 m a frame.
 jump = max(max_jump(A, NAMES, f, f + 1) for f in range(1, 61))
 check(jump < 0.25, "in-between: no jump between frames (%.3f m)" % jump)
-check(cube_state() == other, "in-between left the cube alone")
+check(cube_state() == other, "in-between left the cube and B alone")
 # One undo step: undo gives the keys before, redo the result.
 bpy.ops.ed.undo()
 refresh()
@@ -330,7 +335,7 @@ expect_heads(B, rig_b, expected, list(range(21, 41)), 1, "fill")
 check(max_jump(B, B_NAMES, 22, 39) > 0.05, "fill: the new frames move")
 jump = max(max_jump(B, B_NAMES, f, f + 1) for f in range(19, 42))
 check(jump < 0.25, "fill: no jump in and around the gap (%.3f m)" % jump)
-check(cube_state() == other, "fill left the cube alone")
+check(cube_state() == other, "fill left the cube and A alone")
 bpy.ops.ed.undo()
 refresh()
 B = bpy.data.objects["B"]
@@ -359,7 +364,7 @@ check(hips == list(range(1, 32)), "resample: 31 frames at 30 fps: %s" % hips[:3]
 after_pose = poses(B, list(range(1, 32)))
 worst = max(mat_diff(before_pose[1 + 2 * k][n], after_pose[1 + k][n]) for k in range(31) for n in B_NAMES)
 check(worst < 1e-4, "resample (interp): frame k is the source's frame 2k (%g)" % worst)
-check(cube_state() == other, "resample left the cube alone")
+check(cube_state() == other, "resample left the cube and A alone")
 bpy.ops.ed.undo()
 refresh()
 B = bpy.data.objects["B"]
