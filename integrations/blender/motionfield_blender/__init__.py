@@ -153,7 +153,7 @@ class _TaskOperator:
         self.mf = _mf()
         self.obj = context.active_object
         self.rig = convert.Rig(self.obj, s.root_bone, context.scene.unit_settings.scale_length or 1.0)
-        self.keyed = animation.keyed_frames(self.obj.animation_data.action, self.rig.names)
+        self.keyed = animation.keyed_frames(self.obj, self.rig.names)
         if len(self.keyed) < 2:
             raise ValueError("the action has fewer than two keyed frames on the rig's bones")
 
@@ -239,11 +239,11 @@ class _TaskOperator:
         return self._end(context)
 
 
-def _range(scene, s, action, names):
+def _range(scene, s, obj, names):
     if s.range_mode == 'PREVIEW' and scene.use_preview_range:
         return scene.frame_preview_start, scene.frame_preview_end
     if s.range_mode == 'SELECTED':
-        sel = animation.selected_key_frames(action, names)
+        sel = animation.selected_key_frames(obj, names)
         if len(sel) < 2:
             raise ValueError("select at least two keys (Dope Sheet / Graph Editor)")
         return sel[0], sel[-1]
@@ -257,7 +257,7 @@ class MOTIONFIELD_OT_inbetween(_TaskOperator, bpy.types.Operator):
 
     def prepare(self, context):
         scene, s = context.scene, context.scene.motionfield
-        lo, hi = _range(scene, s, self.obj.animation_data.action, self.rig.names)
+        lo, hi = _range(scene, s, self.obj, self.rig.names)
         keys = [k for k in self.keyed if lo <= k <= hi]
         if len(keys) < 2:
             raise ValueError("fewer than two keyed frames in frames %d..%d" % (lo, hi))

@@ -13,20 +13,31 @@ def bone_of(data_path):
     return data_path[12:end] if end > 0 else None
 
 
-def keyed_frames(action, bone_names):
+def fcurves_of(obj, action=None):
+    """The F-curves `obj` plays from `action` (default: its action): the
+    action's own on Blender 3.x-4.x, the slot's channel bag on the layered
+    actions of Blender versions without Action.fcurves."""
+    action = action or obj.animation_data.action
+    if hasattr(action, "fcurves"):
+        return action.fcurves
+    from bpy_extras import anim_utils
+    return anim_utils.action_ensure_channelbag_for_slot(action, obj.animation_data.action_slot).fcurves
+
+
+def keyed_frames(obj, bone_names):
     """Sorted integer frames where an F-curve of one of the bones has a key."""
     names = set(bone_names)
     frames = set()
-    for fc in action.fcurves:
+    for fc in fcurves_of(obj):
         if bone_of(fc.data_path) in names:
             frames.update(int(round(k.co[0])) for k in fc.keyframe_points)
     return sorted(frames)
 
 
-def selected_key_frames(action, bone_names):
+def selected_key_frames(obj, bone_names):
     names = set(bone_names)
     frames = set()
-    for fc in action.fcurves:
+    for fc in fcurves_of(obj):
         if bone_of(fc.data_path) in names:
             frames.update(int(round(k.co[0])) for k in fc.keyframe_points if k.select_control_point)
     return sorted(frames)
@@ -67,11 +78,14 @@ def channel_values(obj, rig, sampled, motion_rot, motion_root, new):
     return values
 
 
-def _fcurve(action, bone, path, index, create):
+def _fcurve(fcurves, bone, path, index, create):
     dp = 'pose.bones["%s"].%s' % (bone.replace('"', '\\"'), path)
-    fc = action.fcurves.find(dp, index=index)
+    fc = fcurves.find(dp, index=index)
     if fc is None and create:
-        fc = action.fcurves.new(dp, index=index, action_group=bone)
+        try:
+            fc = fcurves.new(dp, index=index, action_group=bone)
+        except TypeError:  # a channel bag's F-curves take no group
+            fc = fcurves.new(dp, index=index)
     return fc
 
 
@@ -80,14 +94,14 @@ def insert_keys(obj, rig, sampled, values, new, keyed):
     when missing and the channel changes). Each F-curve written also gets a key
     with its current value on every keyed frame of the range it lacks one on,
     so that the pose on keyed frames stays what it was."""
-    action = obj.animation_data.action
+    fcurves = fcurves_of(obj)
     frames = sampled.frames
     written = 0
     for (bone, path), seq in values.items():
         for c in range(len(seq[0])):
             old = [sampled.channels[i][(bone, path)][c] for i in range(len(frames))]
             changed = any(abs(seq[i][c] - old[i]) > EPS for i in range(len(frames)))
-            fc = _fcurve(action, bone, path, c, changed)
+            fc = _fcurve(fcurves, bone, path, c, changed)
             if fc is None:
                 continue
             have = {int(round(k.co[0])) for k in fc.keyframe_points}
@@ -120,9 +134,11 @@ def new_action_with(obj, rig, motion_rot, motion_root, first_frame, suffix, pare
             prev = seq[-1] if seq else None
             seq.append(convert.euler_from_basis(m, mode, prev) if p == "rotation_euler"
                        else convert.channel_from_basis(m, p, prev))
+    obj.animation_data.action = act
+    fcurves = fcurves_of(obj, act)
     for (b, p), seq in seqs.items():
         for c in range(len(seq[0])):
-            fc = _fcurve(act, b, p, c, True)
+            fc = _fcurve(fcurves, b, p, c, True)
             fc.keyframe_points.clear()
             fc.keyframe_points.add(len(seq))
             co = []
@@ -132,5 +148,4 @@ def new_action_with(obj, rig, motion_rot, motion_root, first_frame, suffix, pare
             for k in fc.keyframe_points:
                 k.interpolation = 'LINEAR'
             fc.update()
-    obj.animation_data.action = act
     return act
