@@ -152,7 +152,7 @@ class _TaskOperator:
         s = context.scene.motionfield
         self.mf = _mf()
         self.obj = context.active_object
-        self.rig = convert.Rig(self.obj, s.root_bone, context.scene.unit_settings.scale_length or 1.0)
+        self.rig = convert.Rig(self.obj, s.root_bone, convert.metres_per_unit(context.scene, self.obj))
         self.keyed = animation.keyed_frames(self.obj, self.rig.names)
         if len(self.keyed) < 2:
             raise ValueError("the action has fewer than two keyed frames on the rig's bones")

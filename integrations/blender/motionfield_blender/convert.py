@@ -32,6 +32,14 @@ class RigError(ValueError):
     """The armature cannot be read as a motion skeleton (the message says why)."""
 
 
+def metres_per_unit(scene, obj):
+    """Metres per unit of `obj`'s armature space: the scene's unit scale times
+    the object's (mean) world scale, e.g. 0.01 for an FBX import in centimetres
+    under an object scaled by 0.01."""
+    s = obj.matrix_world.to_scale()
+    return (scene.unit_settings.scale_length or 1.0) * (abs(s.x) + abs(s.y) + abs(s.z)) / 3.0
+
+
 def _default_root(arm):
     roots = [b for b in arm.bones if b.parent is None]
     if not roots:

@@ -75,14 +75,17 @@ for f in range(full.frame_count):
 GPOS = full.global_positions
 
 
-def build_armature(name, bone_names, mode, extra_root=False, prop_bone=None):
+def build_armature(name, bone_names, mode, extra_root=False, prop_bone=None, unit=1.0):
     """An armature whose rest pose is the walk's first frame's skeleton at
-    identity rotations; bones point at their first child and are rolled."""
+    identity rotations; bones point at their first child and are rolled.
+    unit: metres per armature unit (the object is scaled by it, as FBX
+    imports in centimetres are)."""
     arm = bpy.data.armatures.new(name)
     obj = bpy.data.objects.new(name, arm)
     scene.collection.objects.link(obj)
     obj.location = (1.0, -2.0, 0.0)
     obj.rotation_euler = (0.0, 0.0, math.radians(30.0))
+    obj.scale = (unit, unit, unit)
     bpy.context.view_layer.objects.active = obj
     bpy.ops.object.mode_set(mode='EDIT')
     heads = []
@@ -92,11 +95,11 @@ def build_armature(name, bone_names, mode, extra_root=False, prop_bone=None):
     eb = []
     for j, p in enumerate(PARENTS):
         b = arm.edit_bones.new(bone_names[j])
-        b.head = convert.C3T @ heads[j]
+        b.head = convert.C3T @ heads[j] / unit
         kids = [k for k, q in enumerate(PARENTS) if q == j]
-        d = (convert.C3T @ (heads[kids[0]] - heads[j])) if kids else Vector((0, 0, 0))
-        if d.length < 1e-3:
-            d = (b.head - eb[p].head).normalized() * 0.08 if p >= 0 else Vector((0, 0, 0.1))
+        d = (convert.C3T @ (heads[kids[0]] - heads[j])) / unit if kids else Vector((0, 0, 0))
+        if d.length < 1e-3 / unit:
+            d = (b.head - eb[p].head).normalized() * 0.08 / unit if p >= 0 else Vector((0, 0, 0.1 / unit))
         b.tail = b.head + d
         b.roll = 0.37 * j - 1.0
         if p >= 0:
@@ -104,12 +107,12 @@ def build_armature(name, bone_names, mode, extra_root=False, prop_bone=None):
         eb.append(b)
     if extra_root:
         r = arm.edit_bones.new("root")
-        r.head, r.tail = (0, 0, 0), (0, 0.3, 0)
+        r.head, r.tail = (0, 0, 0), (0, 0.3 / unit, 0)
         eb[0].parent = r
     if prop_bone:
         hand = eb[NAMES.index("Hand_R")]
         pb = arm.edit_bones.new(prop_bone)
-        pb.head, pb.tail, pb.parent = hand.tail, hand.tail + Vector((0, 0, -0.1)), hand
+        pb.head, pb.tail, pb.parent = hand.tail, hand.tail + Vector((0, 0, -0.1 / unit)), hand
     bpy.ops.object.mode_set(mode='OBJECT')
     obj.animation_data_create()
     obj.animation_data.action = bpy.data.actions.new(name + "_action")
@@ -130,7 +133,7 @@ def key_pose(obj, bone_names, scene_frame, motion_frame):
         rest = obj.data.bones[n].matrix_local.to_3x3()
         rot = convert.C3T @ GROT[motion_frame][j] @ convert.C3 @ rest
         m = rot.to_4x4()
-        m.translation = convert.C3T @ Vector([float(x) for x in GPOS[motion_frame, j]])
+        m.translation = convert.C3T @ Vector([float(x) for x in GPOS[motion_frame, j]]) / obj.scale.x
         pb.matrix = m
         bpy.context.view_layer.update()
     for j, n in enumerate(bone_names):
@@ -157,8 +160,10 @@ def poses(obj, frames):
     return out
 
 
-def mat_diff(a, b):
-    return max(abs(a[i][j] - b[i][j]) for i in range(4) for j in range(4))
+def mat_diff(a, b, unit=1.0):
+    """Largest difference of two bone matrices: rotation entries, and the
+    translation in metres (`unit`: metres per armature unit)."""
+    return max(abs(a[i][j] - b[i][j]) * (unit if j == 3 else 1.0) for i in range(4) for j in range(4))
 
 
 def cube_state():
@@ -187,14 +192,15 @@ def heads_of(obj, frames, names):
 
 
 def max_jump(obj, names, f0, f1):
+    """The largest distance a bone head moves from frame f0 to f1, metres."""
     h = heads_of(obj, [f0, f1], names)
-    return max((a - b).length for a, b in zip(h[f0], h[f1]))
+    return max((a - b).length for a, b in zip(h[f0], h[f1])) * obj.scale.x
 
 
 def library_result(obj, settings_root, frames, call):
     """What the library gives for the armature's current frames: the expected
     result of the operator (equal seeds give equal results)."""
-    rig = convert.Rig(obj, settings_root)
+    rig = convert.Rig(obj, settings_root, convert.metres_per_unit(scene, obj))
     sampled = convert.read_frames(scene, obj, rig, frames)
     motion = mf.Motion.from_arrays(sampled.rotations, sampled.root_positions, 30.0, joint_names=rig.names,
                                    parents=rig.parents, offsets=rig.offsets)
@@ -207,8 +213,8 @@ def expect_heads(obj, rig, result, frames, first, what):
     for f in frames:
         scene.frame_set(f)
         for j, n in enumerate(rig.names):
-            want = convert.C3T @ Vector([float(x) for x in result.global_positions[f - first, j]])
-            worst = max(worst, (obj.pose.bones[n].head - want).length)
+            want = convert.C3T @ Vector([float(x) for x in result.global_positions[f - first, j]]) / rig.scale
+            worst = max(worst, (obj.pose.bones[n].head - want).length * rig.scale)
     check(worst < 1e-4, "%s: heads differ from the library's result by %g m" % (what, worst))
 
 
@@ -228,7 +234,7 @@ for c in range(4):
     fc = A.animation_data.action.fcurves.find('pose.bones["Head"].rotation_quaternion', index=c)
     fc.keyframe_points.remove(next(k for k in fc.keyframe_points if int(k.co[0]) == 31))
 B_NAMES = ["bone_%02d" % j for j in range(len(NAMES))]
-B = build_armature("B", B_NAMES, 'XYZ', extra_root=True, prop_bone="bone_prop")
+B = build_armature("B", B_NAMES, 'XYZ', extra_root=True, prop_bone="bone_prop", unit=0.01)  # centimetres
 B_KEYED = list(range(1, 21)) + list(range(41, 62))
 for f in B_KEYED:
     key_pose(B, B_NAMES, f, f - 1)
@@ -241,7 +247,7 @@ log("scene built")
 
 # ------------------------------------------------------------------ round trip
 for obj, root in ((A, ""), (B, "bone_00")):
-    rig = convert.Rig(obj, root)
+    rig = convert.Rig(obj, root, convert.metres_per_unit(scene, obj))
     frames = list(range(1, 62, 3))
     sampled = convert.read_frames(scene, obj, rig, frames)
     motion = mf.Motion.from_arrays(sampled.rotations, sampled.root_positions, 30.0, joint_names=rig.names,
@@ -253,8 +259,8 @@ for obj, root in ((A, ""), (B, "bone_00")):
         basis = convert.basis_matrices(rig, mats[i], sampled.parent_poses[i])
         for j, n in enumerate(rig.names):
             pb = obj.pose.bones[n]
-            worst_m = max(worst_m, mat_diff(mats[i][j], pb.matrix))
-            worst_b = max(worst_b, mat_diff(basis[j], pb.matrix_basis))
+            worst_m = max(worst_m, mat_diff(mats[i][j], pb.matrix, rig.scale))
+            worst_b = max(worst_b, mat_diff(basis[j], pb.matrix_basis, rig.scale))
     check(worst_m < 1e-4, "round trip %s: armature-space matrices differ by %g" % (obj.name, worst_m))
     check(worst_b < 1e-4, "round trip %s: basis matrices differ by %g" % (obj.name, worst_b))
     log("round trip", obj.name, worst_m, worst_b)
@@ -326,7 +332,7 @@ for key, pts in before_keys.items():
     now = dict(after_keys.get(key, []))
     check(all(abs(now.get(f, math.inf) - v) < 1e-6 for f, v in pts), "fill kept the keys of %s" % (key,))
 after_pose = poses(B, B_KEYED)
-worst = max(mat_diff(before_pose[f][n], after_pose[f][n]) for f in B_KEYED for n in before_pose[f])
+worst = max(mat_diff(before_pose[f][n], after_pose[f][n], B.scale.x) for f in B_KEYED for n in before_pose[f])
 check(worst < 1e-5, "fill: pose on keyed frames changed by %g" % worst)
 euler = sorted(int(f) for f, _ in after_keys[('pose.bones["bone_05"].rotation_euler', 0)])
 check(euler == list(range(1, 62)), "fill keyed frames 21..40 on the Euler curves")
@@ -362,7 +368,7 @@ check(bpy.data.actions[old_action].use_fake_user, "the old action is kept")
 hips = sorted(int(f) for f, _ in fcurve_snapshot(act)[('pose.bones["bone_00"].location', 0)])
 check(hips == list(range(1, 32)), "resample: 31 frames at 30 fps: %s" % hips[:3])
 after_pose = poses(B, list(range(1, 32)))
-worst = max(mat_diff(before_pose[1 + 2 * k][n], after_pose[1 + k][n]) for k in range(31) for n in B_NAMES)
+worst = max(mat_diff(before_pose[1 + 2 * k][n], after_pose[1 + k][n], B.scale.x) for k in range(31) for n in B_NAMES)
 check(worst < 1e-4, "resample (interp): frame k is the source's frame 2k (%g)" % worst)
 check(cube_state() == other, "resample left the cube and A alone")
 bpy.ops.ed.undo()
