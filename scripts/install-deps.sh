@@ -16,6 +16,7 @@ packages=(
   python3 python3-numpy # the Python binding's tests
   python3-venv python3-pip python3-setuptools python3-wheel  # `pip install ./python` into a venv without network (README, capi_python_venv test)
   python3-distributed   # Dask: `python3 -m motionfield.dask` runs batch files on a cluster (python_dask_batch test)
+  blender               # the Blender add-on's headless tests (capi_blender_addon*, integrations/blender); Debian's 3.4 runs on the system python3
 )
 
 missing=()

@@ -31,7 +31,7 @@ bool upsample_by_solving(const Motion& in, double fps, int frames, const TaskCon
   // 20 iterations: the setting the blend below was chosen and measured with
   // (the solver's default rose to 40 later, not re-measured for resampling).
   LatentSolverOptions solver = default_solver_options(SolverMethod::Lbfgs);
-  solver.max_iterations = 20;
+  solver.max_iterations = ctx.max_iterations > 0 ? ctx.max_iterations : 20;
   const Motion solved_raw = complete_motion(*ctx.model, dense, MotionConstraints::full_pose(known), solver, ctx);
   // Half-way between the interpolation and the solution (SLERP / LERP): the
   // solution's frames between keys carry the prior's reconstruction error

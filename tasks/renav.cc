@@ -575,10 +575,12 @@ Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& pa
     throw InputError("the reference's fps must be finite and positive");
   if (!std::isfinite(path_fps) || path_fps < 0) throw InputError("the path's frame rate must be finite and positive");
   const double fps = path_fps > 0 ? path_fps : reference.fps;
+  RenavOptions options = default_renav_options(solver);
+  if (ctx.max_iterations > 0) options.max_iterations = ctx.max_iterations;
   // renavigate() takes any frame rate itself; only another rig needs the adapter.
   if (!reference.skeleton.same_as(model.rig().skeleton))
-    return renavigate_on_model_rig(reference, path, fps, default_renav_options(solver), ctx, report);
-  return renavigate(model, reference, path, fps, default_renav_options(solver), ctx, report);
+    return renavigate_on_model_rig(reference, path, fps, options, ctx, report);
+  return renavigate(model, reference, path, fps, options, ctx, report);
 }
 
 }  // namespace mf

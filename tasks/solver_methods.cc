@@ -32,7 +32,9 @@ Method solver_method(const std::string& name, const std::string& description, So
                                                    const TaskContext& ctx) {
     const NemfModel& model = require_prior(ctx, "method '" + method_name + "'");
     if (!inbetweener.empty()) require_inbetweener(ctx, inbetweener, "method '" + method_name + "'");
-    return complete_motion(model, input, MotionConstraints::full_pose(known), options, ctx);
+    LatentSolverOptions o = options;
+    if (ctx.max_iterations > 0) o.max_iterations = ctx.max_iterations;
+    return complete_motion(model, input, MotionConstraints::full_pose(known), o, ctx);
   };
   m.complete_constrained = [options, method_name = name, inbetweener](const Motion& input, const MotionConstraints& c,
                                                                int variant, const TaskContext& ctx,

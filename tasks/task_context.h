@@ -77,6 +77,10 @@ struct TaskContext : ModelSet {
   /// Where `rig_map` came from (a file name) for its error messages; may be empty.
   std::string rig_map_source;
   uint64_t seed = 0;
+  /// Iteration budget of iterative methods (the latent solvers, prior
+  /// resampling, re-navigation): the most iterations of the full solve per
+  /// window; 0 = each method's default.
+  int max_iterations = 0;
   /// Called now and then by long methods; returning false cancels.
   std::function<bool(const TaskProgress&)> progress;
   /// Non-zero cancels (thread-safe; set from any thread).

@@ -398,6 +398,11 @@ typedef struct mf_task_options {
    *  are prefixed with the path). Giving both rig_map and rig_map_path is
    *  MF_ERROR_INVALID_ARGUMENT. */
   const char *rig_map_path;
+  /** Since 0.1 (appended): the iteration budget of the methods that iterate
+   *  (the latent solvers "nemf*", "prior" resampling, re-navigation): the
+   *  most iterations of the full solve per window; 0 (the default) = each
+   *  method's own. Must be >= 0; methods that do not iterate ignore it. */
+  int32_t max_iterations;
 } mf_task_options;
 
 MF_API int mf_task_options_init(mf_task_options *options);

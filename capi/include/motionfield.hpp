@@ -359,6 +359,7 @@ struct TaskOptions {
   CancelToken* cancel = nullptr;  ///< optional; must outlive the call
   std::string rig_map;            ///< JSON text; "" = automatic
   std::string rig_map_path;       ///< a JSON file; "" = none
+  int32_t max_iterations = 0;     ///< iteration budget of iterative methods; 0 = each method's own
 };
 
 /// mf_renav_options in C++ types.
@@ -381,6 +382,7 @@ class TaskCall {
     c_.cancel = options.cancel ? options.cancel->get() : nullptr;
     c_.rig_map = options.rig_map.empty() ? nullptr : options.rig_map.c_str();
     c_.rig_map_path = options.rig_map_path.empty() ? nullptr : options.rig_map_path.c_str();
+    c_.max_iterations = options.max_iterations;
     if (options.progress) {
       c_.progress = &TaskCall::on_progress;
       c_.user_data = this;

@@ -36,6 +36,10 @@ TaskContext task_context(const mf_model* model, const mf_task_options& o) {
   TaskContext ctx;
   if (model) static_cast<ModelSet&>(ctx) = *model;
   ctx.seed = o.seed;
+  if (o.max_iterations < 0)
+    throw ApiError(MF_ERROR_INVALID_ARGUMENT,
+                   "mf_task_options.max_iterations is " + std::to_string(o.max_iterations) + ": must be >= 0");
+  ctx.max_iterations = o.max_iterations;
   if (o.progress) {
     const mf_progress_fn fn = o.progress;
     void* const user_data = o.user_data;

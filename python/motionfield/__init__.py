@@ -1179,7 +1179,7 @@ class _TaskCall:
     alive for the call; exceptions it raises cancel the task and are re-raised)."""
 
     def __init__(self, method: Optional[str], seed: int, progress: Optional[ProgressCallback],
-                 cancel: Optional[CancelToken], rig_map: Optional[RigMap] = None) -> None:
+                 cancel: Optional[CancelToken], rig_map: Optional[RigMap] = None, max_iterations: int = 0) -> None:
         self.options = _c.MfTaskOptions()
         _check(_c.mf_task_options_init(ctypes.byref(self.options)))
         self._method = method.encode() if method else None
@@ -1188,6 +1188,7 @@ class _TaskCall:
         self._rig_map = (text.encode() if text else None, path.encode() if path else None)
         self.options.rig_map, self.options.rig_map_path = self._rig_map
         self.options.seed = int(seed)
+        self.options.max_iterations = int(max_iterations)
         self.error: Optional[BaseException] = None
         if progress is not None:
             def trampoline(_user_data: Any, p: Any) -> int:
@@ -1255,7 +1256,11 @@ _TASK_PARAMETERS_DOC = """\
     rig_map : dict, str or os.PathLike, optional
         For a motion on another rig than the model's: a dict {user joint:
         model joint or None}, a JSON file's path or JSON text overriding the
-        automatic map (see describe_rig())."""
+        automatic map (see describe_rig()).
+    max_iterations : int, optional
+        Iteration budget of the methods that iterate (the "nemf*" solvers,
+        "prior" resampling, re-navigation): the most iterations of the full
+        solve per window; 0 (the default) = each method's own."""
 
 _TASK_RAISES_DOC = """\
     InvalidArgumentError
@@ -1279,7 +1284,8 @@ def _task_doc(fn: _F) -> _F:
 @_keywords_after(*_TASK_OPTIONS)
 def inbetween(motion: Motion, keyframes: Sequence[int], *, method: Optional[str] = None,
               model: Optional[Model] = None, seed: int = 0, progress: Optional[ProgressCallback] = None,
-              cancel: Optional[CancelToken] = None, rig_map: Optional[RigMap] = None) -> Motion:
+              cancel: Optional[CancelToken] = None, rig_map: Optional[RigMap] = None,
+              max_iterations: int = 0) -> Motion:
     """Keyframe in-betweening: the keyframes are kept, every other frame is produced.
 
     ``inbetween(motion, keys)`` gives what ``motionfield inbetween --in ...
@@ -1303,7 +1309,7 @@ def inbetween(motion: Motion, keyframes: Sequence[int], *, method: Optional[str]
     {task_raises}
     """
     keys = np.ascontiguousarray(keyframes, dtype=np.int32).reshape(-1)
-    call = _TaskCall(method, seed, progress, cancel, rig_map)
+    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
     return call.run(_c.mf_inbetween, _task_model(model, method), motion._live(),
                     keys.ctypes.data_as(ctypes.POINTER(ctypes.c_int32)), keys.size)
 
@@ -1312,7 +1318,7 @@ def inbetween(motion: Motion, keyframes: Sequence[int], *, method: Optional[str]
 @_keywords_after(*_TASK_OPTIONS)
 def fill(motion: Motion, gap_begin: int, gap_end: int, *, method: Optional[str] = None,
          model: Optional[Model] = None, seed: int = 0, progress: Optional[ProgressCallback] = None,
-         cancel: Optional[CancelToken] = None, rig_map: Optional[RigMap] = None) -> Motion:
+         cancel: Optional[CancelToken] = None, rig_map: Optional[RigMap] = None, max_iterations: int = 0) -> Motion:
     """Gap filling: frames gap_begin..gap_end-1 are produced, the others kept.
 
     Parameters
@@ -1332,7 +1338,7 @@ def fill(motion: Motion, gap_begin: int, gap_end: int, *, method: Optional[str] 
     ------
     {task_raises}
     """
-    call = _TaskCall(method, seed, progress, cancel, rig_map)
+    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
     return call.run(_c.mf_fill, _task_model(model, method), motion._live(), int(gap_begin), int(gap_end))
 
 
@@ -1340,7 +1346,7 @@ def fill(motion: Motion, gap_begin: int, gap_end: int, *, method: Optional[str] 
 @_keywords_after(*_TASK_OPTIONS)
 def resample(motion: Motion, fps: float, *, method: Optional[str] = None, model: Optional[Model] = None,
              seed: int = 0, progress: Optional[ProgressCallback] = None, cancel: Optional[CancelToken] = None,
-             rig_map: Optional[RigMap] = None) -> Motion:
+             rig_map: Optional[RigMap] = None, max_iterations: int = 0) -> Motion:
     """Resampling to another frame rate, keeping the time span.
 
     Without a method: "prior" with a model (the default one unless given),
@@ -1364,7 +1370,7 @@ def resample(motion: Motion, fps: float, *, method: Optional[str] = None, model:
     ------
     {task_raises}
     """
-    call = _TaskCall(method, seed, progress, cancel, rig_map)
+    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
     return call.run(_c.mf_resample, _task_model(model, method), motion._live(), float(fps))
 
 
@@ -1751,7 +1757,7 @@ def load_path_csv(path: PathLike) -> FloatArray:
 def renav(reference: Motion, path: npt.ArrayLike, *, model: Optional[Model] = None, method: Optional[str] = None,
           polyline: bool = False, frames: int = 0, fps: float = 0.0, seed: int = 0,
           progress: Optional[ProgressCallback] = None, cancel: Optional[CancelToken] = None,
-          rig_map: Optional[RigMap] = None) -> Motion:
+          rig_map: Optional[RigMap] = None, max_iterations: int = 0) -> Motion:
     """Re-navigation: a motion in the style of `reference` whose root follows `path`.
 
     Always needs a model (the default one unless given). Methods: "nemf"
@@ -1791,7 +1797,7 @@ def renav(reference: Motion, path: npt.ArrayLike, *, model: Optional[Model] = No
     o.path_kind = _c.PATH_POLYLINE if polyline else _c.PATH_PER_FRAME
     o.frame_count = int(frames)
     o.fps = float(fps)
-    call = _TaskCall(method, seed, progress, cancel, rig_map)
+    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
     return call.run(lambda *args: _c.mf_renav(*args[:4], ctypes.byref(o), *args[4:]), handle,
                     reference._live(), _f32_ptr(xz), xz.shape[0])
 

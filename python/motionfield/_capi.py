@@ -120,6 +120,7 @@ class MfTaskOptions(ctypes.Structure):
         ("cancel", ctypes.POINTER(MfCancelToken)),
         ("rig_map", ctypes.c_char_p),
         ("rig_map_path", ctypes.c_char_p),
+        ("max_iterations", ctypes.c_int32),
     ]
 
 

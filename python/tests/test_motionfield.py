@@ -269,6 +269,20 @@ class ModelTest(unittest.TestCase):
         same_code = code.with_latents(code.local_latents, code.global_latents)
         np.testing.assert_array_equal(same_code.decode(60.0).rotations, dec.rotations)
 
+    def test_max_iterations_budgets_the_solver(self):
+        model = mf.Model(os.environ["MF_TEST_MODEL"])
+        m = mf.Motion.from_arrays(random_rotations(30, model.joint_count, 5), np.zeros((30, 3), np.float32), 30.0,
+                                  model=model)
+        budgets = {}
+        for budget in (0, 2):
+            seen = []
+            mf.inbetween(m, [0, 29], method="nemf", model=model, max_iterations=budget, progress=seen.append)
+            budgets[budget] = max(p.max_iterations for p in seen)
+            self.assertLessEqual(max(p.iteration for p in seen), budgets[budget])
+        self.assertLess(budgets[2], budgets[0])
+        with self.assertRaisesRegex(mf.InvalidArgumentError, "max_iterations"):
+            mf.inbetween(m, [0, 29], method="nemf", model=model, max_iterations=-1)
+
     def test_transformers_are_optional_and_named_when_missing(self):
         model = mf.Model(os.environ["MF_TEST_MODEL"])
         self.assertFalse(model.has_inbetweener("twostage"))

@@ -2,6 +2,7 @@
 // (arrays and BVH), tasks, progress and cancel, threads, encode and decode.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -481,6 +482,45 @@ TEST(CApi, CancelFromAnotherThreadStopsASolver) {
   EXPECT_EQ(status, MF_ERROR_CANCELLED) << describe(status);
   EXPECT_EQ(out, reinterpret_cast<mf_motion*>(0x1234)) << "a cancelled task produced a motion";
   EXPECT_EQ(rv.calls.load(), 3) << "the solve went on after the cancel";
+}
+
+// mf_task_options.max_iterations: the solver's iteration budget. The progress
+// reports show it (max_iterations) and the solve stays within it; negative
+// budgets are refused.
+TEST(CApi, MaxIterationsBudgetsTheSolver) {
+  const std::vector<std::string> solvers = methods_with(MF_METHOD_NEEDS_MODEL | MF_METHOD_COMPLETES);
+  ASSERT_FALSE(solvers.empty());
+  const ModelPtr model = load_tiny_model();
+  const MotionPtr input = random_capi_motion(30, 30.0, 5);
+  struct Seen {
+    int32_t iteration = 0, max_iterations = 0;
+  };
+  const auto solve = [&](int32_t budget, Seen* seen) {
+    mf_task_options options;
+    mf_task_options_init(&options);
+    EXPECT_EQ(options.max_iterations, 0);
+    options.method = "nemf";
+    options.max_iterations = budget;
+    options.user_data = seen;
+    options.progress = [](void* user_data, const mf_progress* p) {
+      auto* s = static_cast<Seen*>(user_data);
+      s->iteration = std::max(s->iteration, p->iteration);
+      s->max_iterations = std::max(s->max_iterations, p->max_iterations);
+      return 0;
+    };
+    const int32_t keys[] = {0, 29};
+    mf_motion* out = nullptr;
+    const int status = mf_inbetween(model.get(), input.get(), keys, 2, &options, &out);
+    mf_motion_destroy(out);
+    return status;
+  };
+  Seen by_default, budgeted, refused;
+  ASSERT_EQ(solve(0, &by_default), MF_OK) << mf_last_error_message();
+  ASSERT_EQ(solve(2, &budgeted), MF_OK) << mf_last_error_message();
+  EXPECT_LT(budgeted.max_iterations, by_default.max_iterations);
+  EXPECT_LE(budgeted.iteration, budgeted.max_iterations);
+  EXPECT_EQ(solve(-1, &refused), MF_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(std::string(mf_last_error_message()).find("max_iterations"), std::string::npos) << mf_last_error_message();
 }
 
 TEST(CApi, EncodeAndDecodeAtAnyTimes) {

@@ -29,7 +29,7 @@ TEST(CApiLayout, BvhOptions) {
 }
 
 TEST(CApiLayout, TaskOptions) {
-  EXPECT_EQ(sizeof(mf_task_options), 64u);
+  EXPECT_EQ(sizeof(mf_task_options), 72u);  // max_iterations appended
   EXPECT_EQ(offsetof(mf_task_options, struct_size), 0u);
   EXPECT_EQ(offsetof(mf_task_options, method), 8u);
   EXPECT_EQ(offsetof(mf_task_options, seed), 16u);
@@ -38,6 +38,7 @@ TEST(CApiLayout, TaskOptions) {
   EXPECT_EQ(offsetof(mf_task_options, cancel), 40u);
   EXPECT_EQ(offsetof(mf_task_options, rig_map), 48u);
   EXPECT_EQ(offsetof(mf_task_options, rig_map_path), 56u);
+  EXPECT_EQ(offsetof(mf_task_options, max_iterations), 64u);
 }
 
 TEST(CApiLayout, CodecOptions) {
@@ -91,6 +92,7 @@ TEST(CApiLayout, InitGivesZeroDefaults) {
   EXPECT_EQ(t.cancel, nullptr);
   EXPECT_EQ(t.rig_map, nullptr);
   EXPECT_EQ(t.rig_map_path, nullptr);
+  EXPECT_EQ(t.max_iterations, 0);
   EXPECT_EQ(b.struct_size, sizeof b);
   EXPECT_EQ(b.length_scale, 0.0);
   EXPECT_EQ(c.struct_size, sizeof c);

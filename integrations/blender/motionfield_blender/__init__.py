@@ -1,0 +1,456 @@
+"""motionfield for Blender: in-betweening, gap filling, resampling and
+re-navigation of the active armature's action with motionfield's learned
+motion prior (libmotionfield.so through the motionfield Python package).
+
+The 3D view's side panel (N), tab "motionfield". Every operator reads the
+armature frame by frame (any humanoid rig: the library maps it onto the
+model's rig, see docs/RIGS.md), runs one task and writes keys as one undo
+step, touching only the active armature's action:
+
+* In-between: solves every frame between the keyed ones (in the scene's
+  range, the preview range or the span of the selected keys) and keys only
+  the frames that were not keyed;
+* Fill gap: the unkeyed frames around the current frame, between two keyed
+  ranges;
+* Resample: the keyed span, taken at the given source frame rate, to the
+  scene's frame rate, into a copy of the action;
+* Follow path: a new walk in the action's style along a curve object's
+  ground path, into a copy of the action.
+"""
+
+bl_info = {
+    "name": "motionfield",
+    "author": "motionfield contributors",
+    "version": (0, 1, 0),
+    "blender": (3, 4, 0),
+    "location": "3D View > Sidebar (N) > motionfield",
+    "description": "Learned motion prior: in-betweening, gap filling, resampling, path following",
+    "category": "Animation",
+}
+
+import bpy
+from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+
+from . import animation, convert, engine
+
+# ------------------------------------------------------------------ preferences
+
+
+class MOTIONFIELD_AP_preferences(bpy.types.AddonPreferences):
+    bl_idname = __name__
+
+    python_dir: StringProperty(
+        name="Python package folder", subtype='DIR_PATH',
+        description="Folder holding the motionfield Python package (e.g. <checkout>/python); "
+                    "empty: $MOTIONFIELD_PYTHON, an installed package, or next to the add-on. "
+                    "Read once: a change takes effect after restarting Blender")
+    library: StringProperty(
+        name="Library", subtype='FILE_PATH',
+        description="libmotionfield.so to use (sets $MOTIONFIELD_LIBRARY before the first use); "
+                    "empty: the package finds it. A change takes effect after restarting Blender")
+
+    def draw(self, context):
+        self.layout.prop(self, "python_dir")
+        self.layout.prop(self, "library")
+        try:
+            mf = _mf()
+            self.layout.label(text="motionfield %s: %s" % (mf.version(), mf.library_path()))
+        except Exception as e:  # shown, not raised
+            self.layout.label(text=str(e), icon='ERROR')
+
+
+def _prefs():
+    addon = bpy.context.preferences.addons.get(__name__)
+    return addon.preferences if addon else None
+
+
+def _mf():
+    p = _prefs()
+    return engine.load(bpy.path.abspath(p.python_dir) if p and p.python_dir else "",
+                       bpy.path.abspath(p.library) if p and p.library else "")
+
+
+# ------------------------------------------------------------------ settings
+
+_enum_keep = {}  # Blender needs the enum item strings kept alive
+
+
+def _method_items(kind):
+    def items(self, context):
+        out = [("DEFAULT", "Default", "The library's default method for this task (mf_default_method)")]
+        try:
+            for m in _mf().methods():
+                if (kind == "complete" and m.completes) or (kind == "resample" and m.resamples):
+                    out.append((m.name, m.name, m.description))
+        except Exception:  # the package is missing: the panel says so
+            pass
+        if kind == "renav":
+            out += [("nemf", "nemf", "L-BFGS on the prior's latent codes"),
+                    ("nemf-adam", "nemf-adam", "NeMF's Adam reference (slower)")]
+        _enum_keep[kind] = out
+        return out
+    return items
+
+
+def _is_curve(self, obj):
+    return obj.type == 'CURVE'
+
+
+class MotionfieldSettings(bpy.types.PropertyGroup):
+    method: EnumProperty(name="Method", items=_method_items("complete"),
+                         description="In-betweening and gap-filling method (mf_method_get)")
+    resample_method: EnumProperty(name="Resample method", items=_method_items("resample"))
+    path_method: EnumProperty(name="Path method", items=_method_items("renav"))
+    model_path: StringProperty(name="Model", subtype='FILE_PATH',
+                               description="Model file (.mfm); empty: the bundled default model "
+                                           "(mf_model_default_path)")
+    rig_map: StringProperty(name="Rig map", subtype='FILE_PATH',
+                            description="JSON rig map {armature bone: model joint or null} overriding the "
+                                        "automatic map (docs/RIGS.md); empty: automatic")
+    root_bone: StringProperty(name="Root bone",
+                              description="The bone whose translation moves the character; its tree is "
+                                          "converted. Empty: the armature's root bone")
+    seed: IntProperty(name="Seed", min=0, default=0)
+    max_iterations: IntProperty(name="Iterations", min=0, default=0,
+                                description="Iteration budget of the solvers (per window of the full solve); "
+                                            "0: each method's own (mf_task_options.max_iterations)")
+    range_mode: EnumProperty(name="Range", default='SCENE', items=[
+        ('SCENE', "Scene", "Every frame between keys in the scene's frame range"),
+        ('PREVIEW', "Preview", "Within the preview range (the scene range when off)"),
+        ('SELECTED', "Selected keys", "Within the span of the selected keys"),
+    ])
+    source_fps: FloatProperty(name="Source fps", default=60.0, min=1.0, max=1000.0,
+                              description="Frame rate the keyed frames were sampled at (one frame each)")
+    path_object: PointerProperty(name="Path", type=bpy.types.Object, poll=_is_curve,
+                                 description="Curve object whose ground path (first spline) to follow")
+
+
+# ------------------------------------------------------------------ operators
+
+
+def _scene_fps(scene):
+    return scene.render.fps / scene.render.fps_base
+
+
+def _method_arg(value):
+    return None if value in ("", "DEFAULT") else value
+
+
+class _TaskOperator:
+    """prepare() reads the armature and returns (run, finish); execute() runs
+    inline (scripts, background mode), invoke() on a thread with Esc."""
+
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        obj = context.active_object
+        return (obj is not None and obj.type == 'ARMATURE' and obj.animation_data is not None
+                and obj.animation_data.action is not None)
+
+    def _setup(self, context):
+        s = context.scene.motionfield
+        self.mf = _mf()
+        self.obj = context.active_object
+        self.rig = convert.Rig(self.obj, s.root_bone, convert.metres_per_unit(context.scene, self.obj))
+        self.keyed = animation.keyed_frames(self.obj, self.rig.names)
+        if len(self.keyed) < 2:
+            raise ValueError("the action has fewer than two keyed frames on the rig's bones")
+
+    def task_kwargs(self, context, method):
+        s = context.scene.motionfield
+        m = _method_arg(method)
+        needs = m is None or any(x.name == m and x.needs_model for x in self.mf.methods())
+        kw = {"method": m, "seed": s.seed, "max_iterations": s.max_iterations,
+              "model": engine.model(bpy.path.abspath(s.model_path)) if needs else None}
+        if s.rig_map:
+            kw["rig_map"] = bpy.path.abspath(s.rig_map)
+        return kw
+
+    def motion(self, sampled, fps):
+        return self.mf.Motion.from_arrays(sampled.rotations, sampled.root_positions, fps,
+                                          joint_names=self.rig.names, parents=self.rig.parents,
+                                          offsets=self.rig.offsets)
+
+    def _start(self, context):
+        try:
+            self._setup(context)
+            run, self._finish = self.prepare(context)
+            self._job = engine.Job(run)
+        except Exception as e:
+            self.report({'ERROR'}, "motionfield: %s" % e)
+            return False
+        return True
+
+    def _end(self, context):
+        wm = context.window_manager
+        wm.progress_end()
+        job = self._job
+        if job.error is not None:
+            cancelled = isinstance(job.error, self.mf.CancelledError)
+            self.report({'WARNING'} if cancelled else {'ERROR'},
+                        "motionfield: cancelled, nothing changed" if cancelled else "motionfield: %s" % job.error)
+            return {'CANCELLED'}
+        message = self._finish(context, job.result)
+        if job.result.warnings:
+            self.report({'WARNING'}, "motionfield: %s" % job.result.warnings)
+        self.report({'INFO'}, "motionfield: %s" % message)
+        return {'FINISHED'}
+
+    def execute(self, context):
+        if not self._start(context):
+            return {'CANCELLED'}
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+
+        def shown(progress):
+            i, n = progress
+            wm.progress_update(int(100 * i / n) if n else 0)
+            return False
+        self._job.run_inline(shown)
+        return self._end(context)
+
+    def invoke(self, context, event):
+        if not self._start(context):
+            return {'CANCELLED'}
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+        self._timer = wm.event_timer_add(0.1, window=context.window)
+        wm.modal_handler_add(self)
+        self._job.start()
+        return {'RUNNING_MODAL'}
+
+    def modal(self, context, event):
+        job = self._job
+        if event.type == 'ESC':
+            job.cancel()
+        if event.type != 'TIMER':
+            return {'RUNNING_MODAL'} if not job.done else {'PASS_THROUGH'}
+        i, n = job.progress
+        context.window_manager.progress_update(int(100 * i / n) if n else 0)
+        context.workspace.status_text_set("motionfield %s: iteration %d of %d (Esc cancels)"
+                                          % (self.bl_label, i, n) if n else
+                                          "motionfield %s: working (Esc cancels)" % self.bl_label)
+        if not job.done:
+            return {'RUNNING_MODAL'}
+        job.join()
+        context.window_manager.event_timer_remove(self._timer)
+        context.workspace.status_text_set(None)
+        return self._end(context)
+
+
+def _range(scene, s, obj, names):
+    if s.range_mode == 'PREVIEW' and scene.use_preview_range:
+        return scene.frame_preview_start, scene.frame_preview_end
+    if s.range_mode == 'SELECTED':
+        sel = animation.selected_key_frames(obj, names)
+        if len(sel) < 2:
+            raise ValueError("select at least two keys (Dope Sheet / Graph Editor)")
+        return sel[0], sel[-1]
+    return scene.frame_start, scene.frame_end
+
+
+class MOTIONFIELD_OT_inbetween(_TaskOperator, bpy.types.Operator):
+    """Solve every frame between the keyed ones; keys only the frames that were not keyed"""
+    bl_idname = "motionfield.inbetween"
+    bl_label = "In-between"
+
+    def prepare(self, context):
+        scene, s = context.scene, context.scene.motionfield
+        lo, hi = _range(scene, s, self.obj, self.rig.names)
+        keys = [k for k in self.keyed if lo <= k <= hi]
+        if len(keys) < 2:
+            raise ValueError("fewer than two keyed frames in frames %d..%d" % (lo, hi))
+        frames = list(range(keys[0], keys[-1] + 1))
+        new = set(frames) - set(keys)
+        if not new:
+            raise ValueError("every frame in %d..%d is keyed already" % (keys[0], keys[-1]))
+        sampled = convert.read_frames(scene, self.obj, self.rig, frames)
+        motion = self.motion(sampled, _scene_fps(scene))
+        kw = self.task_kwargs(context, s.method)
+        index = [k - keys[0] for k in keys]
+
+        def run(progress, cancel):
+            return self.mf.inbetween(motion, index, progress=progress, cancel=cancel, **kw)
+
+        def finish(context, result):
+            values = animation.channel_values(self.obj, self.rig, sampled, result.rotations,
+                                              result.root_positions, new)
+            animation.insert_keys(self.obj, self.rig, sampled, values, new, set(self.keyed))
+            return "keyed %d frames between frames %d and %d" % (len(new), keys[0], keys[-1])
+        return run, finish
+
+
+def _gap_around(keyed, frame):
+    """(first, last) unkeyed frames around `frame` between two keys, else None."""
+    before = [k for k in keyed if k < frame]
+    after = [k for k in keyed if k > frame]
+    if frame in keyed or not before or not after:
+        return None
+    return before[-1] + 1, after[0] - 1
+
+
+def _run_edge(keyed, start, step, limit):
+    """The far end of the run of consecutive keyed frames from `start` going `step`."""
+    ks = set(keyed)
+    f = start
+    while f + step in ks and abs(f + step - start) < limit:
+        f += step
+    return f
+
+
+class MOTIONFIELD_OT_fill(_TaskOperator, bpy.types.Operator):
+    """Fill the unkeyed frames around the current frame, between two keyed ranges"""
+    bl_idname = "motionfield.fill"
+    bl_label = "Fill gap"
+
+    CONTEXT_FRAMES = 60
+
+    def prepare(self, context):
+        scene, s = context.scene, context.scene.motionfield
+        gap = _gap_around(self.keyed, scene.frame_current)
+        if gap is None:
+            raise ValueError("put the current frame in a gap of unkeyed frames between two keyed ranges")
+        a = _run_edge(self.keyed, gap[0] - 1, -1, self.CONTEXT_FRAMES)
+        b = _run_edge(self.keyed, gap[1] + 1, 1, self.CONTEXT_FRAMES)
+        frames = list(range(a, b + 1))
+        new = set(range(gap[0], gap[1] + 1))
+        sampled = convert.read_frames(scene, self.obj, self.rig, frames)
+        motion = self.motion(sampled, _scene_fps(scene))
+        kw = self.task_kwargs(context, s.method)
+
+        def run(progress, cancel):
+            return self.mf.fill(motion, gap[0] - a, gap[1] + 1 - a, progress=progress, cancel=cancel, **kw)
+
+        def finish(context, result):
+            values = animation.channel_values(self.obj, self.rig, sampled, result.rotations,
+                                              result.root_positions, new)
+            animation.insert_keys(self.obj, self.rig, sampled, values, new, set(self.keyed))
+            return "filled frames %d..%d" % gap
+        return run, finish
+
+
+class MOTIONFIELD_OT_resample(_TaskOperator, bpy.types.Operator):
+    """Resample the keyed span, sampled at the source frame rate, to the scene's frame rate, into a copy of the action"""
+    bl_idname = "motionfield.resample"
+    bl_label = "Resample"
+
+    def prepare(self, context):
+        scene, s = context.scene, context.scene.motionfield
+        fps = _scene_fps(scene)
+        if abs(s.source_fps - fps) < 1e-6:
+            raise ValueError("the source frame rate is the scene's (%g): nothing to resample" % fps)
+        frames = list(range(self.keyed[0], self.keyed[-1] + 1))
+        sampled = convert.read_frames(scene, self.obj, self.rig, frames)
+        motion = self.motion(sampled, s.source_fps)
+        kw = self.task_kwargs(context, s.resample_method)
+
+        def run(progress, cancel):
+            return self.mf.resample(motion, fps, progress=progress, cancel=cancel, **kw)
+
+        def finish(context, result):
+            act = animation.new_action_with(self.obj, self.rig, result.rotations, result.root_positions,
+                                            frames[0], ".%gfps" % fps, sampled.parent_poses[0])
+            return "%d frames at %g fps in action %r" % (result.frame_count, fps, act.name)
+        return run, finish
+
+
+def curve_ground_path(context, curve, armature, scale):
+    """The curve's first spline, evaluated, as [points, 2] ground (x, z) in
+    the armature's motion space (metres)."""
+    import numpy as np
+    deps = context.evaluated_depsgraph_get()
+    ev = curve.evaluated_get(deps)
+    mesh = ev.to_mesh()
+    try:
+        to_arm = armature.matrix_world.inverted() @ curve.matrix_world
+        pts = [convert.C3 @ (to_arm @ v.co) * scale for v in mesh.vertices]
+    finally:
+        ev.to_mesh_clear()
+    if len(pts) < 2:
+        raise ValueError("curve %r has fewer than two points" % curve.name)
+    return np.array([(p.x, p.z) for p in pts], dtype=np.float32)
+
+
+class MOTIONFIELD_OT_follow_path(_TaskOperator, bpy.types.Operator):
+    """A motion in the action's style whose root follows the path curve, into a copy of the action"""
+    bl_idname = "motionfield.follow_path"
+    bl_label = "Follow path"
+
+    def prepare(self, context):
+        scene, s = context.scene, context.scene.motionfield
+        if s.path_object is None:
+            raise ValueError("choose a curve object as the path")
+        fps = _scene_fps(scene)
+        xz = curve_ground_path(context, s.path_object, self.obj, self.rig.scale)
+        frames = list(range(self.keyed[0], self.keyed[-1] + 1))
+        sampled = convert.read_frames(scene, self.obj, self.rig, frames)
+        motion = self.motion(sampled, fps)
+        kw = self.task_kwargs(context, s.path_method)
+        if kw["model"] is None:
+            kw["model"] = engine.model(bpy.path.abspath(s.model_path))
+
+        def run(progress, cancel):
+            return self.mf.renav(motion, xz, polyline=True, fps=fps, progress=progress, cancel=cancel, **kw)
+
+        def finish(context, result):
+            act = animation.new_action_with(self.obj, self.rig, result.rotations, result.root_positions,
+                                            frames[0], ".path", sampled.parent_poses[0])
+            return "%d frames along %r in action %r" % (result.frame_count, s.path_object.name, act.name)
+        return run, finish
+
+
+# ------------------------------------------------------------------ panel
+
+
+class MOTIONFIELD_PT_panel(bpy.types.Panel):
+    bl_label = "motionfield"
+    bl_space_type = 'VIEW_3D'
+    bl_region_type = 'UI'
+    bl_category = "motionfield"
+
+    def draw(self, context):
+        layout = self.layout
+        s = context.scene.motionfield
+        try:
+            _mf()
+        except Exception as e:
+            layout.label(text=str(e), icon='ERROR')
+            return
+        obj = context.active_object
+        col = layout.column()
+        col.prop(s, "model_path")
+        col.prop(s, "rig_map")
+        if obj is not None and obj.type == 'ARMATURE':
+            col.prop_search(s, "root_bone", obj.data, "bones")
+        col.prop(s, "seed")
+        col.prop(s, "max_iterations")
+        box = layout.box()
+        box.prop(s, "method")
+        box.prop(s, "range_mode")
+        box.operator(MOTIONFIELD_OT_inbetween.bl_idname)
+        box.operator(MOTIONFIELD_OT_fill.bl_idname)
+        box = layout.box()
+        box.prop(s, "resample_method")
+        box.prop(s, "source_fps")
+        box.operator(MOTIONFIELD_OT_resample.bl_idname)
+        box = layout.box()
+        box.prop(s, "path_method")
+        box.prop(s, "path_object")
+        box.operator(MOTIONFIELD_OT_follow_path.bl_idname)
+
+
+_classes = (MOTIONFIELD_AP_preferences, MotionfieldSettings, MOTIONFIELD_OT_inbetween, MOTIONFIELD_OT_fill,
+            MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path, MOTIONFIELD_PT_panel)
+
+
+def register():
+    for c in _classes:
+        bpy.utils.register_class(c)
+    bpy.types.Scene.motionfield = PointerProperty(type=MotionfieldSettings)
+
+
+def unregister():
+    del bpy.types.Scene.motionfield
+    for c in reversed(_classes):
+        bpy.utils.unregister_class(c)

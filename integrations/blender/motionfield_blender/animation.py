@@ -1,0 +1,151 @@
+"""Reading keyed frames from an action and writing a motion back as keys."""
+
+from . import convert
+
+EPS = 1e-7
+
+
+def bone_of(data_path):
+    """The bone name of a 'pose.bones["NAME"].channel' F-curve path, else None."""
+    if not data_path.startswith('pose.bones["'):
+        return None
+    end = data_path.find('"]', 12)
+    return data_path[12:end] if end > 0 else None
+
+
+def fcurves_of(obj, action=None):
+    """The F-curves `obj` plays from `action` (default: its action): the
+    action's own on Blender 3.x-4.x, the slot's channel bag on the layered
+    actions of Blender versions without Action.fcurves."""
+    action = action or obj.animation_data.action
+    if hasattr(action, "fcurves"):
+        return action.fcurves
+    from bpy_extras import anim_utils
+    return anim_utils.action_ensure_channelbag_for_slot(action, obj.animation_data.action_slot).fcurves
+
+
+def keyed_frames(obj, bone_names):
+    """Sorted integer frames where an F-curve of one of the bones has a key."""
+    names = set(bone_names)
+    frames = set()
+    for fc in fcurves_of(obj):
+        if bone_of(fc.data_path) in names:
+            frames.update(int(round(k.co[0])) for k in fc.keyframe_points)
+    return sorted(frames)
+
+
+def selected_key_frames(obj, bone_names):
+    names = set(bone_names)
+    frames = set()
+    for fc in fcurves_of(obj):
+        if bone_of(fc.data_path) in names:
+            frames.update(int(round(k.co[0])) for k in fc.keyframe_points if k.select_control_point)
+    return sorted(frames)
+
+
+def channel_paths(obj, rig):
+    """[(bone, data path, component count, rotation mode)] the motion drives."""
+    out = []
+    for k, name in enumerate(rig.names):
+        pb = obj.pose.bones[name]
+        path, n = convert.rotation_channel(pb)
+        out.append((name, path, n, pb.rotation_mode))
+        if k == 0:
+            out.append((name, "location", 3, None))
+    return out
+
+
+def channel_values(obj, rig, sampled, motion_rot, motion_root, new):
+    """{(bone, path): [value per sampled frame]}: the motion's pose on the
+    frames in `new`, the current values elsewhere, continuous from frame to
+    frame (quaternion signs, Euler branches)."""
+    mats = convert.pose_matrices(rig, motion_rot, motion_root)
+    chans = channel_paths(obj, rig)
+    values = {(b, p): [] for b, p, _, _ in chans}
+    for i, f in enumerate(sampled.frames):
+        basis = convert.basis_matrices(rig, mats[i], sampled.parent_poses[i]) if f in new else None
+        for b, p, _, mode in chans:
+            seq = values[(b, p)]
+            prev = seq[-1] if seq else None
+            if basis is None:
+                seq.append(sampled.channels[i][(b, p)])
+                continue
+            m = basis[rig.names.index(b)]
+            if p == "rotation_euler":
+                seq.append(convert.euler_from_basis(m, mode, prev))
+            else:
+                seq.append(convert.channel_from_basis(m, p, prev))
+    return values
+
+
+def _fcurve(fcurves, bone, path, index, create):
+    dp = 'pose.bones["%s"].%s' % (bone.replace('"', '\\"'), path)
+    fc = fcurves.find(dp, index=index)
+    if fc is None and create:
+        try:
+            fc = fcurves.new(dp, index=index, action_group=bone)
+        except TypeError:  # a channel bag's F-curves take no group
+            fc = fcurves.new(dp, index=index)
+    return fc
+
+
+def insert_keys(obj, rig, sampled, values, new, keyed):
+    """Keys the values on the frames in `new` on the action's F-curves (made
+    when missing and the channel changes). Each F-curve written also gets a key
+    with its current value on every keyed frame of the range it lacks one on,
+    so that the pose on keyed frames stays what it was."""
+    fcurves = fcurves_of(obj)
+    frames = sampled.frames
+    written = 0
+    for (bone, path), seq in values.items():
+        for c in range(len(seq[0])):
+            old = [sampled.channels[i][(bone, path)][c] for i in range(len(frames))]
+            changed = any(abs(seq[i][c] - old[i]) > EPS for i in range(len(frames)))
+            fc = _fcurve(fcurves, bone, path, c, changed)
+            if fc is None:
+                continue
+            have = {int(round(k.co[0])) for k in fc.keyframe_points}
+            for i, f in enumerate(frames):
+                if f in new:
+                    fc.keyframe_points.insert(f, seq[i][c], options={'FAST'})
+                    written += 1
+                elif f in keyed and f not in have:
+                    fc.keyframe_points.insert(f, old[i], options={'FAST'})
+            fc.update()
+    return written
+
+
+def new_action_with(obj, rig, motion_rot, motion_root, first_frame, suffix, parent_pose):
+    """A copy of the armature's action whose rig channels are replaced by the
+    motion from `first_frame` on; assigned to the armature. The old action is
+    kept (fake user) so that nothing is lost."""
+    old = obj.animation_data.action
+    act = old.copy()
+    act.name = old.name + suffix
+    old.use_fake_user = True
+    mats = convert.pose_matrices(rig, motion_rot, motion_root)
+    chans = channel_paths(obj, rig)
+    seqs = {(b, p): [] for b, p, _, _ in chans}
+    for mf in mats:
+        basis = convert.basis_matrices(rig, mf, parent_pose)
+        for b, p, _, mode in chans:
+            seq = seqs[(b, p)]
+            m = basis[rig.names.index(b)]
+            prev = seq[-1] if seq else None
+            seq.append(convert.euler_from_basis(m, mode, prev) if p == "rotation_euler"
+                       else convert.channel_from_basis(m, p, prev))
+    obj.animation_data.action = act
+    fcurves = fcurves_of(obj, act)
+    for (b, p), seq in seqs.items():
+        for c in range(len(seq[0])):
+            fc = _fcurve(fcurves, b, p, c, True)
+            fc.keyframe_points.clear()
+            fc.keyframe_points.add(len(seq))
+            co = []
+            for i, v in enumerate(seq):
+                co += [float(first_frame + i), float(v[c])]
+            fc.keyframe_points.foreach_set("co", co)
+            for k in fc.keyframe_points:
+                k.interpolation = 'LINEAR'
+            fc.update()
+    return act
