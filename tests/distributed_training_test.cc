@@ -5,6 +5,7 @@
 // another world size is refused.
 #include <arpa/inet.h>
 #include <fcntl.h>
+#include <ATen/ATen.h>
 #include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <signal.h>

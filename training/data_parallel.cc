@@ -97,6 +97,12 @@ std::shared_ptr<::gloo::transport::Device> gloo_device(const std::string& master
   return c10d::ProcessGroupGloo::createDefaultDevice();
 }
 
+// The message of `e` without the C++ backtrace that c10::Error appends.
+std::string reason(const std::exception& e) {
+  if (const auto* c10_error = dynamic_cast<const c10::Error*>(&e)) return c10_error->what_without_backtrace();
+  return e.what();
+}
+
 std::chrono::milliseconds to_ms(double seconds) {
   return std::chrono::milliseconds(static_cast<int64_t>(seconds * 1000.0));
 }
@@ -123,7 +129,7 @@ DataParallel::DataParallel(const DistributedOptions& options) : options_(options
     throw DistributedError("distributed training: " + describe() + " could not form the group of " +
                            std::to_string(options.world_size) + " processes at " + where + " within " +
                            std::to_string(static_cast<int>(options.timeout_seconds)) +
-                           " s (is every rank started with the same --master and --world-size?): " + e.what());
+                           " s (is every rank started with the same --master and --world-size?): " + reason(e));
   }
 }
 
@@ -158,7 +164,7 @@ at::Tensor DataParallel::run(const char* what, std::vector<at::Tensor> tensors, 
     throw DistributedError("distributed training: " + describe() + ": " + what +
                            " failed: another process of the group died, hung for more than " +
                            std::to_string(static_cast<int>(options_.timeout_seconds)) +
-                           " s (--dist-timeout) or is unreachable: " + e.what());
+                           " s (--dist-timeout) or is unreachable: " + reason(e));
   }
   return tensors.front();
 }
