@@ -186,21 +186,27 @@ void DataParallel::broadcast(const std::vector<at::Tensor>& tensors) {
 void DataParallel::average_gradients(const std::vector<at::Tensor>& parameters, double local_weight) {
   if (!distributed()) return;
   at::NoGradGuard no_grad;
-  // One buffer: every gradient times the local weight, then the weight itself.
-  std::vector<at::Tensor> flat;
-  for (const at::Tensor& p : parameters) {
-    flat.push_back(p.grad().defined() ? p.grad().reshape({-1}) * local_weight : at::zeros({p.numel()}, p.options()));
-  }
-  flat.push_back(at::full({1}, local_weight, parameters.empty() ? at::kFloat : parameters.front().scalar_type()));
-  at::Tensor all = run("averaging the gradients", {at::cat(flat)}, false);
-  const double total = all[all.size(0) - 1].item<double>();
-  if (!(total > 0)) throw std::runtime_error("average_gradients: the global batch is empty");
-  all.div_(total);
+  // One buffer, kept between steps (Gloo over TCP is several times slower on
+  // freshly allocated memory): every gradient times the local weight, then the weight.
+  int64_t size = 1;
+  for (const at::Tensor& p : parameters) size += p.numel();
+  if (!gradient_buffer_.defined() || gradient_buffer_.numel() != size) gradient_buffer_ = at::empty({size}, at::kFloat);
   int64_t at = 0;
+  for (const at::Tensor& p : parameters) {
+    at::Tensor part = gradient_buffer_.narrow(0, at, p.numel());
+    if (p.grad().defined()) part.copy_(p.grad().reshape({-1})).mul_(local_weight);
+    else part.zero_();
+    at += p.numel();
+  }
+  gradient_buffer_.narrow(0, at, 1).fill_(local_weight);
+  run("averaging the gradients", {gradient_buffer_}, false);
+  const double total = gradient_buffer_[at].item<double>();
+  if (!(total > 0)) throw std::runtime_error("average_gradients: the global batch is empty");
+  at = 0;
   for (const at::Tensor& p : parameters) {
     const int64_t n = p.numel();
     if (!p.grad().defined()) p.mutable_grad() = at::zeros_like(p);
-    p.mutable_grad().copy_(all.narrow(0, at, n).view(p.sizes()));
+    p.mutable_grad().copy_(gradient_buffer_.narrow(0, at, n).view(p.sizes())).div_(total);
     at += n;
   }
 }

@@ -112,6 +112,7 @@ class DataParallel {
   DistributedOptions options_;
   std::unique_ptr<Group> group_;
   std::string scratch_;  // temporary folder of resume_files() on ranks > 0
+  at::Tensor gradient_buffer_;  // average_gradients()' all-reduce buffer, reused
 };
 
 }  // namespace training

@@ -410,7 +410,9 @@ void PriorRun::train_step(const Batch& b, double beta, int64_t offset, int64_t g
   if (profile_) {
     std::fprintf(stderr, "forward %.3f s backward %.3f s\n", seconds_between(c1, c2), seconds_between(c2, Clock::now()));
   }
+  const auto c3 = Clock::now();
   dp_.average_gradients(model_.parameters(), static_cast<double>(b.rot.size(0)));  // weighted by windows
+  if (profile_ && dp_.distributed()) std::fprintf(stderr, "all-reduce %.3f s\n", seconds_between(c3, Clock::now()));
   torch::nn::utils::clip_grad_norm_(model_.parameters(), 1.0);
   optimizer_.step();
   ++state_.step;
