@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ccache pkg-config xz-utils tar
   libtorch-dev          # libtorch 1.13, CPU
+  libgloo-dev           # gloo headers: libtorch's c10d ProcessGroupGloo.hpp includes them (data-parallel training, training/data_parallel.h)
   libceres-dev          # Ceres solver (L-BFGS driver for the latent solvers)
   libeigen3-dev
   libgtest-dev

@@ -286,7 +286,7 @@ class InbetweenRun {
   void print_setup() const;
   double minutes_now() const { return base_minutes_ + seconds_between(t0_, Clock::now()) / 60.0; }
   // The fraction of the budget used (time, or steps with max_steps).
-  double progress() const;
+  double progress();
   // Returns true when the budget is used up.
   bool train_epoch(EpochSums* sums);
   void train_step(EpochSums* sums);
@@ -298,8 +298,10 @@ class InbetweenRun {
   const InbetweenTrainingOptions& o_;
   const Clock::time_point t0_;
   const training::RunFiles files_;
+  training::DataParallel dp_;
   Dataset data_;
-  bool resuming_;
+  bool resuming_ = false;
+  const training::RunFiles resume_from_;  // files_, or on ranks > 0 rank 0's checkpoint copied
   std::unique_ptr<InbetweenModel> model_;
   Sampler train_sampler_, val_sampler_;
   std::vector<at::Tensor> train_contacts_, val_contacts_;
@@ -319,9 +321,11 @@ InbetweenRun::InbetweenRun(const InbetweenTrainingOptions& o)
     : o_(o),
       t0_(Clock::now()),
       files_(o.out_dir),
-      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, 0.0, o.mirror, o.verbose)),
-      resuming_(o.resume && files_.has_checkpoint()),
-      model_(load_or_make_model(o, data_, files_, resuming_)),
+      dp_(o.distributed),
+      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, 0.0, o.mirror,
+                                         o.verbose && dp_.writes())),
+      resume_from_(dp_.resume_files(files_, o.resume, &resuming_)),
+      model_(load_or_make_model(o, data_, resume_from_, resuming_)),
       train_sampler_(data_.train, model_->rig(), model_->window(), o.min_length),
       val_sampler_(data_.validation, model_->rig(), model_->window(), o.min_length),
       lr_(o.lr) {
@@ -335,17 +339,25 @@ InbetweenRun::InbetweenRun(const InbetweenTrainingOptions& o)
   model_->train(true);
   optimizer_ = std::make_unique<torch::optim::Adam>(model_->parameters(), torch::optim::AdamOptions(o.lr));
   if (resuming_) {
-    torch::load(*optimizer_, files_.last_optim);
-    state_ = training::load_trainer_state(files_.last_state);
+    torch::load(*optimizer_, resume_from_.last_optim);
+    state_ = training::load_trainer_state(resume_from_.last_state);
+    dp_.check_resumed_world_size(state_);
+  } else {
+    // Every rank starts from rank 0's weights and statistics.
+    std::vector<at::Tensor> shared = model_->parameters();
+    shared.insert(shared.end(), {model_->stats().pose_mean, model_->stats().pose_std});
+    dp_.broadcast(shared);
   }
+  state_.world_size = dp_.world_size();
   stage_names_ = model_->stage_names();
-  if (!resuming_ || !fs::exists(files_.log)) open_log();
+  if (dp_.writes() && (!resuming_ || !fs::exists(files_.log))) open_log();
   base_minutes_ = state_.minutes;
   const double mean_length = 0.5 * (std::min(o.min_length, model_->window()) + model_->window());
+  const double global_batch = static_cast<double>(o.batch) * dp_.world_size();
   epoch_steps_ = o.epoch_steps > 0
                      ? o.epoch_steps
-                     : std::max(1, static_cast<int>(train_sampler_.total_frames() / (mean_length * o.batch)));
-  if (o.verbose) print_setup();
+                     : std::max(1, static_cast<int>(train_sampler_.total_frames() / (mean_length * global_batch)));
+  if (o.verbose && dp_.writes()) print_setup();
 }
 
 // Pose statistics over sampled training windows (root positions depend on the
@@ -390,10 +402,11 @@ void InbetweenRun::open_log() const {
 void InbetweenRun::print_setup() const {
   std::fprintf(stderr,
                "train %s: %zu training clips, %zu validation clips (%zu validation windows), %d threads; %s; %lld "
-               "parameters; epoch = %d steps%s\n",
+               "parameters; epoch = %d steps%s%s\n",
                model_->kind().c_str(), data_.train.size(), data_.validation.size(),
                static_cast<size_t>(o_.validation_windows), std::max(1, o_.threads), model_->describe().c_str(),
-               static_cast<long long>(model_->num_parameters()), epoch_steps_, resuming_ ? "; resumed" : "");
+               static_cast<long long>(model_->num_parameters()), epoch_steps_, resuming_ ? "; resumed" : "",
+               dp_.distributed() ? ("; " + std::to_string(dp_.world_size()) + " processes").c_str() : "");
   std::fprintf(stderr, "train: set-up (data, statistics, validation set) in %.1f s\n",
                seconds_between(t0_, Clock::now()));
 }
@@ -418,8 +431,8 @@ InbetweenTrainingResult InbetweenRun::train() {
   return result;
 }
 
-double InbetweenRun::progress() const {
-  double p = minutes_now() / o_.max_minutes;
+double InbetweenRun::progress() {
+  double p = dp_.agree({minutes_now()})[0] / o_.max_minutes;  // rank 0's clock
   if (o_.max_steps > 0) p = std::max(p, static_cast<double>(state_.step) / o_.max_steps);
   return p;
 }
@@ -430,12 +443,15 @@ bool InbetweenRun::train_epoch(EpochSums* sums) {
   for (int s = 0; s < epoch_steps_; ++s) {
     const double p = progress();
     if (p >= 1.0) return true;
-    if (seconds_between(epoch_start, Clock::now()) > 60.0 * o_.validate_minutes && sums->count > 0) return false;
+    // Rank 0's clock decides (data_parallel.h): the epoch's and the checkpoint's age.
+    const std::vector<double> age = dp_.agree(
+        {seconds_between(epoch_start, Clock::now()), seconds_between(last_checkpoint_, Clock::now())});
+    if (age[0] > 60.0 * o_.validate_minutes && sums->count > 0) return false;
     lr_ = training::scheduled_lr(o_.lr, o_.lr_final, p, o_.warmup);
     training::set_learning_rate(*optimizer_, lr_);
     train_step(sums);
     print_progress(*sums);
-    if (seconds_between(last_checkpoint_, Clock::now()) > 60.0 * o_.checkpoint_minutes) {
+    if (age[1] > 60.0 * o_.checkpoint_minutes) {
       state_.minutes = minutes_now();
       save_checkpoint();
     }
@@ -448,15 +464,20 @@ void InbetweenRun::train_step(EpochSums* sums) {
   // Per-step seeds: the sample stream does not depend on where a run resumed.
   std::mt19937_64 rng(o_.seed * 1000003ULL + static_cast<uint64_t>(state_.step));
   at::manual_seed(o_.seed * 7919ULL + static_cast<uint64_t>(state_.step));
+  // Every rank draws the global batch and trains on its shard.
   std::vector<Sample> samples;
-  for (int i = 0; i < o_.batch; ++i) samples.push_back(train_sampler_.draw(rng));
+  for (int i = 0; i < o_.batch * dp_.world_size(); ++i) samples.push_back(train_sampler_.draw(rng));
+  const auto [first, last] = dp_.shard(0, samples.size());
+  double valid_frames = 0;
+  for (size_t i = first; i < last; ++i) valid_frames += samples[i].length;
   const auto c0 = Clock::now();
-  Batch b = make_batch(data_.train, train_contacts_, samples, 0, samples.size(), model_->rig());
+  Batch b = make_batch(data_.train, train_contacts_, samples, first, last, model_->rig());
   const auto c1 = Clock::now();
   StepLosses L = compute_losses(*model_, b, o_.contact_weight);
   const auto c2 = Clock::now();
   optimizer_->zero_grad();
   L.total.backward();
+  dp_.average_gradients(model_->parameters(), valid_frames);  // the losses are means over valid frames
   const auto c3 = Clock::now();
   torch::nn::utils::clip_grad_norm_(model_->parameters(), 1.0);
   optimizer_->step();
@@ -475,7 +496,7 @@ void InbetweenRun::train_step(EpochSums* sums) {
 // A progress line after the run's first step and then every 30 s.
 void InbetweenRun::print_progress(const EpochSums& sums) {
   const auto now = Clock::now();
-  if (!o_.verbose || (state_.step != first_step_ + 1 && seconds_between(last_progress_, now) <= 30.0)) return;
+  if (!o_.verbose || !dp_.writes() || (state_.step != first_step_ + 1 && seconds_between(last_progress_, now) <= 30.0)) return;
   last_progress_ = now;
   const double sps = (state_.step - first_step_) / seconds_between(run_start_, now);
   std::fprintf(stderr, "  step %lld  epoch %d  %.1f/%.0f min  lr %.2e  loss %.4f", static_cast<long long>(state_.step),
@@ -486,7 +507,8 @@ void InbetweenRun::print_progress(const EpochSums& sums) {
   std::fprintf(stderr, "  contact %.4f  %.2f steps/s\n", sums.contact(), sps);
 }
 
-// Per-frame means over the fixed validation set; none (zeros) without validation clips.
+// Per-frame means over the fixed validation set (each rank its share of the
+// batches, then the sums over ranks); none (zeros) without validation clips.
 Validation InbetweenRun::validate() {
   Validation v;
   v.stages.assign(stage_names_.size(), 0.0);
@@ -494,7 +516,9 @@ Validation InbetweenRun::validate() {
   at::NoGradGuard no_grad;
   model_->train(false);
   double frames = 0;
-  for (const Batch& b : val_batches_) {
+  for (size_t i = 0; i < val_batches_.size(); ++i) {
+    if (!dp_.owns(i)) continue;
+    const Batch& b = val_batches_[i];
     StepLosses L = compute_losses(*model_, b, o_.contact_weight);
     const double n = item(b.input.valid.sum());
     v.score += item(L.stages.back()) * n;
@@ -506,22 +530,30 @@ Validation InbetweenRun::validate() {
     frames += n;
   }
   model_->train(true);
-  frames = std::max(frames, 1.0);
+  std::vector<double> all = {v.score, v.rot, v.pos, v.root, v.contact, frames};
+  all.insert(all.end(), v.stages.begin(), v.stages.end());
+  all = dp_.sum(all);
+  v.score = all[0], v.rot = all[1], v.pos = all[2], v.root = all[3], v.contact = all[4];
+  std::copy(all.begin() + 6, all.end(), v.stages.begin());
+  frames = std::max(all[5], 1.0);
   for (double* x : {&v.score, &v.rot, &v.pos, &v.root, &v.contact}) *x /= frames;
   for (double& x : v.stages) x /= frames;
   return v;
 }
 
-// Keeps the best model, writes the checkpoint and the log line.
-void InbetweenRun::end_epoch(const EpochSums& sums, const Validation& v) {
+// Keeps the best model, writes the checkpoint and the log line (rank 0; the
+// training losses are the means over ranks).
+void InbetweenRun::end_epoch(const EpochSums& local_sums, const Validation& v) {
+  EpochSums sums = local_sums;
+  sums.values = dp_.sum(sums.values);
+  for (double& x : sums.values) x /= dp_.world_size();
   const double score = val_batches_.empty() ? sums.total() : v.score;  // no validation clips: the training loss decides
   ++state_.epoch;
-  state_.minutes = minutes_now();
+  state_.minutes = dp_.agree({minutes_now()})[0];
   const bool best = score < state_.best;
-  if (best) {
-    state_.best = score;
-    save_inbetweener(*model_, files_.best_model);
-  }
+  if (best) state_.best = score;
+  if (!dp_.writes()) return;
+  if (best) save_inbetweener(*model_, files_.best_model);
   save_checkpoint();
   const double sps = (state_.step - first_step_) / std::max(1e-9, seconds_between(run_start_, last_checkpoint_));
   {
@@ -544,6 +576,10 @@ void InbetweenRun::end_epoch(const EpochSums& sums, const Validation& v) {
 }
 
 void InbetweenRun::save_checkpoint() {
+  if (!dp_.writes()) {
+    last_checkpoint_ = Clock::now();
+    return;
+  }
   save_inbetweener(*model_, files_.last_model);
   torch::save(*optimizer_, files_.last_optim + ".tmp");
   fs::rename(files_.last_optim + ".tmp", files_.last_optim);

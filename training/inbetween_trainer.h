@@ -26,11 +26,19 @@
 // last stage's inbetween_pose_loss and chooses best.mfm. An "epoch" is
 // `epoch_steps` steps (0 = about one pass over the training frames) or
 // `validate_minutes` of wall time, whichever comes first.
+//
+// Data-parallel (options.distributed.world_size = N > 1, training/data_parallel.h):
+// every process draws the step's N * batch samples from the same seed and
+// trains on its own `batch` of them; the gradients are averaged weighted by
+// valid frames, so N processes take the steps of one process with batch
+// N * batch. An epoch of about one pass has N times fewer steps.
 #pragma once
 
 #include <cstdint>
 #include <map>
 #include <string>
+
+#include "training/data_parallel.h"
 
 namespace mf {
 
@@ -59,6 +67,9 @@ struct InbetweenTrainingOptions {
   int max_train_clips = 0;          ///< 0 = all
   bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
   bool verbose = true;
+  /// Data-parallel training (training/data_parallel.h): `batch` samples per
+  /// process and step, a global batch of world_size * batch.
+  DistributedOptions distributed;
 };
 
 struct InbetweenTrainingResult {

@@ -6,6 +6,11 @@
 //                           [--max-minutes M] [--seed S] [--threads N] [--resume] [--export PATH] ...
 //   motionfield-train rig --out FILE.json [--data PATH] [--cache-dir DIR] [--stride N]
 //
+// Data-parallel training (prior and in-betweeners; training/data_parallel.h):
+// start one process per rank with --world-size N --rank R --master ADDR:PORT
+// (or torchrun's WORLD_SIZE, RANK, MASTER_ADDR, MASTER_PORT), the same other
+// options everywhere; rank 0 writes the output folder.
+//
 // `motionfield-train <command> --help` lists every option with its default.
 // --config FILE holds "key = value" lines ('#' starts a comment) with the
 // command's option names without "--"; an option given on the command line
@@ -40,6 +45,23 @@ struct RunArgs {
   bool quiet = false;
 };
 
+// Data-parallel training: `d` holds the environment's defaults (torchrun's variables).
+void add_distributed_options(CLI::App& cmd, mf::DistributedOptions& d) {
+  const std::string group = "Several processes or hosts (training/data_parallel.h)";
+  cmd.add_option("--world-size", d.world_size, "number of training processes (default: $WORLD_SIZE or 1)")
+      ->group(group);
+  cmd.add_option("--rank", d.rank, "this process, 0 .. world size - 1; rank 0 writes the output (default: $RANK or 0)")
+      ->group(group);
+  cmd.add_option_function<std::string>(
+         "--master", [&d](const std::string& address) { d.set_master(address); },
+         "ADDR:PORT of rank 0's rendezvous (default: $MASTER_ADDR:$MASTER_PORT or 127.0.0.1:29500)")
+      ->default_str(d.master_addr + ":" + std::to_string(d.master_port))
+      ->group(group);
+  cmd.add_option("--dist-timeout", d.timeout_seconds,
+                 "seconds to wait for the other processes at the start and at each step before stopping with an error")
+      ->group(group);
+}
+
 // The options the prior's and the in-betweeners' trainers share (same names in
 // both option structs).
 template <class Options>
@@ -63,6 +85,7 @@ void add_run_options(CLI::App& cmd, Options& o, RunArgs& run) {
   cmd.add_flag("--resume", o.resume, "continue from DIR/last.* if present");
   cmd.add_option("--export", run.export_path, "copy the best checkpoint to PATH at the end");
   cmd.add_flag("--quiet", run.quiet, "no progress lines on stderr");
+  add_distributed_options(cmd, o.distributed);
 }
 
 void add_prior_options(CLI::App& cmd, mf::PriorTrainingOptions& o, RunArgs& run) {
@@ -179,6 +202,7 @@ std::map<std::string, double> hyperparameter_map(const std::vector<std::string>&
 int train_prior_main(mf::PriorTrainingOptions o, const RunArgs& run) {
   o.verbose = !run.quiet;
   mf::PriorTrainingResult r = mf::train_prior(o);
+  if (o.distributed.rank != 0) return 0;  // rank 0 reports and exports (it alone wrote the output folder)
   std::printf("trained %d epochs, %lld steps in %.1f min; best validation score %.4f: %s\n", r.epochs,
               static_cast<long long>(r.steps), r.minutes, r.best_validation, r.best_path.c_str());
   if (!run.export_path.empty()) {
@@ -199,6 +223,7 @@ int train_inbetweener_main(mf::InbetweenTrainingOptions o, const RunArgs& run) {
     mf::make_inbetweener(o.kind, o.hyperparameters, probe);
   }
   mf::InbetweenTrainingResult r = mf::train_inbetweener(o);
+  if (o.distributed.rank != 0) return 0;  // rank 0 reports and exports (it alone wrote the output folder)
   std::printf("trained %s: %d epochs, %lld steps in %.1f min (%.2f steps/s this run, %d threads); best validation "
               "loss %.4f: %s\n",
               o.kind.c_str(), r.epochs, static_cast<long long>(r.steps), r.minutes, r.steps_per_second,
@@ -253,6 +278,12 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   mf::PriorTrainingOptions prior_options;
   mf::InbetweenTrainingOptions inbetweener_options;
+  try {
+    prior_options.distributed = inbetweener_options.distributed = mf::DistributedOptions::from_environment();
+  } catch (const mf::InputError& e) {
+    std::fprintf(stderr, "motionfield-train: %s\n", e.what());
+    return 2;
+  }
   std::vector<std::string> hp;
   RunArgs run;
   RigArgs rig_args;
@@ -269,15 +300,21 @@ int main(int argc, char** argv) {
   add_rig_options(*rig, rig_args);
   return mf::cli::run(app, argc, argv, [&] {
     if (rig->parsed()) return measure_rig_main(rig_args);
-    if (prior->parsed()) {
-      if (!run.config.empty()) apply_config_file(*prior, run.config, nullptr);
-      return train_prior_main(prior_options, run);
+    try {
+      if (prior->parsed()) {
+        if (!run.config.empty()) apply_config_file(*prior, run.config, nullptr);
+        return train_prior_main(prior_options, run);
+      }
+      CLI::App* cmd =
+          *std::find_if(inbetweeners.begin(), inbetweeners.end(), [](CLI::App* c) { return c->parsed(); });
+      std::vector<std::string> config_hp;
+      if (!run.config.empty()) apply_config_file(*cmd, run.config, &config_hp);
+      inbetweener_options.kind = cmd->get_name();
+      inbetweener_options.hyperparameters = hyperparameter_map(config_hp, hp);
+      return train_inbetweener_main(inbetweener_options, run);
+    } catch (const mf::training::DistributedError& e) {
+      std::fprintf(stderr, "motionfield-train: %s\n", e.what());  // a peer failed: not an internal error
+      return 1;
     }
-    CLI::App* cmd = *std::find_if(inbetweeners.begin(), inbetweeners.end(), [](CLI::App* c) { return c->parsed(); });
-    std::vector<std::string> config_hp;
-    if (!run.config.empty()) apply_config_file(*cmd, run.config, &config_hp);
-    inbetweener_options.kind = cmd->get_name();
-    inbetweener_options.hyperparameters = hyperparameter_map(config_hp, hp);
-    return train_inbetweener_main(inbetweener_options, run);
   });
 }

@@ -137,7 +137,12 @@ struct Losses {
 
 // frames_per_window > 0: the decoder is evaluated on that many random valid
 // frames of each window and z is sampled; 0: every frame, z = mu (validation).
-Losses compute_losses(const NemfModel& model, const Batch& b, int frames_per_window) {
+// The random numbers are drawn for the whole global batch of `global` windows
+// (0 = this batch) and the rows [offset, offset + B) used, so that each
+// process of a data-parallel run draws what one process on the global batch
+// would (training/data_parallel.h).
+Losses compute_losses(const NemfModel& model, const Batch& b, int frames_per_window, int64_t offset = 0,
+                      int64_t global = 0) {
   const RigInfo& rig = model.rig();
   const int64_t B = b.rot.size(0), W = b.rot.size(1), J = rig.num_joints();
   Losses L;
@@ -146,9 +151,12 @@ Losses compute_losses(const NemfModel& model, const Batch& b, int frames_per_win
   at::Tensor zl = z.mu_l, zg = z.mu_g;
   at::Tensor frames, weight, gt;
   if (frames_per_window > 0) {
-    zl = zl + at::randn_like(zl) * at::exp(0.5 * z.logvar_l);
-    zg = zg + at::randn_like(zg) * at::exp(0.5 * z.logvar_g);
-    frames = (at::rand({B, frames_per_window}) * b.lengths.unsqueeze(1).to(at::kFloat)).floor().to(at::kLong);
+    const int64_t G = std::max(global, B);
+    zl = zl + at::randn({G, zl.size(1)}).narrow(0, offset, B) * at::exp(0.5 * z.logvar_l);
+    zg = zg + at::randn({G, zg.size(1)}).narrow(0, offset, B) * at::exp(0.5 * z.logvar_g);
+    frames = (at::rand({G, frames_per_window}).narrow(0, offset, B) * b.lengths.unsqueeze(1).to(at::kFloat))
+                 .floor()
+                 .to(at::kLong);
     frames = at::minimum(frames, (b.lengths - 1).unsqueeze(1));
     gt = b.rot.gather(1, frames.view({B, frames_per_window, 1, 1, 1}).expand({B, frames_per_window, J, 3, 3}));
     weight = at::ones({B, frames_per_window});
@@ -276,15 +284,17 @@ class PriorRun {
   double minutes_now() const { return base_minutes_ + seconds_between(t0_, Clock::now()) / 60.0; }
   // Returns true when the budget (time or steps) is used up.
   bool train_epoch(EpochSums* sums);
-  void train_step(const Batch& b, double beta, EpochSums* sums);
+  void train_step(const Batch& b, double beta, int64_t offset, int64_t global, EpochSums* sums);
   Validation validate();
   void end_epoch(const EpochSums& sums, const Validation& v);
 
   const PriorTrainingOptions& o_;
   const Clock::time_point t0_;
   const training::RunFiles files_;
+  training::DataParallel dp_;
   Dataset data_;
-  bool resuming_;
+  bool resuming_ = false;
+  const training::RunFiles resume_from_;  // files_, or on ranks > 0 rank 0's checkpoint copied
   NemfModel model_;
   const int W_;
   std::vector<ClipTensors> train_pre_, val_pre_;
@@ -299,9 +309,11 @@ PriorRun::PriorRun(const PriorTrainingOptions& o)
     : o_(o),
       t0_(Clock::now()),
       files_(o.out_dir),
-      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, o.config.fps, o.mirror, o.verbose)),
-      resuming_(o.resume && files_.has_checkpoint()),
-      model_(load_or_make_model(o, data_, files_, resuming_)),
+      dp_(o.distributed),
+      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, o.config.fps, o.mirror,
+                                         o.verbose && dp_.writes())),
+      resume_from_(dp_.resume_files(files_, o.resume, &resuming_)),
+      model_(load_or_make_model(o, data_, resume_from_, resuming_)),
       W_(model_.config().window),
       optimizer_(model_.parameters(), torch::optim::AdamOptions(o.lr)) {
   const auto p0 = Clock::now();
@@ -312,16 +324,25 @@ PriorRun::PriorRun(const PriorTrainingOptions& o)
   model_.set_requires_grad(true);
   model_.train(true);
   if (resuming_) {
-    torch::load(optimizer_, files_.last_optim);
-    state_ = training::load_trainer_state(files_.last_state);
+    torch::load(optimizer_, resume_from_.last_optim);
+    state_ = training::load_trainer_state(resume_from_.last_state);
+    dp_.check_resumed_world_size(state_);
   } else {
-    open_log();
+    if (dp_.writes()) open_log();
+    // Every rank starts from rank 0's weights and statistics.
+    std::vector<at::Tensor> shared = model_.parameters();
+    const NemfStats& st = model_.stats();
+    shared.insert(shared.end(), {st.feature_mean, st.feature_std, st.root_mean, st.root_std, st.gmp_in_mean,
+                                 st.gmp_in_std, st.gmp_out_mean, st.gmp_out_std});
+    dp_.broadcast(shared);
   }
+  state_.world_size = dp_.world_size();
   base_minutes_ = state_.minutes;
-  if (o.verbose) {
-    std::fprintf(stderr, "train: %zu training clips, %zu validation clips, %d threads; model %s; %lld parameters%s\n",
+  if (o.verbose && dp_.writes()) {
+    std::fprintf(stderr, "train: %zu training clips, %zu validation clips, %d threads; model %s; %lld parameters%s%s\n",
                  data_.train.size(), data_.validation.size(), o.threads, model_.config().describe().c_str(),
-                 static_cast<long long>(model_.num_parameters()), resuming_ ? "; resumed" : "");
+                 static_cast<long long>(model_.num_parameters()), resuming_ ? "; resumed" : "",
+                 dp_.distributed() ? ("; " + std::to_string(dp_.world_size()) + " processes").c_str() : "");
   }
   val_windows_ = validation_windows(data_.validation, W_);
 }
@@ -356,17 +377,21 @@ bool PriorRun::train_epoch(EpochSums* sums) {
   const std::vector<Window> windows = epoch_windows(data_.train, W_, o_.stride, rng);
   sums->lr = o_.lr;
   sums->beta = o_.kl_weight;
-  for (size_t i = 0; i < windows.size(); i += o_.batch) {
-    const double progress = std::min(1.0, minutes_now() / o_.max_minutes);
+  // A global batch of world_size * batch windows, each rank its shard.
+  const size_t global_batch = static_cast<size_t>(o_.batch) * dp_.world_size();
+  for (size_t i = 0; i + static_cast<size_t>(dp_.world_size()) <= windows.size(); i += global_batch) {
+    const double progress = std::min(1.0, dp_.agree({minutes_now()})[0] / o_.max_minutes);
     if (progress >= 1.0 || (o_.max_steps > 0 && state_.step >= o_.max_steps)) return true;
     sums->lr = training::scheduled_lr(o_.lr, o_.lr_final, progress);
     sums->beta = o_.kl_weight * std::min(1.0, progress / std::max(1e-9, o_.kl_warmup));
     training::set_learning_rate(optimizer_, sums->lr);
     const auto c0 = Clock::now();
-    Batch b = make_batch(data_.train, train_pre_, windows, i, std::min(windows.size(), i + o_.batch), model_.rig(), W_);
+    const size_t end = std::min(windows.size(), i + global_batch);
+    const auto [first, last] = dp_.shard(i, end);
+    Batch b = make_batch(data_.train, train_pre_, windows, first, last, model_.rig(), W_);
     if (profile_) std::fprintf(stderr, "batch %.3f s ", seconds_between(c0, Clock::now()));
-    train_step(b, sums->beta, sums);
-    if (o_.verbose && state_.step % 100 == 0) {
+    train_step(b, sums->beta, static_cast<int64_t>(first - i), static_cast<int64_t>(end - i), sums);
+    if (o_.verbose && dp_.writes() && state_.step % 100 == 0) {
       std::fprintf(stderr, "  step %lld  %.1f min  lr %.2e  rot %.4f pos %.4f kl %.1f trans %.4f\n",
                    static_cast<long long>(state_.step), minutes_now(), sums->lr, sums->mean(0), sums->mean(2),
                    sums->mean(3), sums->mean(6));
@@ -375,9 +400,9 @@ bool PriorRun::train_epoch(EpochSums* sums) {
   return false;
 }
 
-void PriorRun::train_step(const Batch& b, double beta, EpochSums* sums) {
+void PriorRun::train_step(const Batch& b, double beta, int64_t offset, int64_t global, EpochSums* sums) {
   const auto c1 = Clock::now();
-  Losses L = compute_losses(model_, b, o_.frames_per_window);
+  Losses L = compute_losses(model_, b, o_.frames_per_window, offset, global);
   at::Tensor total = L.total(beta);
   const auto c2 = Clock::now();
   optimizer_.zero_grad();
@@ -385,6 +410,9 @@ void PriorRun::train_step(const Batch& b, double beta, EpochSums* sums) {
   if (profile_) {
     std::fprintf(stderr, "forward %.3f s backward %.3f s\n", seconds_between(c1, c2), seconds_between(c2, Clock::now()));
   }
+  const auto c3 = Clock::now();
+  dp_.average_gradients(model_.parameters(), static_cast<double>(b.rot.size(0)));  // weighted by windows
+  if (profile_ && dp_.distributed()) std::fprintf(stderr, "all-reduce %.3f s\n", seconds_between(c3, Clock::now()));
   torch::nn::utils::clip_grad_norm_(model_.parameters(), 1.0);
   optimizer_.step();
   ++state_.step;
@@ -393,12 +421,14 @@ void PriorRun::train_step(const Batch& b, double beta, EpochSums* sums) {
   ++sums->count;
 }
 
-// Encode the mean, decode every frame of the fixed validation windows.
+// Encode the mean, decode every frame of the fixed validation windows (each
+// rank its share of the batches of 64, then the sums over ranks).
 Validation PriorRun::validate() {
   at::NoGradGuard no_grad;
   Validation v;
   double frames = 0;
   for (size_t i = 0; i < val_windows_.size(); i += 64) {
+    if (!dp_.owns(i / 64)) continue;
     Batch b = make_batch(data_.validation, val_pre_, val_windows_, i, std::min(val_windows_.size(), i + 64),
                          model_.rig(), W_);
     Losses L = compute_losses(model_, b, 0);
@@ -409,20 +439,26 @@ Validation PriorRun::validate() {
     v.trans += item(L.trans) * n;
     frames += n;
   }
+  const std::vector<double> all = dp_.sum({v.rot, v.root, v.pos, v.trans, frames});
+  v = Validation{all[0], all[1], all[2], all[3]};
+  frames = all[4];
   for (double* x : {&v.rot, &v.root, &v.pos, &v.trans}) *x /= std::max(frames, 1.0);
   return v;
 }
 
-// Keeps the best model, writes the checkpoint and the log line.
-void PriorRun::end_epoch(const EpochSums& sums, const Validation& v) {
+// Keeps the best model, writes the checkpoint and the log line (rank 0; the
+// training losses are the means over ranks).
+void PriorRun::end_epoch(const EpochSums& local_sums, const Validation& v) {
+  EpochSums sums = local_sums;
+  const std::vector<double> summed = dp_.sum(std::vector<double>(sums.values, sums.values + 8));
+  for (int k = 0; k < 8; ++k) sums.values[k] = summed[k] / dp_.world_size();
   const double score = v.score();
   ++state_.epoch;
-  state_.minutes = minutes_now();
+  state_.minutes = dp_.agree({minutes_now()})[0];
   const bool best = score < state_.best;
-  if (best) {
-    state_.best = score;
-    save_nemf(model_, files_.best_model);
-  }
+  if (best) state_.best = score;
+  if (!dp_.writes()) return;
+  if (best) save_nemf(model_, files_.best_model);
   save_nemf(model_, files_.last_model);
   torch::save(optimizer_, files_.last_optim);
   training::save_trainer_state(files_.last_state, state_);

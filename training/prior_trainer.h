@@ -13,13 +13,18 @@
 // window (it is a field over time). The GMP is trained on ground-truth local
 // motion: L1(velocity) + L1(height) + L1(translation) + 0.5 * BCE(contacts).
 // Validation (encode the mean, decode every frame) after each epoch chooses
-// the best checkpoint.
+// the best checkpoint. With options.distributed.world_size > 1 the processes
+// share each step's global batch (training/data_parallel.h); N processes with
+// batch B take the steps of one process with batch N * B (exactly so when the
+// windows of a step are all full length; a last global batch of fewer
+// windows than processes is skipped).
 #pragma once
 
 #include <cstdint>
 #include <string>
 
 #include "prior/model/nemf.h"
+#include "training/data_parallel.h"
 
 namespace mf {
 
@@ -44,6 +49,9 @@ struct PriorTrainingOptions {
   bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
   int max_steps = 0;                ///< 0 = unlimited (for tests)
   bool verbose = true;
+  /// Data-parallel training (training/data_parallel.h): `batch` windows per
+  /// process and step, a global batch of world_size * batch.
+  DistributedOptions distributed;
 };
 
 struct PriorTrainingResult {

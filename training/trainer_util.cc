@@ -96,7 +96,8 @@ void save_trainer_state(const std::string& path, const TrainerState& s) {
   {
     std::ofstream out(path + ".tmp");
     out.precision(17);
-    out << "epoch " << s.epoch << "\nstep " << s.step << "\nminutes " << s.minutes << "\nbest " << s.best << "\n";
+    out << "epoch " << s.epoch << "\nstep " << s.step << "\nminutes " << s.minutes << "\nbest " << s.best << "\nworld_size "
+        << s.world_size << "\n";
   }
   std::filesystem::rename(path + ".tmp", path);
 }
@@ -111,6 +112,7 @@ TrainerState load_trainer_state(const std::string& path) {
     else if (key == "step") in >> s.step;
     else if (key == "minutes") in >> s.minutes;
     else if (key == "best") in >> s.best;
+    else if (key == "world_size") in >> s.world_size;
   }
   return s;
 }

@@ -54,6 +54,7 @@ struct TrainerState {
   int64_t step = 0;
   double minutes = 0.0;  ///< wall time of all runs so far
   double best = 1e30;    ///< best validation score
+  int world_size = 1;    ///< processes of the data-parallel run (training/data_parallel.h); 1 in older files
 };
 void save_trainer_state(const std::string& path, const TrainerState& s);
 TrainerState load_trainer_state(const std::string& path);
