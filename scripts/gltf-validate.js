@@ -31,7 +31,7 @@ async function validate(file) {
   });
   const i = report.issues;
   console.log(`${file}: ${i.numErrors} errors, ${i.numWarnings} warnings, ${i.numInfos} infos, ${i.numHints} hints` +
-              ` (${report.info ? report.info.animationCount + ' animations, ' + report.info.nodeCount + ' nodes' : 'no info'})`);
+              (report.info ? `, ${report.info.animationCount} animation(s)` : ''));
   for (const m of i.messages) {
     if (m.severity <= 1) console.log(`  ${m.severity === 0 ? 'error' : 'warning'} ${m.code} at ${m.pointer || m.offset}: ${m.message}`);
   }

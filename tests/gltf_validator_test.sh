@@ -2,7 +2,7 @@
 # glTF output of the motionfield CLI checked by the Khronos glTF validator
 # (scripts/gltf-validate.js; installed by scripts/install-gltf-validator.sh):
 # the demo's main output (scripts/demo.sh) exported with `motionfield export`
-# as .glb and .gltf, and task outputs written with -o OUT.glb / OUT.gltf, must
+# as .glb and .gltf, and task and batch outputs named OUT.glb / OUT.gltf, must
 # have 0 errors; a damaged file must have errors (the check can fail). Then the
 # CLI's errors for bad glTF outputs: an unwritable path, a BVH without frames or
 # with a non-finite number (exit 2, a message, no file).
@@ -24,9 +24,13 @@ bash "$ROOT/scripts/demo.sh" "$BUILD" "$WORK/demo"
 # Task outputs straight to glTF.
 "$MF" --quiet fill --in "$SAMPLE" --gap 20:40 --method interp -o "$WORK/walk_fill.glb"
 "$MF" --quiet resample -i "$SAMPLE" --fps 60 --method interp --out "$WORK/walk_60fps.gltf"
+printf '{"task": "inbetween", "in": "%s", "out": "%s", "keyframes": [0, 30, 60], "method": "interp"}\n' \
+  "$SAMPLE" "$WORK/walk_batch.glb" > "$WORK/jobs.jsonl"
+"$MF" --quiet batch "$WORK/jobs.jsonl"
 [ "$(head -c 4 "$WORK/walk_fill.glb")" = glTF ] || fail "walk_fill.glb is not binary glTF"
 grep -q '"asset"' "$WORK/walk_60fps.gltf" || fail "walk_60fps.gltf is not glTF JSON"
-validate "$WORK/walk_inbetween.glb" "$WORK/walk_inbetween.gltf" "$WORK/walk_fill.glb" "$WORK/walk_60fps.gltf"
+validate "$WORK/walk_inbetween.glb" "$WORK/walk_inbetween.gltf" "$WORK/walk_fill.glb" "$WORK/walk_60fps.gltf" \
+  "$WORK/walk_batch.glb"
 
 # The validator sees a damaged file (a time out of its declared bounds).
 sed 's/"max": *\[/"max": [-1.0, /' "$WORK/walk_60fps.gltf" > "$WORK/damaged.gltf"
