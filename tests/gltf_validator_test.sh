@@ -47,10 +47,12 @@ expect_error() {  # expect_error TEXT COMMAND...
 expect_error "does not exist" "$MF" export "$SAMPLE" "$WORK/no/such/dir/out.glb"
 mkdir -p "$WORK/ro" && chmod a-w "$WORK/ro"
 if [ "$(id -u)" -ne 0 ]; then expect_error "cannot write" "$MF" export "$SAMPLE" "$WORK/ro/out.glb"; fi
+expect_error "cannot write /proc/motionfield-test.glb" "$MF" export "$SAMPLE" /proc/motionfield-test.glb  # even as root
+expect_error "it is a directory" "$MF" export "$SAMPLE" "$WORK/ro"
 awk '/^Frames:/ { print "Frames: 0"; next } { print } /^Frame Time:/ { exit }' "$SAMPLE" > "$WORK/empty.bvh"
-expect_error "frames" "$MF" export "$WORK/empty.bvh" "$WORK/empty.glb"
+expect_error "Frames: 0 must be at least 1" "$MF" export "$WORK/empty.bvh" "$WORK/empty.glb"
 awk 'f == 1 { $4 = "nan"; f = 2 } /^Frame Time:/ { f = 1 } { print }' "$SAMPLE" > "$WORK/nan.bvh"
-expect_error "nan" "$MF" export "$WORK/nan.bvh" "$WORK/nan.glb"
-expect_error "nan" "$MF" fill --in "$WORK/nan.bvh" --gap 20:40 --method interp -o "$WORK/nan_fill.gltf"
+expect_error "non-finite value" "$MF" export "$WORK/nan.bvh" "$WORK/nan.glb"
+expect_error "non-finite value" "$MF" fill --in "$WORK/nan.bvh" --gap 20:40 --method interp -o "$WORK/nan_fill.gltf"
 for f in no ro/out.glb empty.glb nan.glb nan_fill.gltf; do [ ! -e "$WORK/$f" ] || fail "$f was written"; done
 echo "gltf_validator_test: ok"
