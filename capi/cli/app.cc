@@ -202,7 +202,7 @@ void define_export(CLI::App& app, HelpFormatter& help, Arguments& a) {
                               "(base64); any other name is written as BVH. The task commands write glTF the\n"
                               "same way: -o OUT.glb.");
   cmd->add_option("in", a.job.in, "the BVH file; - reads standard input")->required()->type_name("IN.bvh");
-  cmd->add_option("out", a.job.out, "the glTF file")->required()->type_name("OUT.glb");
+  cmd->add_option("out", a.job.out, "the output file: .glb or .gltf")->required()->type_name("OUT.glb");
   cmd->footer(kGlobalOptionsNote);
 }
 
