@@ -16,6 +16,7 @@
 #include <iterator>
 #include <limits>
 
+#include "prior/motion/errors.h"
 #include "prior/motion/motion_gltf.h"
 #include "tests/capi/capi_test_util.h"
 #include "tests/test_util.h"
@@ -181,8 +182,10 @@ TEST(CApiGltf, FilesOfTheSampleReadBackInMetres) {
     const bool binary = std::string(name) == "walk.glb";
     ASSERT_GT(bytes.size(), 12u);
     EXPECT_EQ(std::string(bytes.begin(), bytes.begin() + 4) == "glTF", binary) << name;
-    if (!binary) EXPECT_NE(std::string(bytes.begin(), bytes.end()).find("data:application/octet-stream;base64,"),
-                           std::string::npos);
+    if (!binary) {
+      EXPECT_NE(std::string(bytes.begin(), bytes.end()).find("data:application/octet-stream;base64,"),
+                std::string::npos);
+    }
     expect_matches(bytes, binary, walk.get());
     EXPECT_EQ(bytes, to_memory(walk.get(), binary ? MF_GLTF_BINARY : MF_GLTF_EMBEDDED)) << name;
   }
