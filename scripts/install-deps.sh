@@ -15,6 +15,7 @@ packages=(
   libopenblas0-pthread  # BLAS for libtorch and Eigen: ~3x faster than ATLAS here (docs/BLAS.md)
   python3 python3-numpy # the Python binding's tests
   python3-venv python3-pip python3-setuptools python3-wheel  # `pip install ./python` into a venv without network (README, capi_python_venv test)
+  python3-distributed   # Dask: `python3 -m motionfield.dask` runs batch files on a cluster (python_dask_batch test)
   libtinygltf-dev       # tinygltf 2.7: glTF 2.0 output (prior/motion/motion_gltf.cc) and reading it back in the tests
   nodejs                # runs the Khronos glTF validator (npm gltf-validator) in the gltf_validator_* tests
 )

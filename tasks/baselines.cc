@@ -6,6 +6,8 @@
 
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "tasks/effector_ik.h"
+#include "tasks/foot_locking.h"
 #include "tasks/method.h"
 #include "tasks/residuals.h"
 
@@ -141,6 +143,14 @@ std::vector<Method> baseline_methods() {
   interp.complete = [](const Motion& in, const std::vector<int>& known, const TaskContext&) {
     return interpolate_motion(in, known);
   };
+  interp.complete_constrained = [](const Motion& in, const MotionConstraints& c, int variant, const TaskContext&,
+                                   std::vector<std::string>* warnings) {
+    if (variant > 0) throw InputError("method 'interp' has a single solution: alternatives need a latent solver");
+    Motion out = fill_by_interpolation(in, c);
+    reach_effectors(c, kDefaultEffectorFalloff, &out);
+    for (std::string& w : pin_contacts(c, kDefaultContactRamp, &out)) warnings->push_back(std::move(w));
+    return out;
+  };
   interp.resample = [](const Motion& in, double fps, int frames, const TaskContext&) {
     return resample_interpolate(in, fps, frames);
   };
@@ -173,7 +183,8 @@ Motion fill_by_interpolation(const Motion& window, const MotionConstraints& cons
   bool full = true;
   std::vector<int> frames;
   for (size_t k = 0; k < constraints.keys.size(); ++k) {
-    full = full && constraints.keys[k].joints.empty() && constraints.keys[k].root_position;
+    full = full && constraints.keys[k].joints.empty() && constraints.keys[k].root_position &&
+           constraints.keys[k].rotations;
     frames.push_back(constraints.keys[k].frame);
   }
   if (frames.empty()) throw InputError("interpolation needs at least one key");

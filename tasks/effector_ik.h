@@ -15,6 +15,9 @@
 
 namespace mf {
 
+/// The falloff the tasks use (frames on each side of a target).
+inline constexpr int kDefaultEffectorFalloff = 10;
+
 /// Reaches every end-effector target of `c` in `out` (see the top of this
 /// file); targets with weight 0, on a joint whose chain a key constrains at
 /// the target's frame, or on a chain too short (its grandparent the root or

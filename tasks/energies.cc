@@ -37,6 +37,8 @@ at::Tensor penalty_of_angle(const at::Tensor& angle, Penalty p) {
 // Window problems
 
 int WindowProblem::num_keys() const { return key_frames.defined() ? static_cast<int>(key_frames.size(0)) : 0; }
+int WindowProblem::num_pin_steps() const { return pin_from.defined() ? static_cast<int>(pin_from.size(0)) : 0; }
+
 int WindowProblem::num_effectors() const {
   return effector_frames.defined() ? static_cast<int>(effector_frames.size(0)) : 0;
 }
@@ -127,6 +129,21 @@ void set_effector_targets(int J, int length, const MotionConstraints& c, WindowP
   }
 }
 
+// The contact pins as pairs of consecutive pinned frames (flat frame * J +
+// joint indices into the window's [T, J] positions).
+void set_contact_pins(int J, int length, const MotionConstraints& c, WindowProblem* p) {
+  std::vector<int64_t> from, to;
+  for (const ContactPin& pin : c.contacts) {
+    if (pin.joint < 0 || pin.joint >= J) throw InputError("contact joint out of range");
+    for (int f = std::max(pin.first, 0) + 1; f <= std::min(pin.last, length - 1); ++f) {
+      from.push_back(static_cast<int64_t>(f - 1) * J + pin.joint);
+      to.push_back(static_cast<int64_t>(f) * J + pin.joint);
+    }
+  }
+  p->pin_from = at::tensor(from, at::kLong);
+  p->pin_to = at::tensor(to, at::kLong);
+}
+
 }  // namespace
 
 WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int begin, int length,
@@ -142,6 +159,7 @@ WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int 
   p.transform.z = motion.root_positions[begin + anchor].z();
   set_key_targets(rig, motion, begin, constraints, &p);
   set_effector_targets(rig.num_joints(), length, constraints, &p);
+  set_contact_pins(rig.num_joints(), length, constraints, &p);
   return p;
 }
 
@@ -265,7 +283,7 @@ namespace {
 // how many items each averages over.
 struct ActiveTerms {
   double n_rot = 0, n_root_rot = 0, n_pos = 0, n_root = 0;
-  bool rot = false, root_rot = false, pos = false, root = false, eff = false, skate = false, smooth = false;
+  bool rot = false, root_rot = false, pos = false, root = false, eff = false, pin = false, skate = false, smooth = false;
   bool dense = false;  // a term that needs the whole window decoded
   bool keyed = false;  // a term that needs the key frames decoded
 };
@@ -284,9 +302,10 @@ ActiveTerms active_terms(const RigInfo& rig, const WindowProblem& problem, const
   a.pos = w.position > 0 && a.n_pos > 0;
   a.root = w.root_translation > 0 && a.n_root > 0;
   a.eff = w.effector > 0 && problem.num_effectors() > 0;
+  a.pin = w.contact > 0 && problem.num_pin_steps() > 0;
   a.skate = w.foot_skating > 0 && rig.num_feet() > 0 && T >= 2;
   a.smooth = w.smoothness > 0 && T >= 3;
-  a.dense = a.root || a.eff || a.skate || a.smooth;
+  a.dense = a.root || a.eff || a.pin || a.skate || a.smooth;
   a.keyed = a.rot || a.root_rot || a.pos;
   return a;
 }
@@ -337,6 +356,11 @@ void add_output_terms(const NemfModel& model, const WindowProblem& problem, cons
     at::Tensor d2 = (p - problem.effector_targets).square().sum(-1);
     add_term(out, "effector", w.effector, (penalty_of_squared(d2, w.penalty) * problem.effector_weights).sum() / E);
   }
+  if (a.pin) {
+    at::Tensor flat = pos.reshape({T * J, 3});
+    at::Tensor v = (flat.index_select(0, problem.pin_to) - flat.index_select(0, problem.pin_from)) * fps;
+    add_term(out, "contact", w.contact, penalty_of_squared(v.square().sum(-1), w.penalty).mean());
+  }
   if (a.skate) {
     at::Tensor feet = at::tensor(std::vector<int64_t>(rig.foot_joints.begin(), rig.foot_joints.end()), at::kLong);
     at::Tensor fp = pos.index_select(2, feet);                             // [1, T, F, 3]
@@ -363,7 +387,7 @@ void add_dense_terms(const NemfModel& model, const WindowProblem& problem, const
     add_term(out, "root_translation", w.root_translation,
              masked_mean(penalty_of_squared(d2, w.penalty), problem.key_root_mask, a.n_root));
   }
-  if (a.eff || a.skate || a.smooth) add_output_terms(model, problem, w, a, dense_rot, path, gmp, offsets, out);
+  if (a.eff || a.pin || a.skate || a.smooth) add_output_terms(model, problem, w, a, dense_rot, path, gmp, offsets, out);
 }
 
 }  // namespace

@@ -25,6 +25,8 @@
 //                     against the root position of keys that give it (m)
 //   effector          world (canonical) position of chosen joints at chosen
 //                     frames (m), each target with its own weight
+//   contact           mean squared velocity (m/s) of the joints the caller pins
+//                     (MotionConstraints::contacts) over consecutive pinned frames
 //   latent_prior      0.5 * (|z_l|^2 + |z_g|^2): a Gaussian prior on the codes
 //   foot_skating      mean over frames and feet of p_contact * |v_xz|^2, the
 //                     horizontal foot velocity (m/s) weighted by the GMP's
@@ -32,7 +34,7 @@
 //                     contacts off to escape the term)
 //   smoothness        mean squared second difference of the root-relative
 //                     joint positions (m/s^2), on the dense decode
-// The effector, foot-skating and smoothness terms are measured on the output
+// The effector, contact, foot-skating and smoothness terms are measured on the output
 // motion (EnergyWeights::on_output): the decoded motion with the residual at
 // each key blended in, as complete_motion() will return it, so that the
 // overwrite of the known values cannot undo what they ask for.
@@ -41,7 +43,7 @@
 //
 // What is decoded: only the key frames when no dense term is active; the whole
 // window (frames 0..length-1) once when root_translation (with root keys),
-// effector, foot_skating or smoothness is active, the key frames then being
+// effector, contact, foot_skating or smoothness is active, the key frames then being
 // gathered from it.
 #pragma once
 
@@ -81,8 +83,14 @@ struct WindowProblem {
   at::Tensor effector_targets;  ///< [E, 3] canonical positions
   at::Tensor effector_weights;  ///< [E]
 
+  // Contact pins: P steps between consecutive pinned frames, as flat
+  // frame * J + joint indices.
+  at::Tensor pin_from;  ///< [P] int64
+  at::Tensor pin_to;    ///< [P] int64
+
   int num_keys() const;
   int num_effectors() const;
+  int num_pin_steps() const;
 };
 
 /// Builds the canonical problem of frames [begin, begin + length) of `motion`
@@ -105,6 +113,7 @@ struct EnergyWeights {
   double root_orientation = 1.0;
   double root_translation = 10.0;
   double effector = 100.0;
+  double contact = 10.0;
   double latent_prior = 0.0;
   double foot_skating = 0.0;
   double smoothness = 0.0;

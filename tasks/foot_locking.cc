@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <string>
 
 #include "tasks/two_bone_ik.h"
@@ -99,6 +100,48 @@ void contact_goals(const GlobalPose& pose, int ankle, const std::vector<char>& o
   }
 }
 
+// Moves the chain's end toward `goal` with `weight` at every frame not `fixed`:
+// its ground position (x, z) only, or its height too.
+void hold(const Leg& leg, const std::vector<Eigen::Vector3d>& goal, const std::vector<double>& weight,
+          const std::vector<char>& fixed, bool height, Motion* out, GlobalPose* pose) {
+  for (int f = 0; f < out->num_frames(); ++f) {
+    if (weight[f] <= 0.0 || fixed[f]) continue;
+    const Eigen::Vector3d now = pose->position(f, leg.ankle);
+    Eigen::Vector3d target = now;
+    target.x() += weight[f] * (goal[f].x() - now.x());
+    if (height) target.y() += weight[f] * (goal[f].y() - now.y());
+    target.z() += weight[f] * (goal[f].z() - now.z());
+    two_bone_ik(out, pose, f, leg.hip, leg.knee, leg.ankle, target);
+  }
+}
+
+// The warnings of a pin that cannot hold exactly: keys inside it that place
+// the joint at different points, and frames a key or a target protects.
+void warn_conflicts(const std::string& what, const GlobalPose& pose, int joint, const ContactPin& p,
+                    const std::vector<char>& fixed, const std::vector<char>& known, std::vector<std::string>* out) {
+  int first_known = -1;
+  std::string moved, partial;
+  for (int f = p.first; f <= p.last; ++f) {
+    if (known[f]) {
+      if (first_known < 0) first_known = f;
+      const double cm = (pose.position(f, joint) - pose.position(first_known, joint)).norm() * 100.0;
+      if (cm > 0.5) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, "%s%d (%.1f cm from frame %d)", moved.empty() ? "" : ", ", f, cm, first_known);
+        moved += buf;
+      }
+    } else if (fixed[f]) {
+      partial += (partial.empty() ? "" : ", ") + std::to_string(f);
+    }
+  }
+  if (!moved.empty())
+    out->push_back(what + ": keys inside it place the joint at different points, so it moves between them: frame " +
+                   moved);
+  if (!partial.empty())
+    out->push_back(what + ": keys or end-effector targets constrain its chain at frame(s) " + partial +
+                   ", which keep their values there");
+}
+
 }  // namespace
 
 void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector<float>& contacts, int ramp,
@@ -118,15 +161,37 @@ void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector
     std::vector<Eigen::Vector3d> goal;
     std::vector<double> weight;
     contact_goals(pose, leg.ankle, on, known, ramp, &goal, &weight);
-    for (int f = 0; f < N; ++f) {
-      if (weight[f] <= 0.0 || fixed[f]) continue;
-      const Eigen::Vector3d now = pose.position(f, leg.ankle);
-      Eigen::Vector3d target = now;
-      target.x() += weight[f] * (goal[f].x() - now.x());
-      target.z() += weight[f] * (goal[f].z() - now.z());
-      two_bone_ik(out, &pose, f, leg.hip, leg.knee, leg.ankle, target);
-    }
+    hold(leg, goal, weight, fixed, /*height=*/false, out, &pose);
   }
+}
+
+std::vector<std::string> pin_contacts(const MotionConstraints& c, int ramp, Motion* out) {
+  std::vector<std::string> warnings;
+  const Skeleton& skel = out->skeleton;
+  const int N = out->num_frames();
+  for (const ContactPin& p : c.contacts) {
+    const std::string what = "contact of joint '" + skel.names[p.joint] + "' on frames " + std::to_string(p.first) +
+                             ".." + std::to_string(p.last);
+    Leg leg;
+    leg.ankle = p.joint;
+    leg.knee = skel.parents[p.joint];
+    leg.hip = leg.knee > 0 ? skel.parents[leg.knee] : -1;
+    if (leg.hip <= 0) {
+      warnings.push_back(what + " is not held: the joint needs two bones above it below the root");
+      continue;
+    }
+    std::vector<char> fixed, known;
+    protected_frames(c, skel, leg, N, &fixed, &known);
+    GlobalPose pose = forward_kinematics(*out);
+    std::vector<char> on(N, 0);
+    std::fill(on.begin() + p.first, on.begin() + p.last + 1, 1);
+    std::vector<Eigen::Vector3d> goal;
+    std::vector<double> weight;
+    contact_goals(pose, leg.ankle, on, known, ramp, &goal, &weight);
+    warn_conflicts(what, pose, leg.ankle, p, fixed, known, &warnings);
+    hold(leg, goal, weight, fixed, /*height=*/true, out, &pose);
+  }
+  return warnings;
 }
 
 }  // namespace mf

@@ -11,8 +11,16 @@
 // Frames whose leg joints a key constrains, or that carry an end-effector
 // target on the leg or on the joints above its hip, are not touched; toe
 // joints and feet without a thigh and a shin below the root are skipped.
+//
+// Contacts the caller pins (MotionConstraints::contacts) are held the same way,
+// on any joint with two bones above it below the root (a foot, a hand), in all
+// three coordinates and whatever the predictor says: at the joint's positions
+// at the keys inside the pin that fix it (its chain's rotations and the root),
+// interpolated between them, else at its mean position over the pin; frames a
+// key or an end-effector target protects are left to them.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "prior/model/representation.h"
@@ -21,9 +29,19 @@
 
 namespace mf {
 
+/// The ramp of contact pins the tasks use (frames on each side).
+inline constexpr int kDefaultContactRamp = 3;
+
 /// Locks the feet of `out` (see the top of this file). `contacts` holds the
 /// predictor's contact probabilities [frames, rig.num_feet()] row-major.
 void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector<float>& contacts, int ramp,
                Motion* out);
+
+/// Holds every contact pin of `c` in `out` (see the top of this file), with a
+/// ramp of `ramp` frames on each side. Returns a warning for each pin that
+/// cannot hold exactly: a joint without a two-bone chain, keys inside the pin
+/// that place the joint at different points (the pin then moves between them),
+/// keys or targets that constrain part of its chain inside the pin.
+std::vector<std::string> pin_contacts(const MotionConstraints& c, int ramp, Motion* out);
 
 }  // namespace mf

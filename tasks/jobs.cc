@@ -5,7 +5,9 @@
 #include <sstream>
 
 #include "prior/inbetween/inbetweener.h"
+#include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "tasks/baselines.h"
 #include "tasks/inbetweener_files.h"
 #include "tasks/model_rig.h"
 
@@ -51,6 +53,60 @@ Motion complete_with(const Method& m, const Motion& input, const std::vector<int
   return complete_on_model_rig(input, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
     return m.complete(in, k, ctx);
   });
+}
+
+std::vector<int> key_frames(const MotionConstraints& c) {
+  std::vector<int> frames;
+  for (const PoseKey& k : c.keys) frames.push_back(k.frame);
+  return frames;
+}
+
+// Constrained solves run on the input's own skeleton: it must have the model's
+// joints and hierarchy (its bone lengths may differ; the fix-ups after the
+// solve work on the input's own bones) and the model's frame rate.
+void check_constrained_rig(const Motion& input, const TaskContext& ctx) {
+  const NemfModel& prior = require_prior(ctx, "this method");
+  const Skeleton& model = prior.rig().skeleton;
+  if (input.skeleton.names != model.names || input.skeleton.parents != model.parents)
+    throw InputError("partial keys, end-effector targets, contacts and alternatives need the model's joint names and "
+                     "hierarchy for now (this motion has " + std::to_string(input.num_joints()) + " joints, the model " +
+                     std::to_string(model.num_joints()) + "); whole-pose keys without alternatives work on any rig");
+  if (!same_frame_rate(input.fps, prior.config().fps)) {
+    std::ostringstream msg;
+    msg << "partial keys, end-effector targets, contacts and alternatives need the model's frame rate ("
+        << prior.config().fps << " fps) for now; this motion is at " << input.fps
+        << " fps (resample it first; whole-pose keys without alternatives work at any rate)";
+    throw InputError(msg.str());
+  }
+}
+
+// Warnings for targets the output misses by more than a centimetre.
+void warn_missed_targets(const Motion& out, const MotionConstraints& c, std::vector<std::string>* warnings) {
+  const GlobalPose pose = forward_kinematics(out);
+  for (const EffectorTarget& t : c.effectors) {
+    const double cm = (pose.position(t.frame, t.joint) - t.position).norm() * 100.0;
+    if (cm <= 1.0 || t.weight == 0.0) continue;
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << "the target of joint '" << out.skeleton.names[t.joint] << "' at frame " << t.frame << " is missed by " << cm
+        << " cm (out of the body's reach, or a key at that frame fixes the joint's chain)";
+    warnings->push_back(msg.str());
+  }
+}
+
+// Warnings for contact pins the output lets slide by more than half a centimetre.
+void warn_sliding_pins(const Motion& out, const MotionConstraints& c, std::vector<std::string>* warnings) {
+  for (const ContactPin& p : c.contacts) {
+    MotionConstraints one;
+    one.contacts = {p};
+    const double cm = contact_error(out, one).max_cm;
+    if (cm <= 0.5) continue;
+    std::ostringstream msg;
+    msg.precision(3);
+    msg << "the contact of joint '" << out.skeleton.names[p.joint] << "' on frames " << p.first << ".." << p.last
+        << " slides up to " << cm << " cm (the body moves beyond the limb's reach, or keys move the joint)";
+    warnings->push_back(msg.str());
+  }
 }
 
 }  // namespace
@@ -162,6 +218,34 @@ Motion run_fill(const Motion& input, int a, int b, const std::string& method, co
   const Method& m = checked_method(method, input, ctx);
   // Sorted, unique, in range and at least two (frame 0 and the last): valid keyframes.
   return complete_with(m, input, known_frames_outside_gap(input.num_frames(), a, b), ctx);
+}
+
+ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& constraints, const std::string& method,
+                                  int alternatives, const TaskContext& ctx) {
+  if (alternatives < 0 || alternatives > kMaxAlternatives)
+    throw InputError("alternatives must be between 0 and " + std::to_string(kMaxAlternatives) + " (got " +
+                     std::to_string(alternatives) + ")");
+  ConstrainedResult result;
+  if (!constraints.beyond_full_poses() && alternatives == 0) {
+    result.motions.push_back(run_known_frames(input, key_frames(constraints), method, ctx));
+  } else {
+    const Method& m = resolve_method(method, ctx);
+    check_motion(input);
+    if (!m.complete_constrained)
+      throw InputError("method '" + m.name +
+                       "' takes whole-pose keys only: partial keys, end-effector targets, contacts and alternatives "
+                       "need a latent solver (nemf, nemf-detail, ...) or 'interp' (without alternatives)");
+    constraints.validate(input.num_frames(), input.num_joints());
+    constraints.check_values(input);
+    if (m.needs_model) check_constrained_rig(input, ctx);
+    start(ctx);
+    for (int v = 0; v <= alternatives; ++v)
+      result.motions.push_back(m.complete_constrained(input, constraints, v, ctx, &result.warnings));
+    warn_missed_targets(result.motions.front(), constraints, &result.warnings);
+    warn_sliding_pins(result.motions.front(), constraints, &result.warnings);
+  }
+  for (const Motion& out : result.motions) result.reports.push_back(measure_constraints(input, constraints, out));
+  return result;
 }
 
 Motion run_resample(const Motion& input, double fps, const std::string& method, std::vector<std::string>* warnings,

@@ -19,6 +19,8 @@
 #include <vector>
 
 #include "prior/motion/motion.h"
+#include "tasks/constraint_report.h"
+#include "tasks/motion_constraints.h"
 #include "tasks/method.h"
 
 namespace mf {
@@ -89,5 +91,30 @@ Motion run_resample(const Motion& input, double fps, const std::string& method,
 /// keyframes): the common path of run_inbetween and run_fill.
 Motion run_known_frames(const Motion& input, const std::vector<int>& known, const std::string& method,
                         const TaskContext& ctx = {});
+
+/// Most alternatives one request may ask for.
+inline constexpr int kMaxAlternatives = 16;
+
+/// What run_constrained() returns: the method's solution first, then the
+/// alternatives; how well each meets the constraints (measured on it); and a
+/// warning for each constraint that could not hold exactly (a target out of
+/// reach, a pin that contradicts keys), naming the frames involved.
+struct ConstrainedResult {
+  std::vector<Motion> motions;
+  std::vector<ConstraintReport> reports;
+  std::vector<std::string> warnings;
+};
+
+/// Completes `input` under `constraints` (partial keys, end-effector targets,
+/// contact pins; validated here: frames and joints in range, finite values,
+/// at least one key fixing the root) with `alternatives` (0..kMaxAlternatives)
+/// more solutions from other starts, deterministic for the context's seed.
+/// Whole-pose keys alone without alternatives take run_known_frames()'s path
+/// (any rig, any rate); anything else needs a method with
+/// Method::complete_constrained (the latent solvers; "interp" without
+/// alternatives) and, for the model's methods, the model's own rig and rate.
+/// Known values come out exactly as given.
+ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& constraints, const std::string& method,
+                                  int alternatives, const TaskContext& ctx = {});
 
 }  // namespace mf

@@ -1,6 +1,7 @@
 #include "tasks/latent_solver.h"
 
 #include <ATen/ATen.h>
+#include <ATen/CPUGeneratorImpl.h>
 
 #include <algorithm>
 #include <chrono>
@@ -55,51 +56,11 @@ CodeEnergy window_energy(const NemfModel& model, const WindowProblem& problem, c
   };
 }
 
-void measure_effectors(const Motion& motion, const MotionConstraints& c, EffectorError* e) {
-  *e = EffectorError{};
-  if (c.effectors.empty()) return;
-  GlobalPose pose = forward_kinematics(motion);
-  double sum = 0.0;
-  for (const EffectorTarget& t : c.effectors) {
-    const double d = (pose.position(t.frame, t.joint) - t.position).norm() * 100.0;
-    e->max_cm = std::max(e->max_cm, d);
-    sum += d;
-    ++e->count;
-  }
-  e->mean_cm = sum / e->count;
-}
-
-// The error of the raw solution at the constrained values.
-ConstraintError known_value_error(const Motion& input, const MotionConstraints& c, const Motion& raw) {
-  ConstraintError err;
-  double rot_sum = 0.0, root_sum = 0.0;
-  for (int j = 0; j < input.num_joints(); ++j) {
-    for (size_t k = 0; k < c.keys.size(); ++k) {
-      if (!c.key_has_joint(k, j)) continue;
-      const int f = c.keys[k].frame;
-      const double deg = geodesic_angle(input.rotation(f, j).normalized(), raw.rotation(f, j)) * 180.0 / M_PI;
-      err.rotation_max_deg = std::max(err.rotation_max_deg, deg);
-      rot_sum += deg;
-      ++err.rotations;
-    }
-  }
-  for (const PoseKey& k : c.keys) {
-    if (!k.root_position) continue;
-    const double cm = (input.root_positions[k.frame] - raw.root_positions[k.frame]).norm() * 100.0;
-    err.root_max_cm = std::max(err.root_max_cm, cm);
-    root_sum += cm;
-    ++err.roots;
-  }
-  if (err.rotations) err.rotation_mean_deg = rot_sum / err.rotations;
-  if (err.roots) err.root_mean_cm = root_sum / err.roots;
-  return err;
-}
-
 // Makes the constrained values of `out` exactly the input's, spreading the
 // residuals with smoothstep ramps (see the header). Records the raw error first.
 void overwrite_known(const Motion& input, const MotionConstraints& c, Motion* out, ConstraintError* err) {
   const Motion raw = *out;
-  *err = known_value_error(input, c, raw);
+  *err = key_error(input, c, raw);
   for (int j = 0; j < input.num_joints(); ++j) {
     std::vector<int> frames;
     for (size_t k = 0; k < c.keys.size(); ++k) {
@@ -129,18 +90,7 @@ void check_completion(const NemfModel& model, const Motion& input, const MotionC
   if (input.rotations.size() != static_cast<size_t>(N) * J)
     throw InputError("the motion's rotation count does not match its frames and joints");
   constraints.validate(N, J);
-  for (size_t k = 0; k < constraints.keys.size(); ++k) {
-    const int f = constraints.keys[k].frame;
-    for (int j = 0; j < J; ++j) {
-      if (!constraints.key_has_joint(k, j)) continue;
-      const Eigen::Quaterniond& q = input.rotation(f, j);
-      if (!q.coeffs().allFinite() || q.norm() < 1e-6)
-        throw InputError("the rotation of joint " + input.skeleton.names[j] + " at known frame " + std::to_string(f) +
-                         " is not a finite, non-zero quaternion");
-    }
-    if (constraints.keys[k].root_position && !input.root_positions[f].allFinite())
-      throw InputError("the root position at known frame " + std::to_string(f) + " is not finite");
-  }
+  constraints.check_values(input);
 }
 
 // One window of the solve, in solve order.
@@ -220,7 +170,7 @@ std::vector<WindowPlan> plan_windows(int W, int N, const MotionConstraints& cons
       throw InputError("frames " + std::to_string(p.start) + ".." + std::to_string(p.start + p.length - 1) +
                        " hold no key that fixes the root");  // cannot happen after validation
     }
-    p.caps = window_caps(options, key_frames_of(p.constraints), !p.constraints.effectors.empty(), p.length);
+    p.caps = window_caps(options, key_frames_of(p.constraints), !p.constraints.effectors.empty() || !p.constraints.contacts.empty(), p.length);
     std::fill(solved.begin() + p.start, solved.begin() + p.start + p.length, 1);
     plan.push_back(std::move(p));
   }
@@ -276,6 +226,16 @@ void blend_window(const WindowPlan& w, const Motion& piece, const at::Tensor& pi
   }
 }
 
+// The start of an alternative solution: Gaussian noise on the codes
+// (LatentSolverOptions::start_noise), its own stream per window.
+InitialGuess perturbed(InitialGuess g, const LatentSolverOptions& o, int window) {
+  if (o.start_noise <= 0.0) return g;
+  at::Generator gen = at::make_generator<at::CPUGeneratorImpl>(o.start_seed * 1000003ull + static_cast<uint64_t>(window));
+  g.z_l = g.z_l + o.start_noise * at::randn(g.z_l.sizes(), gen, g.z_l.options());
+  g.z_g = g.z_g + o.start_noise * at::randn(g.z_g.sizes(), gen, g.z_g.options());
+  return g;
+}
+
 // Solves the windows of `plan` in order (the progress total is the sum of
 // their caps) and joins their solutions.
 SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const std::vector<WindowPlan>& plan,
@@ -302,7 +262,7 @@ SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const st
     request.constraints = &w.constraints;
     request.anchor = w.anchor;
     request.context = &ctx;
-    const InitialGuess start = init->initialize(request);
+    const InitialGuess start = perturbed(init->initialize(request), options, window_ctx.window);
     LatentSolverOptions window_options = options;
     window_options.keyed_iterations = w.caps.keyed;
     window_options.max_iterations = w.caps.full;
@@ -325,16 +285,17 @@ SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const st
 void make_known_values_exact(const RigInfo& rig, const Motion& input, const MotionConstraints& constraints,
                              const LatentSolverOptions& options, const std::vector<float>& contacts, Motion* out,
                              CompletionReport* rep) {
-  measure_effectors(*out, constraints, &rep->raw_effectors);
+  rep->raw_effectors = effector_error(*out, constraints);
   if (options.overwrite_known) {
     overwrite_known(input, constraints, out, &rep->raw_known);
     if (options.foot_lock_ramp >= 0) lock_feet(rig, constraints, contacts, options.foot_lock_ramp, out);
     if (options.effector_falloff >= 0) reach_effectors(constraints, options.effector_falloff, out);
+    rep->warnings = pin_contacts(constraints, options.contact_ramp, out);
   } else {
     Motion copy = *out;
     overwrite_known(input, constraints, &copy, &rep->raw_known);
   }
-  measure_effectors(*out, constraints, &rep->effectors);
+  rep->effectors = effector_error(*out, constraints);
 }
 
 }  // namespace
@@ -369,8 +330,10 @@ std::string LatentSolverOptions::validate() const {
   e << LatentOptimizerSettings::validate();
   if (overlap < 1) e << "overlap must be >= 1; ";
   if (keyed_iterations < -1) e << "keyed_iterations must be >= 0, or -1 for the default; ";
+  if (contact_ramp < 0) e << "contact_ramp must be >= 0; ";
+  if (!(start_noise >= 0) || !std::isfinite(start_noise)) e << "start_noise must be finite and non-negative; ";
   const EnergyWeights& w = weights;
-  for (double v : {w.rotation, w.position, w.root_orientation, w.root_translation, w.effector, w.latent_prior,
+  for (double v : {w.rotation, w.position, w.root_orientation, w.root_translation, w.effector, w.contact, w.latent_prior,
                    w.foot_skating, w.smoothness}) {
     if (!(v >= 0) || !std::isfinite(v)) {
       e << "energy weights must be finite and non-negative; ";
@@ -397,7 +360,8 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
   const auto t0 = Clock::now();
   const FlatLatentEnergy energy(window_energy(model, problem, options.weights), zl, zg);
   const at::Tensor x0 = energy.join(start.z_l, start.z_g);
-  const WindowCaps caps = window_caps(options, key_frames_of(problem), problem.num_effectors() > 0, problem.length);
+  const WindowCaps caps = window_caps(options, key_frames_of(problem), problem.num_effectors() > 0 || problem.num_pin_steps() > 0,
+                                      problem.length);
   const int total = iteration_total > 0 ? iteration_total : caps.keyed + caps.full;
 
   LatentSolution out;

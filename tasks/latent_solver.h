@@ -60,13 +60,17 @@
 #pragma once
 
 #include <ATen/core/Tensor.h>
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "prior/motion/motion.h"
+#include "tasks/constraint_report.h"
+#include "tasks/effector_ik.h"
 #include "tasks/energies.h"
+#include "tasks/foot_locking.h"
 #include "tasks/initializers.h"
 #include "tasks/latent_optimizer.h"
 #include "tasks/task_context.h"
@@ -106,7 +110,18 @@ struct LatentSolverOptions : LatentOptimizerSettings {
   /// End-effector IK after the overwrite and the foot locking (see the top of
   /// this file): the falloff in frames on each side of a target; negative
   /// disables it (the targets are then only as close as the energy pulls them).
-  int effector_falloff = 10;
+  int effector_falloff = kDefaultEffectorFalloff;
+
+  /// Contact pins (MotionConstraints::contacts) are held after everything
+  /// else with a ramp of this many frames on each side (tasks/foot_locking.h
+  /// pin_contacts()).
+  int contact_ramp = kDefaultContactRamp;
+
+  /// Alternative solutions: Gaussian noise of this standard deviation is added
+  /// to the initialiser's codes of every window (the prior's codes have unit
+  /// variance), drawn from `start_seed` and the window's index; 0 = none.
+  double start_noise = 0.0;
+  uint64_t start_seed = 0;
 
   /// Diagnostics only: false returns the raw solution, without the overwrite
   /// of the known values (which then do not come out as given).
@@ -170,24 +185,13 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
                              const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset = 0,
                              int iteration_total = 0);
 
-/// Error of the raw solution at the constrained values, before the overwrite.
-struct ConstraintError {
-  double rotation_max_deg = 0.0, rotation_mean_deg = 0.0;  ///< constrained local rotations (root included)
-  double root_max_cm = 0.0, root_mean_cm = 0.0;            ///< constrained root positions
-  long rotations = 0, roots = 0;                           ///< counts
-};
-
-struct EffectorError {
-  double max_cm = 0.0, mean_cm = 0.0;
-  long count = 0;
-};
-
 struct CompletionReport {
   std::vector<SolveSummary> windows;   ///< in solve order
   std::vector<int> window_starts;      ///< first frame of each window, in solve order
   ConstraintError raw_known;           ///< raw solution vs keys, before the overwrite
   EffectorError raw_effectors;         ///< raw solution vs end-effector targets
   EffectorError effectors;             ///< output vs end-effector targets (after the blend)
+  std::vector<std::string> warnings;   ///< constraints that could not hold exactly (contact pins)
   int iterations = 0;                  ///< summed over windows
   double wall_ms = 0.0;                ///< the whole call
 };

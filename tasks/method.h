@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "prior/motion/motion.h"
+#include "tasks/motion_constraints.h"
 #include "tasks/task_context.h"
 
 namespace mf {
@@ -24,6 +25,15 @@ struct Method {
   /// in range): every other frame is produced, known frames come out as given.
   /// Unknown input frames must never be read. Null when unsupported.
   std::function<Motion(const Motion& input, const std::vector<int>& known, const TaskContext& ctx)> complete;
+  /// Completes a motion under any constraints (partial keys, end-effector
+  /// targets, contact pins), validated by the caller. `variant` 0 is the
+  /// method's answer; variant v > 0 the v-th alternative (another start, the
+  /// same for the same context seed). Warnings of constraints that could not
+  /// hold exactly are appended to *warnings. Null when the method takes only
+  /// whole-pose keys (complete).
+  std::function<Motion(const Motion& input, const MotionConstraints& c, int variant, const TaskContext& ctx,
+                       std::vector<std::string>* warnings)>
+      complete_constrained;
   /// Resamples to `fps` with exactly `frames` output frames at times i / fps.
   /// Null when unsupported.
   std::function<Motion(const Motion& input, double fps, int frames, const TaskContext& ctx)> resample;

@@ -21,10 +21,19 @@ MotionConstraints MotionConstraints::full_pose(const std::vector<int>& frames) {
 
 bool MotionConstraints::key_has_joint(size_t k, int joint) const {
   const std::vector<int>& j = keys[k].joints;
+  if (!keys[k].rotations) return false;
   return j.empty() || std::binary_search(j.begin(), j.end(), joint);
 }
 
 bool MotionConstraints::key_fixes_root(size_t k) const { return keys[k].root_position && key_has_joint(k, 0); }
+
+bool MotionConstraints::beyond_full_poses() const {
+  if (!effectors.empty() || !contacts.empty()) return true;
+  for (const PoseKey& k : keys) {
+    if (!k.joints.empty() || !k.root_position || !k.rotations) return true;
+  }
+  return false;
+}
 
 void MotionConstraints::validate(int frames, int joints) const {
   auto range = [&](int f) { return "(the motion has " + std::to_string(frames) + " frames)"; };
@@ -36,6 +45,10 @@ void MotionConstraints::validate(int frames, int joints) const {
     if (k > 0 && key.frame <= keys[k - 1].frame)
       throw InputError("key frames must be strictly increasing (" + std::to_string(keys[k - 1].frame) +
                        " is followed by " + std::to_string(key.frame) + ")");
+    if (!key.rotations && !key.joints.empty())
+      throw InputError("key at frame " + std::to_string(key.frame) + ": joints listed on a key without rotations");
+    if (!key.rotations && !key.root_position)
+      throw InputError("key at frame " + std::to_string(key.frame) + " constrains nothing");
     for (size_t i = 0; i < key.joints.size(); ++i) {
       const int j = key.joints[i];
       if (j < 0 || j >= joints)
@@ -57,9 +70,44 @@ void MotionConstraints::validate(int frames, int joints) const {
     if (!(std::isfinite(e.weight) && e.weight >= 0.0))
       throw InputError("end-effector target weight must be finite and non-negative");
   }
+  validate_contacts(frames, joints);
   if (!anchor) {
     throw InputError(
         "at least one key must give the root's rotation and position (the solver places the motion relative to it)");
+  }
+}
+
+void MotionConstraints::check_values(const Motion& input) const {
+  for (size_t k = 0; k < keys.size(); ++k) {
+    const int f = keys[k].frame;
+    for (int j = 0; j < input.num_joints(); ++j) {
+      if (!key_has_joint(k, j)) continue;
+      const Eigen::Quaterniond& q = input.rotation(f, j);
+      if (!q.coeffs().allFinite() || q.norm() < 1e-6)
+        throw InputError("the rotation of joint " + input.skeleton.names[j] + " at known frame " + std::to_string(f) +
+                         " is not a finite, non-zero quaternion");
+    }
+    if (keys[k].root_position && !input.root_positions[f].allFinite())
+      throw InputError("the root position at known frame " + std::to_string(f) + " is not finite");
+  }
+}
+
+void MotionConstraints::validate_contacts(int frames, int joints) const {
+  for (size_t i = 0; i < contacts.size(); ++i) {
+    const ContactPin& p = contacts[i];
+    const std::string what = "contact " + std::to_string(p.first) + ".." + std::to_string(p.last);
+    if (p.joint < 0 || p.joint >= joints)
+      throw InputError(what + ": joint " + std::to_string(p.joint) + " is out of range (the skeleton has " +
+                       std::to_string(joints) + " joints)");
+    if (p.first < 0 || p.last >= frames)
+      throw InputError(what + " is out of range (the motion has " + std::to_string(frames) + " frames)");
+    if (p.first >= p.last) throw InputError(what + " must span at least two frames (first < last)");
+    for (size_t k = 0; k < i; ++k) {
+      const ContactPin& q = contacts[k];
+      if (q.joint == p.joint && q.first <= p.last && p.first <= q.last)
+        throw InputError(what + " overlaps contact " + std::to_string(q.first) + ".." + std::to_string(q.last) +
+                         " of the same joint: merge them into one");
+    }
   }
 }
 
@@ -76,6 +124,12 @@ MotionConstraints MotionConstraints::slice(int begin, int length) const {
     EffectorTarget s = e;
     s.frame -= begin;
     out.effectors.push_back(s);
+  }
+  for (const ContactPin& p : contacts) {
+    ContactPin s = p;
+    s.first = std::max(p.first, begin) - begin;
+    s.last = std::min(p.last, begin + length - 1) - begin;
+    if (s.first < s.last) out.contacts.push_back(s);
   }
   return out;
 }

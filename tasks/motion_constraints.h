@@ -8,6 +8,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "prior/motion/motion.h"
+
 namespace mf {
 
 /// A pose constraint at one frame: the local rotations of `joints` (joint 0's
@@ -18,6 +20,9 @@ struct PoseKey {
   int frame = 0;
   std::vector<int> joints;     ///< constrained joints, increasing; empty means every joint
   bool root_position = true;   ///< the root translation is constrained too
+  /// False: no rotation at all is constrained (`joints` must be empty): a key
+  /// of the root position alone.
+  bool rotations = true;
 };
 
 /// An end-effector target: the world position (metres) of `joint` at `frame`,
@@ -31,10 +36,20 @@ struct EffectorTarget {
   double weight = 1.0;
 };
 
+/// A contact the caller pins: `joint` (a foot, a hand on a rail) does not move
+/// in the world from frame `first` to frame `last` (inclusive). Where it is held
+/// is the solver's choice unless keys inside the range fix it (then it is held
+/// at their positions; tasks/foot_locking.h pin_contacts()).
+struct ContactPin {
+  int joint = 0;
+  int first = 0, last = 0;
+};
+
 /// Everything known about a motion to complete.
 struct MotionConstraints {
   std::vector<PoseKey> keys;              ///< strictly increasing frames
   std::vector<EffectorTarget> effectors;  ///< any order, any frames in range
+  std::vector<ContactPin> contacts;       ///< any order; pins of one joint must not overlap
 
   /// Full-pose keys (every joint and the root position) at `frames`.
   static MotionConstraints full_pose(const std::vector<int>& frames);
@@ -46,12 +61,24 @@ struct MotionConstraints {
   /// the canonical frame needs.
   void validate(int frames, int joints) const;
 
+  /// Throws mf::InputError naming the joint and frame unless the values the
+  /// keys read from `input` are usable: finite, non-zero rotations and finite
+  /// root positions (call after validate()).
+  void check_values(const Motion& input) const;
+
   /// True when key `k` constrains `joint`'s rotation.
   bool key_has_joint(size_t k, int joint) const;
   /// True when key `k` gives the root's rotation and position (it can anchor a window).
   bool key_fixes_root(size_t k) const;
-  /// Constraints of frames [begin, begin + length), renumbered from 0.
+  /// True when anything but whole-pose keys is asked for (partial keys,
+  /// end-effector targets or contact pins).
+  bool beyond_full_poses() const;
+  /// Constraints of frames [begin, begin + length), renumbered from 0 (contact
+  /// pins clipped to the range, dropped when less than two frames remain).
   MotionConstraints slice(int begin, int length) const;
+
+ private:
+  void validate_contacts(int frames, int joints) const;
 };
 
 }  // namespace mf

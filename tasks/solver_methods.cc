@@ -12,6 +12,11 @@ namespace mf {
 
 namespace {
 
+// The noise on the starting codes of an alternative solution
+// (LatentSolverOptions::start_noise), measured in docs/BENCHMARKS.md
+// ("Alternatives").
+constexpr double kAlternativeStartNoise = 0.5;
+
 // `initializer` empty: the default (interpolation); else a make_initializer()
 // name whose transformer (`inbetweener` kind) comes from the context.
 Method solver_method(const std::string& name, const std::string& description, SolverMethod method,
@@ -28,6 +33,21 @@ Method solver_method(const std::string& name, const std::string& description, So
     const NemfModel& model = require_prior(ctx, "method '" + method_name + "'");
     if (!inbetweener.empty()) require_inbetweener(ctx, inbetweener, "method '" + method_name + "'");
     return complete_motion(model, input, MotionConstraints::full_pose(known), options, ctx);
+  };
+  m.complete_constrained = [options, method_name = name, inbetweener](const Motion& input, const MotionConstraints& c,
+                                                               int variant, const TaskContext& ctx,
+                                                               std::vector<std::string>* warnings) {
+    const NemfModel& model = require_prior(ctx, "method '" + method_name + "'");
+    if (!inbetweener.empty()) require_inbetweener(ctx, inbetweener, "method '" + method_name + "'");
+    LatentSolverOptions o = options;
+    if (variant > 0) {
+      o.start_noise = kAlternativeStartNoise;
+      o.start_seed = ctx.seed * 7919u + static_cast<uint64_t>(variant);
+    }
+    CompletionReport report;
+    Motion out = complete_motion(model, input, c, o, ctx, &report);
+    for (std::string& w : report.warnings) warnings->push_back(std::move(w));
+    return out;
   };
   return m;
 }

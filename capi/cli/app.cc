@@ -83,6 +83,22 @@ void add_method(CLI::App* cmd, BatchJob& job,
   cmd->add_option("--method", job.method, help)->type_name("M")->check(kNonEmpty);
 }
 
+// --constraints, --alternatives and --report of inbetween and fill.
+void add_constraints(CLI::App* cmd, BatchJob& job) {
+  cmd->add_option("--constraints", job.constraints_file,
+                  "a constraints file (JSON, docs/CONSTRAINTS.md): partial keys,\nend-effector targets, contacts")
+      ->type_name("FILE")
+      ->check(kNonEmpty);
+  cmd->add_option("--alternatives", job.alternatives,
+                  "N more solutions, written beside the output as\nOUT_1.bvh .. OUT_N.bvh (0..16)")
+      ->type_name("N")
+      ->check(quiet(CLI::Range(0, 16)));
+  cmd->add_option("--report", job.report_file,
+                  "write how well each solution meets the constraints\n(JSON) to FILE")
+      ->type_name("FILE")
+      ->check(kNonEmpty);
+}
+
 void define_global_options(CLI::App& app, Settings& s, bool& version_flag) {
   app.option_defaults()->group("global options");
   app.set_help_flag("-h,--help", "this help; `motionfield <command> --help` for a command");
@@ -131,6 +147,7 @@ void define_inbetween(CLI::App& app, HelpFormatter& help, Arguments& a) {
       ->required()
       ->type_name("LIST");
   add_method(cmd, a.job);
+  add_constraints(cmd, a.job);
   cmd->footer([] { return method_list(MF_METHOD_COMPLETES) + "\n" + kGlobalOptionsNote; });
 }
 
@@ -142,6 +159,7 @@ void define_fill(CLI::App& app, HelpFormatter& help, Arguments& a) {
   add_task_files(cmd, a.job, "input BVH");
   cmd->add_option("--gap", a.gap, "the unknown frames, A inclusive, B exclusive")->required()->type_name("A:B");
   add_method(cmd, a.job);
+  add_constraints(cmd, a.job);
   cmd->footer([] { return method_list(MF_METHOD_COMPLETES) + "\n" + kGlobalOptionsNote; });
 }
 
@@ -218,7 +236,9 @@ void define_batch(CLI::App& app, HelpFormatter& help, Arguments& a) {
       "  {\"task\": \"renav\", \"in\": \"a.bvh\", \"out\": \"f.bvh\", \"polyline\": \"p.csv\", \"frames\": 90}\n"
       "For fill, a \"keyframes\" list, if given, is authoritative over \"gap\". For\n"
       "renav, \"path\" or \"polyline\" and the optional \"fps\" and \"frames\" mean what\n"
-      "the flags of `motionfield renav` mean. Every task takes \"rig_map\" (a file) and\n"
+      "the flags of `motionfield renav` mean. inbetween and fill take \"constraints\"\n"
+      "(a file or an inline object), \"alternatives\" and \"report\" as the flags\n"
+      "--constraints, --alternatives and --report. Every task takes \"rig_map\" (a file) and\n"
       "\"units\" (a name, auto, or metres per unit), which replace --rig-map and\n"
       "--units for that job. Keys a job does not need (\"id\", frame counts, ...) are\n"
       "ignored; blank lines are skipped; relative paths are relative to the current\n"

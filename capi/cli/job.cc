@@ -40,13 +40,20 @@ void check_output_path(const std::string& out) {
 void check_output_is_not_an_input(const BatchJob& job, const Settings& settings) {
   if (job.out == kStdio) return;
   const std::string rig_map = job.rig_map.empty() ? settings.rig_map : job.rig_map;
-  const std::pair<const std::string*, const char*> inputs[] = {
-      {&job.in, "input"}, {&job.path_file, "path file"}, {&rig_map, "rig map file"}};
-  for (const auto& [file, role] : inputs) {
-    std::error_code ec;
-    if (!file->empty() && *file != kStdio && std::filesystem::equivalent(*file, job.out, ec))
-      throw InputError("the output " + job.out + " is the " + role + " " + *file +
-                       ": refusing to overwrite it (name another output file)");
+  const std::pair<const std::string*, const char*> inputs[] = {{&job.in, "input"},
+                                                               {&job.path_file, "path file"},
+                                                               {&rig_map, "rig map file"},
+                                                               {&job.constraints_file, "constraints file"}};
+  std::vector<std::string> outputs = {job.out};
+  for (int i = 1; i <= job.alternatives; ++i) outputs.push_back(alternative_path(job.out, i));
+  if (!job.report_file.empty()) outputs.push_back(job.report_file);
+  for (const std::string& out : outputs) {
+    for (const auto& [file, role] : inputs) {
+      std::error_code ec;
+      if (!file->empty() && *file != kStdio && std::filesystem::equivalent(*file, out, ec))
+        throw InputError("the output " + out + " is the " + role + " " + *file +
+                         ": refusing to overwrite it (name another output file)");
+    }
   }
 }
 
@@ -60,15 +67,41 @@ void check_job(const BatchJob& job, const Settings& settings) {
     if (job.polyline && job.frames != 0 && job.frames < 2)
       throw InputError("renav: the frame count must be at least 2");
   }
+  if (job.out == kStdio && job.alternatives > 0)
+    throw InputError("--alternatives writes OUT_1.bvh .. beside the output: name an output file, not -");
   check_output_path(job.out);
+  if (!job.report_file.empty()) check_output_path(job.report_file);
   check_output_is_not_an_input(job, settings);
 }
 
-Motion solve(const BatchJob& job, const Settings& settings, const Model& model, const Motion& input,
-             ProgressLine& progress) {
-  TaskOptions options(job.method);
-  options.rig_map_path = job.rig_map.empty() ? settings.rig_map : job.rig_map;
-  if (progress.enabled()) options.progress = [&progress](const mf_progress& p) { return progress.update(p); };
+// The job's constraints: its file or inline JSON, plus the known frames of
+// the task as whole-pose keys.
+Constraints job_constraints(const BatchJob& job, const Motion& input) {
+  Constraints c = !job.constraints_file.empty()   ? Constraints::load_json(job.constraints_file)
+                  : !job.constraints_json.empty() ? Constraints::parse_json(job.constraints_json)
+                                                  : Constraints::create();
+  if (job.task == "inbetween" || job.has_keyframes)
+    return std::move(c.add_pose_keys(std::vector<int32_t>(job.keyframes.begin(), job.keyframes.end())));
+  const int n = input.frame_count();
+  if (!(1 <= job.gap_begin && job.gap_begin < job.gap_end && job.gap_end <= n - 1))
+    throw InputError("gap " + std::to_string(job.gap_begin) + ":" + std::to_string(job.gap_end) +
+                     " must satisfy 1 <= A < B <= frames - 1 (the input has " + std::to_string(n) + " frames)");
+  std::vector<int32_t> known;
+  for (int f = 0; f < n; ++f)
+    if (f < job.gap_begin || f >= job.gap_end) known.push_back(f);
+  return std::move(c.add_pose_keys(known));
+}
+
+// What a job's solve gives: the motion and, with constraints, the
+// alternatives and the report.
+struct Solved {
+  Motion motion;
+  std::vector<Motion> alternatives;
+  std::string report;
+};
+
+// The plain tasks (whole-pose keys, a gap, resampling, re-navigation).
+Motion solve_task(const BatchJob& job, const Model& model, const Motion& input, const TaskOptions& options) {
   if (job.task == "inbetween" || (job.task == "fill" && job.has_keyframes))
     return inbetween(model, input, std::vector<int32_t>(job.keyframes.begin(), job.keyframes.end()), options);
   if (job.task == "fill") return fill(model, input, job.gap_begin, job.gap_end, options);
@@ -81,6 +114,20 @@ Motion solve(const BatchJob& job, const Settings& settings, const Model& model, 
     return renav(model, input, load_path_csv(job.path_file), renav_options, options);
   }
   throw InputError("unknown task '" + job.task + "'");
+}
+
+Solved solve(const BatchJob& job, const Settings& settings, const Model& model, const Motion& input,
+             ProgressLine& progress) {
+  TaskOptions options(job.method);
+  options.rig_map_path = job.rig_map.empty() ? settings.rig_map : job.rig_map;
+  if (progress.enabled()) options.progress = [&progress](const mf_progress& p) { return progress.update(p); };
+  if (job.constrained()) {
+    const Solution s = motionfield::solve(model, input, job_constraints(job, input), job.alternatives, options);
+    Solved out{s.motion(0), {}, s.report_json()};
+    for (int i = 1; i < s.count(); ++i) out.alternatives.push_back(s.motion(i));
+    return out;
+  }
+  return {solve_task(job, model, input, options), {}, ""};
 }
 
 // The method that ran.
@@ -97,6 +144,21 @@ void write_stdout(const Motion& result) {
   errno = 0;
   const bool ok = std::fwrite(text.data(), 1, text.size(), stdout) == text.size() && std::fflush(stdout) == 0;
   if (!ok) throw Error(MF_ERROR_IO, std::string("cannot write the standard output: ") + std::strerror(errno));
+}
+
+// Writes `text` to `path` through a temporary file beside it, renamed over
+// the target, so that a failed write never leaves half a file.
+void write_text_file(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  std::FILE* f = std::fopen(tmp.c_str(), "wb");
+  bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  if (f) ok = std::fclose(f) == 0 && ok;
+  std::error_code ec;
+  if (ok) std::filesystem::rename(tmp, path, ec);
+  if (!ok || ec) {
+    std::filesystem::remove(tmp, ec);
+    throw Error(MF_ERROR_IO, "cannot write " + path);
+  }
 }
 
 // The glTF format an output's name asks for: MF_GLTF_BINARY for .glb,
@@ -125,6 +187,11 @@ double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(
 
 }  // namespace
 
+std::string alternative_path(const std::string& out, int index) {
+  const std::filesystem::path p(out);
+  return (p.parent_path() / (p.stem().string() + "_" + std::to_string(index) + p.extension().string())).string();
+}
+
 JobReport run_job(const BatchJob& job, const Settings& settings, Models& models, ProgressLine& progress) {
   const auto t0 = Clock::now();
   check_job(job, settings);
@@ -141,11 +208,17 @@ JobReport run_job(const BatchJob& job, const Settings& settings, Models& models,
   const Motion input = Motion::load_bvh(job.in == kStdio ? "/dev/stdin" : job.in,
                                         units_scale(job.units.empty() ? settings.units : job.units, "--units"));
   const auto t1 = Clock::now();
-  const Motion solved = export_only ? Motion() : solve(job, settings, model, input, progress);
-  const Motion& result = export_only ? input : solved;
+  const Solved solved = export_only ? Solved{} : solve(job, settings, model, input, progress);
+  const Motion& result = export_only ? input : solved.motion;
   progress.clear();
   const auto t2 = Clock::now();
   write_output(result, job.out);
+  for (size_t i = 0; i < solved.alternatives.size(); ++i) {
+    report.alternatives.push_back(alternative_path(job.out, static_cast<int>(i) + 1));
+    write_output(solved.alternatives[i], report.alternatives.back());
+  }
+  if (!job.report_file.empty()) write_text_file(job.report_file, solved.report + "\n");
+  report.constraints = solved.report;
   const auto t3 = Clock::now();
 
   report.method = method_name(job, model);
@@ -195,6 +268,10 @@ std::string job_json(const BatchJob& job, const JobReport* report, const Failure
     std::istringstream lines(report->warnings);
     for (std::string w; std::getline(lines, w);) warnings.push_back(w);
     j["warnings"] = warnings;
+    if (!report->constraints.empty()) {
+      j["alternatives"] = report->alternatives;
+      j["constraints"] = nlohmann::ordered_json::parse(report->constraints);
+    }
   }
   // Invalid UTF-8 in a file name becomes U+FFFD rather than failing the summary.
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);

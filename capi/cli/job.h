@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "cli.h"
 #include "jsonl.h"
@@ -18,7 +19,12 @@ struct JobReport {
   int frames_in = 0, frames_out = 0;
   double read_ms = 0, solve_ms = 0, write_ms = 0;
   std::string warnings;  ///< the task's warnings (Motion::warnings()) and the CLI's, one per line
+  std::string constraints;  ///< the constraint report (mf_solution_get_report_json), "" when not asked for
+  std::vector<std::string> alternatives;  ///< files the alternatives were written to
 };
+
+/// Where alternative `index` (1..) of output `out` goes: OUT_1.bvh for OUT.bvh.
+std::string alternative_path(const std::string& out, int index);
 
 /// Runs `job` with the model `models` gives for its method, showing the
 /// solver's progress on `progress`. "-" as the input reads standard input, as
@@ -30,7 +36,8 @@ JobReport run_job(const BatchJob& job, const Settings& settings, Models& models,
 
 /// The --json summary of one job: {"task", "in", "out", "status": "ok" |
 /// "error", "method", "model", "frames_in", "frames_out", "timings_ms":
-/// {"read", "solve", "write", "total"}, "warnings": [...]} when it ran, or
+/// {"read", "solve", "write", "total"}, "warnings": [...], and with
+/// constraints "alternatives": [files] and "constraints": the report} when it ran, or
 /// {"task", "in", "out", "status": "error", "exit_code", "error"} when it
 /// failed; batch jobs add "line" and "id" (when given). One line of JSON.
 std::string job_json(const BatchJob& job, const JobReport* report, const Failure* failure, size_t line = 0);

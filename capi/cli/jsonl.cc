@@ -327,6 +327,24 @@ std::vector<int> int_array(const JsonValue& v, const std::string& key) {
   return out;
 }
 
+// "constraints" (a file name or an inline object), "alternatives", "report".
+void read_constraints(const JsonValue& line, BatchJob* job) {
+  if (const JsonValue* c = line.find("constraints")) {
+    if (c->is_object())
+      job->constraints_json = c->dump();
+    else if (c->is_string())
+      job->constraints_file = string_value(*c, "constraints", false);
+    else
+      throw InputError(std::string("\"constraints\" must be a file name or an object, not ") + json_type_name(c->type()));
+  }
+  if (const JsonValue* n = line.find("alternatives")) {
+    job->alternatives = int_value(*n, "\"alternatives\"");
+    if (job->alternatives < 0 || job->alternatives > 16)
+      throw InputError("\"alternatives\" must be between 0 and 16, not " + n->dump());
+  }
+  if (const JsonValue* r = line.find("report")) job->report_file = string_value(*r, "report", false);
+}
+
 }  // namespace
 
 std::string JsonValue::dump() const {
@@ -382,6 +400,7 @@ BatchJob batch_job_from_json(const JsonValue& line) {
     }
   }
 
+  if (job.task == "inbetween" || job.task == "fill") read_constraints(line, &job);
   if (job.task == "inbetween") {
     job.keyframes = int_array(required(line, "keyframes", job.task), "keyframes");
     job.has_keyframes = true;

@@ -637,6 +637,109 @@ MF_API int mf_rig_describe(const mf_model *model, const mf_motion *motion, const
  *  whole number of frames (see mf_resample_frame_count). A string getter. */
 MF_API int mf_motion_get_warnings(const mf_motion *motion, char *out, size_t capacity, size_t *needed);
 
+/* ================================================================ constraints and several solutions */
+
+/* Beyond whole-pose keyframes: partial keys (some joints' local rotations, or
+ * the root alone), end-effector world targets, and contacts the caller pins,
+ * in one description (the same as the constraints file of the CLI and batch
+ * jobs, docs/CONSTRAINTS.md), built here or parsed from that JSON. Joints are
+ * named as in the input motion; frames are the input's; positions are in the
+ * input's world frame and its own length unit (mf_motion_get_length_scale).
+ * mf_solve runs it and can return several distinct solutions. Names and frames
+ * are checked against the input when mf_solve runs (unknown joints, frames out
+ * of range, a frame keyed twice, overlapping pins: MF_ERROR_INVALID_ARGUMENT
+ * naming the item). */
+
+/** A set of constraints (not thread-safe while being built; const use is). */
+typedef struct mf_constraints mf_constraints;
+/** The result of mf_solve: one or more motions and how well each meets the
+ *  constraints. */
+typedef struct mf_solution mf_solution;
+
+/** Root flags of a partial key. */
+#define MF_ROOT_NONE 0u
+#define MF_ROOT_POSITION 1u
+#define MF_ROOT_ROTATION 2u
+
+/** A new, empty set. */
+MF_API int mf_constraints_create(mf_constraints **out);
+/** A set from the constraints file format (JSON text, `length` bytes):
+ *  MF_ERROR_INVALID_ARGUMENT naming the item on a malformed document. */
+MF_API int mf_constraints_parse_json(const char *json, size_t length, mf_constraints **out);
+/** The same from a file (MF_ERROR_IO if it cannot be read; at most 16 MiB;
+ *  errors are prefixed with the path). */
+MF_API int mf_constraints_load_json(const char *path, mf_constraints **out);
+MF_API void mf_constraints_destroy(mf_constraints *constraints);
+/** Whole-pose keys at `frames` (any order). */
+MF_API int mf_constraints_add_pose_keys(mf_constraints *constraints, const int32_t *frames, size_t count);
+/** A partial key at `frame`: the local rotations of `joints` (names; may be
+ *  empty) and, by `root` (MF_ROOT_* flags), the root's position and/or
+ *  rotation. A key must constrain something. */
+MF_API int mf_constraints_add_partial_key(mf_constraints *constraints, int32_t frame, const char *const *joints,
+                                          size_t joint_count, uint32_t root);
+/** An end-effector target: joint `joint` at `position` (x, y, z, world, the
+ *  input's unit) at `frame`, with a relative `weight` (finite, >= 0; 1 is the
+ *  usual). The solver pulls the joint there and IK places it (within reach). */
+MF_API int mf_constraints_add_target(mf_constraints *constraints, int32_t frame, const char *joint,
+                                     const float position[3], float weight);
+/** A contact pin: `joint` (a foot, a hand) stays put in the world from frame
+ *  `first` to `last` inclusive (first < last): where keys inside the range
+ *  fix it, at their positions; else where the solution puts it on average. */
+MF_API int mf_constraints_add_contact(mf_constraints *constraints, const char *joint, int32_t first, int32_t last);
+/** The set as constraints-file JSON (a string getter). */
+MF_API int mf_constraints_to_json(const mf_constraints *constraints, char *out, size_t capacity, size_t *needed);
+
+/** Completes `input` under `constraints` (at least one key must give the
+ *  root's rotation and position) with the method of `options` (default as
+ *  mf_inbetween), plus `alternatives` (0..16) more solutions that honour the
+ *  same constraints from other starts (deterministic for options->seed).
+ *  Partial keys, targets, contacts and alternatives need a latent solver
+ *  method ("nemf", "nemf-detail", ...; "interp" takes them without
+ *  alternatives) and, for the model's methods, a motion on the model's own rig
+ *  and frame rate (MF_ERROR_INVALID_ARGUMENT otherwise); whole-pose keys alone
+ *  work like mf_inbetween on any rig. Known values come out exactly as given.
+ *  Constraints that cannot all hold (a target out of reach, a pin that keys
+ *  contradict) give the best compromise and a warning naming the frames
+ *  (mf_motion_get_warnings of each motion, and the report). */
+MF_API int mf_solve(const mf_model *model, const mf_motion *input, const mf_constraints *constraints,
+                    int32_t alternatives, const mf_task_options *options, mf_solution **out);
+MF_API void mf_solution_destroy(mf_solution *solution);
+/** Number of motions: 1 + alternatives. */
+MF_API int mf_solution_get_count(const mf_solution *solution, int32_t *out);
+/** A new motion handle (the caller destroys it) holding solution `index`: 0
+ *  is the method's answer, 1.. the alternatives. */
+MF_API int mf_solution_get_motion(const mf_solution *solution, int32_t index, mf_motion **out);
+
+/** How well one solution meets the constraints, measured on it. Lengths in
+ *  the input's unit. Targets: distance of the joint from its target; contacts:
+ *  distance of the pinned joint from where it is at the pin's first frame. */
+typedef struct mf_constraint_report {
+  uint32_t struct_size;
+  int32_t key_rotations;       /**< constrained rotations measured */
+  double key_rotation_max_deg;
+  double key_rotation_mean_deg;
+  int32_t key_roots;           /**< constrained root positions measured */
+  double key_root_max;
+  double key_root_mean;
+  int32_t targets;
+  double target_max;
+  double target_mean;
+  int32_t contact_frames;      /**< pinned frames measured */
+  double contact_slide_max;
+  double contact_slide_mean;
+} mf_constraint_report;
+
+MF_API int mf_constraint_report_init(mf_constraint_report *report);
+/** The report of solution `index` (fills what fits in report->struct_size). */
+MF_API int mf_solution_get_report(const mf_solution *solution, int32_t index, mf_constraint_report *report);
+/** Every solution's report and the warnings as JSON (a string getter):
+ *    {"unit": "cm", "solutions": [{"index": 0, "keys": {"rotations": n,
+ *      "rotation_max_deg": x, "rotation_mean_deg": x, "roots": n,
+ *      "root_max": x, "root_mean": x}, "targets": {"count": n, "max": x,
+ *      "mean": x}, "contacts": {"frames": n, "max": x, "mean": x}}, ...],
+ *     "warnings": ["...", ...]} */
+MF_API int mf_solution_get_report_json(const mf_solution *solution, char *out, size_t capacity, size_t *needed);
+
 #ifdef __cplusplus
 }
 #endif

@@ -411,8 +411,11 @@ class TaskCall {
   const mf_task_options* options() const { return &c_; }
 
   // The result of the C call that returned `status` and `out`.
-  Motion finish(int status, mf_motion* out) {
-    Motion result(out);
+  Motion finish(int status, mf_motion* out) { return finish_handle(status, Motion(out)); }
+
+  // The same for any handle the call made.
+  template <class H>
+  H finish_handle(int status, H result) {
     if (error_) std::rethrow_exception(error_);
     check(status);
     return result;
@@ -577,6 +580,94 @@ inline Encoding encode(const Model& model, const Motion& input, const CodecOptio
   mf_encoding* e = nullptr;
   check(mf_encode(model.get(), input.get(), &o, &e));
   return Encoding(e);
+}
+
+// ---------------------------------------------------------------- constraints
+
+/// mf_constraints: whole-pose and partial keys, end-effector targets and
+/// contact pins, joints by name, positions in the input's unit
+/// (docs/CONSTRAINTS.md). The add_* calls return *this for chaining.
+class Constraints : public detail::Handle<mf_constraints, mf_constraints_destroy> {
+ public:
+  using Handle::Handle;
+
+  static Constraints create() {
+    mf_constraints* c = nullptr;
+    check(mf_constraints_create(&c));
+    return Constraints(c);
+  }
+  /// mf_constraints_parse_json: the constraints file format.
+  static Constraints parse_json(const std::string& json) {
+    mf_constraints* c = nullptr;
+    check(mf_constraints_parse_json(json.data(), json.size(), &c));
+    return Constraints(c);
+  }
+  /// mf_constraints_load_json.
+  static Constraints load_json(const std::string& path) {
+    mf_constraints* c = nullptr;
+    check(mf_constraints_load_json(path.c_str(), &c));
+    return Constraints(c);
+  }
+  Constraints& add_pose_keys(const std::vector<int32_t>& frames) {
+    check(mf_constraints_add_pose_keys(get(), frames.data(), frames.size()));
+    return *this;
+  }
+  /// `root`: MF_ROOT_NONE, or MF_ROOT_POSITION and/or MF_ROOT_ROTATION.
+  Constraints& add_partial_key(int32_t frame, const std::vector<std::string>& joints, uint32_t root = MF_ROOT_NONE) {
+    std::vector<const char*> names;
+    for (const std::string& j : joints) names.push_back(j.c_str());
+    check(mf_constraints_add_partial_key(get(), frame, names.data(), names.size(), root));
+    return *this;
+  }
+  Constraints& add_target(int32_t frame, const std::string& joint, const float (&position)[3], float weight = 1.0f) {
+    check(mf_constraints_add_target(get(), frame, joint.c_str(), position, weight));
+    return *this;
+  }
+  Constraints& add_contact(const std::string& joint, int32_t first, int32_t last) {
+    check(mf_constraints_add_contact(get(), joint.c_str(), first, last));
+    return *this;
+  }
+  std::string to_json() const {
+    return detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+      return mf_constraints_to_json(get(), out, capacity, needed);
+    });
+  }
+};
+
+/// mf_solution: the method's motion (index 0) and the alternatives.
+class Solution : public detail::Handle<mf_solution, mf_solution_destroy> {
+ public:
+  using Handle::Handle;
+
+  int32_t count() const {
+    return detail::read_value<int32_t>([&](int32_t* out) { return mf_solution_get_count(get(), out); });
+  }
+  Motion motion(int32_t index) const {
+    mf_motion* m = nullptr;
+    check(mf_solution_get_motion(get(), index, &m));
+    return Motion(m);
+  }
+  mf_constraint_report report(int32_t index) const {
+    mf_constraint_report r;
+    check(mf_constraint_report_init(&r));
+    check(mf_solution_get_report(get(), index, &r));
+    return r;
+  }
+  /// mf_solution_get_report_json: every solution's report and the warnings.
+  std::string report_json() const {
+    return detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+      return mf_solution_get_report_json(get(), out, capacity, needed);
+    });
+  }
+};
+
+/// mf_solve: `input` under `constraints`, plus `alternatives` more solutions.
+inline Solution solve(const Model& model, const Motion& input, const Constraints& constraints,
+                      int32_t alternatives = 0, const TaskOptions& options = {}) {
+  detail::TaskCall call(options);
+  mf_solution* out = nullptr;
+  const int status = mf_solve(model.get(), input.get(), constraints.get(), alternatives, call.options(), &out);
+  return call.finish_handle(status, Solution(out));
 }
 
 }  // namespace motionfield

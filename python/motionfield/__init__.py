@@ -64,10 +64,12 @@ __all__ = [
     "Error", "InvalidArgumentError", "BufferTooSmallError", "FileError", "ModelError", "CancelledError",
     "InternalError", "UnsupportedError", "OutOfMemoryError",
     "version", "abi_version", "library_path", "set_num_threads", "get_num_threads",
-    "Method", "methods", "default_method", "default_model_path", "default_model",
+    "Method", "methods", "find_method", "default_method", "default_model_path", "default_model",
+    "printable_text",
     "Model", "Motion", "CancelToken", "Progress", "Encoding",
     "inbetween", "fill", "resample", "resample_frame_count", "encode",
-    "renav", "load_path_csv", "describe_rig",
+    "Constraints", "Solution", "solve",
+    "renav", "load_path_csv", "describe_rig", "length_unit_scale",
 ]
 
 #: A file path: a string or an os.PathLike.
@@ -227,9 +229,7 @@ def _units_scale(units: Union[str, float, None], length_scale: Optional[float]) 
     if units is None or units == "auto":
         return None
     if isinstance(units, str):
-        v = ctypes.c_double(0)
-        _check(_c.mf_length_unit_scale(units.encode(), ctypes.byref(v)))
-        return v.value
+        return length_unit_scale(units)
     return float(units)
 
 
@@ -422,6 +422,63 @@ def methods() -> List[Method]:
         out.append(Method(name.value.decode(), description.value.decode(), bool(f & _c.METHOD_NEEDS_MODEL),
                           bool(f & _c.METHOD_COMPLETES), bool(f & _c.METHOD_RESAMPLES)))
     return out
+
+
+def find_method(name: str) -> Method:
+    """The method called `name` (mf_method_find), or the library's error.
+
+    The check the CLI makes of a job's method before reading anything
+    (``motionfield batch`` and ``python3 -m motionfield.dask``).
+
+    Parameters
+    ----------
+    name : str
+        A method name, e.g. "interp" or "nemf".
+
+    Returns
+    -------
+    Method
+        Its name, description and flags.
+
+    Raises
+    ------
+    InvalidArgumentError
+        If no method has that name (the library's message lists the names).
+    """
+    index = ctypes.c_int32(0)
+    _check(_c.mf_method_find(name.encode(), ctypes.byref(index)))
+    return methods()[index.value]
+
+
+def printable_text(text: Union[str, bytes]) -> str:
+    """`text` as the library prints messages (mf_printable_text).
+
+    Control bytes and terminal escape sequences are escaped and the text is cut
+    at MF_MESSAGE_MAX_BYTES: what the CLI does to every message that quotes a
+    file name or input before printing it.
+
+    Parameters
+    ----------
+    text : str or bytes
+        The text (str is encoded as UTF-8, lone surrogates as "surrogateescape"
+        bytes).
+
+    Returns
+    -------
+    str
+        The printable text (invalid UTF-8 left in it is decoded with U+FFFD).
+
+    Raises
+    ------
+    OutOfMemoryError
+        Never in practice.
+    """
+    data = text if isinstance(text, bytes) else text.encode("utf-8", "surrogateescape")
+    needed = ctypes.c_size_t(0)
+    _check(_c.mf_printable_text(data, len(data), None, 0, ctypes.byref(needed)))
+    buf = ctypes.create_string_buffer(needed.value)
+    _check(_c.mf_printable_text(data, len(data), buf, needed.value, ctypes.byref(needed)))
+    return buf.value.decode("utf-8", "replace")
 
 
 @functools.lru_cache(maxsize=None)
@@ -723,6 +780,25 @@ class Model(_Handle):
     def window(self) -> int:
         """Frames per window."""
         return self._i32(_c.mf_model_get_window)
+
+    def describe(self) -> Dict[str, Any]:
+        """What the model holds and what did not load with it (mf_model_describe).
+
+        Returns
+        -------
+        dict
+            {"format_version", "joints", "fps", "window", "inbetweeners":
+            {kind: {"file", "loaded", "error"}}, "rig_anatomy",
+            "rig_anatomy_error"}: a transformer file next to the model that
+            was there but did not load has "loaded" False and the reason in
+            "error" (the default method then runs without it).
+
+        Raises
+        ------
+        InvalidArgumentError
+            If the model is closed.
+        """
+        return json.loads(_read_string(_c.mf_model_describe, self._live()))
 
     @property
     def latent_sizes(self) -> Tuple[int, int]:
@@ -1194,13 +1270,13 @@ class _TaskCall:
         if cancel is not None:
             self.options.cancel = cancel._live()
 
-    def run(self, fn: Any, *args: Any) -> Motion:
-        out = ctypes.POINTER(_c.MfMotion)()
+    def run(self, fn: Any, *args: Any, out_type: Any = None) -> Any:
+        out = ctypes.POINTER(out_type or _c.MfMotion)()
         status = fn(*args, ctypes.byref(self.options), ctypes.byref(out))
         if self.error is not None:
             raise self.error
         _check(status)
-        return Motion._wrap(out)
+        return out if out_type is not None else Motion._wrap(out)
 
 
 def _task_model(model: Optional[Model], method: Optional[str]) -> Any:
@@ -1360,6 +1436,301 @@ def resample(motion: Motion, fps: float, *, method: Optional[str] = None, model:
     return call.run(_c.mf_resample, _task_model(model, method), motion._live(), float(fps))
 
 
+# ------------------------------------------------------------------ constraints
+
+_ROOT_FLAGS = {None: 0, "none": 0, "position": _c.ROOT_POSITION, "rotation": _c.ROOT_ROTATION,
+               "both": _c.ROOT_POSITION | _c.ROOT_ROTATION}
+
+#: A partial key: (frame, joint names) or (frame, joint names, root), root one
+#: of None/"none", "position", "rotation", "both".
+PartialKey = Union[Tuple[int, Sequence[str]], Tuple[int, Sequence[str], Optional[str]]]
+#: An end-effector target: (frame, joint, [x, y, z]) or (frame, joint, [x, y, z], weight).
+Target = Union[Tuple[int, str, npt.ArrayLike], Tuple[int, str, npt.ArrayLike, float]]
+
+
+class Constraints(_Handle):
+    """Constraints beyond whole-pose keyframes (docs/CONSTRAINTS.md): partial
+    keys, end-effector targets and contact pins. Joints are named as in the
+    input motion, frames are its frames, positions are in its world frame and
+    its own length unit. Names and frames are checked when solve() runs.
+
+    Parameters
+    ----------
+    json_or_dict : str or dict, optional
+        The constraints file format, as JSON text or the equivalent dict;
+        empty when omitted.
+
+    Raises
+    ------
+    InvalidArgumentError
+        If the JSON is malformed (the message names the item).
+    """
+
+    _destroy = _c.mf_constraints_destroy
+
+    def __init__(self, json_or_dict: Union[str, Dict[str, Any], None] = None) -> None:
+        out = ctypes.POINTER(_c.MfConstraints)()
+        if json_or_dict is None:
+            _check(_c.mf_constraints_create(ctypes.byref(out)))
+        else:
+            text = (json_or_dict if isinstance(json_or_dict, str) else json.dumps(json_or_dict)).encode()
+            _check(_c.mf_constraints_parse_json(text, len(text), ctypes.byref(out)))
+        super().__init__(out)
+
+    @classmethod
+    def load(cls, path: PathLike) -> "Constraints":
+        """Reads a constraints file.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The JSON file.
+
+        Returns
+        -------
+        Constraints
+
+        Raises
+        ------
+        FileError
+            If it cannot be read.
+        InvalidArgumentError
+            If it is malformed (the message starts with the path).
+        """
+        out = ctypes.POINTER(_c.MfConstraints)()
+        _check(_c.mf_constraints_load_json(os.fsencode(path), ctypes.byref(out)))
+        c = cls.__new__(cls)
+        _Handle.__init__(c, out)
+        return c
+
+    def add_keys(self, frames: Sequence[int]) -> "Constraints":
+        """Adds whole-pose keys.
+
+        Parameters
+        ----------
+        frames : sequence of int
+            Frame indices, any order.
+
+        Returns
+        -------
+        Constraints
+            self, for chaining.
+
+        Raises
+        ------
+        InvalidArgumentError
+            If a frame is negative.
+        """
+        f = np.ascontiguousarray(frames, dtype=np.int32).reshape(-1)
+        _check(_c.mf_constraints_add_pose_keys(self._live(), f.ctypes.data_as(ctypes.POINTER(ctypes.c_int32)), f.size))
+        return self
+
+    def add_partial_key(self, frame: int, joints: Sequence[str] = (), root: Optional[str] = None) -> "Constraints":
+        """Adds a partial key: the local rotations of some joints and/or the root.
+
+        Parameters
+        ----------
+        frame : int
+            The key's frame.
+        joints : sequence of str
+            Joints whose local rotation the input gives at that frame.
+        root : {None, "none", "position", "rotation", "both"}
+            What of the root the key fixes.
+
+        Returns
+        -------
+        Constraints
+            self, for chaining.
+
+        Raises
+        ------
+        InvalidArgumentError
+            If the key constrains nothing or `root` is not one of the above.
+        """
+        if root not in _ROOT_FLAGS:
+            raise InvalidArgumentError("root must be None, 'none', 'position', 'rotation' or 'both', not %r" % (root,))
+        names = [j.encode() for j in joints]
+        arr = (ctypes.c_char_p * max(1, len(names)))(*names)
+        _check(_c.mf_constraints_add_partial_key(self._live(), int(frame), arr, len(names), _ROOT_FLAGS[root]))
+        return self
+
+    def add_target(self, frame: int, joint: str, position: npt.ArrayLike, weight: float = 1.0) -> "Constraints":
+        """Adds an end-effector target.
+
+        Parameters
+        ----------
+        frame : int
+            The frame.
+        joint : str
+            The joint to place (a hand, a foot).
+        position : array_like, shape (3,)
+            World position, in the input's length unit.
+        weight : float
+            Relative weight (finite, >= 0).
+
+        Returns
+        -------
+        Constraints
+            self, for chaining.
+
+        Raises
+        ------
+        InvalidArgumentError
+            If the position or the weight is not finite (or the weight negative).
+        """
+        p = np.ascontiguousarray(position, dtype=np.float32).reshape(-1)
+        if p.size != 3:
+            raise InvalidArgumentError("position must have 3 values [x, y, z], not %d" % p.size)
+        _check(_c.mf_constraints_add_target(self._live(), int(frame), joint.encode(), _f32_ptr(p), float(weight)))
+        return self
+
+    def add_contact(self, joint: str, first: int, last: int) -> "Constraints":
+        """Pins a joint in place from frame `first` to frame `last` (inclusive).
+
+        Parameters
+        ----------
+        joint : str
+            A foot, a hand.
+        first, last : int
+            The pinned frames, first < last.
+
+        Returns
+        -------
+        Constraints
+            self, for chaining.
+
+        Raises
+        ------
+        InvalidArgumentError
+            If first >= last or a frame is negative.
+        """
+        _check(_c.mf_constraints_add_contact(self._live(), joint.encode(), int(first), int(last)))
+        return self
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The constraints in the file format.
+
+        Returns
+        -------
+        dict
+
+        Raises
+        ------
+        InvalidArgumentError
+            If the object is closed.
+        """
+        return json.loads(_read_string(_c.mf_constraints_to_json, self._live()))
+
+
+class Solution(NamedTuple):
+    """What solve() returns.
+
+    Attributes
+    ----------
+    motions : list of Motion
+        The method's solution first, then the alternatives.
+    report : dict
+        How well each solution meets the constraints (mf_solution_get_report_json:
+        {"unit", "solutions": [{"index", "keys", "targets", "contacts"}], "warnings"}).
+    warnings : list of str
+        Constraints that could not hold exactly, with the frames involved.
+    """
+
+    motions: List[Motion]
+    report: Dict[str, Any]
+    warnings: List[str]
+
+    @property
+    def motion(self) -> Motion:
+        """The method's solution (motions[0])."""
+        return self.motions[0]
+
+
+@_task_doc
+def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequence[PartialKey] = (),
+          targets: Union[Sequence[Target], Dict[str, Tuple[npt.ArrayLike, npt.ArrayLike]]] = (),
+          contacts: Sequence[Tuple[str, int, int]] = (), constraints: Union[Constraints, str, Dict[str, Any], None] = None,
+          alternatives: int = 0, method: Optional[str] = None, model: Optional[Model] = None, seed: int = 0,
+          progress: Optional[ProgressCallback] = None, cancel: Optional[CancelToken] = None,
+          rig_map: Optional[RigMap] = None) -> Solution:
+    """Completes a motion under any constraints, with alternative solutions.
+
+    ``solve(motion, [0, 60], targets=[(30, "Hand_R", [20, 120, 40])])`` is
+    ``motionfield inbetween --keyframes 0,60 --constraints FILE`` with that
+    target in FILE.
+
+    Parameters
+    ----------
+    motion : Motion
+        The input; only the values the keys name are read.
+    keyframes : sequence of int
+        Whole-pose keys.
+    partial_keys : sequence of (frame, joints) or (frame, joints, root)
+        Keys of some joints' local rotations; root None, "position",
+        "rotation" or "both".
+    targets : sequence of (frame, joint, position[, weight]), or dict
+        End-effector targets in the input's unit; or {joint: (frames [n],
+        positions [n, 3])} for a joint's path over many frames.
+    contacts : sequence of (joint, first, last)
+        Joints pinned in place over frames first..last.
+    constraints : Constraints, str or dict, optional
+        More constraints: a Constraints, a constraints file's path, or the
+        file format as a dict.
+    alternatives : int
+        More solutions (0..16) from other starts, deterministic for `seed`.
+    {task_parameters}
+
+    Returns
+    -------
+    Solution
+        The motions (the method's first), the report and the warnings.
+
+    Raises
+    ------
+    {task_raises}
+    """
+    if constraints is None:
+        c = Constraints()
+    elif isinstance(constraints, Constraints):
+        c = Constraints(constraints.to_dict())
+    elif isinstance(constraints, dict):
+        c = Constraints(constraints)
+    else:
+        c = Constraints.load(constraints)
+    if len(keyframes):
+        c.add_keys(keyframes)
+    for key in partial_keys:
+        c.add_partial_key(key[0], key[1], key[2] if len(key) > 2 else None)  # type: ignore[misc]
+    if isinstance(targets, dict):
+        for joint, (frames, positions) in targets.items():
+            f = np.asarray(frames, dtype=np.int64).reshape(-1)
+            p = _float_array(positions, (3,), "positions").reshape(-1, 3)
+            if len(f) != len(p):
+                raise InvalidArgumentError("targets[%r]: %d frames but %d positions" % (joint, len(f), len(p)))
+            for frame, pos in zip(f, p):
+                c.add_target(int(frame), joint, pos)
+    else:
+        for t in targets:
+            c.add_target(t[0], t[1], t[2], t[3] if len(t) > 3 else 1.0)  # type: ignore[misc]
+    for joint, first, last in contacts:
+        c.add_contact(joint, first, last)
+    call = _TaskCall(method, seed, progress, cancel, rig_map)
+    handle = call.run(_c.mf_solve, _task_model(model, method), motion._live(), c._live(), int(alternatives),
+                      out_type=_c.MfSolution)
+    try:
+        n = ctypes.c_int32(0)
+        _check(_c.mf_solution_get_count(handle, ctypes.byref(n)))
+        motions = []
+        for i in range(n.value):
+            m = ctypes.POINTER(_c.MfMotion)()
+            _check(_c.mf_solution_get_motion(handle, i, ctypes.byref(m)))
+            motions.append(Motion._wrap(m))
+        report = json.loads(_read_string(_c.mf_solution_get_report_json, handle))
+    finally:
+        _c.mf_solution_destroy(handle)
+    return Solution(motions, report, list(report.get("warnings", [])))
+
+
 def resample_frame_count(frames: int, fps_in: float, fps_out: float) -> Tuple[int, bool]:
     """How many frames resample() makes.
 
@@ -1385,6 +1756,29 @@ def resample_frame_count(frames: int, fps_in: float, fps_out: float) -> Tuple[in
     _check(_c.mf_resample_frame_count(int(frames), float(fps_in), float(fps_out), ctypes.byref(n),
                                       ctypes.byref(rounded)))
     return n.value, bool(rounded.value)
+
+
+def length_unit_scale(unit: str) -> float:
+    """Metres per unit of a BVH length unit name (mf_length_unit_scale).
+
+    Parameters
+    ----------
+    unit : str
+        "cm", "m", "mm", "in", "ft" or "asf".
+
+    Returns
+    -------
+    float
+        Metres per unit, e.g. 0.01 for "cm".
+
+    Raises
+    ------
+    InvalidArgumentError
+        If the name is not a known unit (the message lists them).
+    """
+    v = ctypes.c_double(0)
+    _check(_c.mf_length_unit_scale(unit.encode(), ctypes.byref(v)))
+    return v.value
 
 
 def load_path_csv(path: PathLike) -> FloatArray:

@@ -43,6 +43,8 @@ ROOT_FROM_INPUT = 1
 
 PATH_PER_FRAME = 0
 PATH_POLYLINE = 1
+ROOT_POSITION = 1
+ROOT_ROTATION = 2
 
 
 class MfModel(ctypes.Structure):
@@ -59,6 +61,32 @@ class MfEncoding(ctypes.Structure):
 
 class MfCancelToken(ctypes.Structure):
     """Opaque mf_cancel_token."""
+
+
+class MfConstraints(ctypes.Structure):
+    """Opaque mf_constraints."""
+
+
+class MfSolution(ctypes.Structure):
+    """Opaque mf_solution."""
+
+
+class MfConstraintReport(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("key_rotations", ctypes.c_int32),
+        ("key_rotation_max_deg", ctypes.c_double),
+        ("key_rotation_mean_deg", ctypes.c_double),
+        ("key_roots", ctypes.c_int32),
+        ("key_root_max", ctypes.c_double),
+        ("key_root_mean", ctypes.c_double),
+        ("targets", ctypes.c_int32),
+        ("target_max", ctypes.c_double),
+        ("target_mean", ctypes.c_double),
+        ("contact_frames", ctypes.c_int32),
+        ("contact_slide_max", ctypes.c_double),
+        ("contact_slide_mean", ctypes.c_double),
+    ]
 
 
 class MfProgress(ctypes.Structure):
@@ -289,6 +317,25 @@ _declare("mf_motion_get_length_scale", _int, _motion, _P(_f64))
 _declare("mf_length_unit_scale", _int, _str, _P(_f64))
 _declare("mf_rig_describe", _int, _model, _motion, _str, ctypes.c_char_p, _size, _P(_size))
 _declare("mf_motion_get_warnings", _int, _motion, ctypes.c_char_p, _size, _P(_size))
+
+_constraints = _P(MfConstraints)
+_solution = _P(MfSolution)
+_declare("mf_constraints_create", _int, _P(_constraints))
+_declare("mf_constraints_parse_json", _int, ctypes.c_char_p, _size, _P(_constraints))
+_declare("mf_constraints_load_json", _int, _str, _P(_constraints))
+_declare("mf_constraints_destroy", None, _constraints)
+_declare("mf_constraints_add_pose_keys", _int, _constraints, _P(_i32), _size)
+_declare("mf_constraints_add_partial_key", _int, _constraints, _i32, _P(_str), _size, _u32)
+_declare("mf_constraints_add_target", _int, _constraints, _i32, _str, _P(_f32), _f32)
+_declare("mf_constraints_add_contact", _int, _constraints, _str, _i32, _i32)
+_declare("mf_constraints_to_json", _int, _constraints, ctypes.c_char_p, _size, _P(_size))
+_declare("mf_solve", _int, _model, _motion, _constraints, _i32, _P(MfTaskOptions), _P(_solution))
+_declare("mf_solution_destroy", None, _solution)
+_declare("mf_solution_get_count", _int, _solution, _P(_i32))
+_declare("mf_solution_get_motion", _int, _solution, _i32, _P(_motion))
+_declare("mf_constraint_report_init", _int, _P(MfConstraintReport))
+_declare("mf_solution_get_report", _int, _solution, _i32, _P(MfConstraintReport))
+_declare("mf_solution_get_report_json", _int, _solution, ctypes.c_char_p, _size, _P(_size))
 
 if mf_abi_version() != ABI_VERSION:  # noqa: F821 (declared above)
     raise ImportError("%s has ABI version %d; this package needs %d" %

@@ -42,6 +42,16 @@ TEST(CApiLayout, TaskOptions) {
 }
 
 TEST(CApiLayout, CodecOptions) {
+  EXPECT_EQ(sizeof(mf_constraint_report), 96u);
+  EXPECT_EQ(offsetof(mf_constraint_report, struct_size), 0u);
+  EXPECT_EQ(offsetof(mf_constraint_report, key_rotations), 4u);
+  EXPECT_EQ(offsetof(mf_constraint_report, key_rotation_max_deg), 8u);
+  EXPECT_EQ(offsetof(mf_constraint_report, key_roots), 24u);
+  EXPECT_EQ(offsetof(mf_constraint_report, key_root_max), 32u);
+  EXPECT_EQ(offsetof(mf_constraint_report, targets), 48u);
+  EXPECT_EQ(offsetof(mf_constraint_report, target_max), 56u);
+  EXPECT_EQ(offsetof(mf_constraint_report, contact_frames), 72u);
+  EXPECT_EQ(offsetof(mf_constraint_report, contact_slide_max), 80u);
   EXPECT_EQ(sizeof(mf_codec_options), 12u);
   EXPECT_EQ(offsetof(mf_codec_options, struct_size), 0u);
   EXPECT_EQ(offsetof(mf_codec_options, hop), 4u);

@@ -1,0 +1,225 @@
+"""A library of clips on Dask: the jobs of ``motionfield batch`` on a cluster.
+
+Usage::
+
+    python3 -m motionfield.dask JOBS.jsonl [--workers N | --scheduler ADDRESS]
+        [--threads N] [--model PATH] [--twostage PATH] [--citl PATH]
+        [--rig-map FILE] [--units U] [--json] [--quiet] [--verbose]
+
+Reads the same JSON-lines jobs as ``motionfield batch JOBS.jsonl`` (one job
+per line, the same keys, checks and messages: motionfield.batch) and runs them
+on a ``distributed.Client``: a LocalCluster of N worker processes (one thread
+each) on this machine by default, or the scheduler at ADDRESS (its workers need
+this package and the library, and see the same file system). Each worker
+process loads the model once and keeps it for every job it runs; each job
+writes its output atomically (the library writes a temporary file in the
+output's directory and renames it). The outputs are those of ``motionfield
+batch`` with the same ``--threads`` (the intra-op threads of each worker
+process, 2 by default as for the CLI), bit for bit. Messages are the CLI's:
+a failed job is reported on stderr with its line and id (the others still
+run), ``--json`` prints one summary per job on stdout, in line order; the exit
+code is 0 when every job succeeded, 1 when one hit an internal error, else 2.
+On a terminal, a progress line on stderr counts the finished jobs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import sys
+import time
+import uuid
+from typing import Dict, List, Optional, Sequence
+
+from . import batch as mfb
+
+
+def _arguments(argv: Optional[Sequence[str]]) -> argparse.Namespace:
+    p = argparse.ArgumentParser(
+        prog="python3 -m motionfield.dask",
+        description="Runs the jobs of a `motionfield batch` file (JSON lines) on Dask: a local cluster of "
+                    "worker processes, or an existing scheduler.")
+    p.add_argument("jobs", metavar="JOBS.jsonl", help="the jobs, one JSON object per line")
+    where = p.add_mutually_exclusive_group()
+    where.add_argument("--workers", type=int, default=2, metavar="N",
+                       help="worker processes of the local cluster, one thread each (default 2)")
+    where.add_argument("--scheduler", type=_non_empty, metavar="ADDRESS",
+                       help="an existing Dask scheduler, e.g. tcp://host:8786")
+    p.add_argument("--threads", type=int, default=2, metavar="N",
+                   help="intra-op threads of each worker process (default 2, as the CLI's --threads)")
+    p.add_argument("--model", type=_non_empty, metavar="PATH",
+                   help="the prior's model file (default: the default model)")
+    p.add_argument("--twostage", action="append", default=[], type=_non_empty, metavar="PATH",
+                   help="a two-stage transformer file (repeatable)")
+    p.add_argument("--citl", action="append", default=[], type=_non_empty, metavar="PATH",
+                   help="a CITL transformer file (repeatable)")
+    p.add_argument("--rig-map", type=_non_empty, metavar="FILE", help="a JSON rig map for every job without its own")
+    p.add_argument("--units", "--length-scale", default="", metavar="U",
+                   help="the BVH length unit of every job without its own (default auto)")
+    p.add_argument("--json", action="store_true", help="a JSON summary of each job on stdout, in line order")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress line and no warnings")
+    p.add_argument("-v", "--verbose", action="store_true", help="what each job ran and how long it took (stderr)")
+    args = p.parse_args(argv)
+    if not 1 <= args.workers <= 256:
+        p.error("--workers must be 1 to 256")
+    if not 1 <= args.threads <= 1024:
+        p.error("--threads must be 1 to 1024")
+    return args
+
+
+def _non_empty(value: str) -> str:
+    """An option's value; an empty one (--model "") would silently mean the default: refused, as by the CLI."""
+    if not value:
+        raise argparse.ArgumentTypeError("needs a value")
+    return value
+
+
+class _ProgressLine:
+    """"[done/total] jobs" on stderr, redrawn as jobs finish (a terminal only)."""
+
+    def __init__(self, enabled: bool, total: int) -> None:
+        self.enabled, self.total, self.start = enabled, total, time.monotonic()
+        self.drawn = False
+
+    def draw(self, done: int, failed: int) -> None:
+        if not self.enabled:
+            return
+        width = 30
+        filled = width * done // max(self.total, 1)
+        sys.stderr.write("\r\033[K[%s%s] %d/%d jobs, %d failed, %.0f s" % (
+            "#" * filled, "." * (width - filled), done, self.total, failed, time.monotonic() - self.start))
+        sys.stderr.flush()
+        self.drawn = True
+
+    def clear(self) -> None:
+        if self.drawn:
+            sys.stderr.write("\r\033[K")
+            sys.stderr.flush()
+            self.drawn = False
+
+
+def _distributed():  # type: ignore[no-untyped-def]
+    try:
+        import distributed
+    except ImportError as e:
+        raise mfb.InputError("python3 -m motionfield.dask needs Dask's distributed package (Debian: "
+                             "python3-distributed; `make deps` installs it): %s" % e) from None
+    return distributed
+
+
+def _client(args: argparse.Namespace):  # type: ignore[no-untyped-def]
+    distributed = _distributed()
+
+    if args.scheduler:
+        return distributed.Client(args.scheduler), None
+    cluster = distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                                       dashboard_address=None, silence_logs=logging.ERROR, memory_limit=0)
+    return distributed.Client(cluster), cluster
+
+
+class _Printer:
+    """Prints each line's messages in line order, as soon as every earlier line has finished."""
+
+    def __init__(self, entries: List[mfb.Entry], settings: mfb.Settings, progress: _ProgressLine) -> None:
+        self.entries, self.settings, self.progress = entries, settings, progress
+        self.outcomes: Dict[int, mfb.Outcome] = {}
+        self.printed = 0
+        self.warned = False  # the model's load warnings go to the first job without a method, once
+
+    def finish(self, k: int, outcome: mfb.Outcome) -> None:
+        self.outcomes[k] = outcome
+        self.progress.clear()
+        while self.printed < len(self.entries) and self.printed in self.outcomes:
+            o = self.outcomes[self.printed]
+            if o.asked_load_warnings and not self.warned:
+                self.warned = True
+                if o.ok and o.report is not None:
+                    o.report.warnings = o.load_warnings + o.report.warnings
+            err, out = mfb.outcome_text(self.entries[self.printed], o, self.settings)
+            sys.stderr.write(err)
+            sys.stderr.flush()
+            sys.stdout.write(out)
+            sys.stdout.flush()
+            self.printed += 1
+        self.progress.draw(len(self.outcomes), sum(1 for x in self.outcomes.values() if not x.ok))
+
+
+def _run(args: argparse.Namespace, settings: mfb.Settings) -> int:
+    entries = mfb.read_batch(args.jobs)
+    settings.preload_model = bool(settings.model) or any(mfb.needs_model(e.job) for e in entries if e.runnable)
+    if settings.model:  # a --model that does not load fails the batch before any job, as in the CLI
+        mfb.Models(settings.model, settings.transformers()).load_explicit()
+    progress = _ProgressLine(sys.stderr.isatty() and not settings.quiet, len(entries))
+    printer = _Printer(entries, settings, progress)
+    runnable = [k for k, e in enumerate(entries) if e.runnable]
+    if runnable:
+        distributed = _distributed()
+        progress.draw(0, 0)
+        client, cluster = _client(args)
+        try:
+            run = uuid.uuid4().hex[:12]  # task keys unique to this run: a shared scheduler merges equal keys
+            futures = {client.submit(mfb.run_job_in_process, entries[k].job, settings, pure=False,
+                                     key="motionfield-%s-line-%d" % (run, entries[k].line)): k for k in runnable}
+            for k, e in enumerate(entries):
+                if not e.runnable:
+                    printer.finish(k, mfb.Outcome(failure=e.failure))
+            for future in distributed.as_completed(futures):
+                k = futures[future]
+                try:
+                    outcome = future.result()
+                except Exception as err:  # noqa: BLE001 (a worker died: the job failed, the others go on)
+                    outcome = mfb.Outcome(failure=mfb.Failure(mfb.EXIT_INTERNAL, "the Dask worker running the job "
+                                                              "failed: %s" % (str(err) or type(err).__name__)))
+                printer.finish(k, outcome)
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    else:
+        for k, e in enumerate(entries):
+            printer.finish(k, mfb.Outcome(failure=e.failure))
+    progress.clear()
+    line, code = mfb.summary(args.jobs, [printer.outcomes[k] for k in range(len(entries))], settings, progress.enabled)
+    sys.stderr.write(line)
+    return code
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Runs a batch file on Dask (see the module's documentation).
+
+    Parameters
+    ----------
+    argv : sequence of str, optional
+        The arguments (default: sys.argv[1:]).
+
+    Returns
+    -------
+    int
+        The exit code: 0 every job succeeded, 1 an internal error, 2 bad input.
+
+    Raises
+    ------
+    SystemExit
+        For bad arguments (argparse, exit code 2).
+    """
+    args = _arguments(argv)
+    settings = mfb.Settings(threads=args.threads, verbose=args.verbose, quiet=args.quiet, json=args.json,
+                            model=args.model or "", twostage=tuple(args.twostage), citl=tuple(args.citl),
+                            rig_map=args.rig_map or "", units=args.units)
+    try:
+        import motionfield as mf
+
+        mf.set_num_threads(settings.threads)
+        if settings.verbose:
+            sys.stderr.write("motionfield: %d intra-op threads\n" % settings.threads)
+        return _run(args, settings)
+    except Exception as e:  # noqa: BLE001 (the CLI's top-level handler: a message and an exit code)
+        failure = mfb.failure_of(e)
+        sys.stderr.write(mfb.failure_line(failure))
+        return failure.exit_code
+
+
+if __name__ == "__main__":
+    os.environ.setdefault("PYTHONDONTWRITEBYTECODE", "1")
+    sys.exit(main())
