@@ -72,8 +72,8 @@ const CLI::Validator kNonEmpty(
 void add_task_files(CLI::App* cmd, BatchJob& job, const std::string& in_help) {
   cmd->add_option("-i,--in", job.in, in_help + "; - reads standard input")->required()->type_name("PATH");
   cmd->add_option("-o,--out", job.out,
-                  "output BVH (a file is replaced atomically; a device or\nFIFO is written in place); - writes "
-                  "standard output")
+                  "output: BVH, or glTF 2.0 for a name ending in .glb\n(binary) or .gltf (JSON); a file is replaced "
+                  "atomically,\na device or FIFO written in place; - writes BVH to\nstandard output")
       ->required()
       ->type_name("PATH");
 }
@@ -209,6 +209,21 @@ void define_renav(CLI::App& app, HelpFormatter& help, Arguments& a) {
               kGlobalOptionsNote);
 }
 
+void define_export(CLI::App& app, HelpFormatter& help, Arguments& a) {
+  CLI::App* cmd = add_command(app, help, "export", "write a BVH clip as glTF 2.0 (.glb or .gltf)",
+                              "motionfield export IN.bvh OUT.glb|OUT.gltf [--units U]",
+                              "Writes the motion of IN.bvh as glTF 2.0: a skin-less armature (one node per\n"
+                              "joint, named after it, its rest offset as translation) and one animation with\n"
+                              "every joint's rotation and the root's translation at each frame time. Metres\n"
+                              "(the BVH's unit is detected from the leg length unless --units names it),\n"
+                              "seconds, Y up. OUT.glb is binary, OUT.gltf JSON with the buffer embedded\n"
+                              "(base64); any other name is written as BVH. The task commands write glTF the\n"
+                              "same way: -o OUT.glb.");
+  cmd->add_option("in", a.job.in, "the BVH file; - reads standard input")->required()->type_name("IN.bvh");
+  cmd->add_option("out", a.job.out, "the output file: .glb or .gltf")->required()->type_name("OUT.glb");
+  cmd->footer(kGlobalOptionsNote);
+}
+
 void define_batch(CLI::App& app, HelpFormatter& help, Arguments& a) {
   CLI::App* cmd = add_command(
       app, help, "batch", "run many jobs from a JSON Lines file in one process",
@@ -275,13 +290,15 @@ void define_command_line(CLI::App& app, Arguments& args) {
   define_fill(app, *help, args);
   define_resample(app, *help, args);
   define_renav(app, *help, args);
+  define_export(app, *help, args);
   define_batch(app, *help, args);
   define_rig(app, *help, args);
   app.footer(
       "Any humanoid rig works, in its own unit and frame rate: methods that need the\n"
       "model retarget it to the model's rig and back (`motionfield rig IN.bvh` shows\n"
       "the map). Output BVH files keep the input's skeleton, channel layout, unit and\n"
-      "frame time.\n"
+      "frame time; outputs named .glb or .gltf are glTF 2.0 in metres (motionfield\n"
+      "export --help).\n"
       "A progress bar (iterations, windows, time left) is drawn on stderr when it is a\n"
       "terminal, unless --quiet. Messages quote file names and input with control\n"
       "characters escaped.\n"

@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -130,7 +132,7 @@ Solved solve(const BatchJob& job, const Settings& settings, const Model& model, 
 
 // The method that ran.
 std::string method_name(const BatchJob& job, const Model& model) {
-  if (!job.method.empty()) return job.method;
+  if (!job.method.empty() || job.task == "export") return job.method;
   if (job.task == "resample") return model ? "prior" : "interp";
   if (job.task == "renav") return "nemf";
   return default_method(model);
@@ -159,6 +161,28 @@ void write_text_file(const std::string& path, const std::string& text) {
   }
 }
 
+// The glTF format an output's name asks for: MF_GLTF_BINARY for .glb,
+// MF_GLTF_EMBEDDED for .gltf (any case), else -1 (BVH).
+int gltf_format_of(const std::string& out) {
+  const size_t dot = out.rfind('.');
+  if (dot == std::string::npos || out.find('/', dot) != std::string::npos) return -1;
+  std::string ext = out.substr(dot + 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == "glb" ? MF_GLTF_BINARY : ext == "gltf" ? MF_GLTF_EMBEDDED : -1;
+}
+
+// Writes `result` to `out`: "-" is standard output (BVH), a .glb or .gltf
+// name glTF 2.0, anything else BVH.
+void write_output(const Motion& result, const std::string& out) {
+  const int gltf = out == kStdio ? -1 : gltf_format_of(out);
+  if (out == kStdio)
+    write_stdout(result);
+  else if (gltf >= 0)
+    result.save_gltf(out, gltf);
+  else
+    result.save_bvh(out);
+}
+
 double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
 }  // namespace
@@ -171,26 +195,27 @@ std::string alternative_path(const std::string& out, int index) {
 JobReport run_job(const BatchJob& job, const Settings& settings, Models& models, ProgressLine& progress) {
   const auto t0 = Clock::now();
   check_job(job, settings);
+  // Export writes the input as it is read: no method, no model.
+  const bool export_only = job.task == "export";
+  static const Model kNoModel;
   // Re-navigation always needs the prior, whatever the method.
-  const Model& model = models.for_method(job.task == "renav" && job.method.empty() ? "nemf" : job.method);
+  const Model& model =
+      export_only ? kNoModel : models.for_method(job.task == "renav" && job.method.empty() ? "nemf" : job.method);
   JobReport report;
-  if (job.method.empty()) report.warnings = models.load_warnings();  // what the default method lost
+  if (job.method.empty() && !export_only) report.warnings = models.load_warnings();  // what the default method lost
   // Standard input through its device file: the library reads pipes and
   // redirected files with its size limit, and refuses a terminal.
   const Motion input = Motion::load_bvh(job.in == kStdio ? "/dev/stdin" : job.in,
                                         units_scale(job.units.empty() ? settings.units : job.units, "--units"));
   const auto t1 = Clock::now();
-  const Solved solved = solve(job, settings, model, input, progress);
-  const Motion& result = solved.motion;
+  const Solved solved = export_only ? Solved{} : solve(job, settings, model, input, progress);
+  const Motion& result = export_only ? input : solved.motion;
   progress.clear();
   const auto t2 = Clock::now();
-  if (job.out == kStdio)
-    write_stdout(result);
-  else
-    result.save_bvh(job.out);
+  write_output(result, job.out);
   for (size_t i = 0; i < solved.alternatives.size(); ++i) {
     report.alternatives.push_back(alternative_path(job.out, static_cast<int>(i) + 1));
-    solved.alternatives[i].save_bvh(report.alternatives.back());
+    write_output(solved.alternatives[i], report.alternatives.back());
   }
   if (!job.report_file.empty()) write_text_file(job.report_file, solved.report + "\n");
   report.constraints = solved.report;

@@ -375,6 +375,38 @@ MF_API int mf_motion_get_root_positions(const mf_motion *motion, float *out, siz
 /** [frames][joints][3] global joint positions (forward kinematics), metres. */
 MF_API int mf_motion_get_global_positions(const mf_motion *motion, float *out, size_t capacity, size_t *needed);
 
+/** glTF formats (mf_gltf_options.format). */
+#define MF_GLTF_AUTO 0     /**< from the file name: ".glb" binary, ".gltf" JSON */
+#define MF_GLTF_BINARY 1   /**< .glb: JSON and binary chunks in one file */
+#define MF_GLTF_EMBEDDED 2 /**< .gltf: JSON text, the buffer embedded as base64 */
+
+/** glTF writing options. */
+typedef struct mf_gltf_options {
+  uint32_t struct_size;
+  /** MF_GLTF_AUTO (0, the default): from the path's extension (".glb" or
+   *  ".gltf", any case; another name is MF_ERROR_INVALID_ARGUMENT), binary
+   *  for mf_motion_save_gltf_to_memory. MF_GLTF_BINARY or MF_GLTF_EMBEDDED
+   *  whatever the name. */
+  int32_t format;
+} mf_gltf_options;
+
+MF_API int mf_gltf_options_init(mf_gltf_options *options);
+/** Writes the motion as glTF 2.0, atomically: a skin-less armature, one node
+ *  per joint named after it (node j = joint j, children as in the skeleton,
+ *  translation = the joint's rest offset, rotation identity; the scene's root
+ *  is joint 0), and one animation "motion" with LINEAR samplers at the frame
+ *  times (frame f at f / fps seconds): every joint's local rotation and joint
+ *  0's translation (the root positions). Metres (a BVH's unit converted with
+ *  the length scale it was read with, mf_motion_get_length_scale), seconds,
+ *  Y up; 32-bit floats. MF_ERROR_IO if the file cannot be written;
+ *  MF_ERROR_INVALID_ARGUMENT for an unknown extension with MF_GLTF_AUTO or a
+ *  motion glTF cannot hold (a number beyond 32-bit floats). */
+MF_API int mf_motion_save_gltf(const mf_motion *motion, const char *path, const mf_gltf_options *options);
+/** The same bytes into a caller buffer (a buffer getter, see "Arrays": counts
+ *  in bytes; the JSON of MF_GLTF_EMBEDDED has no terminating NUL). */
+MF_API int mf_motion_save_gltf_to_memory(const mf_motion *motion, const mf_gltf_options *options, uint8_t *out,
+                                         size_t capacity, size_t *needed);
+
 /* ================================================================ tasks */
 
 /** Options of every task. Fields a task does not use are ignored. */

@@ -232,6 +232,19 @@ class Motion : public detail::Handle<mf_motion, mf_motion_destroy> {
     });
   }
 
+  /// mf_motion_save_gltf (atomic); format MF_GLTF_AUTO: from the extension (.glb, .gltf).
+  void save_gltf(const std::string& path, int32_t format = MF_GLTF_AUTO) const {
+    const mf_gltf_options o = gltf_options(format);
+    check(mf_motion_save_gltf(get(), path.c_str(), &o));
+  }
+  /// mf_motion_save_gltf_to_memory: the bytes save_gltf would write (binary by default).
+  std::vector<uint8_t> to_gltf(int32_t format = MF_GLTF_BINARY) const {
+    const mf_gltf_options o = gltf_options(format);
+    return detail::read_array<uint8_t>([&](uint8_t* out, size_t capacity, size_t* needed) {
+      return mf_motion_save_gltf_to_memory(get(), &o, out, capacity, needed);
+    });
+  }
+
   int32_t frame_count() const { return value<int32_t>(mf_motion_get_frame_count); }
   int32_t joint_count() const { return value<int32_t>(mf_motion_get_joint_count); }
   double fps() const { return value<double>(mf_motion_get_fps); }
@@ -271,6 +284,12 @@ class Motion : public detail::Handle<mf_motion, mf_motion_destroy> {
     mf_bvh_options o;
     check(mf_bvh_options_init(&o));
     o.length_scale = length_scale;
+    return o;
+  }
+  static mf_gltf_options gltf_options(int32_t format) {
+    mf_gltf_options o;
+    check(mf_gltf_options_init(&o));
+    o.format = format;
     return o;
   }
   template <class T, class Get>

@@ -11,6 +11,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/motion_bvh.h"
+#include "prior/motion/motion_gltf.h"
 #include "prior/rig/units.h"
 #include "prior/util/binary_io.h"
 
@@ -148,6 +149,22 @@ BvhDocument document_of(const mf_motion& m, const BvhUnits& units) {
   return doc;
 }
 
+// The glTF format of `options` for `path` ("" for memory: binary by default).
+GltfFormat gltf_format_of(const mf_gltf_options* options, const std::string& path) {
+  const mf_gltf_options o = read_options(options, "mf_gltf_options");
+  if (o.format == MF_GLTF_BINARY) return GltfFormat::Binary;
+  if (o.format == MF_GLTF_EMBEDDED) return GltfFormat::Embedded;
+  if (o.format != MF_GLTF_AUTO)
+    throw ApiError(MF_ERROR_INVALID_ARGUMENT, "mf_gltf_options.format must be MF_GLTF_AUTO, MF_GLTF_BINARY or "
+                                              "MF_GLTF_EMBEDDED, not " + std::to_string(o.format));
+  GltfFormat format = GltfFormat::Binary;
+  if (!path.empty() && !gltf_format_from_path(path, &format))
+    throw ApiError(MF_ERROR_INVALID_ARGUMENT, "cannot tell the glTF format of " + path +
+                                                  ": name it .glb (binary) or .gltf (JSON), or set "
+                                                  "mf_gltf_options.format");
+  return format;
+}
+
 }  // namespace
 
 mf_motion* derived_motion(Motion motion, const mf_motion& like) {
@@ -260,6 +277,24 @@ int mf_motion_save_bvh_to_memory(const mf_motion* motion, const mf_bvh_options* 
     const mf_motion& m = mf::capi::get(motion);
     const std::string text = mf::format_bvh(mf::capi::document_of(m, mf::capi::units_of(options, m.length_scale)));
     mf::capi::write_string(text, out, capacity, needed);
+  });
+}
+
+int mf_motion_save_gltf(const mf_motion* motion, const char* path, const mf_gltf_options* options) {
+  return guard([&] {
+    const mf_motion& m = mf::capi::get(motion);
+    require(path, "path");
+    if (!*path) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the output path is empty");
+    mf::write_gltf_file(path, m.motion, mf::capi::gltf_format_of(options, path));  // FileError: MF_ERROR_IO
+  });
+}
+
+int mf_motion_save_gltf_to_memory(const mf_motion* motion, const mf_gltf_options* options, uint8_t* out,
+                                  size_t capacity, size_t* needed) {
+  return guard([&] {
+    const mf_motion& m = mf::capi::get(motion);
+    const std::vector<uint8_t> bytes = mf::format_gltf(m.motion, mf::capi::gltf_format_of(options, ""));
+    mf::capi::write_buffer(bytes.data(), bytes.size(), out, capacity, needed);
   });
 }
 

@@ -330,6 +330,14 @@ int mf_bvh_options_init(mf_bvh_options* options) {
   });
 }
 
+int mf_gltf_options_init(mf_gltf_options* options) {
+  return guard([&] {
+    require(options, "options");
+    std::memset(options, 0, sizeof *options);
+    options->struct_size = sizeof *options;
+  });
+}
+
 int mf_task_options_init(mf_task_options* options) {
   return guard([&] {
     require(options, "options");

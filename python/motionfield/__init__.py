@@ -207,6 +207,18 @@ def _bvh_options(length_scale: Optional[float]) -> Any:
     return o
 
 
+_GLTF_FORMATS = {None: 0, "auto": 0, "glb": 1, "gltf": 2}  # MF_GLTF_AUTO, MF_GLTF_BINARY, MF_GLTF_EMBEDDED
+
+
+def _gltf_options(format: Optional[str]) -> Any:
+    if format not in _GLTF_FORMATS:
+        raise InvalidArgumentError("format must be None, 'auto', 'glb' or 'gltf', not %r" % (format,))
+    o = _c.MfGltfOptions()
+    _check(_c.mf_gltf_options_init(ctypes.byref(o)))
+    o.format = _GLTF_FORMATS[format]
+    return o
+
+
 def _units_scale(units: Union[str, float, None], length_scale: Optional[float]) -> Optional[float]:
     """Metres per file unit for reading: None or "auto" -> None (detected), a
     unit name ("cm", "m", "mm", "in", "ft", "asf") or a number."""
@@ -1010,6 +1022,62 @@ class Motion(_Handle):
         """
         o = _bvh_options(length_scale)
         return _read_string(_c.mf_motion_save_bvh_to_memory, self._live(), ctypes.byref(o))
+
+    def save_gltf(self, path: PathLike, format: Optional[str] = None) -> None:
+        """Writes glTF 2.0 (atomically): a skin-less armature and one animation.
+
+        One node per joint (named after it, its rest offset as translation, the
+        skeleton's hierarchy) and one animation with every joint's rotation and
+        the root's translation at the frame times; metres (a BVH's unit
+        converted with the length scale it was read with), seconds, Y up
+        (mf_motion_save_gltf).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+        format : {None, "auto", "glb", "gltf"}, optional
+            "glb" binary, "gltf" JSON with the buffer embedded (base64); None or
+            "auto" from the extension of `path` (.glb or .gltf).
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        InvalidArgumentError
+            If the format is unknown, or None with another extension.
+        FileError
+            If the file cannot be written.
+        """
+        o = _gltf_options(format)
+        _check(_c.mf_motion_save_gltf(self._live(), os.fspath(path).encode(), ctypes.byref(o)))
+
+    def to_gltf_bytes(self, format: str = "glb") -> bytes:
+        """The bytes save_gltf() would write.
+
+        Parameters
+        ----------
+        format : {"glb", "gltf"}, optional
+            Binary glTF (the default) or the JSON text with the buffer embedded.
+
+        Returns
+        -------
+        bytes
+
+        Raises
+        ------
+        InvalidArgumentError
+            If the format is unknown.
+        """
+        o = _gltf_options(format)
+        needed = ctypes.c_size_t(0)
+        _check(_c.mf_motion_save_gltf_to_memory(self._live(), ctypes.byref(o), None, 0, ctypes.byref(needed)))
+        buf = (ctypes.c_uint8 * needed.value)()
+        _check(_c.mf_motion_save_gltf_to_memory(self._live(), ctypes.byref(o), buf, needed.value,
+                                                ctypes.byref(needed)))
+        return bytes(buf)
 
     def _i32(self, getter: Any) -> int:
         v = ctypes.c_int32(0)

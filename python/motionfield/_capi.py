@@ -110,6 +110,13 @@ class MfBvhOptions(ctypes.Structure):
     ]
 
 
+class MfGltfOptions(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("format", ctypes.c_int32),
+    ]
+
+
 class MfTaskOptions(ctypes.Structure):
     _fields_ = [
         ("struct_size", ctypes.c_uint32),
@@ -281,6 +288,9 @@ _declare("mf_motion_get_offsets", _int, _motion, _P(_f32), _size, _P(_size))
 _declare("mf_motion_get_rotations", _int, _motion, _P(_f32), _size, _P(_size))
 _declare("mf_motion_get_root_positions", _int, _motion, _P(_f32), _size, _P(_size))
 _declare("mf_motion_get_global_positions", _int, _motion, _P(_f32), _size, _P(_size))
+_declare("mf_gltf_options_init", _int, _P(MfGltfOptions))
+_declare("mf_motion_save_gltf", _int, _motion, _str, _P(MfGltfOptions))
+_declare("mf_motion_save_gltf_to_memory", _int, _motion, _P(MfGltfOptions), _P(ctypes.c_uint8), _size, _P(_size))
 
 _declare("mf_task_options_init", _int, _P(MfTaskOptions))
 _declare("mf_inbetween", _int, _model, _motion, _P(_i32), _size, _P(MfTaskOptions), _P(_motion))

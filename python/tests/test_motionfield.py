@@ -8,8 +8,10 @@ one with mf_capi_tiny_model) and the bundled model (in the repository); they
 fail without them, so that a broken set-up cannot pass by skipping.
 """
 
+import base64
 import json
 import os
+import struct
 import sys
 import tempfile
 import threading
@@ -120,6 +122,48 @@ class MotionTest(unittest.TestCase):
             m.save_bvh(path)
             with open(path) as f:
                 self.assertEqual(f.read(), text)
+
+    def test_gltf(self):
+        m = mf.Motion.load_bvh(SAMPLE)  # centimetres: glTF is in metres
+
+        def check(doc, buffer):
+            self.assertEqual([n["name"] for n in doc["nodes"]], m.joint_names)
+            np.testing.assert_allclose([n["translation"] for n in doc["nodes"]], m.offsets, atol=1e-6)
+            channels = doc["animations"][0]["channels"]
+            self.assertEqual(len(channels), m.joint_count + 1)
+
+            def output(channel):
+                accessor = doc["accessors"][doc["animations"][0]["samplers"][channel["sampler"]]["output"]]
+                view = doc["bufferViews"][accessor["bufferView"]]
+                return np.frombuffer(buffer, np.float32, view["byteLength"] // 4, view.get("byteOffset", 0))
+
+            root = [c for c in channels if c["target"]["path"] == "translation"][0]
+            np.testing.assert_allclose(output(root).reshape(-1, 3), m.root_positions, atol=1e-6)
+            spine = [c for c in channels if c["target"] == {"node": 1, "path": "rotation"}][0]
+            np.testing.assert_allclose(output(spine).reshape(-1, 4), m.rotations[:, 1, [1, 2, 3, 0]], atol=1e-6)
+
+        with tempfile.TemporaryDirectory() as d:
+            m.save_gltf(os.path.join(d, "a.glb"))
+            with open(os.path.join(d, "a.glb"), "rb") as f:
+                glb = f.read()
+            self.assertEqual(glb, m.to_gltf_bytes())
+            self.assertEqual(glb[:4], b"glTF")
+            json_length = struct.unpack_from("<I", glb, 12)[0]
+            check(json.loads(glb[20:20 + json_length]), glb[20 + json_length + 8:])
+            m.save_gltf(os.path.join(d, "b.gltf"))
+            with open(os.path.join(d, "b.gltf"), "rb") as f:
+                text = f.read()
+            self.assertEqual(text, m.to_gltf_bytes("gltf"))
+            doc = json.loads(text)
+            check(doc, base64.b64decode(doc["buffers"][0]["uri"].split(",", 1)[1]))
+            m.save_gltf(os.path.join(d, "c.bin"), format="glb")
+            with self.assertRaises(mf.InvalidArgumentError):
+                m.save_gltf(os.path.join(d, "d.bvh"))
+            with self.assertRaises(mf.InvalidArgumentError):
+                m.to_gltf_bytes("obj")
+            with self.assertRaises(mf.FileError):
+                m.save_gltf(os.path.join(d, "no", "e.glb"))
+            self.assertEqual(sorted(os.listdir(d)), ["a.glb", "b.gltf", "c.bin"])
 
     def test_arrays_round_trip(self):
         names, parents, offsets = small_skeleton()

@@ -514,5 +514,47 @@ TEST(CApiBadInput, NoDefaultModel) {
   unsetenv("MF_MODEL");
 }
 
+TEST(CApiBadInput, GltfOutput) {
+  const std::string dir = scratch();
+  const MotionPtr walk = random_capi_motion(5, 30.0, 1);
+  mf_gltf_options o;
+  ASSERT_EQ(mf_gltf_options_init(&o), MF_OK);
+  EXPECT_TRUE(Fails(mf_gltf_options_init(nullptr), MF_ERROR_INVALID_ARGUMENT, "options"));
+  EXPECT_TRUE(Fails(mf_motion_save_gltf(nullptr, (dir + "/a.glb").c_str(), &o), MF_ERROR_INVALID_ARGUMENT, "motion"));
+  EXPECT_TRUE(Fails(mf_motion_save_gltf(walk.get(), nullptr, &o), MF_ERROR_INVALID_ARGUMENT, "path"));
+  EXPECT_TRUE(Fails(mf_motion_save_gltf(walk.get(), "", &o), MF_ERROR_INVALID_ARGUMENT, "empty"));
+  // Unwritable: a missing directory, a directory, a read-only directory (unless root).
+  EXPECT_TRUE(Fails(mf_motion_save_gltf(walk.get(), (dir + "/no/such/dir/out.glb").c_str(), &o), MF_ERROR_IO,
+                    "cannot write " + dir + "/no/such/dir/out.glb"));
+  std::filesystem::create_directories(dir + "/d.glb");
+  EXPECT_TRUE(Fails(mf_motion_save_gltf(walk.get(), (dir + "/d.glb").c_str(), &o), MF_ERROR_IO, "cannot write"));
+  // The format: not from an unknown extension, not an unknown value, not an uninitialised struct.
+  EXPECT_TRUE(Fails(mf_motion_save_gltf(walk.get(), (dir + "/out.bvh").c_str(), &o), MF_ERROR_INVALID_ARGUMENT,
+                    ".glb"));
+  mf_gltf_options bad = o;
+  bad.format = 7;
+  EXPECT_TRUE(Fails(mf_motion_save_gltf(walk.get(), (dir + "/out.glb").c_str(), &bad), MF_ERROR_INVALID_ARGUMENT,
+                    "MF_GLTF_BINARY"));
+  bad = o;
+  bad.struct_size = 0;
+  EXPECT_TRUE(Fails(mf_motion_save_gltf(walk.get(), (dir + "/out.glb").c_str(), &bad), MF_ERROR_INVALID_ARGUMENT,
+                    "mf_gltf_options_init"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out.glb"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out.bvh"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/no"));
+  // To memory: a size query needs `needed`; a short buffer is untouched.
+  EXPECT_TRUE(Fails(mf_motion_save_gltf_to_memory(walk.get(), nullptr, nullptr, 0, nullptr),
+                    MF_ERROR_INVALID_ARGUMENT, "needed"));
+  size_t needed = 0;
+  ASSERT_EQ(mf_motion_save_gltf_to_memory(walk.get(), nullptr, nullptr, 0, &needed), MF_OK);
+  std::vector<uint8_t> small(needed - 1, 0xab);
+  size_t told = 0;
+  EXPECT_TRUE(Fails(mf_motion_save_gltf_to_memory(walk.get(), nullptr, small.data(), small.size(), &told),
+                    MF_ERROR_BUFFER_TOO_SMALL));
+  EXPECT_EQ(told, needed);
+  EXPECT_EQ(small, std::vector<uint8_t>(needed - 1, 0xab));
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace mf::capi_test

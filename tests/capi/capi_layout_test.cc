@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstddef>
+#include <cstring>
 
 #include "motionfield.h"
 
@@ -74,6 +75,20 @@ TEST(CApiLayout, Constants) {
   EXPECT_EQ(MF_ROOT_FROM_PRIOR, 0);
   EXPECT_EQ(MF_ROOT_FROM_INPUT, 1);
   EXPECT_EQ(MF_ABI_VERSION, 0);
+}
+
+TEST(CApiLayout, GltfOptions) {
+  EXPECT_EQ(sizeof(mf_gltf_options), 8u);
+  EXPECT_EQ(offsetof(mf_gltf_options, struct_size), 0u);
+  EXPECT_EQ(offsetof(mf_gltf_options, format), 4u);
+  EXPECT_EQ(MF_GLTF_AUTO, 0);
+  EXPECT_EQ(MF_GLTF_BINARY, 1);
+  EXPECT_EQ(MF_GLTF_EMBEDDED, 2);
+  mf_gltf_options o;
+  std::memset(&o, 0xff, sizeof o);
+  ASSERT_EQ(mf_gltf_options_init(&o), MF_OK);
+  EXPECT_EQ(o.struct_size, sizeof o);
+  EXPECT_EQ(o.format, MF_GLTF_AUTO);
 }
 
 // The options' defaults are all zero (the rule that makes newer structs safe).
