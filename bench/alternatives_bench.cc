@@ -1,8 +1,9 @@
 // alternatives-bench: several distinct solutions of one request
 // (tasks/jobs.h run_constrained with alternatives) on the gap-filling windows
 // of the benchmark protocol (bench/protocol.h: 10 context frames, a gap of T,
-// the target frame), optionally with end-effector targets and a contact pin
-// inside the gap taken from the ground truth. Per gap length it reports the
+// the target frame), optionally with end-effector targets (both hands at the
+// gap's middle frame) and a contact pin (where a foot of the ground truth stays
+// within 2 cm) inside the gap, taken from the ground truth. Per gap length it reports the
 // quality (L2P, L2Q, NPSS, foot skating) of the method's solution, of the mean
 // alternative, of the best alternative per window and of the worst alternative
 // (the alternative index with the highest mean L2P), the diversity (mean
@@ -66,10 +67,14 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("--method", a.method, "the method (default nemf-detail)");
   app.add_option("--seed", a.seed, "the requests' seed (default 0)");
   app.add_flag("--with-targets", a.with_targets,
-               "add end-effector targets (both hands at the gap's middle frame) and a contact pin (the foot "
-               "lowest over the gap's middle third) from the ground truth");
+               "add end-effector targets (both hands at the gap's middle frame) and a contact pin (the longest "
+               "run of gap frames where a foot stays within 2 cm in the ground truth) from the ground truth");
   app.add_option("--out", a.out, "also write the markdown to FILE");
 }
+
+struct ContactPinChoice {
+  int joint = -1, first = 0, last = 0;
+};
 
 // Targets and a pin inside the gap [a, b), from the ground truth `truth`.
 void add_truth_targets(const mf::Motion& truth, int a, int b, mf::MotionConstraints* c) {
@@ -79,17 +84,19 @@ void add_truth_targets(const mf::Motion& truth, int a, int b, mf::MotionConstrai
     const int j = truth.skeleton.find(hand);
     if (j >= 0) c->effectors.push_back({mid, j, pose.position(mid, j), 1.0});
   }
-  const int first = a + (b - a) / 3, last = a + 2 * (b - a) / 3;
-  int foot = -1;
-  double lowest = 1e9;
+  // The pin: the longest run of gap frames over which a foot stays within 2 cm
+  // of where the run starts in the ground truth (a planted foot), 3 frames or more.
+  ContactPinChoice best;
   for (const char* name : {"Foot_L", "Foot_R"}) {
     const int j = truth.skeleton.find(name);
     if (j < 0) continue;
-    double h = 0.0;
-    for (int f = first; f <= last; ++f) h += pose.position(f, j).y();
-    if (h < lowest) lowest = h, foot = j;
+    for (int s = a; s < b; ++s) {
+      int e = s;
+      while (e + 1 < b && (pose.position(e + 1, j) - pose.position(s, j)).norm() < 0.02) ++e;
+      if (e - s > best.last - best.first) best = {j, s, e};
+    }
   }
-  if (foot >= 0 && last > first) c->contacts.push_back({foot, first, last});
+  if (best.joint >= 0 && best.last - best.first >= 2) c->contacts.push_back({best.joint, best.first, best.last});
 }
 
 // Mean pairwise distance (cm) of the joints over `frames` between the solutions.
@@ -191,7 +198,7 @@ int run(Args& args, const std::string& command) {
   std::ostringstream md;
   md << "## alternatives-bench\n\n- command: `" << command << "`\n- model: " << args.model << "\n- method: "
      << args.method << ", " << args.alternatives << " alternatives, seed " << args.seed
-     << (args.with_targets ? ", with targets (both hands at the gap's middle) and a foot pin from the ground truth" : "")
+     << (args.with_targets ? ", with targets (both hands at the gap's middle) and a foot pin where the ground truth's foot is planted" : "")
      << "\n- " << args.split.split << " split, torch threads: " << at::get_num_threads() << "\n\n"
      << "| gap | windows | solution | L2P | L2Q | NPSS | skating (cm) | diversity (cm) | alternatives within 10 % "
         "of the method's L2P | constraints (largest error of any solution), time |\n"

@@ -42,6 +42,7 @@ Method solver_method(const std::string& name, const std::string& description, So
     const NemfModel& model = require_prior(ctx, "method '" + method_name + "'");
     if (!inbetweener.empty()) require_inbetweener(ctx, inbetweener, "method '" + method_name + "'");
     LatentSolverOptions o = options;
+    if (ctx.max_iterations > 0) o.max_iterations = ctx.max_iterations;
     if (variant > 0) {
       o.start_noise = kAlternativeStartNoise;
       o.start_seed = ctx.seed * 7919u + static_cast<uint64_t>(variant);
