@@ -15,7 +15,7 @@ SECONDS_PER_TARGET=${1:-60}
 shift || true
 BUILD=${FUZZ_BUILD:-build-fuzz}
 JOBS=${FUZZ_JOBS:-2}
-ALL_TARGETS=(fuzz_bvh fuzz_jsonl fuzz_path_csv fuzz_model_file fuzz_capi_motion fuzz_capi_inbetween)
+ALL_TARGETS=(fuzz_bvh fuzz_jsonl fuzz_path_csv fuzz_constraints fuzz_model_file fuzz_capi_motion fuzz_capi_inbetween)
 TARGETS=("${ALL_TARGETS[@]}")
 [ $# -gt 0 ] && TARGETS=("$@")
 
@@ -29,7 +29,7 @@ nice -n 15 cmake --build "$BUILD" -j 2 --target mf_fuzz_all
 dict_of() {
   case "$1" in
     fuzz_bvh) echo fuzz/dict/bvh.dict ;;
-    fuzz_jsonl) echo fuzz/dict/json.dict ;;
+    fuzz_jsonl | fuzz_constraints) echo fuzz/dict/json.dict ;;
     fuzz_path_csv) echo fuzz/dict/csv.dict ;;
   esac
 }
