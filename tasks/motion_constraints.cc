@@ -28,7 +28,7 @@ bool MotionConstraints::key_has_joint(size_t k, int joint) const {
 bool MotionConstraints::key_fixes_root(size_t k) const { return keys[k].root_position && key_has_joint(k, 0); }
 
 bool MotionConstraints::beyond_full_poses() const {
-  if (!effectors.empty() || !contacts.empty()) return true;
+  if (!effectors.empty() || !contacts.empty() || !trajectory.empty()) return true;
   for (const PoseKey& k : keys) {
     if (!k.joints.empty() || !k.root_position || !k.rotations) return true;
   }
@@ -71,6 +71,7 @@ void MotionConstraints::validate(int frames, int joints) const {
       throw InputError("end-effector target weight must be finite and non-negative");
   }
   validate_contacts(frames, joints);
+  validate_trajectory(frames);
   if (!anchor) {
     throw InputError(
         "at least one key must give the root's rotation and position (the solver places the motion relative to it)");
@@ -111,6 +112,22 @@ void MotionConstraints::validate_contacts(int frames, int joints) const {
   }
 }
 
+void MotionConstraints::validate_trajectory(int frames) const {
+  for (size_t i = 0; i < trajectory.size(); ++i) {
+    const TrajectoryPoint& p = trajectory[i];
+    const std::string what = "trajectory row at frame " + std::to_string(p.frame);
+    if (p.frame < 0 || p.frame >= frames)
+      throw InputError(what + " is out of range (the motion has " + std::to_string(frames) + " frames)");
+    if (i > 0 && p.frame <= trajectory[i - 1].frame)
+      throw InputError("trajectory frames must be strictly increasing (" + std::to_string(trajectory[i - 1].frame) +
+                       " is followed by " + std::to_string(p.frame) + ")");
+    if (!std::isfinite(p.x) || !std::isfinite(p.z) || !std::isfinite(p.forward_x) || !std::isfinite(p.forward_z))
+      throw InputError(what + ": values must be finite");
+    if (std::hypot(p.forward_x, p.forward_z) < 1e-6)
+      throw InputError(what + ": the facing direction (forward_x, forward_z) has zero length");
+  }
+}
+
 MotionConstraints MotionConstraints::slice(int begin, int length) const {
   MotionConstraints out;
   for (const PoseKey& k : keys) {
@@ -130,6 +147,12 @@ MotionConstraints MotionConstraints::slice(int begin, int length) const {
     s.first = std::max(p.first, begin) - begin;
     s.last = std::min(p.last, begin + length - 1) - begin;
     if (s.first < s.last) out.contacts.push_back(s);
+  }
+  for (const TrajectoryPoint& p : trajectory) {
+    if (p.frame < begin || p.frame >= begin + length) continue;
+    TrajectoryPoint s = p;
+    s.frame -= begin;
+    out.trajectory.push_back(s);
   }
   return out;
 }

@@ -45,18 +45,32 @@ struct ContactPin {
   int first = 0, last = 0;
 };
 
+/// One row of the ground trajectory the caller asks for: where the root is on
+/// the ground at `frame` (world x and z, metres) and which way it faces (the
+/// root's heading, prior/model/representation.h: a horizontal direction,
+/// normalised on validation). Rows at frames whose root position a key fixes
+/// are ignored (the known frames win).
+struct TrajectoryPoint {
+  int frame = 0;
+  double x = 0, z = 0;
+  double forward_x = 0, forward_z = 1;
+};
+
 /// Everything known about a motion to complete.
 struct MotionConstraints {
   std::vector<PoseKey> keys;              ///< strictly increasing frames
   std::vector<EffectorTarget> effectors;  ///< any order, any frames in range
   std::vector<ContactPin> contacts;       ///< any order; pins of one joint must not overlap
+  std::vector<TrajectoryPoint> trajectory;  ///< strictly increasing frames, any subset of the frames
 
   /// Full-pose keys (every joint and the root position) at `frames`.
   static MotionConstraints full_pose(const std::vector<int>& frames);
 
   /// Throws mf::InputError unless: keys are in range and strictly increasing,
   /// key joints are in range, increasing and unique, effector frames and joints
-  /// are in range with finite positions and non-negative finite weights, and at
+  /// are in range with finite positions and non-negative finite weights,
+  /// trajectory rows are in range, strictly increasing, finite, with a facing
+  /// direction of non-zero length (|(forward_x, forward_z)| >= 1e-6), and at
   /// least one key fixes the root (rotation of joint 0 and root position), which
   /// the canonical frame needs.
   void validate(int frames, int joints) const;
@@ -71,14 +85,16 @@ struct MotionConstraints {
   /// True when key `k` gives the root's rotation and position (it can anchor a window).
   bool key_fixes_root(size_t k) const;
   /// True when anything but whole-pose keys is asked for (partial keys,
-  /// end-effector targets or contact pins).
+  /// end-effector targets, contact pins or a trajectory).
   bool beyond_full_poses() const;
   /// Constraints of frames [begin, begin + length), renumbered from 0 (contact
-  /// pins clipped to the range, dropped when less than two frames remain).
+  /// pins clipped to the range, dropped when less than two frames remain;
+  /// trajectory rows outside the range dropped).
   MotionConstraints slice(int begin, int length) const;
 
  private:
   void validate_contacts(int frames, int joints) const;
+  void validate_trajectory(int frames) const;
 };
 
 }  // namespace mf

@@ -52,6 +52,11 @@ struct InbetweenBatch {
   at::Tensor pose;   ///< [B, T, J * 6 + 3] raw (not normalised); zero where unknown
   at::Tensor known;  ///< [B, T, J + 1] float in {0, 1}
   at::Tensor valid;  ///< [B, T] float in {0, 1}; padding frames are 0
+  /// Optional ground trajectory [B, T, 4] in the window's canonical frame
+  /// (trajectory_features(): root x, z in metres, facing forward_x, forward_z),
+  /// for kinds conditioned on it; undefined when the caller has none. Kinds
+  /// that do not read it ignore it.
+  at::Tensor trajectory;
 };
 
 struct InbetweenOutput {

@@ -204,6 +204,16 @@ at::Tensor heading_rotation(const at::Tensor& root_rotations, const Eigen::Vecto
   return at::stack({c, zero, s, zero, one, zero, -s, zero, c}, -1).unflatten(-1, {3, 3});
 }
 
+at::Tensor trajectory_features(const at::Tensor& root_rotations, const at::Tensor& root_positions,
+                               const Eigen::Vector3d& root_forward) {
+  at::Tensor h = heading_rotation(root_rotations, root_forward);
+  // heading_rotation is R_y(yaw): column 2 is the forward direction (sin yaw, 0, cos yaw).
+  at::Tensor forward = h.select(-1, 2);
+  return at::stack({root_positions.select(-1, 0), root_positions.select(-1, 2), forward.select(-1, 0),
+                    forward.select(-1, 2)},
+                   -1);
+}
+
 at::Tensor heading_relative_positions(const at::Tensor& local_rotations, const RigInfo& rig) {
   return heading_free_fk(local_rotations, rig).positions;
 }

@@ -78,6 +78,14 @@ at::Tensor ground_xz(const at::Tensor& points);
 /// Heading rotations H(t) [..., 3, 3] from root rotations [..., 3, 3].
 at::Tensor heading_rotation(const at::Tensor& root_rotations, const Eigen::Vector3d& root_forward);
 
+/// The ground trajectory of a motion, [..., 4] per frame: the root's ground
+/// position (x, z; the positions' unit) and its facing direction (the heading's
+/// forward unit vector, forward_x = sin(yaw), forward_z = cos(yaw)), from root
+/// rotations [..., 3, 3] and root positions [..., 3] in the same frame. The
+/// row format of MotionConstraints::trajectory (tasks/motion_constraints.h).
+at::Tensor trajectory_features(const at::Tensor& root_rotations, const at::Tensor& root_positions,
+                               const Eigen::Vector3d& root_forward);
+
 /// Per-frame local-motion features of the encoder, [B, T, J, 15]: root-relative
 /// joint positions in the heading frame (3), their velocities (3, central
 /// differences, one-sided at the ends, per second), the 6D of each joint's
