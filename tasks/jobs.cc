@@ -61,25 +61,6 @@ std::vector<int> key_frames(const MotionConstraints& c) {
   return frames;
 }
 
-// Constrained solves run on the input's own skeleton: it must have the model's
-// joints and hierarchy (its bone lengths may differ; the fix-ups after the
-// solve work on the input's own bones) and the model's frame rate.
-void check_constrained_rig(const Motion& input, const TaskContext& ctx) {
-  const NemfModel& prior = require_prior(ctx, "this method");
-  const Skeleton& model = prior.rig().skeleton;
-  if (input.skeleton.names != model.names || input.skeleton.parents != model.parents)
-    throw InputError("partial keys, end-effector targets, contacts and alternatives need the model's joint names and "
-                     "hierarchy for now (this motion has " + std::to_string(input.num_joints()) + " joints, the model " +
-                     std::to_string(model.num_joints()) + "); whole-pose keys without alternatives work on any rig");
-  if (!same_frame_rate(input.fps, prior.config().fps)) {
-    std::ostringstream msg;
-    msg << "partial keys, end-effector targets, contacts and alternatives need the model's frame rate ("
-        << prior.config().fps << " fps) for now; this motion is at " << input.fps
-        << " fps (resample it first; whole-pose keys without alternatives work at any rate)";
-    throw InputError(msg.str());
-  }
-}
-
 // Warnings for targets the output misses by more than a centimetre.
 void warn_missed_targets(const Motion& out, const MotionConstraints& c, std::vector<std::string>* warnings) {
   const GlobalPose pose = forward_kinematics(out);
@@ -237,10 +218,16 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
                        "need a latent solver (nemf, nemf-detail, ...) or 'interp' (without alternatives)");
     constraints.validate(input.num_frames(), input.num_joints());
     constraints.check_values(input);
-    if (m.needs_model) check_constrained_rig(input, ctx);
+    if (m.needs_model) check_model_rig(input.skeleton, ctx);
     start(ctx);
-    for (int v = 0; v <= alternatives; ++v)
-      result.motions.push_back(m.complete_constrained(input, constraints, v, ctx, &result.warnings));
+    for (int v = 0; v <= alternatives; ++v) {
+      auto solve = [&](const Motion& in, const MotionConstraints& c) {
+        return m.complete_constrained(in, c, v, ctx, &result.warnings);
+      };
+      result.motions.push_back(m.needs_model ? complete_constrained_on_model_rig(input, constraints, ctx, solve,
+                                                                                 &result.warnings)
+                                             : solve(input, constraints));
+    }
     warn_missed_targets(result.motions.front(), constraints, &result.warnings);
     warn_sliding_pins(result.motions.front(), constraints, &result.warnings);
   }

@@ -112,8 +112,10 @@ struct ConstrainedResult {
 /// Whole-pose keys alone without alternatives take run_known_frames()'s path
 /// (any rig, any rate); anything else needs a method with
 /// Method::complete_constrained (the latent solvers; "interp" without
-/// alternatives) and, for the model's methods, the model's own rig and rate.
-/// Known values come out exactly as given.
+/// alternatives). The model's methods serve any rig and rate the model can
+/// retarget from (tasks/model_rig.h complete_constrained_on_model_rig(); on
+/// another rig one key must give the whole pose). Known values come out
+/// exactly as given.
 ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& constraints, const std::string& method,
                                   int alternatives, const TaskContext& ctx = {});
 

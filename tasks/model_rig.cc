@@ -12,6 +12,8 @@
 #include "prior/motion/rotations.h"
 #include "prior/util/binary_io.h"
 #include "tasks/baselines.h"
+#include "tasks/effector_ik.h"
+#include "tasks/foot_locking.h"
 #include "tasks/residuals.h"
 
 namespace mf {
@@ -52,6 +54,114 @@ std::vector<int> model_rate_known(const std::vector<int>& known, double fps, dou
     throw InputError("the known frames are too close together in time to solve at the model's " +
                      std::to_string(static_cast<int>(model_fps)) + " fps");
   return out;
+}
+
+// How the constraints of a motion on the user's rig and rate read on the
+// model's: frames rescaled in time, joints through the rig map, positions scaled.
+struct ConstraintMapping {
+  double frame_scale = 1.0;  ///< model frames per user frame
+  int model_frames = 0;
+  double position_scale = 1.0;
+  const Skeleton* user = nullptr;
+  const RigMap* map = nullptr;  ///< null: the same skeleton
+
+  int frame(int f) const { return clamped(std::lround(f * frame_scale)); }
+  // A pin covers at least the time of the user's: its ends rounded outwards.
+  int first_frame(int f) const { return clamped(static_cast<long>(std::floor(f * frame_scale + 1e-6))); }
+  int last_frame(int f) const { return clamped(static_cast<long>(std::ceil(f * frame_scale - 1e-6))); }
+  int clamped(long f) const { return static_cast<int>(std::clamp<long>(f, 0, model_frames - 1)); }
+  std::vector<int> joints(const std::vector<int>& user_joints) const {
+    if (!map) return user_joints;
+    std::vector<int> out;
+    for (size_t m = 0; m < map->user_of_model.size(); ++m) {
+      const int u = map->user_of_model[m];
+      if (u >= 0 && std::find(user_joints.begin(), user_joints.end(), u) != user_joints.end())
+        out.push_back(static_cast<int>(m));
+    }
+    return out;
+  }
+  int joint(int u, const std::string& what) const {
+    if (!map) return u;
+    for (size_t m = 0; m < map->user_of_model.size(); ++m)
+      if (map->user_of_model[m] == u) return static_cast<int>(m);
+    throw InputError(what + ": joint '" + user->names[u] +
+                     "' has no counterpart on the model's rig (map it with a rig map, or constrain a mapped joint)");
+  }
+};
+
+MotionConstraints map_keys(const MotionConstraints& c, const ConstraintMapping& m) {
+  MotionConstraints out;
+  for (const PoseKey& k : c.keys) {
+    PoseKey mk = k;
+    mk.frame = m.frame(k.frame);
+    if (!out.keys.empty() && out.keys.back().frame >= mk.frame) continue;
+    if (k.rotations && !k.joints.empty()) {
+      mk.joints = m.joints(k.joints);
+      // Only joints the model lacks: what is left is the root position, if any.
+      if (mk.joints.empty()) {
+        if (!k.root_position) continue;
+        mk.rotations = false;
+      }
+    }
+    out.keys.push_back(mk);
+  }
+  return out;
+}
+
+MotionConstraints map_constraints(const MotionConstraints& c, const ConstraintMapping& m) {
+  MotionConstraints out = map_keys(c, m);
+  for (const EffectorTarget& t : c.effectors) {
+    EffectorTarget mt = t;
+    mt.frame = m.frame(t.frame);
+    mt.joint = m.joint(t.joint, "the target at frame " + std::to_string(t.frame));
+    mt.position = t.position * m.position_scale;
+    out.effectors.push_back(mt);
+  }
+  for (const ContactPin& p : c.contacts) {
+    ContactPin mp = p;
+    mp.joint = m.joint(p.joint, "the contact on frames " + std::to_string(p.first) + ".." + std::to_string(p.last));
+    mp.first = m.first_frame(p.first);
+    mp.last = m.last_frame(p.last);
+    if (mp.first < mp.last) out.contacts.push_back(mp);
+  }
+  for (const TrajectoryPoint& r : c.trajectory) {
+    TrajectoryPoint mr = r;
+    mr.frame = m.frame(r.frame);
+    mr.x *= m.position_scale;
+    mr.z *= m.position_scale;
+    if (out.trajectory.empty() || out.trajectory.back().frame < mr.frame) out.trajectory.push_back(mr);
+  }
+  return out;
+}
+
+// The keys of `constraints` made exact in `out` (a solution on `input`'s rig
+// and rate): per joint, the residual at the keys that give it spread linearly
+// between them.
+void match_keys(const Motion& input, const MotionConstraints& constraints, Motion* out) {
+  const Motion solution = *out;
+  for (int j = 0; j < input.num_joints(); ++j) {
+    std::vector<int> frames;
+    for (size_t k = 0; k < constraints.keys.size(); ++k)
+      if (constraints.key_has_joint(k, j)) frames.push_back(constraints.keys[k].frame);
+    spread_rotation_residual(input, solution, j, frames, ResidualRamp::Linear, out);
+  }
+  std::vector<int> root;
+  for (const PoseKey& k : constraints.keys)
+    if (k.root_position) root.push_back(k.frame);
+  spread_root_residual(input, solution, root, ResidualRamp::Linear, out);
+}
+
+std::vector<int> key_frames_of(const MotionConstraints& c) {
+  std::vector<int> frames;
+  for (const PoseKey& k : c.keys)
+    if (k.rotations && k.joints.empty()) frames.push_back(k.frame);
+  return frames;
+}
+
+bool has_full_rotation_key(const MotionConstraints& c) {
+  for (const PoseKey& k : c.keys)
+    if (k.rotations && k.joints.empty()) return true;
+  return false;
 }
 
 }  // namespace
@@ -137,6 +247,44 @@ Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known,
   back.skeleton = input.skeleton;
   back.fps = input.fps;
   return match_known_frames(back, input, known);
+}
+
+Motion complete_constrained_on_model_rig(const Motion& input, const MotionConstraints& constraints,
+                                         const TaskContext& ctx, const ConstrainedFn& complete,
+                                         std::vector<std::string>* warnings) {
+  const NemfModel& prior = require_prior(ctx, "this method");
+  const Skeleton& model = prior.rig().skeleton;
+  const double model_fps = prior.config().fps;
+  // The model's joints and hierarchy: the solvers work on the input's own bone lengths.
+  const bool native = input.skeleton.names == model.names && input.skeleton.parents == model.parents;
+  const bool same_rate = same_frame_rate(input.fps, model_fps);
+  if (native && same_rate) return complete(input, constraints);
+  if (!native && !has_full_rotation_key(constraints))
+    throw InputError("on another rig than the model's, at least one key must give the whole pose (every joint's "
+                     "rotation): the joints no key gives have nothing to retarget from");
+  const Motion reference = fill_by_interpolation(input, constraints);
+  std::optional<Retargeter> rig;
+  if (!native) rig.emplace(model_retargeter(input, key_frames_of(constraints), ctx));
+  Motion on_model = native ? reference : rig->to_model(reference);
+
+  ConstraintMapping mapping;
+  mapping.model_frames = same_rate ? input.num_frames() : model_rate_frames(input.num_frames(), input.fps, model_fps);
+  mapping.frame_scale = same_rate ? 1.0 : model_fps / input.fps;
+  mapping.position_scale = native ? 1.0 : rig->scale();
+  mapping.user = &input.skeleton;
+  if (!native) mapping.map = &rig->map();
+  const MotionConstraints on_model_constraints = map_constraints(constraints, mapping);
+  if (!same_rate) on_model = resample_interpolate(on_model, model_fps, mapping.model_frames);
+
+  Motion result = complete(on_model, on_model_constraints);
+  if (!same_rate) result = resample_interpolate(result, input.fps, input.num_frames());
+  Motion back = native ? result : rig->to_user(result, reference);
+  back.skeleton = input.skeleton;
+  back.fps = input.fps;
+  match_keys(input, constraints, &back);
+  reach_effectors(constraints, kDefaultEffectorFalloff, &back);
+  for (std::string& w : pin_contacts(constraints, kDefaultContactRamp, &back)) warnings->push_back(std::move(w));
+  return back;
 }
 
 Motion resample_on_model_rig(const Motion& input, double fps, int frames, const TaskContext& ctx,

@@ -15,6 +15,7 @@
 
 #include "prior/motion/motion.h"
 #include "prior/rig/retarget.h"
+#include "tasks/motion_constraints.h"
 #include "tasks/task_context.h"
 
 namespace mf {
@@ -50,11 +51,34 @@ Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, 
 
 using CompleteFn = std::function<Motion(const Motion& input, const std::vector<int>& known)>;
 using ResampleFn = std::function<Motion(const Motion& input, double fps, int frames)>;
+using ConstrainedFn = std::function<Motion(const Motion& input, const MotionConstraints& constraints)>;
 
 /// Runs `complete` (a method on the model's rig and rate) for `input` with
 /// known frames `known` (validated by the caller).
 Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
                              const CompleteFn& complete);
+
+/// Runs `complete` (a constrained method on the model's rig and rate) for
+/// `input` under `constraints` (validated against `input` by the caller).
+/// A motion with the model's joint names and hierarchy at the model's rate
+/// goes to `complete` as it is (its bone lengths may differ). Otherwise the
+/// reference (fill_by_interpolation() of the keys, on the user's rig) is
+/// retargeted and resampled to the model's rate, and the constraints follow:
+/// key, target and trajectory frames to the nearest model frame, pin ends
+/// rounded outwards (keys
+/// and trajectory rows that land on a frame taken already are dropped, pins
+/// shorter than two model frames too), joints through the rig map (a partial
+/// key keeps the model joints its joints play; target and pin joints must be
+/// mapped: InputError otherwise), positions scaled by the retargeter's scale.
+/// The result comes back on the user's rig at the input's rate and is made
+/// exact there: each key's values with their residual spread linearly to the
+/// neighbouring keys of the same joint, then end-effector IK and contact pins
+/// on the user's own bones (their warnings are appended to `warnings`).
+/// InputError when a key-free joint would be needed: on another rig, at least
+/// one key must give every rotation.
+Motion complete_constrained_on_model_rig(const Motion& input, const MotionConstraints& constraints,
+                                         const TaskContext& ctx, const ConstrainedFn& complete,
+                                         std::vector<std::string>* warnings);
 
 /// Runs `resample` (a method on the model's rig; any input rate) for `input`.
 Motion resample_on_model_rig(const Motion& input, double fps, int frames, const TaskContext& ctx,

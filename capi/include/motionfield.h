@@ -700,9 +700,12 @@ MF_API int mf_constraints_to_json(const mf_constraints *constraints, char *out, 
  *  same constraints from other starts (deterministic for options->seed).
  *  Partial keys, targets, contacts and alternatives need a latent solver
  *  method ("nemf", "nemf-detail", ...; "interp" takes them without
- *  alternatives) and, for the model's methods, a motion on the model's own rig
- *  and frame rate (MF_ERROR_INVALID_ARGUMENT otherwise); whole-pose keys alone
- *  work like mf_inbetween on any rig. Known values come out exactly as given.
+ *  alternatives). Like mf_inbetween, the model's methods serve any humanoid
+ *  rig, unit and frame rate (options->rig_map applies); on a rig that is not
+ *  the model's, one key must give the whole pose, and target and pin joints
+ *  must have a counterpart on the model's rig. Known values, targets and
+ *  pins are made exact on the input's own rig. Known values come out exactly
+ *  as given.
  *  Constraints that cannot all hold (a target out of reach, a pin that keys
  *  contradict) give the best compromise and a warning naming the frames
  *  (mf_motion_get_warnings of each motion, and the report). */

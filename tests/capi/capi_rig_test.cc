@@ -6,7 +6,10 @@
 #include <nlohmann/json.hpp>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -232,6 +235,99 @@ TEST(CApiRig, LearnedMethodsServeAnotherRig) {
   ASSERT_EQ(mf_motion_get_fps(filled.get(), &fps), MF_OK);
   EXPECT_EQ(fps, 25.0);
   EXPECT_EQ(rotations(filled.get())[9 * per_frame], rotations(slow.get())[9 * per_frame]);
+}
+
+std::vector<float> global_positions(const mf_motion* m) {
+  size_t n = 0;
+  mf_motion_get_global_positions(m, nullptr, 0, &n);
+  std::vector<float> p(n);
+  EXPECT_EQ(mf_motion_get_global_positions(m, p.data(), p.size(), &n), MF_OK);
+  return p;
+}
+
+int joint_index(const mf_motion* m, const std::string& name) {
+  const std::vector<std::string> names = joint_names(m);
+  const auto it = std::find(names.begin(), names.end(), name);
+  EXPECT_NE(it, names.end()) << name;
+  return static_cast<int>(it - names.begin());
+}
+
+// Partial keys, a target, a contact pin and an alternative on another rig at
+// another frame rate (Mixamo names, metres, 25 fps): the solve runs on the
+// model's rig and rate and every constraint is made exact on the user's.
+TEST(CApiRig, ConstraintsServeAnotherRigAndRate) {
+  REQUIRE_DEFAULT_MODEL();
+  std::string text = bvh_text(mixamo_metres().get());
+  const size_t at = text.find("Frame Time:");
+  text.replace(at, text.find('\n', at) - at, "Frame Time: 0.04");
+  const MotionPtr user = motion_from_text(text);
+  const int J = static_cast<int>(joint_names(user.get()).size());
+  const int hand = joint_index(user.get(), "mixamorig:RightHand"), foot = joint_index(user.get(), "mixamorig:LeftFoot");
+  const int arm = joint_index(user.get(), "mixamorig:LeftArm"), fore = joint_index(user.get(), "mixamorig:LeftForeArm");
+  const std::vector<float> p_in = global_positions(user.get());
+  char json[1024];
+  std::snprintf(json, sizeof json, R"({"keys": [{"frame": 0}, {"frame": 60},
+      {"frame": 30, "joints": ["mixamorig:LeftArm", "mixamorig:LeftForeArm"]}],
+      "targets": [{"frame": 45, "joint": "mixamorig:RightHand", "position": [%.6f, %.6f, %.6f]}],
+      "contacts": [{"joint": "mixamorig:LeftFoot", "first": 18, "last": 26}]})",
+                p_in[(45 * J + hand) * 3], p_in[(45 * J + hand) * 3 + 1] + 0.1, p_in[(45 * J + hand) * 3 + 2]);
+  mf_constraints* c = nullptr;
+  ASSERT_EQ(mf_constraints_parse_json(json, std::strlen(json), &c), MF_OK) << describe(MF_OK);
+  mf_task_options o;
+  mf_task_options_init(&o);
+  o.method = "nemf";
+  mf_solution* s = nullptr;
+  const int status = mf_solve(default_model(), user.get(), c, 1, &o, &s);
+  mf_constraints_destroy(c);
+  ASSERT_EQ(status, MF_OK) << describe(status);
+  std::vector<std::vector<float>> pos;
+  const std::vector<float> qi = rotations(user.get());
+  for (int i = 0; i < 2; ++i) {
+    mf_motion* raw = nullptr;
+    ASSERT_EQ(mf_solution_get_motion(s, i, &raw), MF_OK);
+    const MotionPtr out(raw);
+    EXPECT_EQ(joint_names(out.get()), joint_names(user.get()));
+    double fps = 0;
+    ASSERT_EQ(mf_motion_get_fps(out.get(), &fps), MF_OK);
+    EXPECT_EQ(fps, 25.0);
+    const std::vector<float> q = rotations(out.get());
+    ASSERT_EQ(q.size(), qi.size());
+    for (int k : {0, 60})
+      for (int v = 0; v < J * 4; ++v) ASSERT_EQ(q[k * J * 4 + v], qi[k * J * 4 + v]) << "solution " << i << " key " << k;
+    for (int j : {arm, fore})
+      for (int v = 0; v < 4; ++v) EXPECT_EQ(q[(30 * J + j) * 4 + v], qi[(30 * J + j) * 4 + v]) << "partial key joint " << j;
+    const std::vector<float> p = global_positions(out.get());
+    double d = 0;
+    for (int v = 0; v < 3; ++v) {
+      const double goal = p_in[(45 * J + hand) * 3 + v] + (v == 1 ? 0.1 : 0.0);
+      d += std::pow(p[(45 * J + hand) * 3 + v] - goal, 2);
+    }
+    EXPECT_LT(std::sqrt(d), 0.005) << "solution " << i << ": the hand is " << std::sqrt(d) * 100 << " cm from its target";
+    double slide = 0;
+    for (int f = 19; f <= 26; ++f) {
+      double e = 0;
+      for (int v = 0; v < 3; ++v) e += std::pow(p[(f * J + foot) * 3 + v] - p[(18 * J + foot) * 3 + v], 2);
+      slide = std::max(slide, std::sqrt(e));
+    }
+    EXPECT_LT(slide, 1e-3) << "solution " << i << ": the pinned foot moves " << slide * 100 << " cm";
+    pos.push_back(p);
+  }
+  mf_solution_destroy(s);
+  double sum = 0;
+  for (size_t v = 0; v < pos[0].size(); v += 3)
+    sum += std::sqrt(std::pow(pos[0][v] - pos[1][v], 2) + std::pow(pos[0][v + 1] - pos[1][v + 1], 2) +
+                     std::pow(pos[0][v + 2] - pos[1][v + 2], 2));
+  EXPECT_GT(sum / (pos[0].size() / 3), 0.002) << "the alternative differs by less than 2 mm";
+
+  // Without a whole-pose key there is nothing to retarget the other joints from.
+  const std::string root_only = R"({"keys": [{"frame": 0, "root": "both"}, {"frame": 60, "root": "both",
+      "joints": ["mixamorig:LeftArm"]}]})";
+  ASSERT_EQ(mf_constraints_parse_json(root_only.data(), root_only.size(), &c), MF_OK) << describe(MF_OK);
+  s = nullptr;
+  EXPECT_TRUE(Fails(mf_solve(default_model(), user.get(), c, 0, &o, &s), MF_ERROR_INVALID_ARGUMENT,
+                    "at least one key must give the whole pose"));
+  EXPECT_EQ(s, nullptr);
+  mf_constraints_destroy(c);
 }
 
 TEST(CApiRig, BadRigMapsFailWithTheirMessage) {
