@@ -7,7 +7,6 @@
 #include "tasks/inbetweener_files.h"
 #include "tasks/latent_solver.h"
 #include "tasks/method.h"
-#include <cstdlib>
 
 namespace mf {
 
@@ -45,7 +44,7 @@ Method solver_method(const std::string& name, const std::string& description, So
     LatentSolverOptions o = options;
     if (ctx.max_iterations > 0) o.max_iterations = ctx.max_iterations;
     if (variant > 0) {
-      o.start_noise = std::getenv("MF_PILOT_NOISE") ? std::atof(std::getenv("MF_PILOT_NOISE")) : kAlternativeStartNoise;
+      o.start_noise = kAlternativeStartNoise;
       o.start_seed = ctx.seed * 7919u + static_cast<uint64_t>(variant);
     }
     CompletionReport report;
