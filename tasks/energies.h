@@ -129,8 +129,8 @@ struct EnergyWeights {
   double root_translation = 10.0;
   double effector = 100.0;
   double contact = 10.0;
-  double trajectory = 10.0;
-  double trajectory_facing = 1.0;
+  double trajectory = 100.0;
+  double trajectory_facing = 30.0;
   double latent_prior = 0.0;
   double foot_skating = 0.0;
   double smoothness = 0.0;
