@@ -129,6 +129,8 @@ struct EnergyWeights {
   double root_translation = 10.0;
   double effector = 100.0;
   double contact = 10.0;
+  /// The trajectory terms' weights: docs/CONSTRAINTS.md ("Trajectory") has
+  /// their measurement (trajectory-bench).
   double trajectory = 100.0;
   double trajectory_facing = 30.0;
   double latent_prior = 0.0;
