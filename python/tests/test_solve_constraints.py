@@ -57,18 +57,19 @@ class ConstraintsTest(unittest.TestCase):
         np.testing.assert_array_equal(again.motions[1].rotations, s.motions[1].rotations)
 
     def _bumped_trajectory(self, first, last, bump_m):
-        """The sample's root path on frames first..last pushed sideways by up
-        to bump_m metres, facing along the direction of travel: [N, 5] rows
-        (frame, x, z in the file's unit, forward_x, forward_z)."""
+        """The straight line between the sample's root at the keys first - 1
+        and last + 1 (the way it walks), pushed sideways by up to bump_m
+        metres, facing along the line: [N, 5] rows (frame, x, z in the file's
+        unit, forward_x, forward_z)."""
         m = self.motion
-        r = m.root_positions  # metres
-        d = r[last, [0, 2]] - r[first, [0, 2]]
+        r = m.root_positions[:, [0, 2]]  # metres
+        a, b = first - 1, last + 1
+        d = r[b] - r[a]
         side = np.array([-d[1], d[0]]) / np.linalg.norm(d)
         frames = np.arange(first, last + 1)
-        bump = bump_m * np.sin(np.pi * (frames - first + 1) / (last - first + 2))
-        ground = (r[frames][:, [0, 2]] + bump[:, None] * side) / m.length_scale
-        forward = r[frames + 1][:, [0, 2]] - r[frames - 1][:, [0, 2]]
-        return np.column_stack([frames, ground, forward])
+        t = (frames - a) / float(b - a)
+        ground = (r[a] + t[:, None] * d + (bump_m * np.sin(np.pi * t))[:, None] * side) / m.length_scale
+        return np.column_stack([frames, ground, np.tile(d, (len(frames), 1))])
 
     def test_trajectory_is_followed(self):
         model = mf.Model(MODEL)

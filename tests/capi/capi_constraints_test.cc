@@ -347,23 +347,23 @@ std::vector<float> root_positions(const mf_motion* m) {
   return p;
 }
 
-// A ground-truth-like trajectory that is not the interpolation: the sample's
-// own root path on frames first..last, pushed sideways by up to `bump_m`
-// metres (a half sine over the rows), facing along the path's direction of
-// travel. Frames into *frames, rows (x, z in the input's unit `scale` metres,
-// forward_x, forward_z) into *rows.
+// A walkable trajectory that is not the interpolation: the straight line
+// between the sample's root at the keys `first - 1` and `last + 1` (the way it
+// walks), pushed sideways by up to `bump_m` metres (a half sine over the
+// rows), facing along the line. Frames into *frames, rows (x, z in the input's
+// unit, `scale` metres; forward_x, forward_z) into *rows.
 void bumped_trajectory(const mf_motion* in, double scale, int first, int last, double bump_m,
                        std::vector<int32_t>* frames, std::vector<float>* rows) {
   const std::vector<float> r = root_positions(in);  // metres
-  const double dx = r[last * 3] - r[first * 3], dz = r[last * 3 + 2] - r[first * 3 + 2];
+  const int a = first - 1, b = last + 1;
+  const double dx = r[b * 3] - r[a * 3], dz = r[b * 3 + 2] - r[a * 3 + 2];
   const double n = std::hypot(dx, dz);
   for (int f = first; f <= last; ++f) {
-    const double s = bump_m * std::sin(M_PI * (f - first + 1) / (last - first + 2));
-    const int a = f - 1, b = f + 1;
+    const double t = static_cast<double>(f - a) / (b - a), s = bump_m * std::sin(M_PI * t);
     frames->push_back(f);
-    rows->insert(rows->end(), {static_cast<float>((r[f * 3] - s * dz / n) / scale),
-                               static_cast<float>((r[f * 3 + 2] + s * dx / n) / scale), r[b * 3] - r[a * 3],
-                               r[b * 3 + 2] - r[a * 3 + 2]});
+    rows->insert(rows->end(), {static_cast<float>((r[a * 3] + t * dx - s * dz / n) / scale),
+                               static_cast<float>((r[a * 3 + 2] + t * dz + s * dx / n) / scale),
+                               static_cast<float>(dx), static_cast<float>(dz)});
   }
 }
 
