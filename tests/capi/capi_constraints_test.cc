@@ -379,8 +379,9 @@ double max_ground_distance(const mf_motion* m, double scale, const std::vector<i
 }
 
 // The latent solver follows a trajectory 30 cm off the sample's path (which
-// the interpolation misses by far more) within 5.0 cm, the keys stay
-// exact, and the report measures the same distance.
+// the interpolation misses by 35 cm) within 5 cm and 5 degrees of facing on
+// average, from both kinds of start; the keys stay exact, and the report
+// measures the same distance.
 TEST(CApiConstraints, TrajectoryIsFollowed) {
   MotionPtr in = sample();
   double scale = 0;
@@ -397,20 +398,24 @@ TEST(CApiConstraints, TrajectoryIsFollowed) {
   const double lerp_cm = max_ground_distance(lerp.get(), scale, frames, rows) * 100;
   EXPECT_GT(lerp_cm, 25.0) << "the trajectory must differ from the interpolation";
 
+  // From interpolation and from the two-stage transformer (measured: 1.7 and 3.5 cm at worst).
+  for (const char* method : {"nemf-detail", "nemf"}) {
+    SCOPED_TRACE(method);
+    SolutionPtr s = solve(in.get(), c.get(), method);
+    MotionPtr out = motion_of(s.get(), 0);
+    const double cm = max_ground_distance(out.get(), scale, frames, rows) * 100;
+    EXPECT_LT(cm, 5.0) << "interpolation misses it by " << lerp_cm << " cm";
+    const std::vector<float> qi = rotations(in.get()), qo = rotations(out.get());
+    const int J = joints_of(in.get());
+    for (int k : {0, 15, 45, 60})
+      for (int v = 0; v < J * 4; ++v) ASSERT_EQ(qo[k * J * 4 + v], qi[k * J * 4 + v]) << "key " << k;
+    const mf_constraint_report r = report_of(s.get(), 0);
+    EXPECT_EQ(r.trajectory_rows, 29);
+    EXPECT_NEAR(r.trajectory_max * scale * 100, cm, 1e-2);
+    EXPECT_LT(r.facing_mean_deg, 5.0);
+    EXPECT_EQ(warnings_of(out.get()), "");
+  }
   SolutionPtr s = solve(in.get(), c.get(), "nemf");
-  MotionPtr out = motion_of(s.get(), 0);
-  const double cm = max_ground_distance(out.get(), scale, frames, rows) * 100;
-  EXPECT_LT(cm, 5.0) << "interpolation misses it by " << lerp_cm << " cm";
-  const std::vector<float> qi = rotations(in.get()), qo = rotations(out.get());
-  const int J = joints_of(in.get());
-  for (int k : {0, 15, 45, 60})
-    for (int v = 0; v < J * 4; ++v) ASSERT_EQ(qo[k * J * 4 + v], qi[k * J * 4 + v]) << "key " << k;
-  const mf_constraint_report r = report_of(s.get(), 0);
-  EXPECT_EQ(r.trajectory_rows, 29);
-  EXPECT_NEAR(r.trajectory_max * scale * 100, cm, 1e-2);
-  EXPECT_LT(r.facing_mean_deg, 20.0);
-  EXPECT_EQ(warnings_of(out.get()), "");
-
   // The report JSON has the trajectory member; a report of an older, smaller
   // struct gets the fields it has and no more.
   size_t n = 0;
