@@ -5,6 +5,7 @@
 // report (tasks/constraint_report.h) and the refusal of methods that cannot
 // follow a trajectory (tasks/jobs.h run_constrained).
 #include <ATen/ATen.h>
+#include <ATen/Parallel.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
