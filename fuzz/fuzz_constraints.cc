@@ -1,5 +1,6 @@
 // Fuzz target: the constraints file format (tasks/constraint_spec.h) on any
-// bytes, resolved against a small skeleton and validated for a 40-frame motion.
+// bytes (the "trajectory" member included), resolved against a small skeleton
+// and validated for a 40-frame motion.
 // Contract checked: bad input throws mf::InputError naming the source; what
 // parses writes back (to_json) to a document that parses to the same text.
 #include <cstdint>

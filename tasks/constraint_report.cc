@@ -65,8 +65,33 @@ ContactError contact_error(const Motion& motion, const MotionConstraints& c) {
   return e;
 }
 
-ConstraintReport measure_constraints(const Motion& input, const MotionConstraints& c, const Motion& motion) {
-  return ConstraintReport{key_error(input, c, motion), effector_error(motion, c), contact_error(motion, c)};
+TrajectoryError trajectory_error(const Motion& motion, const MotionConstraints& c, const Eigen::Vector3d& root_forward) {
+  TrajectoryError e;
+  double sum = 0.0, facing_sum = 0.0;
+  for (const TrajectoryPoint& p : c.followed_trajectory()) {
+    const Eigen::Vector3d& x = motion.root_positions[p.frame];
+    const double cm = std::hypot(x.x() - p.x, x.z() - p.z) * 100.0;
+    // The heading's forward (as heading_rotation(): the root's forward axis on the ground).
+    const Eigen::Vector3d f = motion.rotation(p.frame, 0).normalized() * root_forward;
+    const double deg = std::abs(std::remainder(std::atan2(f.x(), f.z()) - std::atan2(p.forward_x, p.forward_z),
+                                               2.0 * M_PI)) * 180.0 / M_PI;
+    e.max_cm = std::max(e.max_cm, cm);
+    e.facing_max_deg = std::max(e.facing_max_deg, deg);
+    sum += cm;
+    facing_sum += deg;
+    ++e.rows;
+  }
+  if (e.rows) {
+    e.mean_cm = sum / e.rows;
+    e.facing_mean_deg = facing_sum / e.rows;
+  }
+  return e;
+}
+
+ConstraintReport measure_constraints(const Motion& input, const MotionConstraints& c, const Motion& motion,
+                                     const Eigen::Vector3d& root_forward) {
+  return ConstraintReport{key_error(input, c, motion), effector_error(motion, c), contact_error(motion, c),
+                          trajectory_error(motion, c, root_forward)};
 }
 
 }  // namespace mf

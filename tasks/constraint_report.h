@@ -29,10 +29,22 @@ struct ContactError {
   long frames = 0;  ///< pinned frames measured (all pins)
 };
 
+/// How closely the root follows the trajectory rows the solvers follow
+/// (MotionConstraints::followed_trajectory()): the ground distance (x, z) of
+/// the root from each row, and the angle between the root's facing (its
+/// heading, trajectory_features() of prior/model/representation.h) and the
+/// row's forward direction.
+struct TrajectoryError {
+  double max_cm = 0.0, mean_cm = 0.0;
+  double facing_max_deg = 0.0, facing_mean_deg = 0.0;
+  long rows = 0;  ///< rows measured
+};
+
 struct ConstraintReport {
   ConstraintError keys;
   EffectorError targets;
   ContactError contacts;
+  TrajectoryError trajectory;
 };
 
 /// Keys of `c` in `motion` against `input` (which holds the key values).
@@ -41,7 +53,12 @@ ConstraintError key_error(const Motion& input, const MotionConstraints& c, const
 EffectorError effector_error(const Motion& motion, const MotionConstraints& c);
 /// Contact pins of `c` in `motion`.
 ContactError contact_error(const Motion& motion, const MotionConstraints& c);
-/// The three above.
-ConstraintReport measure_constraints(const Motion& input, const MotionConstraints& c, const Motion& motion);
+/// Trajectory rows of `c` in `motion`; `root_forward` is the root-local axis
+/// that points forward (RigInfo::root_forward of the model's rig).
+TrajectoryError trajectory_error(const Motion& motion, const MotionConstraints& c,
+                                 const Eigen::Vector3d& root_forward = Eigen::Vector3d::UnitZ());
+/// The four above.
+ConstraintReport measure_constraints(const Motion& input, const MotionConstraints& c, const Motion& motion,
+                                     const Eigen::Vector3d& root_forward = Eigen::Vector3d::UnitZ());
 
 }  // namespace mf

@@ -120,6 +120,19 @@ ContactSpec parse_contact(const json& item, const std::string& where) {
   return c;
 }
 
+TrajectoryPoint parse_trajectory_row(const json& item, const std::string& where) {
+  Fields f(item, where);
+  TrajectoryPoint p;
+  p.frame = f.frame("frame");
+  p.x = f.number("x");
+  p.z = f.number("z");
+  p.forward_x = f.number("forward_x");
+  p.forward_z = f.number("forward_z");
+  if (std::hypot(p.forward_x, p.forward_z) < 1e-6) f.fail("has a facing direction (forward_x, forward_z) of zero length");
+  f.done();
+  return p;
+}
+
 int joint_index(const Skeleton& skel, const std::string& name, const std::string& where) {
   const int j = skel.find(name);
   if (j >= 0) return j;
@@ -165,6 +178,9 @@ ConstraintSpec ConstraintSpec::parse_json(const std::string& text, const std::st
   const json& contacts = array_field(top, "contacts");
   for (size_t i = 0; i < contacts.size(); ++i)
     spec.contacts.push_back(parse_contact(contacts[i], source + ": contacts[" + std::to_string(i) + "]"));
+  const json& trajectory = array_field(top, "trajectory");
+  for (size_t i = 0; i < trajectory.size(); ++i)
+    spec.trajectory.push_back(parse_trajectory_row(trajectory[i], source + ": trajectory[" + std::to_string(i) + "]"));
   top.done();
   return spec;
 }
@@ -173,6 +189,7 @@ void ConstraintSpec::append(const ConstraintSpec& other) {
   keys.insert(keys.end(), other.keys.begin(), other.keys.end());
   targets.insert(targets.end(), other.targets.begin(), other.targets.end());
   contacts.insert(contacts.end(), other.contacts.begin(), other.contacts.end());
+  trajectory.insert(trajectory.end(), other.trajectory.begin(), other.trajectory.end());
 }
 
 void ConstraintSpec::add_whole_pose_keys(const std::vector<int>& frames) {
@@ -226,6 +243,14 @@ MotionConstraints ConstraintSpec::resolve(const Skeleton& skel, double length_sc
     pin.last = p.last;
     c.contacts.push_back(pin);
   }
+  for (const TrajectoryPoint& p : trajectory) {
+    TrajectoryPoint q = p;
+    q.x *= length_scale;
+    q.z *= length_scale;
+    c.trajectory.push_back(q);
+  }
+  std::stable_sort(c.trajectory.begin(), c.trajectory.end(),
+                   [](const TrajectoryPoint& a, const TrajectoryPoint& b) { return a.frame < b.frame; });
   return c;
 }
 
@@ -247,6 +272,12 @@ std::string ConstraintSpec::to_json() const {
   doc["keys"] = k;
   doc["targets"] = t;
   doc["contacts"] = c;
+  if (!trajectory.empty()) {
+    json r = json::array();
+    for (const TrajectoryPoint& p : trajectory)
+      r.push_back({{"frame", p.frame}, {"x", p.x}, {"z", p.z}, {"forward_x", p.forward_x}, {"forward_z", p.forward_z}});
+    doc["trajectory"] = r;
+  }
   return doc.dump(2);
 }
 

@@ -42,11 +42,14 @@ struct ConstraintSpec {
   std::vector<KeySpec> keys;
   std::vector<TargetSpec> targets;
   std::vector<ContactSpec> contacts;
+  /// The ground trajectory (TrajectoryPoint rows, x and z in the input's
+  /// unit; any order here, sorted by frame by resolve()).
+  std::vector<TrajectoryPoint> trajectory;
 
   /// Parses the constraints file format (docs/CONSTRAINTS.md). Throws
   /// mf::InputError, prefixed with `source`, on invalid JSON, unknown fields,
-  /// wrong types, non-integer frames, non-finite or negative weights, and
-  /// keys that constrain nothing.
+  /// wrong types, non-integer frames, non-finite or negative weights, keys
+  /// that constrain nothing, and trajectory rows with a zero-length facing.
   static ConstraintSpec parse_json(const std::string& text, const std::string& source = "constraints");
 
   /// Appends the constraints of `other` (frames and names as they are).
@@ -54,14 +57,16 @@ struct ConstraintSpec {
   /// Appends whole-pose keys at `frames`.
   void add_whole_pose_keys(const std::vector<int>& frames);
 
-  /// The constraints on `skeleton`, positions scaled by `length_scale` (metres
-  /// per input unit), keys sorted by frame; keys at one frame are merged into
+  /// The constraints on `skeleton`, positions (targets, trajectory x and z)
+  /// scaled by `length_scale` (metres per input unit), keys and trajectory
+  /// rows sorted by frame; keys at one frame are merged into
   /// one that constrains what either does (a whole pose covers everything).
   /// Throws mf::InputError on an unknown joint name (listing the skeleton's);
   /// the rest is checked by MotionConstraints::validate().
   MotionConstraints resolve(const Skeleton& skeleton, double length_scale) const;
 
-  /// The same description as JSON text (parse_json() reads it back).
+  /// The same description as JSON text (parse_json() reads it back; the
+  /// "trajectory" member only when there are rows).
   std::string to_json() const;
 };
 

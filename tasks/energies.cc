@@ -36,6 +36,9 @@ at::Tensor penalty_of_angle(const at::Tensor& angle, Penalty p) {
 // ---------------------------------------------------------------------------
 // Window problems
 
+int WindowProblem::num_trajectory() const {
+  return trajectory_frames.defined() ? static_cast<int>(trajectory_frames.size(0)) : 0;
+}
 int WindowProblem::num_keys() const { return key_frames.defined() ? static_cast<int>(key_frames.size(0)) : 0; }
 int WindowProblem::num_pin_steps() const { return pin_from.defined() ? static_cast<int>(pin_from.size(0)) : 0; }
 
@@ -144,6 +147,31 @@ void set_contact_pins(int J, int length, const MotionConstraints& c, WindowProbl
   p->pin_to = at::tensor(to, at::kLong);
 }
 
+// The trajectory rows the solver follows, in the canonical frame.
+void set_trajectory_targets(int length, const MotionConstraints& c, WindowProblem* p) {
+  const std::vector<TrajectoryPoint> rows = c.followed_trajectory();
+  const Eigen::Matrix3d unturn = rot_y(-p->transform.yaw);
+  const Eigen::Vector3d origin(p->transform.x, 0.0, p->transform.z);
+  const int R = static_cast<int>(rows.size());
+  p->trajectory_frames = at::empty({R}, at::kLong);
+  p->trajectory_ground = at::empty({R, 2}, at::kFloat);
+  p->trajectory_forward = at::empty({R, 2}, at::kFloat);
+  int64_t* frames = p->trajectory_frames.data_ptr<int64_t>();
+  float* ground = p->trajectory_ground.data_ptr<float>();
+  float* forward = p->trajectory_forward.data_ptr<float>();
+  for (int r = 0; r < R; ++r) {
+    const TrajectoryPoint& t = rows[r];
+    if (t.frame < 0 || t.frame >= length) throw InputError("a trajectory row lies outside its window");
+    frames[r] = t.frame;
+    const Eigen::Vector3d x = unturn * (Eigen::Vector3d(t.x, 0.0, t.z) - origin);
+    const Eigen::Vector3d f = (unturn * Eigen::Vector3d(t.forward_x, 0.0, t.forward_z)).normalized();
+    ground[r * 2] = static_cast<float>(x.x());
+    ground[r * 2 + 1] = static_cast<float>(x.z());
+    forward[r * 2] = static_cast<float>(f.x());
+    forward[r * 2 + 1] = static_cast<float>(f.z());
+  }
+}
+
 }  // namespace
 
 WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int begin, int length,
@@ -160,6 +188,7 @@ WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int 
   set_key_targets(rig, motion, begin, constraints, &p);
   set_effector_targets(rig.num_joints(), length, constraints, &p);
   set_contact_pins(rig.num_joints(), length, constraints, &p);
+  set_trajectory_targets(length, constraints, &p);
   return p;
 }
 
@@ -284,6 +313,7 @@ namespace {
 struct ActiveTerms {
   double n_rot = 0, n_root_rot = 0, n_pos = 0, n_root = 0;
   bool rot = false, root_rot = false, pos = false, root = false, eff = false, pin = false, skate = false, smooth = false;
+  bool traj = false, facing = false;
   bool dense = false;  // a term that needs the whole window decoded
   bool keyed = false;  // a term that needs the key frames decoded
 };
@@ -305,7 +335,9 @@ ActiveTerms active_terms(const RigInfo& rig, const WindowProblem& problem, const
   a.pin = w.contact > 0 && problem.num_pin_steps() > 0;
   a.skate = w.foot_skating > 0 && rig.num_feet() > 0 && T >= 2;
   a.smooth = w.smoothness > 0 && T >= 3;
-  a.dense = a.root || a.eff || a.pin || a.skate || a.smooth;
+  a.traj = w.trajectory > 0 && problem.num_trajectory() > 0;
+  a.facing = w.trajectory_facing > 0 && problem.num_trajectory() > 0;
+  a.dense = a.root || a.eff || a.pin || a.traj || a.facing || a.skate || a.smooth;
   a.keyed = a.rot || a.root_rot || a.pos;
   return a;
 }
@@ -339,6 +371,23 @@ void add_key_terms(const Skeleton& skel, const WindowProblem& problem, const Ene
   }
 }
 
+// The trajectory terms on the output motion: ground position and facing of the
+// root at the rows' frames. rotations [1, T, J, 3, 3], path [1, T, 3].
+void add_trajectory_terms(const RigInfo& rig, const WindowProblem& problem, const EnergyWeights& w,
+                          const ActiveTerms& a, const at::Tensor& rotations, const at::Tensor& path, EnergyTerms* out) {
+  const at::Tensor frames = problem.trajectory_frames;
+  const at::Tensor root = rotations.squeeze(0).index_select(0, frames).select(1, 0);  // [R, 3, 3]
+  const at::Tensor features = trajectory_features(root, path.squeeze(0).index_select(0, frames), rig.root_forward);
+  if (a.traj) {
+    at::Tensor d2 = (features.narrow(-1, 0, 2) - problem.trajectory_ground).square().sum(-1);
+    add_term(out, "trajectory", w.trajectory, penalty_of_squared(d2, w.penalty).mean());
+  }
+  if (a.facing) {
+    at::Tensor d2 = (features.narrow(-1, 2, 2) - problem.trajectory_forward).square().sum(-1);
+    add_term(out, "trajectory_facing", w.trajectory_facing, penalty_of_squared(d2, w.penalty).mean());
+  }
+}
+
 // The terms on the output motion (see EnergyWeights::on_output): effector,
 // foot skating, smoothness. rotations [1, T, J, 3, 3], path [1, T, 3].
 void add_output_terms(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& w,
@@ -361,6 +410,7 @@ void add_output_terms(const NemfModel& model, const WindowProblem& problem, cons
     at::Tensor v = (flat.index_select(0, problem.pin_to) - flat.index_select(0, problem.pin_from)) * fps;
     add_term(out, "contact", w.contact, penalty_of_squared(v.square().sum(-1), w.penalty).mean());
   }
+  if (a.traj || a.facing) add_trajectory_terms(rig, problem, w, a, out_rot, out_path, out);
   if (a.skate) {
     at::Tensor feet = at::tensor(std::vector<int64_t>(rig.foot_joints.begin(), rig.foot_joints.end()), at::kLong);
     at::Tensor fp = pos.index_select(2, feet);                             // [1, T, F, 3]
@@ -387,7 +437,7 @@ void add_dense_terms(const NemfModel& model, const WindowProblem& problem, const
     add_term(out, "root_translation", w.root_translation,
              masked_mean(penalty_of_squared(d2, w.penalty), problem.key_root_mask, a.n_root));
   }
-  if (a.eff || a.pin || a.skate || a.smooth) add_output_terms(model, problem, w, a, dense_rot, path, gmp, offsets, out);
+  if (a.eff || a.pin || a.traj || a.facing || a.skate || a.smooth) add_output_terms(model, problem, w, a, dense_rot, path, gmp, offsets, out);
 }
 
 }  // namespace

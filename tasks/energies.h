@@ -27,6 +27,14 @@
 //                     frames (m), each target with its own weight
 //   contact           mean squared velocity (m/s) of the joints the caller pins
 //                     (MotionConstraints::contacts) over consecutive pinned frames
+//   trajectory        squared ground distance (x, z; m^2) of the root from the
+//                     caller's trajectory row (MotionConstraints::trajectory) at
+//                     every frame that has a row and no key fixing the root
+//                     position, mean over those rows
+//   trajectory_facing squared difference of the root's facing unit vector
+//                     (trajectory_features(), prior/model/representation.h)
+//                     and the row's normalised forward, = 2 (1 - cos angle),
+//                     over the same rows
 //   latent_prior      0.5 * (|z_l|^2 + |z_g|^2): a Gaussian prior on the codes
 //   foot_skating      mean over frames and feet of p_contact * |v_xz|^2, the
 //                     horizontal foot velocity (m/s) weighted by the GMP's
@@ -34,7 +42,7 @@
 //                     contacts off to escape the term)
 //   smoothness        mean squared second difference of the root-relative
 //                     joint positions (m/s^2), on the dense decode
-// The effector, contact, foot-skating and smoothness terms are measured on the output
+// The effector, contact, trajectory, foot-skating and smoothness terms are measured on the output
 // motion (EnergyWeights::on_output): the decoded motion with the residual at
 // each key blended in, as complete_motion() will return it, so that the
 // overwrite of the known values cannot undo what they ask for.
@@ -43,7 +51,7 @@
 //
 // What is decoded: only the key frames when no dense term is active; the whole
 // window (frames 0..length-1) once when root_translation (with root keys),
-// effector, contact, foot_skating or smoothness is active, the key frames then being
+// effector, contact, trajectory, foot_skating or smoothness is active, the key frames then being
 // gathered from it.
 #pragma once
 
@@ -88,9 +96,16 @@ struct WindowProblem {
   at::Tensor pin_from;  ///< [P] int64
   at::Tensor pin_to;    ///< [P] int64
 
+  // R trajectory rows (MotionConstraints::followed_trajectory(): none at a
+  // frame whose root position a key fixes).
+  at::Tensor trajectory_frames;   ///< [R] int64
+  at::Tensor trajectory_ground;   ///< [R, 2] canonical ground position (x, z)
+  at::Tensor trajectory_forward;  ///< [R, 2] canonical facing (x, z), unit length
+
   int num_keys() const;
   int num_effectors() const;
   int num_pin_steps() const;
+  int num_trajectory() const;
 };
 
 /// Builds the canonical problem of frames [begin, begin + length) of `motion`
@@ -114,11 +129,16 @@ struct EnergyWeights {
   double root_translation = 10.0;
   double effector = 100.0;
   double contact = 10.0;
+  /// The trajectory terms' weights: docs/CONSTRAINTS.md ("Trajectory") has
+  /// their measurement (trajectory-bench).
+  double trajectory = 100.0;
+  double trajectory_facing = 30.0;
   double latent_prior = 0.0;
   double foot_skating = 0.0;
   double smoothness = 0.0;
   Penalty penalty = Penalty::Squared;
-  /// The dense output terms (effector, foot_skating, smoothness) see the
+  /// The dense output terms (effector, contact, trajectory, foot_skating,
+  /// smoothness) see the
   /// motion as complete_motion() returns it: after the overwrite of the known
   /// values, whose residuals are blended into the frames between keys (see
   /// tasks/latent_solver.h); otherwise the raw decoded motion.

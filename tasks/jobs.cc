@@ -90,6 +90,30 @@ void warn_sliding_pins(const Motion& out, const MotionConstraints& c, std::vecto
   }
 }
 
+// Refuses a trajectory for a method that cannot follow one, naming those that can.
+void check_follows_trajectory(const Method& m, const MotionConstraints& c) {
+  if (c.trajectory.empty() || m.follows_trajectory) return;
+  std::string can;
+  for (const Method& a : registered_methods()) {
+    if (a.follows_trajectory) can += (can.empty() ? "" : ", ") + a.name;
+  }
+  throw InputError("method '" + m.name + "' cannot follow a trajectory; the methods that can: " + can);
+}
+
+// One warning when the output misses the trajectory it follows by more than
+// kTrajectoryWarnCm on the ground or kTrajectoryWarnDeg in facing on any row.
+void warn_missed_trajectory(const Motion& out, const MotionConstraints& c, const Eigen::Vector3d& root_forward,
+                            std::vector<std::string>* warnings) {
+  const TrajectoryError e = trajectory_error(out, c, root_forward);
+  if (e.rows == 0 || (e.max_cm <= kTrajectoryWarnCm && e.facing_max_deg <= kTrajectoryWarnDeg)) return;
+  std::ostringstream msg;
+  msg.precision(3);
+  msg << "the trajectory is missed by up to " << e.max_cm << " cm on the ground (mean " << e.mean_cm
+      << " cm) and " << e.facing_max_deg << " degrees in facing (mean " << e.facing_mean_deg << ") over " << e.rows
+      << " rows (a path the body cannot walk between the keys in the time given, or keys that contradict it)";
+  warnings->push_back(msg.str());
+}
+
 }  // namespace
 
 const std::vector<Method>& registered_methods() {
@@ -207,11 +231,13 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
     throw InputError("alternatives must be between 0 and " + std::to_string(kMaxAlternatives) + " (got " +
                      std::to_string(alternatives) + ")");
   ConstrainedResult result;
+  const Eigen::Vector3d root_forward = ctx.model ? ctx.model->rig().root_forward : Eigen::Vector3d::UnitZ();
   if (!constraints.beyond_full_poses() && alternatives == 0) {
     result.motions.push_back(run_known_frames(input, key_frames(constraints), method, ctx));
   } else {
     const Method& m = resolve_method(method, ctx);
     check_motion(input);
+    check_follows_trajectory(m, constraints);
     if (!m.complete_constrained)
       throw InputError("method '" + m.name +
                        "' takes whole-pose keys only: partial keys, end-effector targets, contacts and alternatives "
@@ -230,8 +256,10 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
     }
     warn_missed_targets(result.motions.front(), constraints, &result.warnings);
     warn_sliding_pins(result.motions.front(), constraints, &result.warnings);
+    warn_missed_trajectory(result.motions.front(), constraints, root_forward, &result.warnings);
   }
-  for (const Motion& out : result.motions) result.reports.push_back(measure_constraints(input, constraints, out));
+  for (const Motion& out : result.motions)
+    result.reports.push_back(measure_constraints(input, constraints, out, root_forward));
   return result;
 }
 

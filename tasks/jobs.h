@@ -105,8 +105,15 @@ struct ConstrainedResult {
   std::vector<std::string> warnings;
 };
 
+/// run_constrained() warns when the result misses its trajectory by more than
+/// this on the ground on any followed row (a few times what the trajectory
+/// energy leaves on ground-truth rows, docs/CONSTRAINTS.md)...
+inline constexpr double kTrajectoryWarnCm = 10.0;
+/// ... or by more than this in facing.
+inline constexpr double kTrajectoryWarnDeg = 20.0;
+
 /// Completes `input` under `constraints` (partial keys, end-effector targets,
-/// contact pins; validated here: frames and joints in range, finite values,
+/// contact pins, a trajectory; validated here: frames and joints in range, finite values,
 /// at least one key fixing the root) with `alternatives` (0..kMaxAlternatives)
 /// more solutions from other starts, deterministic for the context's seed.
 /// Whole-pose keys alone without alternatives take run_known_frames()'s path
@@ -115,7 +122,10 @@ struct ConstrainedResult {
 /// alternatives). The model's methods serve any rig and rate the model can
 /// retarget from (tasks/model_rig.h complete_constrained_on_model_rig(); on
 /// another rig one key must give the whole pose). Known values come out
-/// exactly as given.
+/// exactly as given. A trajectory needs a method with
+/// Method::follows_trajectory (the latent solvers): any other throws
+/// InputError naming those that can, and a result that misses the trajectory
+/// by more than kTrajectoryWarnCm / kTrajectoryWarnDeg gets a warning.
 ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& constraints, const std::string& method,
                                   int alternatives, const TaskContext& ctx = {});
 

@@ -32,7 +32,8 @@ int default_iterations(SolverMethod m) { return m == SolverMethod::Adam ? 600 : 
 
 // A keys-only stage only pays where a dense term is left for the second stage.
 bool has_dense_term(const EnergyWeights& w) {
-  return w.root_translation > 0 || w.effector > 0 || w.foot_skating > 0 || w.smoothness > 0;
+  return w.root_translation > 0 || w.effector > 0 || w.trajectory > 0 || w.trajectory_facing > 0 ||
+         w.foot_skating > 0 || w.smoothness > 0;
 }
 
 std::vector<int> key_frames_of(const MotionConstraints& c) {
@@ -170,7 +171,10 @@ std::vector<WindowPlan> plan_windows(int W, int N, const MotionConstraints& cons
       throw InputError("frames " + std::to_string(p.start) + ".." + std::to_string(p.start + p.length - 1) +
                        " hold no key that fixes the root");  // cannot happen after validation
     }
-    p.caps = window_caps(options, key_frames_of(p.constraints), !p.constraints.effectors.empty() || !p.constraints.contacts.empty(), p.length);
+    p.caps = window_caps(options, key_frames_of(p.constraints),
+                         !p.constraints.effectors.empty() || !p.constraints.contacts.empty() ||
+                             !p.constraints.followed_trajectory().empty(),
+                         p.length);
     std::fill(solved.begin() + p.start, solved.begin() + p.start + p.length, 1);
     plan.push_back(std::move(p));
   }
@@ -333,8 +337,8 @@ std::string LatentSolverOptions::validate() const {
   if (contact_ramp < 0) e << "contact_ramp must be >= 0; ";
   if (!(start_noise >= 0) || !std::isfinite(start_noise)) e << "start_noise must be finite and non-negative; ";
   const EnergyWeights& w = weights;
-  for (double v : {w.rotation, w.position, w.root_orientation, w.root_translation, w.effector, w.contact, w.latent_prior,
-                   w.foot_skating, w.smoothness}) {
+  for (double v : {w.rotation, w.position, w.root_orientation, w.root_translation, w.effector, w.contact, w.trajectory,
+                   w.trajectory_facing, w.latent_prior, w.foot_skating, w.smoothness}) {
     if (!(v >= 0) || !std::isfinite(v)) {
       e << "energy weights must be finite and non-negative; ";
       break;
@@ -360,8 +364,9 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
   const auto t0 = Clock::now();
   const FlatLatentEnergy energy(window_energy(model, problem, options.weights), zl, zg);
   const at::Tensor x0 = energy.join(start.z_l, start.z_g);
-  const WindowCaps caps = window_caps(options, key_frames_of(problem), problem.num_effectors() > 0 || problem.num_pin_steps() > 0,
-                                      problem.length);
+  const WindowCaps caps =
+      window_caps(options, key_frames_of(problem),
+                  problem.num_effectors() > 0 || problem.num_pin_steps() > 0 || problem.num_trajectory() > 0, problem.length);
   const int total = iteration_total > 0 ? iteration_total : caps.keyed + caps.full;
 
   LatentSolution out;
@@ -371,6 +376,7 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
   if (caps.keyed > 0) {
     EnergyWeights keyed = options.weights;
     keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
+    keyed.trajectory = keyed.trajectory_facing = 0.0;
     const FlatLatentEnergy cheap(window_energy(model, problem, keyed), zl, zg);
     LatentOptimizerStats first;
     x = minimize_latent(cheap.total(), x, options.method, options.capped(caps.keyed), ctx, &first, iteration_offset,

@@ -34,6 +34,10 @@ struct Method {
   std::function<Motion(const Motion& input, const MotionConstraints& c, int variant, const TaskContext& ctx,
                        std::vector<std::string>* warnings)>
       complete_constrained;
+  /// True when complete_constrained follows MotionConstraints::trajectory;
+  /// run_constrained() refuses a trajectory for the other methods (naming
+  /// the ones that can) rather than ignoring it.
+  bool follows_trajectory = false;
   /// Resamples to `fps` with exactly `frames` output frames at times i / fps.
   /// Null when unsupported.
   std::function<Motion(const Motion& input, double fps, int frames, const TaskContext& ctx)> resample;

@@ -27,6 +27,23 @@ bool MotionConstraints::key_has_joint(size_t k, int joint) const {
 
 bool MotionConstraints::key_fixes_root(size_t k) const { return keys[k].root_position && key_has_joint(k, 0); }
 
+bool MotionConstraints::fixes_root_position(int frame) const {
+  for (const PoseKey& k : keys) {
+    if (k.frame == frame && k.root_position) return true;
+  }
+  return false;
+}
+
+std::vector<TrajectoryPoint> MotionConstraints::followed_trajectory() const {
+  std::vector<TrajectoryPoint> out;
+  size_t k = 0;  // keys and rows are both sorted by frame
+  for (const TrajectoryPoint& p : trajectory) {
+    while (k < keys.size() && keys[k].frame < p.frame) ++k;
+    if (!(k < keys.size() && keys[k].frame == p.frame && keys[k].root_position)) out.push_back(p);
+  }
+  return out;
+}
+
 bool MotionConstraints::beyond_full_poses() const {
   if (!effectors.empty() || !contacts.empty() || !trajectory.empty()) return true;
   for (const PoseKey& k : keys) {

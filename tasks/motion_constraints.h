@@ -84,6 +84,11 @@ struct MotionConstraints {
   bool key_has_joint(size_t k, int joint) const;
   /// True when key `k` gives the root's rotation and position (it can anchor a window).
   bool key_fixes_root(size_t k) const;
+  /// True when a key fixes the root's position at `frame`.
+  bool fixes_root_position(int frame) const;
+  /// The trajectory rows the solvers follow: those at frames where no key
+  /// fixes the root position (the known frames win).
+  std::vector<TrajectoryPoint> followed_trajectory() const;
   /// True when anything but whole-pose keys is asked for (partial keys,
   /// end-effector targets, contact pins or a trajectory).
   bool beyond_full_poses() const;

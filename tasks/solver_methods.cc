@@ -26,6 +26,7 @@ Method solver_method(const std::string& name, const std::string& description, So
   m.description = description;
   m.needs_model = true;
   m.needs_inbetweener = inbetweener;
+  m.follows_trajectory = true;  // the trajectory energy (tasks/energies.h)
   LatentSolverOptions options = default_solver_options(method);
   if (!initializer.empty()) options.initializer = make_initializer(initializer);
   m.complete = [options, method_name = name, inbetweener](const Motion& input, const std::vector<int>& known,

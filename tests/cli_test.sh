@@ -596,5 +596,31 @@ bad "--alternatives with interp" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TM
 expect_stderr "single solution" "interp alternatives message"
 expect_rc 2 "--alternatives to standard output" -- "$MF" inbetween -i "$SAMPLE" --keyframes 0,60 -o - --alternatives 1
 
+# ------------------------------------------------------------ trajectory (issue 15, docs/CONSTRAINTS.md)
+# The sample's hips path on frames 20..40 (BVH columns 7 and 9, cm), 15 cm to
+# the side, facing +Z (the way it walks).
+awk 'f { n++; fr = n - 1; if (fr >= 20 && fr <= 40) printf "%d,%.4f,%.4f,0,1\n", fr, $7 + 15 * sin(3.14159 * (fr - 19) / 22), $9 }
+     /Frame Time/ { f = 1; print "frame,x,z,forward_x,forward_z" }' "$SAMPLE" >"$TMP/t.csv"
+expect_rc 0 "fill --trajectory (nemf)" -- "$MF" --threads 1 fill -i "$SAMPLE" --gap 15:45 -o "$TMP/t.bvh" \
+  --trajectory "$TMP/t.csv" --method nemf --report "$TMP/t-report.json"
+expect_rc 0 "a trajectory keeps the known frames" -- "$DIFF" "$SAMPLE" "$TMP/t.bvh" --frames 0,14,45,60
+grep -q '"rows": 21' "$TMP/t-report.json" && pass || fail "the report measures the trajectory's 21 rows"
+printf '%s\n' "{\"task\": \"fill\", \"in\": \"$SAMPLE\", \"out\": \"$TMP/bt.bvh\", \"gap\": [15, 45], \"method\": \"nemf\", \"trajectory\": \"$TMP/t.csv\", \"report\": \"$TMP/bt-report.json\"}" \
+  "{\"task\": \"fill\", \"in\": \"$SAMPLE\", \"out\": \"$TMP/bt2.bvh\", \"gap\": [15, 45], \"trajectory\": 3}" \
+  >"$TMP/tjobs.jsonl"
+expect_rc 2 "batch with a trajectory (one bad line)" -- "$MF" --threads 1 batch "$TMP/tjobs.jsonl"
+expect_stderr 'line 2: error: "trajectory" must be a string' "batch names a bad trajectory value"
+cmp -s "$TMP/bt.bvh" "$TMP/t.bvh" && pass || fail "batch trajectory = --trajectory"
+cmp -s "$TMP/bt-report.json" "$TMP/t-report.json" && pass || fail "batch trajectory report = --report"
+bad "--trajectory with interp" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --trajectory "$TMP/t.csv" --method interp
+expect_stderr "method 'interp' cannot follow a trajectory; the methods that can: nemf" "interp trajectory message"
+printf 'frame,x,z,forward_x,forward_z\n5,0,0,0,1\n5,1,0,0,1\n' >"$TMP/t-bad.csv"
+bad "--trajectory with a repeated frame" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --trajectory "$TMP/t-bad.csv" --method nemf
+expect_stderr "t-bad.csv:3: frame 5 is given twice" "trajectory CSV error names the line"
+bad "--trajectory file missing" inbetween -i "$SAMPLE" --keyframes 0,60 -o "$TMP/bad.bvh" --trajectory "$TMP/none.csv"
+cp "$TMP/t.csv" "$TMP/tt.bvh"
+bad "--trajectory is the output" fill -i "$SAMPLE" --gap 15:45 -o "$TMP/tt.bvh" --trajectory "$TMP/tt.bvh"
+expect_stderr "is the trajectory file" "refuses to overwrite the trajectory file"
+
 echo "cli_test: $((checks - failures)) of $checks checks passed"
 [ "$failures" -eq 0 ]

@@ -89,6 +89,10 @@ void add_constraints(CLI::App* cmd, BatchJob& job) {
                   "a constraints file (JSON, docs/CONSTRAINTS.md): partial keys,\nend-effector targets, contacts")
       ->type_name("FILE")
       ->check(kNonEmpty);
+  cmd->add_option("--trajectory", job.trajectory_file,
+                  "a trajectory CSV (frame,x,z,forward_x,forward_z per frame,\ndocs/CONSTRAINTS.md) the root follows (latent solvers)")
+      ->type_name("FILE")
+      ->check(kNonEmpty);
   cmd->add_option("--alternatives", job.alternatives,
                   "N more solutions, written beside the output as\nOUT_1.bvh .. OUT_N.bvh (0..16)")
       ->type_name("N")
@@ -237,8 +241,9 @@ void define_batch(CLI::App& app, HelpFormatter& help, Arguments& a) {
       "For fill, a \"keyframes\" list, if given, is authoritative over \"gap\". For\n"
       "renav, \"path\" or \"polyline\" and the optional \"fps\" and \"frames\" mean what\n"
       "the flags of `motionfield renav` mean. inbetween and fill take \"constraints\"\n"
-      "(a file or an inline object), \"alternatives\" and \"report\" as the flags\n"
-      "--constraints, --alternatives and --report. Every task takes \"rig_map\" (a file) and\n"
+      "(a file or an inline object), \"trajectory\" (a CSV file), \"alternatives\" and\n"
+      "\"report\" as the flags --constraints, --trajectory, --alternatives and --report.\n"
+      "Every task takes \"rig_map\" (a file) and\n"
       "\"units\" (a name, auto, or metres per unit), which replace --rig-map and\n"
       "--units for that job. Keys a job does not need (\"id\", frame counts, ...) are\n"
       "ignored; blank lines are skipped; relative paths are relative to the current\n"

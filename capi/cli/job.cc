@@ -43,7 +43,8 @@ void check_output_is_not_an_input(const BatchJob& job, const Settings& settings)
   const std::pair<const std::string*, const char*> inputs[] = {{&job.in, "input"},
                                                                {&job.path_file, "path file"},
                                                                {&rig_map, "rig map file"},
-                                                               {&job.constraints_file, "constraints file"}};
+                                                               {&job.constraints_file, "constraints file"},
+                                                               {&job.trajectory_file, "trajectory file"}};
   std::vector<std::string> outputs = {job.out};
   for (int i = 1; i <= job.alternatives; ++i) outputs.push_back(alternative_path(job.out, i));
   if (!job.report_file.empty()) outputs.push_back(job.report_file);
@@ -80,6 +81,7 @@ Constraints job_constraints(const BatchJob& job, const Motion& input) {
   Constraints c = !job.constraints_file.empty()   ? Constraints::load_json(job.constraints_file)
                   : !job.constraints_json.empty() ? Constraints::parse_json(job.constraints_json)
                                                   : Constraints::create();
+  if (!job.trajectory_file.empty()) c.load_trajectory_csv(job.trajectory_file);
   if (job.task == "inbetween" || job.has_keyframes)
     return std::move(c.add_pose_keys(std::vector<int32_t>(job.keyframes.begin(), job.keyframes.end())));
   const int n = input.frame_count();

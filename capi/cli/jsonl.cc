@@ -327,7 +327,7 @@ std::vector<int> int_array(const JsonValue& v, const std::string& key) {
   return out;
 }
 
-// "constraints" (a file name or an inline object), "alternatives", "report".
+// "constraints" (a file name or an inline object), "trajectory", "alternatives", "report".
 void read_constraints(const JsonValue& line, BatchJob* job) {
   if (const JsonValue* c = line.find("constraints")) {
     if (c->is_object())
@@ -337,6 +337,7 @@ void read_constraints(const JsonValue& line, BatchJob* job) {
     else
       throw InputError(std::string("\"constraints\" must be a file name or an object, not ") + json_type_name(c->type()));
   }
+  if (const JsonValue* t = line.find("trajectory")) job->trajectory_file = string_value(*t, "trajectory", false);
   if (const JsonValue* n = line.find("alternatives")) {
     job->alternatives = int_value(*n, "\"alternatives\"");
     if (job->alternatives < 0 || job->alternatives > 16)

@@ -94,7 +94,8 @@ const char* json_type_name(JsonValue::Type type);
 /// optional "frames": N), and an optional "fps". Every task takes an optional
 /// "rig_map" (a JSON map file) and "units" (a unit name, "auto", or metres per
 /// unit as a number or a string). inbetween and fill also take "constraints"
-/// (a constraints file, or the same JSON inline as an object), "alternatives"
+/// (a constraints file, or the same JSON inline as an object), "trajectory"
+/// (a trajectory CSV file, merged into the constraints), "alternatives"
 /// and "report" (a file for the constraint report). Only the keys the task needs
 /// are read and type-checked; any other key ("id", a frame count, the input's
 /// fps, ...) is ignored, so callers can annotate jobs.
@@ -116,12 +117,14 @@ struct BatchJob {
   // inbetween and fill: constraints beyond whole-pose keys (docs/CONSTRAINTS.md)
   std::string constraints_file;    ///< a constraints file; empty: none
   std::string constraints_json;    ///< inline constraints (JSON text); empty: none
+  std::string trajectory_file;     ///< a trajectory CSV (merged into the constraints); empty: none
   int alternatives = 0;            ///< more solutions, written to OUT_1.bvh .. OUT_N.bvh
   std::string report_file;         ///< where the constraint report goes (JSON); empty: nowhere
 
   /// True when the job goes through mf_solve (constraints, alternatives or a report).
   bool constrained() const {
-    return !constraints_file.empty() || !constraints_json.empty() || alternatives > 0 || !report_file.empty();
+    return !constraints_file.empty() || !constraints_json.empty() || !trajectory_file.empty() || alternatives > 0 ||
+           !report_file.empty();
   }
 };
 
@@ -131,7 +134,8 @@ struct BatchJob {
 /// strings; "keyframes" an array of integers; "gap" an array of two integers;
 /// "fps" a number; "method", "path", "polyline" and "rig_map" strings;
 /// "frames" an integer; "units" a string or a positive number; for inbetween
-/// and fill "constraints" a file name or an inline object, "alternatives" an
+/// and fill "constraints" a file name or an inline object, "trajectory" a file
+/// name, "alternatives" an
 /// integer in 0..16, "report" a file name; no string
 /// may contain a NUL, "\u0000", which would cut a file name). Range checks
 /// (keyframes within the clip, fps positive, ...) are the library's, once the

@@ -735,6 +735,12 @@ typedef struct mf_constraint_report {
   int32_t contact_frames;      /**< pinned frames measured */
   double contact_slide_max;
   double contact_slide_mean;
+  /* Appended (a caller's older, smaller struct_size gets the fields above). */
+  int32_t trajectory_rows;     /**< trajectory rows measured (those not at a frame whose root position a key fixes) */
+  double trajectory_max;       /**< ground distance (x, z) of the root from its row, the input's unit */
+  double trajectory_mean;
+  double facing_max_deg;       /**< angle between the root's facing and the row's forward */
+  double facing_mean_deg;
 } mf_constraint_report;
 
 MF_API int mf_constraint_report_init(mf_constraint_report *report);
@@ -745,8 +751,26 @@ MF_API int mf_solution_get_report(const mf_solution *solution, int32_t index, mf
  *      "rotation_max_deg": x, "rotation_mean_deg": x, "roots": n,
  *      "root_max": x, "root_mean": x}, "targets": {"count": n, "max": x,
  *      "mean": x}, "contacts": {"frames": n, "max": x, "mean": x}}, ...],
- *     "warnings": ["...", ...]} */
+ *     "warnings": ["...", ...]}
+ *  With a trajectory, each solution also has "trajectory": {"rows": n,
+ *  "max": x, "mean": x, "facing_max_deg": x, "facing_mean_deg": x}. */
 MF_API int mf_solution_get_report_json(const mf_solution *solution, char *out, size_t capacity, size_t *needed);
+
+/** A ground trajectory for the solve: `count` rows, row i at frame
+ *  `frames[i]` (non-negative, strictly increasing across all rows of the set
+ *  when mf_solve runs), with `rows[4 * i ..]` = x, z (the root's ground
+ *  position, world, the input's unit) and forward_x, forward_z (the facing
+ *  direction: any non-zero length). The latent solvers pull the root's ground
+ *  position and facing toward every row not at a frame whose root position a
+ *  key fixes (the known frames win); other methods refuse a trajectory
+ *  (MF_ERROR_INVALID_ARGUMENT naming those that can). Non-finite values and a
+ *  zero-length facing are MF_ERROR_INVALID_ARGUMENT naming the row. */
+MF_API int mf_constraints_add_trajectory(mf_constraints *constraints, const int32_t *frames, const float *rows,
+                                         size_t count);
+/** The same from a trajectory CSV file (header frame,x,z,forward_x,forward_z,
+ *  docs/CONSTRAINTS.md): MF_ERROR_IO if it cannot be read,
+ *  MF_ERROR_INVALID_ARGUMENT "<path>:<line>: ..." on a malformed file. */
+MF_API int mf_constraints_load_trajectory_csv(mf_constraints *constraints, const char *path);
 
 #ifdef __cplusplus
 }

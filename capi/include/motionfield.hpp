@@ -629,6 +629,21 @@ class Constraints : public detail::Handle<mf_constraints, mf_constraints_destroy
     check(mf_constraints_add_contact(get(), joint.c_str(), first, last));
     return *this;
   }
+  /// mf_constraints_add_trajectory: `rows` holds 4 values per frame (x, z,
+  /// forward_x, forward_z); its size must be 4 * frames.size().
+  Constraints& add_trajectory(const std::vector<int32_t>& frames, const std::vector<float>& rows) {
+    if (rows.size() != frames.size() * 4)
+      throw Error(MF_ERROR_INVALID_ARGUMENT, "add_trajectory: rows must hold 4 values per frame (" +
+                                                 std::to_string(frames.size() * 4) + "), got " +
+                                                 std::to_string(rows.size()));
+    check(mf_constraints_add_trajectory(get(), frames.data(), rows.data(), frames.size()));
+    return *this;
+  }
+  /// mf_constraints_load_trajectory_csv.
+  Constraints& load_trajectory_csv(const std::string& path) {
+    check(mf_constraints_load_trajectory_csv(get(), path.c_str()));
+    return *this;
+  }
   std::string to_json() const {
     return detail::read_string([&](char* out, size_t capacity, size_t* needed) {
       return mf_constraints_to_json(get(), out, capacity, needed);

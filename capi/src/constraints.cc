@@ -10,6 +10,7 @@
 #include "prior/util/binary_io.h"
 #include "tasks/constraint_spec.h"
 #include "tasks/jobs.h"
+#include "tasks/trajectory_csv.h"
 
 /// Largest constraints file mf_constraints_load_json reads.
 static constexpr size_t kMaxConstraintsFileBytes = 16u << 20;
@@ -24,6 +25,7 @@ struct mf_solution {
   std::vector<std::string> warnings;
   double length_scale = 0.01;  ///< metres per input unit
   std::string unit;
+  bool trajectory = false;  ///< the constraints had a trajectory (its report fields are written)
 };
 
 namespace mf::capi {
@@ -54,6 +56,19 @@ nlohmann::json report_json(const ConstraintReport& r, double cm_to_unit, int ind
           {"targets", {{"count", r.targets.count}, {"max", r.targets.max_cm * cm_to_unit}, {"mean", r.targets.mean_cm * cm_to_unit}}},
           {"contacts",
            {{"frames", r.contacts.frames}, {"max", r.contacts.max_cm * cm_to_unit}, {"mean", r.contacts.mean_cm * cm_to_unit}}}};
+}
+
+// The report JSON of one solution: report_json() plus the trajectory's when
+// the constraints have one (so reports without one keep their old bytes).
+nlohmann::json solution_report_json(const ConstraintReport& r, double cm_to_unit, int index, bool trajectory) {
+  nlohmann::json j = report_json(r, cm_to_unit, index);
+  if (trajectory)
+    j["trajectory"] = {{"rows", r.trajectory.rows},
+                       {"max", r.trajectory.max_cm * cm_to_unit},
+                       {"mean", r.trajectory.mean_cm * cm_to_unit},
+                       {"facing_max_deg", r.trajectory.facing_max_deg},
+                       {"facing_mean_deg", r.trajectory.facing_mean_deg}};
+  return j;
 }
 
 }  // namespace
@@ -188,6 +203,7 @@ int mf_solve(const mf_model* model, const mf_motion* input, const mf_constraints
     s->warnings = std::move(r.warnings);
     s->length_scale = input->length_scale;
     s->unit = input->unit;
+    s->trajectory = !c.trajectory.empty();
     *out = s.release();
   });
 }
@@ -243,6 +259,11 @@ int mf_solution_get_report(const mf_solution* solution, int32_t index, mf_constr
     full.contact_frames = static_cast<int32_t>(r.contacts.frames);
     full.contact_slide_max = r.contacts.max_cm * u;
     full.contact_slide_mean = r.contacts.mean_cm * u;
+    full.trajectory_rows = static_cast<int32_t>(r.trajectory.rows);
+    full.trajectory_max = r.trajectory.max_cm * u;
+    full.trajectory_mean = r.trajectory.mean_cm * u;
+    full.facing_max_deg = r.trajectory.facing_max_deg;
+    full.facing_mean_deg = r.trajectory.facing_mean_deg;
     std::memcpy(report, &full, size < sizeof full ? size : sizeof full);
   });
 }
@@ -254,8 +275,41 @@ int mf_solution_get_report_json(const mf_solution* solution, char* out, size_t c
                           {"warnings", solution->warnings}};
     const double u = 0.01 / solution->length_scale;
     for (size_t i = 0; i < solution->reports.size(); ++i)
-      doc["solutions"].push_back(mf::capi::report_json(solution->reports[i], u, static_cast<int>(i)));
+      doc["solutions"].push_back(
+          mf::capi::solution_report_json(solution->reports[i], u, static_cast<int>(i), solution->trajectory));
     mf::capi::write_string(doc.dump(2, ' ', false, nlohmann::json::error_handler_t::replace), out, capacity, needed);
+  });
+}
+
+int mf_constraints_add_trajectory(mf_constraints* constraints, const int32_t* frames, const float* rows, size_t count) {
+  return guard([&] {
+    require(constraints, "constraints");
+    if ((!frames || !rows) && count != 0) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "frames or rows is NULL");
+    std::vector<mf::TrajectoryPoint> add;
+    for (size_t i = 0; i < count; ++i) {
+      mf::TrajectoryPoint p;
+      p.frame = mf::capi::frame_arg(frames[i], "trajectory frame");
+      p.x = rows[4 * i];
+      p.z = rows[4 * i + 1];
+      p.forward_x = rows[4 * i + 2];
+      p.forward_z = rows[4 * i + 3];
+      const std::string what = "trajectory row " + std::to_string(i) + " (frame " + std::to_string(p.frame) + ")";
+      if (!std::isfinite(p.x) || !std::isfinite(p.z) || !std::isfinite(p.forward_x) || !std::isfinite(p.forward_z))
+        throw ApiError(MF_ERROR_INVALID_ARGUMENT, what + ": values must be finite");
+      if (std::hypot(p.forward_x, p.forward_z) < 1e-6)
+        throw ApiError(MF_ERROR_INVALID_ARGUMENT, what + ": the facing direction (forward_x, forward_z) has zero length");
+      add.push_back(p);
+    }
+    constraints->spec.trajectory.insert(constraints->spec.trajectory.end(), add.begin(), add.end());
+  });
+}
+
+int mf_constraints_load_trajectory_csv(mf_constraints* constraints, const char* path) {
+  return guard([&] {
+    require(constraints, "constraints");
+    require(path, "path");
+    const std::vector<mf::TrajectoryPoint> rows = mf::read_trajectory_csv(path);
+    constraints->spec.trajectory.insert(constraints->spec.trajectory.end(), rows.begin(), rows.end());
   });
 }
 

@@ -1613,6 +1613,74 @@ class Constraints(_Handle):
         _check(_c.mf_constraints_add_contact(self._live(), joint.encode(), int(first), int(last)))
         return self
 
+    def add_trajectory(self, trajectory: npt.ArrayLike, rows: Optional[npt.ArrayLike] = None) -> "Constraints":
+        """Adds a ground trajectory the root follows (latent solvers only).
+
+        Parameters
+        ----------
+        trajectory : array [N, 5] (frame, x, z, forward_x, forward_z), or frames [N]
+            One row per frame: the root's ground position (the input's unit,
+            world) and facing direction (any non-zero length). With `rows`,
+            the frames alone.
+        rows : array [N, 4] (x, z, forward_x, forward_z), optional
+            The rows when `trajectory` holds the frames.
+
+        Returns
+        -------
+        Constraints
+            self, for chaining.
+
+        Raises
+        ------
+        InvalidArgumentError
+            On a shape mismatch, a non-integer or negative frame, non-finite
+            values or a zero-length facing.
+        """
+        if rows is None:
+            t = np.asarray(trajectory, dtype=np.float64)
+            if t.ndim != 2 or t.shape[1] != 5:
+                raise InvalidArgumentError("trajectory must be an array [N, 5] (frame, x, z, forward_x, forward_z), "
+                                           "got shape %s" % (t.shape,))
+            frames_f, values = t[:, 0], t[:, 1:]
+        else:
+            frames_f = np.asarray(trajectory, dtype=np.float64).reshape(-1)
+            values = np.asarray(rows, dtype=np.float64)
+            if values.ndim != 2 or values.shape != (len(frames_f), 4):
+                raise InvalidArgumentError("rows must be an array [%d, 4] (x, z, forward_x, forward_z), got shape %s"
+                                           % (len(frames_f), values.shape))
+        if not np.all(np.isfinite(frames_f)) or np.any(frames_f != np.floor(frames_f)) or np.any(frames_f < 0) \
+                or np.any(frames_f > 2**31 - 1):
+            raise InvalidArgumentError("trajectory frames must be non-negative integers")
+        frames = np.ascontiguousarray(frames_f, dtype=np.int32)
+        flat = np.ascontiguousarray(values, dtype=np.float32).reshape(-1)
+        _check(_c.mf_constraints_add_trajectory(
+            self._live(), frames.ctypes.data_as(ctypes.POINTER(ctypes.c_int32)),
+            flat.ctypes.data_as(ctypes.POINTER(ctypes.c_float)), len(frames)))
+        return self
+
+    def load_trajectory(self, path: PathLike) -> "Constraints":
+        """Adds the trajectory of a CSV file (header frame,x,z,forward_x,forward_z;
+        docs/CONSTRAINTS.md), as ``--trajectory`` does.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+
+        Returns
+        -------
+        Constraints
+            self, for chaining.
+
+        Raises
+        ------
+        FileError
+            If the file cannot be read.
+        InvalidArgumentError
+            "<path>:<line>: ..." on a malformed file.
+        """
+        _check(_c.mf_constraints_load_trajectory_csv(self._live(), os.fsencode(path)))
+        return self
+
     def to_dict(self) -> Dict[str, Any]:
         """The constraints in the file format.
 
@@ -1659,7 +1727,7 @@ class Solution(NamedTuple):
 def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequence[PartialKey] = (),
           targets: Union[Sequence[Target], Dict[str, Tuple[npt.ArrayLike, npt.ArrayLike]]] = (),
           contacts: Sequence[Tuple[str, int, int]] = (), constraints: Union[Constraints, str, Dict[str, Any], None] = None,
-          alternatives: int = 0, method: Optional[str] = None, model: Optional[Model] = None, seed: int = 0,
+          trajectory: Union[npt.ArrayLike, str, "os.PathLike[str]", None] = None, alternatives: int = 0, method: Optional[str] = None, model: Optional[Model] = None, seed: int = 0,
           progress: Optional[ProgressCallback] = None, cancel: Optional[CancelToken] = None,
           rig_map: Optional[RigMap] = None) -> Solution:
     """Completes a motion under any constraints, with alternative solutions.
@@ -1685,6 +1753,11 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
     constraints : Constraints, str or dict, optional
         More constraints: a Constraints, a constraints file's path, or the
         file format as a dict.
+    trajectory : array [N, 5], (frames [N], rows [N, 4]), or a CSV path, optional
+        A ground trajectory the root follows (Constraints.add_trajectory,
+        Constraints.load_trajectory): frame, x, z (the input's unit),
+        forward_x, forward_z. Only the latent solvers follow one; other
+        methods raise InvalidArgumentError.
     alternatives : int
         More solutions (0..16) from other starts, deterministic for `seed`.
     {task_parameters}
@@ -1723,6 +1796,12 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
             c.add_target(t[0], t[1], t[2], t[3] if len(t) > 3 else 1.0)  # type: ignore[misc]
     for joint, first, last in contacts:
         c.add_contact(joint, first, last)
+    if isinstance(trajectory, (str, os.PathLike)):
+        c.load_trajectory(trajectory)
+    elif isinstance(trajectory, tuple) and len(trajectory) == 2:
+        c.add_trajectory(trajectory[0], trajectory[1])
+    elif trajectory is not None:
+        c.add_trajectory(trajectory)
     call = _TaskCall(method, seed, progress, cancel, rig_map)
     handle = call.run(_c.mf_solve, _task_model(model, method), motion._live(), c._live(), int(alternatives),
                       out_type=_c.MfSolution)

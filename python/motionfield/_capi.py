@@ -86,6 +86,11 @@ class MfConstraintReport(ctypes.Structure):
         ("contact_frames", ctypes.c_int32),
         ("contact_slide_max", ctypes.c_double),
         ("contact_slide_mean", ctypes.c_double),
+        ("trajectory_rows", ctypes.c_int32),
+        ("trajectory_max", ctypes.c_double),
+        ("trajectory_mean", ctypes.c_double),
+        ("facing_max_deg", ctypes.c_double),
+        ("facing_mean_deg", ctypes.c_double),
     ]
 
 
@@ -337,6 +342,8 @@ _declare("mf_solution_get_motion", _int, _solution, _i32, _P(_motion))
 _declare("mf_constraint_report_init", _int, _P(MfConstraintReport))
 _declare("mf_solution_get_report", _int, _solution, _i32, _P(MfConstraintReport))
 _declare("mf_solution_get_report_json", _int, _solution, ctypes.c_char_p, _size, _P(_size))
+_declare("mf_constraints_add_trajectory", _int, _constraints, _P(_i32), _P(_f32), _size)
+_declare("mf_constraints_load_trajectory_csv", _int, _constraints, _str)
 
 if mf_abi_version() != ABI_VERSION:  # noqa: F821 (declared above)
     raise ImportError("%s has ABI version %d; this package needs %d" %

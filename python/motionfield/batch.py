@@ -91,13 +91,15 @@ class BatchJob:
     units: str = ""
     constraints_file: str = ""  # inbetween, fill: a constraints file
     constraints_json: str = ""  # ... or the same inline (JSON text)
+    trajectory_file: str = ""  # inbetween, fill: a trajectory CSV, merged into the constraints
     alternatives: int = 0
     report_file: str = ""
 
     @property
     def constrained(self) -> bool:
         """Whether the job goes through solve() (constraints, alternatives or a report)."""
-        return bool(self.constraints_file or self.constraints_json or self.alternatives or self.report_file)
+        return bool(self.constraints_file or self.constraints_json or self.trajectory_file or self.alternatives
+                    or self.report_file)
 
 
 @dataclasses.dataclass
@@ -442,6 +444,8 @@ def _read_constraints(line: Dict[str, Any], job: BatchJob) -> None:
             job.constraints_file = _string_value(c, "constraints", False)
         else:
             raise InputError('"constraints" must be a file name or an object, not ' + json_type_name(c))
+    if "trajectory" in line:
+        job.trajectory_file = _string_value(line["trajectory"], "trajectory", False)
     if "alternatives" in line:
         job.alternatives = _int_value(line["alternatives"], '"alternatives"')
         if not 0 <= job.alternatives <= 16:
@@ -802,7 +806,7 @@ def _check_output(job: BatchJob, settings: Settings) -> None:
         outputs.append(job.report_file)
     for out in outputs:
         for file, role in ((job.in_path, "input"), (job.path_file, "path file"), (rig_map, "rig map file"),
-                           (job.constraints_file, "constraints file")):
+                           (job.constraints_file, "constraints file"), (job.trajectory_file, "trajectory file")):
             try:
                 same = bool(file) and file != _STDIO and os.path.samefile(file, out)
             except OSError:
@@ -830,6 +834,8 @@ def _solve_constrained(job: BatchJob, options: Dict[str, Any], motion: mf.Motion
     """The CLI's constrained path: the job's constraints plus its known frames as whole-pose keys."""
     constraints = (mf.Constraints.load(job.constraints_file) if job.constraints_file
                    else mf.Constraints(job.constraints_json) if job.constraints_json else mf.Constraints())
+    if job.trajectory_file:
+        constraints.load_trajectory(job.trajectory_file)
     if job.task == "inbetween" or job.has_keyframes:
         keys = job.keyframes
     else:

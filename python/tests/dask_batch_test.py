@@ -17,6 +17,7 @@ with $MOTIONFIELD_LIBRARY and $MF_CLI set.
 """
 
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -44,8 +45,10 @@ GOOD = [
      "constraints": {"keys": [{"frame": 25, "joints": ["Head"]}], "contacts": [{"joint": "Foot_L", "first": 30,
                                                                                "last": 35}]},
      "report": "out/constrained-report.json"},                                       # docs/CONSTRAINTS.md
+    {"task": "fill", "in": "walk.bvh", "out": "out/trajectory.bvh", "gap": [15, 45], "method": "nemf",
+     "trajectory": "t.csv", "report": "out/trajectory-report.json"},                 # a trajectory CSV
 ]
-REPORTS = ["constrained-report.json"]
+REPORTS = ["constrained-report.json", "trajectory-report.json"]
 BAD_LINES = [
     '{"id": 7, "task": "fill", "in": "walk.bvh", "out": "out/bad-gap.bvh", "gap": [10]}',
     '{"task": "fill",}',
@@ -61,6 +64,7 @@ BAD_LINES = [
     '{"task": "inbetween", "in": "walk.bvh", "out": "z.bvh", "keyframes": [0, 3000000000]}',
     '{"task": "inbetween", "in": "walk.bvh", "out": "z.bvh", "keyframes": [0, 60], "constraints": 3}',
     '{"task": "inbetween", "in": "walk.bvh", "out": "z.bvh", "keyframes": [0, 60], "alternatives": 17}',
+    '{"task": "fill", "in": "walk.bvh", "out": "z.bvh", "gap": [15, 45], "trajectory": 3}',
 ]
 WORKER_FAILURES = [
     {"task": "fill", "in": "missing.bvh", "out": "out/missing.bvh", "gap": [1, 5]},
@@ -76,6 +80,8 @@ WORKER_FAILURES = [
     {"task": "resample", "in": "walk.bvh", "out": "out/s.bvh", "fps": -5},
     {"task": "inbetween", "in": "walk.bvh", "out": "out/c.bvh", "keyframes": [0, 60], "method": "interp",
      "constraints": {"keys": [{"frame": 30, "joints": ["Tail"]}]}},
+    {"task": "fill", "in": "walk.bvh", "out": "out/t1.bvh", "gap": [15, 45], "method": "interp", "trajectory": "t.csv"},
+    {"task": "fill", "in": "walk.bvh", "out": "out/t2.bvh", "gap": [15, 45], "method": "nemf", "trajectory": "none.csv"},
 ]
 
 
@@ -90,6 +96,9 @@ def set_up_dir(path):
     shutil.copy(SAMPLE, os.path.join(path, "walk.bvh"))
     with open(os.path.join(path, "path.csv"), "w") as f:
         f.write("x,z\n" + "".join("%.4f,%.4f\n" % (0.3 * (i / 30.0) ** 2, 0.04 * i) for i in range(30)))
+    with open(os.path.join(path, "t.csv"), "w") as f:  # 15 cm left of a straight walk along +Z, facing +Z
+        f.write("frame,x,z,forward_x,forward_z\n" + "".join(
+            "%d,%.4f,%.4f,0,1\n" % (i, 15 * math.sin(math.pi * (i - 14) / 32), -60 + 3.24 * i) for i in range(15, 45)))
     with open(os.path.join(path, "notamap.json"), "w") as f:
         f.write('{"a": 1}\n')
     with open(os.path.join(path, "jobs.jsonl"), "w") as f:
@@ -151,9 +160,9 @@ class DaskBatchTest(unittest.TestCase):
                          ["ok"] * len(GOOD) + ["error"] * (len(BAD_LINES) + len(WORKER_FAILURES)))
         self.assertEqual([s["line"] for s in summaries[:4]], [1, 2, 4, 5])  # line 3 is blank
         self.assertEqual(summaries[0]["method"], mf.default_method())
-        self.assertIn('motionfield: jobs.jsonl line 8 (id 7): error: "gap" must be an array of two integers',
+        self.assertIn('motionfield: jobs.jsonl line 9 (id 7): error: "gap" must be an array of two integers',
                       self.dask_run.stderr)
-        self.assertIn("jobs.jsonl line 23: error: cannot write nodir/x.bvh: directory nodir does not exist",
+        self.assertIn("jobs.jsonl line 25: error: cannot write nodir/x.bvh: directory nodir does not exist",
                       self.dask_run.stderr)
         self.assertTrue(self.dask_run.stderr.endswith("motionfield: batch jobs.jsonl: %d jobs, %d ok, %d failed\n" % (
             len(summaries), len(GOOD), len(summaries) - len(GOOD))), self.dask_run.stderr)

@@ -56,6 +56,72 @@ class ConstraintsTest(unittest.TestCase):
         again = mf.solve(self.motion, [0, 60], alternatives=1, method="nemf", model=model, seed=3)
         np.testing.assert_array_equal(again.motions[1].rotations, s.motions[1].rotations)
 
+    def _bumped_trajectory(self, first, last, bump_m):
+        """The straight line between the sample's root at the keys first - 1
+        and last + 1 (the way it walks), pushed sideways by up to bump_m
+        metres, facing along the line: [N, 5] rows (frame, x, z in the file's
+        unit, forward_x, forward_z)."""
+        m = self.motion
+        r = m.root_positions[:, [0, 2]]  # metres
+        a, b = first - 1, last + 1
+        d = r[b] - r[a]
+        side = np.array([-d[1], d[0]]) / np.linalg.norm(d)
+        frames = np.arange(first, last + 1)
+        t = (frames - a) / float(b - a)
+        ground = (r[a] + t[:, None] * d + (bump_m * np.sin(np.pi * t))[:, None] * side) / m.length_scale
+        return np.column_stack([frames, ground, np.tile(d, (len(frames), 1))])
+
+    def test_trajectory_is_followed(self):
+        model = mf.Model(MODEL)
+        t = self._bumped_trajectory(16, 44, 0.3)
+        keys = [0, 15, 45, 60]
+        s = mf.solve(self.motion, keys, trajectory=t, method="nemf", model=model)
+        ground = s.motion.root_positions[t[:, 0].astype(int)][:, [0, 2]] / self.motion.length_scale
+        miss = np.linalg.norm(ground - t[:, 1:3], axis=1).max()  # file units (cm)
+        self.assertLess(miss, 5.0)  # measured 1.7 cm
+        self.assertLess(s.report["solutions"][0]["trajectory"]["facing_mean_deg"], 5.0)  # measured 1.1
+        r = s.report["solutions"][0]["trajectory"]
+        self.assertEqual(r["rows"], 29)
+        self.assertAlmostEqual(r["max"], float(miss), places=2)
+        # The same as frames + [N, 4] rows, and from a CSV file.
+        b = mf.solve(self.motion, keys, trajectory=(t[:, 0], t[:, 1:]), method="nemf", model=model)
+        np.testing.assert_array_equal(b.motion.rotations, s.motion.rotations)
+        path = os.path.join(self._tmp(), "t.csv")
+        with open(path, "w") as f:
+            f.write("frame,x,z,forward_x,forward_z\n")
+            for row in t.astype(np.float32):
+                f.write("%d,%r,%r,%r,%r\n" % (int(row[0]), float(row[1]), float(row[2]), float(row[3]), float(row[4])))
+        c = mf.solve(self.motion, keys, trajectory=path, method="nemf", model=model)
+        np.testing.assert_array_equal(c.motion.rotations, s.motion.rotations)
+
+    def _tmp(self):
+        import tempfile
+        d = tempfile.mkdtemp(prefix="mf-traj-")
+        self.addCleanup(lambda: __import__("shutil").rmtree(d, ignore_errors=True))
+        return d
+
+    def test_bad_trajectories(self):
+        m = self.motion
+        row = [[30, 0.0, 0.0, 0.0, 1.0]]
+        with self.assertRaises(mf.InvalidArgumentError) as e:
+            mf.solve(m, [0, 60], trajectory=row, method="interp")
+        self.assertIn("cannot follow a trajectory; the methods that can: nemf", str(e.exception))
+        for t, text in [([[30, 0, 0, 0, 0]], "zero length"), ([[30, np.nan, 0, 0, 1]], "finite"),
+                        ([[30, 0, 0, 0]], "[N, 5]"), ([[-1, 0, 0, 0, 1]], "non-negative integers"),
+                        ([[2.5, 0, 0, 0, 1]], "non-negative integers"), (([1, 2], [[0, 0, 0, 1]]), "[2, 4]")]:
+            with self.subTest(t=t):
+                with self.assertRaises(mf.InvalidArgumentError) as e:
+                    mf.solve(m, [0, 60], trajectory=t, method="nemf")
+                self.assertIn(text, str(e.exception))
+        path = os.path.join(self._tmp(), "bad.csv")
+        with open(path, "w") as f:
+            f.write("frame,x,z,forward_x,forward_z\n5,0,0,0,1\n4,0,0,0,1\n")
+        with self.assertRaises(mf.InvalidArgumentError) as e:
+            mf.Constraints().load_trajectory(path)
+        self.assertIn(path + ":3: frame 4 comes after frame 5", str(e.exception))
+        with self.assertRaises(mf.FileError):
+            mf.Constraints().load_trajectory(path + ".missing")
+
     def test_bad_constraints(self):
         m = self.motion
         cases = [

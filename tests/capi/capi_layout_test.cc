@@ -43,7 +43,7 @@ TEST(CApiLayout, TaskOptions) {
 }
 
 TEST(CApiLayout, CodecOptions) {
-  EXPECT_EQ(sizeof(mf_constraint_report), 96u);
+  EXPECT_EQ(sizeof(mf_constraint_report), 136u);
   EXPECT_EQ(offsetof(mf_constraint_report, struct_size), 0u);
   EXPECT_EQ(offsetof(mf_constraint_report, key_rotations), 4u);
   EXPECT_EQ(offsetof(mf_constraint_report, key_rotation_max_deg), 8u);
@@ -53,6 +53,9 @@ TEST(CApiLayout, CodecOptions) {
   EXPECT_EQ(offsetof(mf_constraint_report, target_max), 56u);
   EXPECT_EQ(offsetof(mf_constraint_report, contact_frames), 72u);
   EXPECT_EQ(offsetof(mf_constraint_report, contact_slide_max), 80u);
+  EXPECT_EQ(offsetof(mf_constraint_report, trajectory_rows), 96u);
+  EXPECT_EQ(offsetof(mf_constraint_report, trajectory_max), 104u);
+  EXPECT_EQ(offsetof(mf_constraint_report, facing_mean_deg), 128u);
   EXPECT_EQ(sizeof(mf_codec_options), 12u);
   EXPECT_EQ(offsetof(mf_codec_options, struct_size), 0u);
   EXPECT_EQ(offsetof(mf_codec_options, hop), 4u);
