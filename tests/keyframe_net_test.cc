@@ -10,6 +10,7 @@
 #include "prior/inbetween/keyframe_net.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations_torch.h"
+#include "tasks/inbetweener_fill.h"
 #include "tests/test_util.h"
 #include "training/salient_poses.h"
 
@@ -20,7 +21,9 @@ constexpr int kFrames = 40;
 
 std::unique_ptr<InbetweenModel> tiny_model() {
   at::manual_seed(3);
-  auto model = make_keyframe_net({{"width", 32}, {"layers", 1}, {"heads", 2}, {"ffn", 32}, {"window", 64}}, test::tiny_rig());
+  auto model = make_keyframe_net({{"width", 32}, {"layers", 1}, {"heads", 2}, {"ffn", 32}, {"window", 64},
+                                  {"min_spacing", 3}, {"max_spacing", 8}},
+                                 test::tiny_rig());
   model->train(false);
   return model;
 }
@@ -45,20 +48,24 @@ TEST(KeyframeNet, TheTrajectoryIsRead) {
   at::NoGradGuard no_grad;
   at::Tensor truth;
   InbetweenBatch b = gap_window(*model, &truth);
-  // Without a trajectory the model uses interpolated_trajectory(): the same output.
-  at::Tensor implicit = model->forward(b).stages.back();
   InbetweenBatch explicit_batch = b;
   explicit_batch.trajectory = interpolated_trajectory(b.pose, b.known, model->rig());
-  EXPECT_TRUE(at::allclose(model->forward(explicit_batch).stages.back(), implicit, 1e-5, 1e-6));
-  // Its facing vectors are unit length; its ground positions pass through the known ones.
+  // The default trajectory: facing vectors of unit length, ground positions through the known ones.
   EXPECT_TRUE(at::allclose(explicit_batch.trajectory.narrow(-1, 2, 2).norm(2, -1), at::ones({1, kFrames}), 1e-4));
-  EXPECT_NEAR(explicit_batch.trajectory[0][kFrames - 1][0].item<float>(), b.pose[0][kFrames - 1][model->pose_size() - 3].item<float>(), 1e-5);
+  const int64_t D = model->pose_size();
+  EXPECT_NEAR(explicit_batch.trajectory[0][kFrames - 1][0].item<float>(), b.pose[0][kFrames - 1][D - 3].item<float>(), 1e-5);
+  // A given trajectory is followed at the keyframes the interpolation runs through.
+  InbetweenOutput given = model->forward(explicit_batch);
+  at::Tensor picked = given.keyframes[0] * (1 - b.known[0].select(-1, 0));
+  ASSERT_GT(picked.sum().item<float>(), 0.0f);  // a 29-frame gap, keyframes at most 8 apart
+  at::Tensor dx = (given.stages[0][0].select(-1, D - 3) - explicit_batch.trajectory[0].select(-1, 0)).abs() * picked;
+  EXPECT_LT(dx.max().item<float>(), 1e-4);
   // Another path changes the answer inside the gap.
   InbetweenBatch moved = explicit_batch;
   moved.trajectory = explicit_batch.trajectory.clone();
   moved.trajectory[0].narrow(0, 15, 10).select(-1, 0).add_(1.0);
   at::Tensor out = model->forward(moved).stages.back();
-  EXPECT_GT((out - implicit).abs().max().item<float>(), 1e-4);
+  EXPECT_GT((out - given.stages.back()).abs().max().item<float>(), 1e-4);
   moved.trajectory = at::zeros({1, kFrames, 3});
   EXPECT_THROW(model->forward(moved), InputError);
 }
@@ -144,12 +151,13 @@ at::Tensor cornered_path() {
 TEST(SalientPoses, CornersAreTheOptimalKeyframes) {
   at::Tensor p = cornered_path();
   auto cost = training::salient_span_costs(p);
-  EXPECT_DOUBLE_EQ(cost[0][7], 0.0);  // straight spans cost nothing
-  EXPECT_NEAR(cost[7][15], 0.0, 1e-12);
+  EXPECT_NEAR(cost[0][7], 0.0, 1e-6);  // straight spans cost nothing (float inputs)
+  EXPECT_NEAR(cost[7][15], 0.0, 1e-6);
   EXPECT_GT(cost[0][15], 0.3);  // across a corner: the corner's distance to the chord
   auto sets = training::salient_keyframe_sets(p, 5);
   ASSERT_EQ(sets.size(), 4u);
   EXPECT_EQ(sets[0], (std::vector<int>{0, 20}));
+  EXPECT_EQ(sets[1], (std::vector<int>{0, 7, 20}));      // the larger corner
   EXPECT_EQ(sets[2], (std::vector<int>{0, 7, 15, 20}));  // zero cost, unique
   EXPECT_EQ(sets[3].size(), 5u);
   EXPECT_EQ(sets[3].front(), 0);
@@ -164,6 +172,48 @@ TEST(SalientPoses, CornersAreTheOptimalKeyframes) {
   }
   EXPECT_THROW(training::salient_scores(p, 0), InputError);
   EXPECT_THROW(training::salient_keyframe_sets(p.narrow(0, 0, 1), 3), InputError);
+}
+
+TEST(KeyframeNetGlue, CanonicalTrajectoryUndoesTheGroundTransform) {
+  GroundTransform g;
+  g.yaw = M_PI / 2;
+  g.x = 1.0;
+  g.z = 2.0;
+  // world = R_y(yaw) canonical + (x, 0, z): canonical (-1, 0) facing -x is world (1, 3) facing +z.
+  at::Tensor c = canonical_trajectory(at::tensor({1.0f, 3.0f, 0.0f, 1.0f}), g);
+  EXPECT_TRUE(at::allclose(c, at::tensor({-1.0f, 0.0f, -1.0f, 0.0f}), 1e-5, 1e-5)) << c;
+  EXPECT_THROW(canonical_trajectory(at::zeros({3}), g), InputError);
+}
+
+TEST(KeyframeNetGlue, ConstrainedTrajectoryKeysWinRowsFillTheRest) {
+  const RigInfo rig = test::tiny_rig();
+  Motion m = test::random_motion(rig.skeleton, 21, 30.0, 5);
+  MotionConstraints c = MotionConstraints::full_pose({0, 20});
+  EXPECT_FALSE(constrained_trajectory(m, c, rig).defined());  // no rows: the model interpolates itself
+  c.trajectory = {{0, 50.0, 50.0, 1.0, 0.0}, {10, 3.0, -1.0, 0.0, 2.0}};
+  at::Tensor t = constrained_trajectory(m, c, rig);
+  ASSERT_EQ(t.sizes(), (at::IntArrayRef{21, 4}));
+  EXPECT_NEAR(t[0][0].item<float>(), m.root_positions[0].x(), 1e-5);  // the key wins over the row
+  EXPECT_NEAR(t[20][1].item<float>(), m.root_positions[20].z(), 1e-5);
+  EXPECT_NEAR(t[10][0].item<float>(), 3.0, 1e-5);
+  EXPECT_NEAR(t[10][3].item<float>(), 1.0, 1e-5);  // facing normalised
+  EXPECT_NEAR(t[5][0].item<float>(), 0.5 * (m.root_positions[0].x() + 3.0), 1e-4);  // interpolated
+}
+
+TEST(KeyframeNetGlue, FillReadsTheTrajectory) {
+  auto model = tiny_model();
+  Motion m = test::random_motion(model->rig().skeleton, kFrames, 30.0, 8);
+  std::vector<int> known;
+  for (int f = 0; f < 10; ++f) known.push_back(f);
+  known.push_back(kFrames - 1);
+  MotionConstraints c = MotionConstraints::full_pose(known);
+  const Motion plain = inbetweener_fill(*model, -1, m, c, LongGapPolicy::Throw);
+  for (int f = 10; f < kFrames - 1; ++f) c.trajectory.push_back({f, 0.1 * f, 2.0, 1.0, 0.0});
+  const Motion along = inbetweener_fill(*model, -1, m, c, LongGapPolicy::Throw);
+  double moved = 0.0;
+  for (int f = 10; f < kFrames - 1; ++f) moved = std::max(moved, (along.root_positions[f] - plain.root_positions[f]).norm());
+  EXPECT_GT(moved, 1e-4);
+  for (int f : known) EXPECT_TRUE(along.root_positions[f].isApprox(m.root_positions[f])) << f;
 }
 
 }  // namespace

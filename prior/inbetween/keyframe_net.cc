@@ -203,7 +203,8 @@ struct KeyframeNetImpl : torch::nn::Module {
 
   // pose [B, T, D] raw; known [B, T, J + 1]; valid [B, T]; trajectory [B, T, 4]; mean/std [D].
   InbetweenOutput forward(const at::Tensor& pose, const at::Tensor& known_in, const at::Tensor& valid,
-                          const at::Tensor& trajectory, const at::Tensor& mean, const at::Tensor& scale) {
+                          const at::Tensor& trajectory, bool trajectory_given, const at::Tensor& mean,
+                          const at::Tensor& scale) {
     const int64_t J = joints, D = pose_size;
     at::Tensor known = known_in * valid.unsqueeze(-1);
     at::Tensor channel_known = known_channel_mask(known, joints) > 0.5;  // [B, T, D]
@@ -225,7 +226,9 @@ struct KeyframeNetImpl : torch::nn::Module {
     // Selection and interpolation through the known values and KeyframeNet's picks.
     at::Tensor picked = select_keyframes(logits, key, valid, config.min_spacing, config.max_spacing);
     at::Tensor anchors = key | picked | last_valid(valid);
-    at::Tensor key_pose = at::where(channel_known, pose, k_pose.detach());
+    at::Tensor predicted = k_pose.detach();
+    if (trajectory_given) predicted = follow_trajectory(predicted, trajectory, joints, rig.root_forward);
+    at::Tensor key_pose = at::where(channel_known, pose, predicted);
     at::Tensor interpolated = interpolate_keyframes(key_pose, anchors & (valid > 0.5), joints);
 
     at::Tensor i_norm = (interpolated - mean) / scale;
@@ -240,6 +243,23 @@ struct KeyframeNetImpl : torch::nn::Module {
     out.keyframe_logits = logits;
     out.keyframes = (anchors & (valid > 0.5)).to(pose.scalar_type());
     return out;
+  }
+
+  // Poses [B, T, D] (raw) moved onto the trajectory: root ground x, z set to
+  // the trajectory's, the root rotation turned about +Y to its facing.
+  static at::Tensor follow_trajectory(const at::Tensor& pose, const at::Tensor& trajectory, int joints,
+                                      const Eigen::Vector3d& root_forward) {
+    const int64_t J = joints;
+    at::Tensor rotations, root;
+    split_pose_features(pose, joints, &rotations, &root);
+    at::Tensor facing = trajectory_features(rotations.select(2, 0), root, root_forward).narrow(-1, 2, 2);
+    at::Tensor delta = at::atan2(trajectory.select(-1, 2), trajectory.select(-1, 3)) -
+                       at::atan2(facing.select(-1, 0), facing.select(-1, 1));  // [B, T]
+    at::Tensor c = at::cos(delta), s = at::sin(delta), zero = at::zeros_like(delta), one = at::ones_like(delta);
+    at::Tensor turn = at::stack({c, zero, s, zero, one, zero, -s, zero, c}, -1).unflatten(-1, {3, 3});
+    at::Tensor root_rotation = torch_rot::matmul3(turn, rotations.select(2, 0));
+    at::Tensor moved_root = at::stack({trajectory.select(-1, 0), root.select(-1, 1), trajectory.select(-1, 1)}, -1);
+    return at::cat({torch_rot::matrix_to_sixd(root_rotation), pose.narrow(-1, 6, 6 * (J - 1)), moved_root}, -1);
   }
 
   // [B, T] bool: the last valid frame of each row.
@@ -290,7 +310,7 @@ class KeyframeModel final : public InbetweenModel {
       at::NoGradGuard no_grad;
       trajectory = interpolated_trajectory(pose, known * batch.valid.to(n.options).unsqueeze(-1), rig());
     }
-    return net_->forward(pose, known, batch.valid.to(n.options), trajectory, n.mean.reshape({D}),
+    return net_->forward(pose, known, batch.valid.to(n.options), trajectory, batch.trajectory.defined(), n.mean.reshape({D}),
                          n.scale.reshape({D}));
   }
 

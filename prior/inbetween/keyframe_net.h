@@ -35,8 +35,11 @@
 // max_spacing frames away; closer, the best frame is picked only when its score
 // is above 0.5 (sigmoid of the logit). Spacings are therefore within
 // [min_spacing, max_spacing] except where two anchors are closer than that.
-// The keyframes' poses are KeyframeNet's (known channels written over them;
-// detached, so RefineNet's loss does not train KeyframeNet) and are interpolated
+// The keyframes' poses are KeyframeNet's (detached, so RefineNet's loss does
+// not train KeyframeNet); when the batch has a trajectory, their root is moved
+// onto it (ground x, z set to the trajectory's, the root rotation turned about
+// +Y to its facing: the trajectory is a constraint, like a known value); known
+// channels are written over them; they are interpolated
 // (interpolate_keyframes()): stage 0.
 //
 // RefineNet: the same trunk without the frame-position encoding, input = the
