@@ -1,5 +1,7 @@
 #include "bench/metrics.h"
 
+#include <ATen/ATen.h>
+
 #include "prior/model/representation.h"
 
 #include <algorithm>
@@ -343,6 +345,29 @@ KnownFrameError known_frame_error(const Motion& truth, const GlobalPose& truth_p
   return e;
 }
 
+double l2t(const Motion& truth, const Motion& pred, const std::vector<int>& evaluated,
+           const Eigen::Vector3d& root_forward) {
+  check_frames(evaluated, truth.num_frames(), "l2t");
+  check_frames(evaluated, pred.num_frames(), "l2t");
+  if (evaluated.empty()) throw InputError("l2t: no evaluated frame");
+  auto features = [&](const Motion& m) {
+    const int64_t n = static_cast<int64_t>(evaluated.size());
+    at::Tensor r = at::empty({n, 3, 3}, at::kDouble), p = at::empty({n, 3}, at::kDouble);
+    auto ra = r.accessor<double, 3>();
+    auto pa = p.accessor<double, 2>();
+    for (int64_t i = 0; i < n; ++i) {
+      const int f = evaluated[static_cast<size_t>(i)];
+      const Eigen::Matrix3d q = m.rotation(f, 0).normalized().toRotationMatrix();
+      for (int a = 0; a < 3; ++a) {
+        pa[i][a] = m.root_positions[f][a];
+        for (int b = 0; b < 3; ++b) ra[i][a][b] = q(a, b);
+      }
+    }
+    return trajectory_features(r, p, root_forward);
+  };
+  return (features(truth) - features(pred)).norm(2, -1).mean().item<double>();
+}
+
 void MetricAccumulator::add(const Motion& truth, const Motion& pred, const std::vector<int>& evaluated,
                             const std::vector<int>& known) {
   if (truth.num_frames() != pred.num_frames() || truth.num_joints() != pred.num_joints()) {
@@ -367,6 +392,7 @@ void MetricAccumulator::add(const Motion& truth, const Motion& pred, const std::
   l2p_h_sum_ += l2p(tp, pp, evaluated, stats_, L2PAxes::Horizontal) * n;
   l2p_v_sum_ += l2p(tp, pp, evaluated, stats_, L2PAxes::Vertical) * n;
   mpjpe_sum_ += mpjpe_cm(tp, pp, evaluated) * n;
+  l2t_sum_ += l2t(truth, pred, evaluated, root_forward_) * n;
 
   const std::vector<double> tq = continuous_quaternions(tp);
   const std::vector<double> pq = continuous_quaternions(pp, &tp);
@@ -404,6 +430,7 @@ MetricSummary MetricAccumulator::summary() const {
     s.l2p_horizontal = l2p_h_sum_ / frames_;
     s.l2p_vertical = l2p_v_sum_ / frames_;
     s.l2q = l2q_sum_ / frames_;
+    s.l2t = l2t_sum_ / frames_;
     s.mpjpe_cm = mpjpe_sum_ / frames_;
   }
   s.npss = npss_.value();

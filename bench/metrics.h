@@ -233,8 +233,17 @@ struct MetricSummary {
   double mpjpe_cm = 0.0;
   double skating_cm = 0.0;        ///< of the prediction
   double truth_skating_cm = 0.0;  ///< of the ground truth, same frames
+  double l2t = 0.0;               ///< l2t() over the evaluated frames
   KnownFrameError known;
 };
+
+/// L2T: the mean over `evaluated` frames of the L2 distance between the
+/// trajectory features of truth and prediction (both in the same canonical
+/// frame): root ground x, z in metres and the unit facing vector (forward_x,
+/// forward_z) of the root's heading (trajectory_features() of
+/// prior/model/representation.h; `root_forward` the root-local forward axis).
+double l2t(const Motion& truth, const Motion& pred, const std::vector<int>& evaluated,
+           const Eigen::Vector3d& root_forward);
 
 /// Adds windows one at a time and summarises them. L2P, L2Q and MPJPE are means
 /// over every evaluated (window, frame) pair, skating over every (window, frame,
@@ -242,7 +251,9 @@ struct MetricSummary {
 /// Keeps a reference to `stats`, which must outlive it.
 class MetricAccumulator {
  public:
-  explicit MetricAccumulator(const EvalStats& stats) : stats_(stats) {}
+  /// `root_forward`: the root-local forward axis, for L2T.
+  explicit MetricAccumulator(const EvalStats& stats, const Eigen::Vector3d& root_forward = Eigen::Vector3d::UnitZ())
+      : stats_(stats), root_forward_(root_forward) {}
 
   /// `truth` and `pred` are already in the same (canonical) frame; metrics are
   /// taken over `evaluated` frames, the known-frame error over `known` frames.
@@ -255,7 +266,9 @@ class MetricAccumulator {
 
  private:
   const EvalStats& stats_;
+  Eigen::Vector3d root_forward_;
   int windows_ = 0;
+  double l2t_sum_ = 0.0;
   double l2p_sum_ = 0.0, l2p_h_sum_ = 0.0, l2p_v_sum_ = 0.0, l2q_sum_ = 0.0, mpjpe_sum_ = 0.0;
   long frames_ = 0;
   NpssTerms npss_;

@@ -63,6 +63,9 @@ struct Args {
   std::string out;
   bool l2p_axes = false;
   bool print_stats = false;
+  std::vector<int> gaps;    // gap lengths (default: the protocol's)
+  bool trajectory = false;  // gap filling with the ground-truth trajectory
+  bool l2t = false;
 };
 
 void add_options(CLI::App& app, Args& args) {
@@ -87,6 +90,11 @@ void add_options(CLI::App& app, Args& args) {
       });
   app.add_option("--out", args.out, "also write the markdown to FILE");
   app.add_flag("--l2p-axes", args.l2p_axes, "add columns splitting L2P into horizontal (x, z) and vertical (y) parts");
+  mf::bench::add_list_option(app, "--gaps", args.gaps, "gap lengths of the gap task (default: 5, 15, 30, 45, 90)");
+  app.add_flag("--trajectory", args.trajectory,
+               "gap filling with the ground truth's trajectory of the gap (through the constrained path; methods "
+               "without it are skipped)");
+  app.add_flag("--l2t", args.l2t, "add the L2T column (trajectory error, bench/metrics.h)");
   app.add_flag("--print-stats", args.print_stats,
                "add the table of training statistics (position mean / std, standing heights)");
 }
@@ -161,7 +169,8 @@ int run(Args& args, const std::string& command) {
   md << "## motionfield-bench\n\n";
   md << "- command: `" << command << "`\n";
   md << "- model: " << (model ? args.model + " (" + model->config().describe() + ")" : std::string("none")) << "\n";
-  for (const char* kind : {mf::kTwoStageKind, mf::kCitlKind}) {
+  for (const mf::InbetweenerKind& k : mf::inbetweener_kinds()) {
+    const std::string& kind = k.name;
     const mf::InbetweenModel* t = ctx.inbetweener(kind);
     md << "- " << kind << " transformer: " << (t ? t->describe() : std::string("not loaded")) << "\n";
   }
@@ -188,6 +197,9 @@ int run(Args& args, const std::string& command) {
   options.max_windows = args.split.max_windows;
   options.rig = args.rig;
   options.rig_anatomy = ctx.model_anatomy;
+  if (!args.gaps.empty()) options.gap_lengths = args.gaps;
+  options.trajectory = args.trajectory;
+  options.l2t = args.l2t || args.trajectory;
   if (!args.rig.empty()) emit("- rig: " + args.rig + " (bench/synthetic_rigs.h)\n\n");
   for (mf::bench::Task task : args.tasks) {
     for (const std::string& method : args.methods) {
@@ -198,12 +210,17 @@ int run(Args& args, const std::string& command) {
         }
         continue;
       }
-      bool needs_model = false;
+      bool needs_model = false, constrained = false;
       std::string needs_inbetweener;
       for (const mf::Method& m : mf::registered_methods()) {
         if (m.name != method) continue;
         needs_model = m.needs_model;
         needs_inbetweener = m.needs_inbetweener;
+        constrained = static_cast<bool>(m.complete_constrained);
+      }
+      if (args.trajectory && task == mf::bench::Task::Gap && !constrained) {
+        if (args.methods_given) emit("Method `" + method + "` cannot take a trajectory: skipped.\n\n");
+        continue;
       }
       if (needs_model && !ctx.model) {
         emit("Method `" + method + "` needs a model and none was given (--model PATH): skipped on the " +

@@ -1,4 +1,5 @@
 #include "bench/protocol.h"
+#include <ATen/ATen.h>
 
 #include <ATen/Parallel.h>
 
@@ -12,6 +13,7 @@
 #include "bench/text.h"
 #include "bench/synthetic_rigs.h"
 #include "tasks/jobs.h"
+#include "prior/model/representation.h"
 
 namespace mf::bench {
 namespace {
@@ -137,10 +139,48 @@ Motion hide_unknown_frames(const Motion& motion, const std::vector<int>& known) 
   return out;
 }
 
+std::vector<TrajectoryPoint> truth_trajectory(const Motion& truth, int a, int b, const Eigen::Vector3d& root_forward) {
+  std::vector<int> frames;
+  for (int f = a; f < b; ++f) frames.push_back(f);
+  if (frames.empty()) return {};
+  at::Tensor r = at::empty({b - a, 3, 3}, at::kDouble), p = at::empty({b - a, 3}, at::kDouble);
+  for (int f = a; f < b; ++f) {
+    const Eigen::Matrix3d q = truth.rotation(f, 0).normalized().toRotationMatrix();
+    for (int i = 0; i < 3; ++i) {
+      p[f - a][i] = truth.root_positions[f][i];
+      for (int j = 0; j < 3; ++j) r[f - a][i][j] = q(i, j);
+    }
+  }
+  at::Tensor t = trajectory_features(r, p, root_forward).contiguous();
+  std::vector<TrajectoryPoint> rows;
+  for (int f = a; f < b; ++f) {
+    const double* v = t[f - a].data_ptr<double>();
+    rows.push_back({f, v[0], v[1], v[2], v[3]});
+  }
+  return rows;
+}
+
+// Gap filling of one window, with the ground-truth trajectory of the gap when asked.
+Motion fill_gap(const Motion& truth, const std::vector<int>& known, int a, int b, const std::string& method,
+                const ProtocolOptions& options, const TaskContext& ctx) {
+  if (!options.trajectory) {
+    return predict(truth, known, options, [&](const Motion& input, const std::vector<int>& k) {
+      const auto gap = std::adjacent_find(k.begin(), k.end(), [](int x, int y) { return y != x + 1; });
+      return run_fill(input, *gap + 1, *(gap + 1), method, ctx);
+    });
+  }
+  if (!options.rig.empty()) throw InputError("gap filling with a trajectory runs on the native rig only");
+  MotionConstraints c = MotionConstraints::full_pose(known);
+  c.trajectory = truth_trajectory(truth, a, b, options.root_forward);
+  return run_constrained(hide_unknown_frames(truth, known), c, method, 0, ctx).motions.front();
+}
+
 TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
                            const ProtocolOptions& options, const TaskContext& ctx) {
   if (options.context < 1) throw InputError("gap filling needs at least one context frame");
   TaskResult result = start_result(Task::Gap, method);
+  result.trajectory = options.trajectory;
+  result.l2t = options.l2t;
   for (int T : options.gap_lengths) {
     if (T < 1) throw InputError("gap lengths must be positive");
     const int length = options.context + T + 1;
@@ -148,16 +188,13 @@ TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stat
     const std::vector<Window> windows = cap_windows(protocol_windows(clips, length, options.stride), options.max_windows);
     std::vector<int> evaluated, known;
     for (int f = 0; f < length; ++f) (f >= a && f < b ? evaluated : known).push_back(f);
-    MetricAccumulator acc(stats);
+    MetricAccumulator acc(stats, options.root_forward);
     double ms = 0.0;
     for (const Window& w : windows) {
       const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), options.context - 1,
                                         options.root_forward);
       const auto t0 = Clock::now();
-      const Motion pred = predict(truth, known, options, [&](const Motion& input, const std::vector<int>& k) {
-        const auto gap = std::adjacent_find(k.begin(), k.end(), [](int x, int y) { return y != x + 1; });
-        return run_fill(input, *gap + 1, *(gap + 1), method, ctx);
-      });
+      const Motion pred = fill_gap(truth, known, a, b, method, options, ctx);
       ms += ms_since(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, known);
@@ -280,15 +317,17 @@ std::string format_table(const TaskResult& result, bool l2p_axes) {
       break;
   }
   out << "### " << title << "\n\n";
-  out << "method: `" << result.method << "`, torch threads: " << result.threads << "\n\n";
-  out << "| " << param << " | windows | L2P" << (l2p_axes ? " | L2P xz | L2P y" : "")
+  out << "method: `" << result.method << "`, torch threads: " << result.threads
+      << (result.trajectory ? ", given the ground-truth trajectory" : "") << "\n\n";
+  out << "| " << param << " | windows | L2P" << (l2p_axes ? " | L2P xz | L2P y" : "") << (result.l2t ? " | L2T" : "")
       << " | L2Q | NPSS | MPJPE (cm) | skating (cm) | skating GT (cm) "
          "| known pos max / mean (cm) | known rot max / mean (deg) | ms / window |\n";
-  out << "|---:|---:|---:|" << (l2p_axes ? "---:|---:|" : "") << "---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  out << "|---:|---:|---:|" << (l2p_axes ? "---:|---:|" : "") << (result.l2t ? "---:|" : "") << "---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const RowResult& row : result.rows) {
     const MetricSummary& m = row.metrics;
     out << "| " << row.parameter << " | " << m.windows << " | " << fixed(m.l2p, 3);
     if (l2p_axes) out << " | " << fixed(m.l2p_horizontal, 3) << " | " << fixed(m.l2p_vertical, 3);
+    if (result.l2t) out << " | " << fixed(m.l2t, 3);
     out << " | " << fixed(m.l2q, 3)
         << " | " << fixed(m.npss, 4) << " | " << fixed(m.mpjpe_cm, 2) << " | " << fixed(m.skating_cm, 3) << " | "
         << fixed(m.truth_skating_cm, 3) << " | " << fixed(m.known.position_max_cm, 3) << " / "

@@ -39,6 +39,7 @@
 #include "prior/data/dataset.h"
 #include "prior/rig/retarget.h"
 #include "tasks/method.h"
+#include "tasks/motion_constraints.h"
 
 namespace mf::bench {
 
@@ -68,7 +69,18 @@ struct ProtocolOptions {
   /// for the metrics. `rig_anatomy`: the native rig's, for the rig's rest pose.
   std::string rig;
   std::shared_ptr<const RigAnatomy> rig_anatomy;
+  /// Gap filling: give the method the ground truth's trajectory of the gap
+  /// frames (MotionConstraints::trajectory, the window's canonical frame) and
+  /// run it through mf::run_constrained (methods without complete_constrained
+  /// are then not supported). Native rig only.
+  bool trajectory = false;
+  /// Add the L2T column (MetricSummary::l2t) to the tables.
+  bool l2t = false;
 };
+
+/// The ground truth's trajectory rows (trajectory_features(), frames a..b-1)
+/// of `truth` as MotionConstraints::trajectory.
+std::vector<TrajectoryPoint> truth_trajectory(const Motion& truth, int a, int b, const Eigen::Vector3d& root_forward);
 
 /// Windows of `length` frames starting at 0, stride, 2 stride, ... in each
 /// clip, only those that fit (start + length <= frames), clip by clip in order.
@@ -99,6 +111,8 @@ struct TaskResult {
   Task task = Task::Gap;
   std::string method;
   int threads = 1;             ///< torch intra-op threads during the run
+  bool trajectory = false;     ///< the method was given the ground-truth trajectory
+  bool l2t = false;            ///< format_table shows L2T
   std::vector<RowResult> rows;
 };
 

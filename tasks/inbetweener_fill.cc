@@ -3,11 +3,13 @@
 #include <ATen/ATen.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "prior/inbetween/inbetweener.h"
+#include "prior/inbetween/keyframe_net.h"
 #include "prior/model/representation.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
@@ -103,7 +105,7 @@ struct FillBatch {
 };
 
 FillBatch make_batch(const InbetweenModel& model, const Motion& filled, const std::vector<FillWindow>& windows,
-                     const KeyIndex& keys, const MotionConstraints& c) {
+                     const KeyIndex& keys, const MotionConstraints& c, const at::Tensor& world_trajectory) {
   const RigInfo& rig = model.rig();
   const int J = filled.num_joints();
   const int B = static_cast<int>(windows.size());
@@ -130,6 +132,15 @@ FillBatch make_batch(const InbetweenModel& model, const Motion& filled, const st
     }
   }
   out.batch = InbetweenBatch{pose * known_channel_mask(known, J), known, valid};
+  if (world_trajectory.defined()) {
+    std::vector<at::Tensor> rows;
+    for (int b = 0; b < B; ++b) {
+      const FillWindow& w = windows[b];
+      at::Tensor r = canonical_trajectory(world_trajectory.narrow(0, w.start, w.end - w.start + 1), out.transforms[b]);
+      rows.push_back(at::cat({r, r.narrow(0, r.size(0) - 1, 1).expand({L - r.size(0), 4})}, 0));  // padding: held
+    }
+    out.batch.trajectory = at::stack(rows);
+  }
   return out;
 }
 
@@ -203,6 +214,45 @@ void copy_constrained(const Motion& input, const MotionConstraints& c, Motion* o
 
 }  // namespace
 
+at::Tensor constrained_trajectory(const Motion& input, const MotionConstraints& c, const RigInfo& rig) {
+  if (c.trajectory.empty()) return at::Tensor();
+  const int n = input.num_frames();
+  at::Tensor rows = at::zeros({1, n, 4}, at::kFloat);
+  at::Tensor xz_known = at::zeros({1, n}, at::kBool), facing_known = at::zeros({1, n}, at::kBool);
+  for (const TrajectoryPoint& p : c.trajectory) {
+    rows[0][p.frame] = at::tensor({p.x, p.z, p.forward_x, p.forward_z}, at::kDouble).to(at::kFloat);
+    xz_known[0][p.frame] = true;
+    facing_known[0][p.frame] = true;
+  }
+  for (size_t k = 0; k < c.keys.size(); ++k) {
+    const int f = c.keys[k].frame;
+    at::Tensor r = at::empty({3, 3}, at::kFloat), pos = at::empty({3}, at::kFloat);
+    const Eigen::Matrix3d m = input.rotation(f, 0).normalized().toRotationMatrix();
+    for (int a = 0; a < 3; ++a) {
+      pos[a] = input.root_positions[f][a];
+      for (int b = 0; b < 3; ++b) r[a][b] = m(a, b);
+    }
+    at::Tensor own = trajectory_features(r, pos, rig.root_forward);  // [4]
+    if (c.keys[k].root_position) {
+      rows[0][f].narrow(0, 0, 2).copy_(own.narrow(0, 0, 2));
+      xz_known[0][f] = true;
+    }
+    if (c.key_has_joint(k, 0)) {
+      rows[0][f].narrow(0, 2, 2).copy_(own.narrow(0, 2, 2));
+      facing_known[0][f] = true;
+    }
+  }
+  return interpolate_trajectory_rows(rows, xz_known, facing_known)[0];
+}
+
+at::Tensor canonical_trajectory(const at::Tensor& world, const GroundTransform& transform) {
+  if (world.dim() < 1 || world.size(-1) != 4) throw InputError("canonical_trajectory: rows must be [..., 4]");
+  const double c = std::cos(transform.yaw), s = std::sin(transform.yaw);
+  at::Tensor x = world.select(-1, 0) - transform.x, z = world.select(-1, 1) - transform.z;
+  at::Tensor fx = world.select(-1, 2), fz = world.select(-1, 3);
+  return at::stack({c * x - s * z, s * x + c * z, c * fx - s * fz, s * fx + c * fz}, -1);
+}
+
 Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
                         const MotionConstraints& constraints, LongGapPolicy policy) {
   const int used_stage = checked_stage(model, stage, input, constraints);
@@ -213,7 +263,8 @@ Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& in
       plan_windows(keys.roots, model.window(), policy, inbetweener_title(model.kind()));
   if (!windows.empty()) {
     at::NoGradGuard no_grad;
-    const FillBatch fill = make_batch(model, out, windows, keys, constraints);
+    const FillBatch fill =
+        make_batch(model, out, windows, keys, constraints, constrained_trajectory(input, constraints, model.rig()));
     const InbetweenOutput result = model.forward(fill.batch);
     if (used_stage >= static_cast<int>(result.stages.size()))
       throw std::logic_error("the in-betweener returned fewer stages than stage_names() lists");

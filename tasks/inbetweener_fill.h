@@ -31,10 +31,21 @@
 //    key's residual fading from full next to it to none at the other key
 //    (the two residual rotations composed; unlike tasks/residuals.h, which
 //    interpolates between them).
+//  * A ground trajectory (constraints.trajectory, world x, z and facing) goes
+//    to the model as InbetweenBatch::trajectory, in each window's canonical
+//    frame (canonical_trajectory()), for the kinds that read it (the others
+//    ignore it): constrained_trajectory() completes it over every frame (the
+//    keys' own root wins over a row at the same frame; frames without a row
+//    are interpolated). Without trajectory rows the batch has none and a
+//    trajectory-conditioned kind interpolates between the known roots itself.
+//    Callers (CLI, C ABI, batch) only fill MotionConstraints::trajectory.
 //  * The input's frames are taken as frames of the model (no resampling to
 //    the model's fps). Deterministic for a given input and thread count.
 #pragma once
 
+#include <ATen/core/Tensor.h>
+
+#include "prior/model/representation.h"
 #include "prior/motion/motion.h"
 #include "tasks/motion_constraints.h"
 
@@ -55,5 +66,19 @@ enum class LongGapPolicy {
 /// (LongGapPolicy::Throw) a gap longer than the window.
 Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
                         const MotionConstraints& constraints, LongGapPolicy policy);
+
+/// The ground trajectory of every frame of `input`, [frames, 4] float (world:
+/// x, z, forward_x, forward_z as trajectory_features() of
+/// prior/model/representation.h), that `constraints` ask for: the rows of
+/// constraints.trajectory, except at keys that give the root position (x, z)
+/// or the root rotation (facing), whose own values win; the other frames
+/// interpolated between those (interpolate_trajectory_rows() of
+/// prior/inbetween/keyframe_net.h: linear, facing normalised, held at the
+/// ends). Undefined when constraints.trajectory is empty.
+at::Tensor constrained_trajectory(const Motion& input, const MotionConstraints& constraints, const RigInfo& rig);
+
+/// World trajectory rows [..., 4] in the canonical frame of `transform`
+/// (canonical = R_y(-yaw) (world - (x, 0, z)); the facing only rotated).
+at::Tensor canonical_trajectory(const at::Tensor& world, const GroundTransform& transform);
 
 }  // namespace mf

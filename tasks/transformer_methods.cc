@@ -1,6 +1,7 @@
 #include "tasks/transformer_methods.h"
 
 #include "prior/inbetween/inbetweener.h"
+#include "prior/motion/errors.h"
 
 namespace mf {
 namespace {
@@ -15,6 +16,16 @@ Method transformer_method(const std::string& name, const std::string& descriptio
   m.complete = [name, kind, stage](const Motion& input, const std::vector<int>& known, const TaskContext& ctx) {
     const InbetweenModel& model = require_inbetweener(ctx, kind, "method '" + name + "'");
     return inbetweener_fill(model, stage, input, MotionConstraints::full_pose(known), LongGapPolicy::Throw);
+  };
+  // Keys (full or partial) and a trajectory, one answer: inbetweener_fill reads both.
+  m.complete_constrained = [name, kind, stage](const Motion& input, const MotionConstraints& c, int variant,
+                                               const TaskContext& ctx, std::vector<std::string>*) {
+    if (variant > 0 || !c.effectors.empty() || !c.contacts.empty())
+      throw InputError("method '" + name +
+                       "' takes keys and a trajectory only: end-effector targets, contacts and alternatives need a "
+                       "latent solver (nemf, nemf-" + name + ", ...)");
+    const InbetweenModel& model = require_inbetweener(ctx, kind, "method '" + name + "'");
+    return inbetweener_fill(model, stage, input, c, LongGapPolicy::Throw);
   };
   return m;
 }

@@ -3,11 +3,16 @@
 //   "context"  stage 0 of the two-stage model (Context Transformer)
 //   "detail"   stage 1 of the two-stage model (Detail Transformer)
 //   "citl"     the CITL model
-// Each needs its model in TaskContext (twostage / citl); the C API loads them
-// from motionfield-twostage.mfm and motionfield-citl.mfm next to the prior's
-// model file (tasks/inbetweener_files.h). Each fills the motion with one pass
-// of its model (inbetweener_fill() of tasks/inbetweener_fill.h,
-// LongGapPolicy::Throw).
+//   "keyframe" stage 0 of KeyframeNet + RefineNet (the interpolated keyframes)
+//   "refine"   stage 1 of KeyframeNet + RefineNet (trajectory-conditioned)
+// (one method per stage of every kind of inbetweener_kinds()). Each needs its
+// model in TaskContext (twostage / citl / keyframe); the C API loads them from
+// motionfield-<kind>.mfm next to the prior's model file
+// (tasks/inbetweener_files.h). Each fills the motion with one pass of its model
+// (inbetweener_fill() of tasks/inbetweener_fill.h, LongGapPolicy::Throw), from
+// whole-pose keys (Method::complete) or from keys and a trajectory
+// (Method::complete_constrained, one answer; effector targets and contact pins
+// are refused with mf::InputError).
 //
 // This header also brings in those two headers for the callers that include
 // it for them (the C API, the benchmarks).

@@ -108,10 +108,14 @@ TEST(InbetweenTraining, LossDecreasesCheckpointAndResume) {
 
 TEST(InbetweenTraining, RealKindsTrainAFewSteps) {
   std::string data = make_data("inbetween_training_kinds");
-  for (const std::string kind : {kTwoStageKind, kCitlKind}) {
+  for (const std::string kind : {kTwoStageKind, kCitlKind, kKeyframeKind}) {
     InbetweenTrainingOptions o = tiny_options(data, kind);
     o.hyperparameters = {{"width", 16}, {"layers", 1}, {"heads", 2}, {"ffn", 32}, {"window", 32}};
     if (kind == kCitlKind) o.hyperparameters["time_dim"] = 4;
+    if (kind == kKeyframeKind) {  // transitions of 5..20 frames after 4 context frames
+      o.context = 4;
+      o.max_transition = 20;
+    }
     o.max_epochs = 2;
     o.epoch_steps = 3;
     InbetweenTrainingResult r = train_inbetweener(o);

@@ -10,6 +10,7 @@
 #include <functional>
 
 #include "prior/inbetween/citl.h"
+#include "prior/inbetween/keyframe_net.h"
 #include "prior/inbetween/two_stage.h"
 #include "prior/motion/errors.h"
 #include "tests/test_util.h"
@@ -63,6 +64,22 @@ Kind citl_kind() {
           0.6f};
 }
 
+Kind keyframe_kind() {
+  return {kKeyframeKind,
+          make_keyframe_net,
+          {{"width", 32}, {"layers", 1}, {"heads", 2}, {"ffn", 48}, {"window", kWindow}, {"fps", 30},
+           {"min_spacing", 2}, {"max_spacing", 5}},
+          {{"width", 64}, {"layers", 2}, {"heads", 4}, {"ffn", 128}, {"window", 256}, {"fps", 30},
+           {"min_spacing", 5}, {"max_spacing", 30}},
+          {"keyframe", "refine"},
+          true,
+          "KeyframeNet 1x32",
+          {"keyframe.input.fc1.weight", "keyframe.keyframe.fc1.weight", "refine.layers.0.attn.relative.fc1.weight"},
+          {{"min_spacing", 0}, {"max_spacing", 3}},  // max_spacing below twice min_spacing
+          60,
+          0.75f};
+}
+
 std::unique_ptr<InbetweenModel> tiny(const Kind& kind, uint64_t seed) {
   at::manual_seed(seed);
   auto model = kind.make(kind.tiny, test::tiny_rig());
@@ -97,6 +114,9 @@ std::vector<at::Tensor> outputs(const InbetweenModel& model, const InbetweenBatc
   InbetweenOutput out = model.forward(batch);
   std::vector<at::Tensor> all = out.stages;
   if (out.contact_logits.defined()) all.push_back(out.contact_logits);
+  // Keyframe kinds: KeyframeNet's own outputs too (its stage is detached from them).
+  for (const at::Tensor& t : {out.keyframe_poses, out.keyframe_logits, out.keyframes})
+    if (t.defined()) all.push_back(t);
   return all;
 }
 
@@ -298,8 +318,10 @@ TEST_P(TransformerKind, OverfitsOneBatch) {
   torch::optim::Adam optimizer(model->parameters(), torch::optim::AdamOptions(3e-3));
   auto loss_of = [&] {
     at::Tensor loss = at::zeros({});
-    for (const at::Tensor& stage : model->forward(b).stages)
-      loss = loss + ((stage - target).abs() * weight).sum() / weight.sum();
+    InbetweenOutput out = model->forward(b);
+    std::vector<at::Tensor> poses = out.stages;
+    if (out.keyframe_poses.defined()) poses.push_back(out.keyframe_poses);
+    for (const at::Tensor& stage : poses) loss = loss + ((stage - target).abs() * weight).sum() / weight.sum();
     return loss;
   };
   const float initial = loss_of().item<float>();
@@ -312,7 +334,7 @@ TEST_P(TransformerKind, OverfitsOneBatch) {
   EXPECT_LT(loss_of().item<float>(), kind.overfit_ratio * initial);
 }
 
-INSTANTIATE_TEST_SUITE_P(Kinds, TransformerKind, ::testing::Values(two_stage_kind(), citl_kind()));
+INSTANTIATE_TEST_SUITE_P(Kinds, TransformerKind, ::testing::Values(two_stage_kind(), citl_kind(), keyframe_kind()));
 
 // CITL alone keeps the known values of valid frames exactly, partial keys included.
 TEST(Citl, KnownValuesComeBackExactly) {

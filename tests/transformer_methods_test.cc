@@ -181,7 +181,7 @@ TEST(TransformerMethods, RegisteredWithTheirNeedsAndTheDefault) {
 // method, a solver start ("nemf-<stage>") and an initialiser
 // ("<stage>-encoder"), all needing that kind.
 TEST(TransformerMethods, EveryKindsStagesBecomeMethodsAndInitialisers) {
-  ASSERT_EQ(inbetweener_kinds().size(), 2u);
+  ASSERT_EQ(inbetweener_kinds().size(), 3u);
   const std::vector<std::string> inits = initializer_names();
   int stages = 0;
   for (const InbetweenerKind& kind : inbetweener_kinds()) {
@@ -198,8 +198,9 @@ TEST(TransformerMethods, EveryKindsStagesBecomeMethodsAndInitialisers) {
       EXPECT_NE(std::find(inits.begin(), inits.end(), stage.name + "-encoder"), inits.end()) << stage.name;
     }
   }
-  EXPECT_EQ(stages, 3);
+  EXPECT_EQ(stages, 5);
   EXPECT_EQ(find_inbetweener_stage("detail")->name, kTwoStageKind);
+  EXPECT_EQ(find_inbetweener_stage("refine")->name, kKeyframeKind);
   EXPECT_EQ(find_inbetweener_stage("nemf"), nullptr);
   EXPECT_THROW(inbetweener_kind("keyframenet"), InputError);
 }

@@ -19,6 +19,9 @@
 
 #include "prior/inbetween/inbetweener.h"
 #include "prior/motion/errors.h"
+#include "prior/motion/kinematics_torch.h"
+#include "training/keyframe_losses.h"
+#include "training/salient_poses.h"
 #include "training/trainer_util.h"
 #include "prior/util/threads.h"
 
@@ -32,13 +35,23 @@ struct Sample {
   int clip = 0;
   int start = 0;
   int length = 0;
+  int gap_begin = -1;        // transitions (keyframe kinds): the last context frame; -1 otherwise
   std::vector<float> known;  // [length, J + 1]
+};
+
+// The transition protocol of keyframe kinds (inbetween_trainer.h); off for the others.
+struct TransitionProtocol {
+  bool on = false;
+  int context = 10, min_transition = 5, max_transition = 90;
+  int min_spacing = 5;  // the model's, for the Salient Poses scores
 };
 
 struct Batch {
   InbetweenBatch input;
-  at::Tensor target;    // [B, T, D] raw pose features (padding repeats the last frame)
-  at::Tensor contacts;  // [B, T, F]
+  at::Tensor target;      // [B, T, D] raw pose features (padding repeats the last frame)
+  at::Tensor contacts;    // [B, T, F]
+  at::Tensor scores;      // transitions: [B, T] Salient Poses scores
+  at::Tensor score_mask;  // transitions: [B, T] the frames strictly inside the transition
 };
 
 // Joints that belong to the legs: the feet, their ancestors below the root and
@@ -60,9 +73,10 @@ std::vector<bool> leg_joints(const RigInfo& rig) {
 
 class Sampler {
  public:
-  Sampler(const std::vector<Clip>& clips, const RigInfo& rig, int window, int min_length)
+  Sampler(const std::vector<Clip>& clips, const RigInfo& rig, int window, int min_length,
+          const TransitionProtocol& transitions)
       : clips_(clips), J_(rig.num_joints()), window_(window), min_length_(std::min(min_length, window)),
-        legs_(leg_joints(rig)) {
+        transitions_(transitions), legs_(leg_joints(rig)) {
     for (size_t c = 0; c < clips.size(); ++c) {
       const int n = clips[c].motion.num_frames();
       if (n >= 2) {
@@ -80,6 +94,7 @@ class Sampler {
     Sample s;
     s.clip = usable_[std::min(k, usable_.size() - 1)];
     const int n = clips_[s.clip].motion.num_frames();
+    if (transitions_.on) return draw_transition(s, n, rng);
     const int L = std::uniform_int_distribution<int>(min_length_, window_)(rng);
     s.length = std::min(L, n);
     s.start = n > s.length ? std::uniform_int_distribution<int>(0, n - s.length)(rng) : 0;
@@ -88,6 +103,21 @@ class Sampler {
   }
 
  private:
+  // Context frames, a transition, the target (the clip's length when shorter).
+  Sample draw_transition(Sample s, int n, std::mt19937_64& rng) const {
+    const TransitionProtocol& p = transitions_;
+    const int gap = std::uniform_int_distribution<int>(p.min_transition, p.max_transition)(rng);
+    s.length = std::min({p.context + gap + 1, n, window_});
+    s.start = n > s.length ? std::uniform_int_distribution<int>(0, n - s.length)(rng) : 0;
+    const int context = std::max(1, std::min(p.context, s.length - 2));
+    s.gap_begin = context - 1;
+    const int K = J_ + 1;
+    s.known.assign(static_cast<size_t>(s.length) * K, 0.0f);
+    std::fill(s.known.begin(), s.known.begin() + context * K, 1.0f);
+    std::fill(s.known.end() - K, s.known.end(), 1.0f);
+    return s;
+  }
+
   std::vector<float> known_pattern(int n, std::mt19937_64& rng) const {
     const int K = J_ + 1;
     std::vector<float> known(static_cast<size_t>(n) * K, 0.0f);
@@ -131,6 +161,7 @@ class Sampler {
 
   const std::vector<Clip>& clips_;
   int J_, window_, min_length_;
+  TransitionProtocol transitions_;
   std::vector<bool> legs_;
   std::vector<int> usable_;
   std::vector<double> cumulative_;
@@ -152,18 +183,43 @@ std::vector<at::Tensor> clip_contacts(const std::vector<Clip>& clips, const RigI
   return out;
 }
 
+// Salient Poses scores [1, T] of a transition sample's frames gap_begin .. length - 1
+// and the mask [1, T] of the frames strictly inside the transition.
+void transition_scores(const WindowTensors& w, const Sample& s, const RigInfo& rig, int min_spacing, int T,
+                       at::Tensor* scores, at::Tensor* mask) {
+  *scores = at::zeros({1, T});
+  *mask = at::zeros({1, T});
+  const int n = s.length - s.gap_begin;
+  if (s.gap_begin < 0 || n < 3) return;
+  at::Tensor offsets = offsets_tensor(rig.skeleton);
+  at::Tensor g = forward_kinematics(rig.skeleton.parents, offsets, w.local_rotations.narrow(1, s.gap_begin, n),
+                                    w.root_positions.narrow(1, s.gap_begin, n))
+                     .positions.squeeze(0);  // [n, J, 3]
+  scores->narrow(1, s.gap_begin, n).copy_(training::salient_scores(g, min_spacing).unsqueeze(0));
+  mask->narrow(1, s.gap_begin + 1, n - 2).fill_(1.0);
+}
+
 Batch make_batch(const std::vector<Clip>& clips, const std::vector<at::Tensor>& contacts,
-                 const std::vector<Sample>& samples, size_t begin, size_t end, const RigInfo& rig) {
+                 const std::vector<Sample>& samples, size_t begin, size_t end, const RigInfo& rig,
+                 const TransitionProtocol& transitions) {
   at::NoGradGuard no_grad;
   const int J = rig.num_joints();
   int T = 0;
   for (size_t i = begin; i < end; ++i) T = std::max(T, samples[i].length);
-  std::vector<at::Tensor> targets, knowns, valids, feet;
+  std::vector<at::Tensor> targets, knowns, valids, feet, trajectories, scores, score_masks;
   for (size_t i = begin; i < end; ++i) {
     const Sample& s = samples[i];
     WindowTensors w = window_tensors(clips[s.clip].motion, s.start, s.length, rig, 0);
     at::Tensor pose = pose_features(w.local_rotations, w.root_positions).squeeze(0);  // [n, D]
     targets.push_back(training::padded_slice(pose, 0, s.length, T));
+    if (transitions.on) {
+      at::Tensor trajectory =
+          trajectory_features(w.local_rotations.select(2, 0), w.root_positions, rig.root_forward).squeeze(0);
+      trajectories.push_back(training::padded_slice(trajectory, 0, s.length, T));
+      scores.emplace_back();
+      score_masks.emplace_back();
+      transition_scores(w, s, rig, transitions.min_spacing, T, &scores.back(), &score_masks.back());
+    }
     at::Tensor known = at::zeros({1, T, J + 1});
     known.narrow(1, 0, s.length).copy_(at::from_blob(const_cast<float*>(s.known.data()), {1, s.length, J + 1},
                                                      at::kFloat));
@@ -179,6 +235,11 @@ Batch make_batch(const std::vector<Clip>& clips, const std::vector<at::Tensor>& 
   b.input.valid = at::cat(valids, 0);
   b.input.pose = b.target * known_channel_mask(b.input.known, J);
   if (!feet.empty()) b.contacts = at::cat(feet, 0);
+  if (!trajectories.empty()) {
+    b.input.trajectory = at::cat(trajectories, 0);
+    b.scores = at::cat(scores, 0);
+    b.score_mask = at::cat(score_masks, 0);
+  }
   return b;
 }
 
@@ -189,9 +250,22 @@ struct StepLosses {
   at::Tensor total;
 };
 
+// Keyframe kinds: training/keyframe_losses.h; stages = KeyframeNet's and RefineNet's totals.
+StepLosses keyframe_step_losses(const InbetweenModel& model, const Batch& b, const InbetweenOutput& out) {
+  training::KeyframeTargets t{b.target, b.input.valid, b.input.trajectory, b.scores, b.score_mask, b.contacts};
+  training::KeyframeLosses k = training::keyframe_losses(model, out, t);
+  StepLosses L;
+  L.stages = {k.keyframe_total, k.refine_total};
+  L.last = k.refine_parts;
+  L.contact = k.contact;
+  L.total = k.total;
+  return L;
+}
+
 StepLosses compute_losses(const InbetweenModel& model, const Batch& b, double contact_weight) {
   InbetweenOutput out = model.forward(b.input);
   if (out.stages.empty()) throw std::runtime_error("in-betweener returned no stage");
+  if (out.keyframe_logits.defined() && b.scores.defined()) return keyframe_step_losses(model, b, out);
   StepLosses L;
   L.total = at::zeros({});
   for (size_t k = 0; k < out.stages.size(); ++k) {
@@ -257,6 +331,25 @@ void check_data_fits(const InbetweenModel& model, const Dataset& data) {
   }
 }
 
+// The transition protocol for keyframe kinds (their "min_spacing" hyperparameter sets the scores').
+TransitionProtocol transition_protocol(const InbetweenTrainingOptions& o, const InbetweenModel& model) {
+  TransitionProtocol p;
+  p.on = model.kind() == kKeyframeKind;
+  if (!p.on) return p;
+  if (o.context < 1 || o.min_transition < 1 || o.max_transition < o.min_transition ||
+      o.context + o.max_transition + 1 > model.window()) {
+    throw InputError("train: need context >= 1, 1 <= min transition <= max transition and context + max transition "
+                     "+ 1 <= the model's window (" + std::to_string(model.window()) + ")");
+  }
+  p.context = o.context;
+  p.min_transition = o.min_transition;
+  p.max_transition = o.max_transition;
+  const auto hp = model.hyperparameters();
+  auto it = hp.find("min_spacing");
+  if (it != hp.end()) p.min_spacing = static_cast<int>(it->second);
+  return p;
+}
+
 // Training-loss sums of one epoch: total, one per stage, contact.
 struct EpochSums {
   explicit EpochSums(size_t stages) : values(stages + 2, 0.0) {}
@@ -303,6 +396,7 @@ class InbetweenRun {
   bool resuming_ = false;
   const training::RunFiles resume_from_;  // files_, or on ranks > 0 rank 0's checkpoint copied
   std::unique_ptr<InbetweenModel> model_;
+  TransitionProtocol transitions_;
   Sampler train_sampler_, val_sampler_;
   std::vector<at::Tensor> train_contacts_, val_contacts_;
   std::vector<Batch> val_batches_;
@@ -326,8 +420,9 @@ InbetweenRun::InbetweenRun(const InbetweenTrainingOptions& o)
                                          o.verbose && dp_.writes())),
       resume_from_(dp_.resume_files(files_, o.resume, &resuming_)),
       model_(load_or_make_model(o, data_, resume_from_, resuming_)),
-      train_sampler_(data_.train, model_->rig(), model_->window(), o.min_length),
-      val_sampler_(data_.validation, model_->rig(), model_->window(), o.min_length),
+      transitions_(transition_protocol(o, *model_)),
+      train_sampler_(data_.train, model_->rig(), model_->window(), o.min_length, transitions_),
+      val_sampler_(data_.validation, model_->rig(), model_->window(), o.min_length, transitions_),
       lr_(o.lr) {
   check_data_fits(*model_, data_);
   if (train_sampler_.empty()) throw InputError("train: no training clip has 2 frames or more");
@@ -352,7 +447,9 @@ InbetweenRun::InbetweenRun(const InbetweenTrainingOptions& o)
   stage_names_ = model_->stage_names();
   if (dp_.writes() && (!resuming_ || !fs::exists(files_.log))) open_log();
   base_minutes_ = state_.minutes;
-  const double mean_length = 0.5 * (std::min(o.min_length, model_->window()) + model_->window());
+  const double mean_length = transitions_.on
+                                 ? transitions_.context + 0.5 * (o.min_transition + o.max_transition) + 1
+                                 : 0.5 * (std::min(o.min_length, model_->window()) + model_->window());
   const double global_batch = static_cast<double>(o.batch) * dp_.world_size();
   epoch_steps_ = o.epoch_steps > 0
                      ? o.epoch_steps
@@ -370,7 +467,7 @@ void InbetweenRun::measure_pose_statistics() {
   for (int i = 0; i < n; ++i) samples.push_back(train_sampler_.draw(rng));
   std::vector<at::Tensor> frames;
   for (size_t i = 0; i < samples.size(); i += 64) {
-    Batch b = make_batch(data_.train, train_contacts_, samples, i, std::min(samples.size(), i + 64), model_->rig());
+    Batch b = make_batch(data_.train, train_contacts_, samples, i, std::min(samples.size(), i + 64), model_->rig(), transitions_);
     frames.push_back(b.target.flatten(0, 1).index({b.input.valid.flatten() > 0.5}));
   }
   at::Tensor all = at::cat(frames, 0).to(at::kDouble);
@@ -386,7 +483,8 @@ void InbetweenRun::make_validation_set() {
   for (int i = 0; i < o_.validation_windows; ++i) samples.push_back(val_sampler_.draw(rng));
   for (size_t i = 0; i < samples.size(); i += 64) {
     val_batches_.push_back(
-        make_batch(data_.validation, val_contacts_, samples, i, std::min(samples.size(), i + 64), model_->rig()));
+        make_batch(data_.validation, val_contacts_, samples, i, std::min(samples.size(), i + 64), model_->rig(),
+                   transitions_));
   }
 }
 
@@ -471,7 +569,7 @@ void InbetweenRun::train_step(EpochSums* sums) {
   double valid_frames = 0;
   for (size_t i = first; i < last; ++i) valid_frames += samples[i].length;
   const auto c0 = Clock::now();
-  Batch b = make_batch(data_.train, train_contacts_, samples, first, last, model_->rig());
+  Batch b = make_batch(data_.train, train_contacts_, samples, first, last, model_->rig(), transitions_);
   const auto c1 = Clock::now();
   StepLosses L = compute_losses(*model_, b, o_.contact_weight);
   const auto c2 = Clock::now();

@@ -14,7 +14,18 @@
 //   10% partial  like sparse, then about half of the interior keys give only
 //                the root, only the legs or a random subset of joints, and
 //                their root position with probability 1/2
-// Loss: the sum over stages of inbetween_pose_loss on every valid frame, plus
+// Kinds that predict keyframes (kKeyframeKind, prior/inbetween/keyframe_net.h)
+// train on transitions instead: `context` known frames from frame 0, a
+// transition uniform in [min_transition, max_transition] frames, then the
+// target frame (a clip shorter than that gives its own length with the context
+// cut to leave at least one unknown frame); the trajectory of every frame is
+// the ground truth's (InbetweenBatch::trajectory), the keyframe score targets
+// are the Salient Poses scores of the transition (last context frame .. target;
+// training/salient_poses.h, with the model's min_spacing), and the loss is
+// training/keyframe_losses.h's (the per-stage columns of the log hold
+// KeyframeNet's and RefineNet's weighted totals; the validation score is
+// RefineNet's).
+// Loss (other kinds): the sum over stages of inbetween_pose_loss on every valid frame, plus
 // contact_weight * BCE(contact logits, gmp_targets(...).contacts) when the
 // model predicts contacts.
 //
@@ -59,6 +70,9 @@ struct InbetweenTrainingOptions {
   double lr_final = 1e-5;
   double warmup = 0.03;             ///< fraction of the budget
   double contact_weight = 0.5;
+  int context = 10;                 ///< keyframe kinds: known frames before the transition
+  int min_transition = 5;           ///< keyframe kinds: shortest transition, frames
+  int max_transition = 90;          ///< keyframe kinds: longest transition, frames
   double checkpoint_minutes = 5.0;  ///< last.* written at least this often
   double validate_minutes = 6.0;    ///< an epoch ends after at most this long
   int epoch_steps = 0;              ///< 0 = about one pass over the training frames

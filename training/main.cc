@@ -2,7 +2,7 @@
 //
 //   motionfield-train prior --out DIR [--data PATH] [--config FILE] [--width N] [--layers N]
 //                           [--zl N] [--zg N] [--max-minutes M] [--seed S] [--threads N] [--resume] ...
-//   motionfield-train twostage|citl --out DIR [--data PATH] [--hp key=value]... [--config FILE]
+//   motionfield-train twostage|citl|keyframe --out DIR [--data PATH] [--hp key=value]... [--config FILE]
 //                           [--max-minutes M] [--seed S] [--threads N] [--resume] [--export PATH] ...
 //   motionfield-train rig --out FILE.json [--data PATH] [--cache-dir DIR] [--stride N]
 //
@@ -126,6 +126,10 @@ void add_inbetweener_options(CLI::App& cmd, mf::InbetweenTrainingOptions& o, std
   cmd.add_option("--validate-minutes", o.validate_minutes, "an epoch ends after at most this long");
   cmd.add_option("--epoch-steps", o.epoch_steps, "steps per epoch (0 = one pass over the training frames)");
   cmd.add_option("--validation-windows", o.validation_windows, "validation windows (fixed seed)");
+  const std::string transitions = "Transitions (keyframe kinds only; training/inbetween_trainer.h)";
+  cmd.add_option("--context", o.context, "known frames before the transition")->group(transitions);
+  cmd.add_option("--min-transition", o.min_transition, "shortest transition, frames")->group(transitions);
+  cmd.add_option("--max-transition", o.max_transition, "longest transition, frames")->group(transitions);
   cmd.footer("Model hyperparameters go in --hp KEY=VALUE.");
 }
 

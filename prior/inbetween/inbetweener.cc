@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "prior/inbetween/citl.h"
+#include "prior/inbetween/keyframe_net.h"
 #include "prior/inbetween/two_stage.h"
 #include "prior/model/model_file.h"
 #include "prior/motion/errors.h"
@@ -196,7 +197,7 @@ void InbetweenModel::set_requires_grad(bool on) {
 }
 
 const std::vector<InbetweenerKind>& inbetweener_kinds() {
-  static const std::vector<InbetweenerKind> kinds = {two_stage_kind(), citl_kind()};
+  static const std::vector<InbetweenerKind> kinds = {two_stage_kind(), citl_kind(), keyframe_net_kind()};
   return kinds;
 }
 

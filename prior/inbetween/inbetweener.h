@@ -4,7 +4,10 @@
 //   "twostage"  Context Transformer + Detail Transformer (prior/inbetween/two_stage.h);
 //               stage 0 is the context output, stage 1 the detail output
 //   "citl"      CITL (prior/inbetween/citl.h); one stage
-// They are used standalone (methods "context", "detail", "citl") and as
+//   "keyframe"  KeyframeNet + RefineNet (prior/inbetween/keyframe_net.h),
+//               trajectory-conditioned; stage 0 "keyframe" (the interpolated
+//               predicted keyframes), stage 1 "refine"
+// They are used standalone (methods "context", "detail", "citl", "keyframe", "refine") and as
 // initialisers of the latent solvers (output -> prior encoders -> z0).
 //
 // Pose representation, shared by every kind, one vector per frame:
@@ -36,6 +39,7 @@ namespace mf {
 
 constexpr char kTwoStageKind[] = "twostage";
 constexpr char kCitlKind[] = "citl";
+constexpr char kKeyframeKind[] = "keyframe";
 
 /// Pose features [B, T, J * 6 + 3] from local rotations [B, T, J, 3, 3] and
 /// root positions [B, T, 3].
@@ -64,6 +68,14 @@ struct InbetweenOutput {
   std::vector<at::Tensor> stages;
   /// Foot contact logits [B, T, F] (rig().foot_joints order) when the model predicts them.
   at::Tensor contact_logits;
+  /// Kinds that predict keyframes (kKeyframeKind, prior/inbetween/keyframe_net.h)
+  /// also return: their own pose of every frame [B, T, D] (raw) before the
+  /// keyframe selection, the keyframe score logits [B, T], and the frames the
+  /// interpolation ran through [B, T] (float in {0, 1}: known frames, the last
+  /// valid frame and the picked keyframes). Undefined for the other kinds.
+  at::Tensor keyframe_poses;
+  at::Tensor keyframe_logits;
+  at::Tensor keyframes;
 };
 
 /// Z-score statistics of the pose features, measured on the training split.
@@ -183,7 +195,7 @@ struct InbetweenerKind {
   InbetweenFactory make;
 };
 
-/// The product's kinds, in a fixed order (two-stage, CITL). Adding a kind is
+/// The product's kinds, in a fixed order (two-stage, CITL, keyframe). Adding a kind is
 /// its network's file (which defines its InbetweenerKind) and one line in the
 /// list in inbetweener.cc.
 const std::vector<InbetweenerKind>& inbetweener_kinds();
