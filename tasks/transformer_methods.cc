@@ -7,9 +7,10 @@ namespace mf {
 namespace {
 
 Method transformer_method(const std::string& name, const std::string& description, const std::string& kind,
-                          int stage) {
+                          int stage, bool reads_trajectory) {
   Method m;
   m.name = name;
+  m.follows_trajectory = reads_trajectory;
   m.description = description;
   m.needs_model = true;
   m.needs_inbetweener = kind;
@@ -38,7 +39,7 @@ std::vector<Method> transformer_methods() {
     for (size_t stage = 0; stage < kind.stages.size(); ++stage) {
       const InbetweenerStage& s = kind.stages[stage];
       methods.push_back(transformer_method(s.name, kind.title + ", " + s.description + " (one pass)", kind.name,
-                                           static_cast<int>(stage)));
+                                           static_cast<int>(stage), kind.reads_trajectory));
     }
   }
   return methods;

@@ -193,6 +193,9 @@ struct InbetweenerKind {
   std::string file_name;                 ///< "motionfield-twostage.mfm", next to the prior's file
   std::vector<InbetweenerStage> stages;  ///< in the model's stage_names() order
   InbetweenFactory make;
+  /// The network is conditioned on InbetweenBatch::trajectory, so its
+  /// methods follow a trajectory the caller gives.
+  bool reads_trajectory = false;
 };
 
 /// The product's kinds, in a fixed order (two-stage, CITL, keyframe). Adding a kind is

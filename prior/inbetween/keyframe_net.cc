@@ -340,7 +340,8 @@ InbetweenerKind keyframe_net_kind() {
           "motionfield-keyframe.mfm",
           {{"keyframe", "KeyframeNet's keyframes, interpolated"},
            {"refine", "KeyframeNet + RefineNet (trajectory-conditioned)"}},
-          make_keyframe_net};
+          make_keyframe_net,
+          /*reads_trajectory=*/true};
 }
 
 }  // namespace mf
