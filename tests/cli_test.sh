@@ -622,5 +622,173 @@ cp "$TMP/t.csv" "$TMP/tt.bvh"
 bad "--trajectory is the output" fill -i "$SAMPLE" --gap 15:45 -o "$TMP/tt.bvh" --trajectory "$TMP/tt.bvh"
 expect_stderr "is the trajectory file" "refuses to overwrite the trajectory file"
 
+# ------------------------------------------------------------ the bad-input catalogue (issue 18, docs/RELIABILITY.md "Cases")
+# Each case: exit code 2, a message naming the problem (and file:line for files),
+# no output file. Every input file of the catalogue is checksummed before and
+# compared after: no case may modify its input.
+CAT="$TMP/cat"
+mkdir -p "$CAT/dir" "$CAT/nodir-parent"
+cp "$SAMPLE" "$CAT/walk.bvh"
+: >"$CAT/empty.bvh"
+head -n 3 "$SAMPLE" >"$CAT/cut-hierarchy.bvh"
+awk '{ print } /^MOTION/ { exit }' "$SAMPLE" >"$CAT/cut-motion.bvh"
+awk '{ print } /^Frames:/ { exit }' "$SAMPLE" >"$CAT/cut-frames.bvh"
+awk '{ print } /^Frame Time:/ { on = 1; next } on { n++ } n == 30 { exit }' "$SAMPLE" >"$CAT/cut-data.bvh"
+head -c -100 "$SAMPLE" >"$CAT/cut-value.bvh"
+head -c 3000 "$SRC/models/motionfield-prior.mfm" >"$CAT/binary.bvh"
+awk '/^Frame Time:/ { print; getline; $8 = "nan"; print; next } { print }' "$SAMPLE" >"$CAT/nan.bvh"
+sed 's/^\([[:space:]]*OFFSET\) [^ ]*/\1 1e400/' "$SAMPLE" >"$CAT/overflow.bvh"
+sed 's/^Frames: 61/Frames: 99999999999/' "$SAMPLE" >"$CAT/huge-frames.bvh"
+awk 'BEGIN { print "HIERARCHY"; print "ROOT J0"; print "{"; print "OFFSET 0 0 0"; print "CHANNELS 1 Xrotation"
+  for (d = 1; d <= 64; d++) { print "JOINT J" d; print "{"; print "OFFSET 0 1 0" }
+  for (d = 1; d <= 64; d++) print "}"; print "}"; print "MOTION"; print "Frames: 1"; print "Frame Time: 0.1"; print "0" }' \
+  >"$CAT/deep.bvh"
+sums_before=$(cd "$CAT" && sha256sum ./*.bvh | sha256sum)
+catalogue() {  # DESCRIPTION STDERR-PATTERN ARGS...
+  local what=$1 pattern=$2
+  shift 2
+  bad "$what" "$@"
+  expect_stderr "$pattern" "$what: message"
+}
+# BVH, every section truncated or broken.
+catalogue "empty BVH" "empty.bvh:1: empty file" inbetween --in "$CAT/empty.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+catalogue "BVH cut inside HIERARCHY" "cut-hierarchy.bvh:3: unexpected end of file inside joint" \
+  inbetween --in "$CAT/cut-hierarchy.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+catalogue "BVH cut after MOTION" "cut-motion.bvh:[0-9]*: unexpected end of file: expected 'Frames:'" \
+  inbetween --in "$CAT/cut-motion.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+catalogue "BVH cut after Frames:" "cut-frames.bvh:[0-9]*: unexpected end of file: expected 'Frame'" \
+  inbetween --in "$CAT/cut-frames.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+catalogue "BVH cut between frames" "cut-data.bvh:[0-9]*: unexpected end of file in motion data: expected 4392 values" \
+  inbetween --in "$CAT/cut-data.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+catalogue "BVH cut inside a frame" "cut-value.bvh:[0-9]*: unexpected end of file in motion data" \
+  inbetween --in "$CAT/cut-value.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+catalogue "binary garbage as BVH" "binary.bvh:1: expected HIERARCHY" inbetween --in "$CAT/binary.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+LC_ALL=C grep -q '[[:cntrl:]]' <(tr -d '\n' <"$TMP/err") && fail "control bytes of a binary BVH reached stderr" || pass
+catalogue "NaN in the motion data" "nan.bvh:[0-9]*: non-finite value 'nan'" inbetween --in "$CAT/nan.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+catalogue "an OFFSET of 1e400" "overflow.bvh:[0-9]*: .*out of range" inbetween --in "$CAT/overflow.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+catalogue "Frames: 99999999999" "huge-frames.bvh:[0-9]*: Frames: 99999999999 exceeds the limit of 10000000" \
+  inbetween --in "$CAT/huge-frames.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+catalogue "joints nested 65 deep" "deep.bvh:[0-9]*: .*nested deeper than 64" inbetween --in "$CAT/deep.bvh" --keyframes 0,1 --out "$TMP/bad.bvh"
+# Directories, devices and FIFOs as inputs.
+catalogue "a directory as --in" "cannot read BVH file .*dir: it is a directory" inbetween --in "$CAT/dir" --keyframes 0,1 --out "$TMP/bad.bvh"
+catalogue "/dev/zero as --model" "cannot read model file /dev/zero: it is a device, not a file" \
+  --model /dev/zero inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh"
+catalogue "a directory as --model" "cannot read model file .*dir: it is a directory" \
+  --model "$CAT/dir" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh"
+catalogue "/dev/zero as --rig-map" "cannot read rig map file /dev/zero: it is a device, not a file" \
+  --rig-map /dev/zero inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh"
+catalogue "/dev/zero as --constraints" "cannot read constraints file /dev/zero: it is a device, not a file" \
+  inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --constraints /dev/zero
+catalogue "a directory as the batch file" "cannot read the batch file .*dir: it is a directory" batch "$CAT/dir"
+mkfifo "$CAT/fifo"
+(cat "$SAMPLE" >"$CAT/fifo" &)
+expect_rc 0 "a FIFO as --in" -- timeout 20 "$MF" inbetween --in "$CAT/fifo" --keyframes 0,60 --out "$TMP/fifo.bvh" --method interp
+cmp -s "$TMP/fifo.bvh" "$TMP/kf-interp.bvh" 2>/dev/null || expect_rc 0 "a FIFO as --in: the same frames" -- \
+  "$DIFF" "$TMP/fifo.bvh" "$SAMPLE" --frames 0,60
+(head -c 70M /dev/zero >"$CAT/fifo" 2>/dev/null &)
+expect_rc 2 "a FIFO batch file past 64 MiB" -- timeout 60 "$MF" batch "$CAT/fifo"
+expect_stderr "cannot read the batch file .*fifo: larger than the limit of 64 MiB" "FIFO past the limit: message"
+rm -f "$CAT/fifo"
+# A terminal as --in - (script(1) gives the command one on stdin): refused at once.
+script -qec "timeout 20 \"$MF\" inbetween --in - --keyframes 0,60 --out \"$TMP/bad.bvh\" --method interp" /dev/null \
+  </dev/null >"$TMP/err" 2>&1
+[ $? -eq 2 ] && pass || fail "--in - on a terminal: exit code 2"
+expect_stderr "cannot read BVH file /dev/stdin: it is a device, not a file" "--in - on a terminal: message"
+expect_absent "$TMP/bad.bvh"
+# Non-finite and absurd numbers on the command line.
+catalogue "--fps nan" "the target fps must be finite and positive" resample --in "$SAMPLE" --fps nan --out "$TMP/bad.bvh"
+catalogue "--fps inf" "the target fps must be finite and positive" resample --in "$SAMPLE" --fps inf --out "$TMP/bad.bvh"
+catalogue "--fps -30" "the target fps must be finite and positive" resample --in "$SAMPLE" --fps -30 --out "$TMP/bad.bvh"
+catalogue "--fps 1e300" "would give more than 10000000 frames" resample --in "$SAMPLE" --fps 1e300 --out "$TMP/bad.bvh"
+catalogue "a keyframe past 2^31" "bad integer for --keyframes: '2147483648'" inbetween --in "$SAMPLE" --keyframes 0,2147483648 --out "$TMP/bad.bvh"
+catalogue "--gap 1:1e9" "bad integer for --gap" fill --in "$SAMPLE" --gap 1:1e9 --out "$TMP/bad.bvh"
+catalogue "--threads 100000" "--threads: Value 100000 not in range 1 to 1024" --threads 100000 inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh"
+catalogue "--length-scale nan" "must be positive, not nan" --length-scale nan inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --method interp
+catalogue "--length-scale 0" "must be positive, not 0" --length-scale 0 inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --method interp
+catalogue "--alternatives -1" "--alternatives: Value -1 not in range 0 to 16" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --alternatives -1
+# Outputs: a directory, an existing file kept unchanged by a failing run.
+catalogue "--out naming a directory" "cannot write .*dir: it is a directory" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$CAT/dir" --method interp
+[ -d "$CAT/dir" ] && [ -z "$(ls -A "$CAT/dir")" ] && pass || fail "--out naming a directory changed the directory"
+printf 'an existing file\n' >"$TMP/keep.bvh"
+for args in "inbetween --keyframes 0,99 --method interp" "resample --fps nan" "fill --gap 0:10" "inbetween --keyframes 0,60 --method magic"; do
+  # shellcheck disable=SC2086
+  expect_rc 2 "failing run ($args) onto an existing file" -- "$MF" $args --in "$SAMPLE" --out "$TMP/keep.bvh"
+  [ "$(cat "$TMP/keep.bvh")" = "an existing file" ] && pass || fail "a failing run ($args) changed the existing output"
+done
+expect_rc 2 "a broken --model onto an existing file" -- "$MF" --model "$CAT/binary.bvh" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/keep.bvh"
+[ "$(cat "$TMP/keep.bvh")" = "an existing file" ] && pass || fail "a broken model changed the existing output"
+[ "$(find "$TMP" -maxdepth 1 -name 'keep.bvh.tmp*' | wc -l)" -eq 0 ] && pass || fail "a temporary file was left next to keep.bvh"
+# Model files truncated, empty or with a flipped byte (the tiny model and its transformers).
+if [ -x "$HELPER" ] && mkdir -p "$CAT/m" && "$HELPER" "$CAT/m/prior.mfm" --transformers; then
+  head -c 1000 "$CAT/m/prior.mfm" >"$CAT/trunc.mfm"
+  : >"$CAT/empty.mfm"
+  cp "$CAT/m/prior.mfm" "$CAT/flip.mfm"
+  printf '\x55' | dd of="$CAT/flip.mfm" bs=1 seek=5000 conv=notrunc 2>/dev/null
+  catalogue "a truncated model" "trunc.mfm: truncated model file" --model "$CAT/trunc.mfm" inbetween --in "$SMALL" --keyframes 0,39 --out "$TMP/bad.bvh"
+  catalogue "an empty model" "empty.mfm: not a motionfield model file" --model "$CAT/empty.mfm" inbetween --in "$SMALL" --keyframes 0,39 --out "$TMP/bad.bvh"
+  catalogue "a model with a flipped byte" "flip.mfm: corrupted model file (checksum mismatch)" \
+    --model "$CAT/flip.mfm" inbetween --in "$SMALL" --keyframes 0,39 --out "$TMP/bad.bvh"
+  printf '\x55' | dd of="$CAT/m/motionfield-twostage.mfm" bs=1 seek=3000 conv=notrunc 2>/dev/null
+  catalogue "a two-stage file with a flipped byte, --method detail" \
+    "needs models/motionfield-twostage.mfm .*motionfield-twostage.mfm: corrupted model file (checksum mismatch)" \
+    --model "$CAT/m/prior.mfm" inbetween --in "$SMALL" --keyframes 0,20,39 --out "$TMP/bad.bvh" --method detail
+  cp "$CAT/m/motionfield-citl.mfm" "$CAT/citl.mfm"
+  head -c 5000 "$CAT/citl.mfm" >"$CAT/m/motionfield-citl.mfm"
+  catalogue "--citl naming a truncated file" "truncated" \
+    --model "$CAT/m/prior.mfm" --citl "$CAT/m/motionfield-citl.mfm" inbetween --in "$SMALL" --keyframes 0,20,39 --out "$TMP/bad.bvh" --method citl
+else
+  fail "mf_capi_tiny_model not built or failed: the model-file cases could not run"
+fi
+# Path CSVs: cut, binary, overflowing, too many points (renav needs a model: the tiny one).
+if [ -n "$TINY" ]; then
+  printf 'x,z\n0,0\n0.5,0.1\n1,' >"$CAT/cut.csv"
+  head -c 2000 "$SRC/models/motionfield-prior.mfm" >"$CAT/binary.csv"
+  printf '0,0\n1e400,1\n' >"$CAT/overflow.csv"
+  awk 'BEGIN { for (i = 0; i <= 1000000; i++) printf "%d,0\n", i }' >"$CAT/many.csv"
+  catalogue "a path CSV cut in its last line" "cut.csv:4:" --model "$TINY" renav --in "$SMALL" --path "$CAT/cut.csv" --out "$TMP/bad.bvh"
+  catalogue "binary garbage as a path CSV" "binary.csv:1:" --model "$TINY" renav --in "$SMALL" --path "$CAT/binary.csv" --out "$TMP/bad.bvh"
+  catalogue "1e400 in a path CSV" "overflow.csv:2:" --model "$TINY" renav --in "$SMALL" --path "$CAT/overflow.csv" --out "$TMP/bad.bvh"
+  catalogue "a path of 1000001 points" "more than 1000000 points" --model "$TINY" renav --in "$SMALL" --path "$CAT/many.csv" --out "$TMP/bad.bvh"
+  catalogue "/dev/zero as --path" "cannot read path file /dev/zero: it is a device, not a file" \
+    --model "$TINY" renav --in "$SMALL" --path /dev/zero --out "$TMP/bad.bvh"
+  catalogue "a directory as --polyline" "cannot read path file .*dir: it is a directory" \
+    --model "$TINY" renav --in "$SMALL" --polyline "$CAT/dir" --out "$TMP/bad.bvh"
+fi
+# Batch: bad lines of every kind; the good jobs before and after them still run.
+mkdir -p "$CAT/batch"
+cp "$SAMPLE" "$CAT/batch/walk.bvh"
+{
+  echo '{"task": "inbetween", "in": "walk.bvh", "out": "j1.bvh", "keyframes": [0, 60], "method": "interp"}'
+  head -c 3000 "$SRC/models/motionfield-prior.mfm" | tr '\n' ' '
+  echo
+  head -c 100000 /dev/zero | tr '\0' '['
+  echo
+  echo '{"task": "resample", "in": "walk.bvh", "out": "j4.bvh", "fps": 1e400}'
+  echo '{"task": "resample", "in": "walk.bvh", "out": "j5.bvh", "fps": 1e300}'
+  echo '{"task": "inbetween", "in": "walk.bvh", "out": "j6.bvh", "keyframes": [0, 1e20]}'
+  echo '{}'
+  echo '{"task": "inbetween", "in": "../dir", "out": "j8.bvh", "keyframes": [0, 60]}'
+  echo '{"task": "inbetween", "in": "walk.bvh", "out": "nodir/j9.bvh", "keyframes": [0, 60]}'
+  echo '{"task": "inbetween", "in": "walk.bvh", "out": "j10.bvh", "keyframes": [0, 30, 60], "method": "interp"}'
+  printf '{"task": "inbetween", "in": "walk.bvh", "out": "j11.bvh", "keyf'
+} >"$CAT/batch/bad.jsonl"
+in_dir "$CAT/batch" expect_rc 2 "batch with bad lines of every kind" -- "$MF" batch bad.jsonl
+expect_stderr "line 2: error: invalid JSON: column 1:" "batch: a binary line"
+expect_stderr "line 3: error: invalid JSON: column 65: nesting deeper than 64 levels" "batch: deep nesting"
+expect_stderr "line 4: error: invalid JSON: column [0-9]*: number out of range: 1e400" "batch: 1e400"
+expect_stderr "line 5: error: resampling 61 frames from 30 to 1e+300 fps would give more than 10000000 frames" "batch: fps 1e300"
+expect_stderr 'line 6: error: "keyframes" item 1 must be an integer, not 1e+20' "batch: keyframe 1e20"
+expect_stderr 'line 7: error: missing key "task"' "batch: an empty object"
+expect_stderr "line 8: error: cannot read BVH file ../dir: it is a directory" "batch: a directory as in"
+expect_stderr "line 9: error: cannot write nodir/j9.bvh: directory nodir does not exist" "batch: an output directory that does not exist"
+expect_stderr "line 11: error: invalid JSON: .*missing closing quote" "batch: a last line cut short"
+expect_stderr "11 jobs, 2 ok, 9 failed" "batch summary"
+expect_frames "$CAT/batch/j1.bvh" "$N"
+expect_frames "$CAT/batch/j10.bvh" "$N"
+[ "$(find "$CAT/batch" -name 'j*.bvh' | wc -l)" -eq 2 ] && pass || fail "a failed batch job left an output"
+# Inputs are never modified.
+[ "$(cd "$CAT" && sha256sum ./*.bvh | sha256sum)" = "$sums_before" ] && pass || fail "a catalogue case modified its input"
+cmp -s "$CAT/batch/walk.bvh" "$SAMPLE" && pass || fail "batch modified its input"
+
 echo "cli_test: $((checks - failures)) of $checks checks passed"
 [ "$failures" -eq 0 ]

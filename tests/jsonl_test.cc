@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "capi/cli/input_error.h"
@@ -73,6 +74,20 @@ TEST(JsonlTest, DumpEscapesAndRoundTrips) {
   const JsonValue v = parse_json(text);
   EXPECT_EQ(v.dump(), R"(["q\"\\\n\u0001",true,false,null,-0.5,1e+300])");
   EXPECT_EQ(parse_json(v.dump()).dump(), v.dump());
+}
+
+// The sign of zero survives a dump and a parse: -0.0 dumps as "-0.0" (the
+// text "-0" is the integer 0 to the parser), so a dump reads back to the same
+// value and dumps to the same text.
+TEST(JsonlTest, NegativeZeroRoundTrips) {
+  const JsonValue v = parse_json("[-0.0, -0e5, 0.0, -0]");
+  EXPECT_EQ(v.dump(), "[-0.0,-0.0,0,0]");
+  const JsonValue back = parse_json(v.dump());
+  EXPECT_TRUE(std::signbit(back.as_array()[0].as_number()));
+  EXPECT_FALSE(std::signbit(back.as_array()[2].as_number()));
+  EXPECT_EQ(back.dump(), v.dump());
+  EXPECT_EQ(JsonValue::number(-0.0).dump(), "-0.0");
+  EXPECT_EQ(parse_json(JsonValue::number(-0.0).dump()).dump(), "-0.0");
 }
 
 TEST(JsonlTest, WrongTypeAccessThrowsLogicError) {

@@ -127,6 +127,12 @@ void dump_value(const JsonValue& v, std::string& out) {
     case JsonValue::Type::Null: out += "null"; break;
     case JsonValue::Type::Bool: out += v.as_bool() ? "true" : "false"; break;
     case JsonValue::Type::Number: {
+      // -0.0 as "-0.0", not to_chars' "-0": the parser reads "-0" as the
+      // integer 0, and the sign would be lost on the way back.
+      if (v.as_number() == 0.0 && std::signbit(v.as_number())) {
+        out += "-0.0";
+        break;
+      }
       char buf[32];
       auto r = std::to_chars(buf, buf + sizeof buf, v.as_number());  // shortest round-trip form
       out.append(buf, r.ptr);

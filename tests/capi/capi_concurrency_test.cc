@@ -4,10 +4,17 @@
 // reproducible.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <thread>
 
+#include "prior/inbetween/inbetweener.h"
+#include "prior/model/model_file.h"
 #include "tests/capi/capi_test_util.h"
+#include "tests/test_util.h"
 
 namespace mf::capi_test {
 namespace {
@@ -123,6 +130,49 @@ TEST_F(CApiConcurrency, EncodeAndDecode) {
     mf_encoding_destroy(code);
     return capture(status, out);
   });
+}
+
+// The learned default method of a model with its transformers next to it (the
+// shipped layout: today "nemf-detail", the two-stage transformer's fill refined
+// by the prior's solver) and the transformer methods themselves, on one shared
+// model handle from several threads: the serial results bit for bit. Tiny
+// random networks (the shipped ones take seconds per solve; the code paths are
+// the same).
+TEST_F(CApiConcurrency, LearnedDefaultAndTransformerMethods) {
+  const std::string dir = test::scratch_dir("capi-concurrency-" + std::to_string(::getpid()));
+  const std::string prior = dir + "/motionfield-prior.mfm";
+  std::ofstream(prior, std::ios::binary)
+      .write(reinterpret_cast<const char*>(tiny_model_bytes().data()),
+             static_cast<std::streamsize>(tiny_model_bytes().size()));
+  const RigInfo rig = load_nemf(prior).rig();
+  save_inbetweener(*test::tiny_transformer(kTwoStageKind, rig, 1), dir + "/motionfield-twostage.mfm");
+  save_inbetweener(*test::tiny_transformer(kCitlKind, rig, 2), dir + "/motionfield-citl.mfm");
+  mf_model* raw = nullptr;
+  ASSERT_EQ(mf_model_load(prior.c_str(), &raw), MF_OK) << describe(MF_ERROR_MODEL);
+  const ModelPtr model(raw);
+  const char* default_name = nullptr;
+  ASSERT_EQ(mf_default_method(model.get(), &default_name), MF_OK);
+  ASSERT_NE(std::string(default_name), "interp") << "the model's default method is not a learned one";
+
+  constexpr int kSolves = 3;
+  std::vector<MotionPtr> inputs;
+  for (int i = 0; i < kSolves; ++i) inputs.push_back(random_capi_motion(18 + 3 * i, 30.0, 300 + i));
+  for (const char* method : {static_cast<const char*>(nullptr), "detail", "citl"}) {
+    SCOPED_TRACE(method ? method : default_name);
+    expect_same_results_concurrently([&](int i) {
+      mf_task_options options;
+      mf_task_options_init(&options);
+      options.method = method;  // NULL: the model's default
+      options.seed = 11;
+      const int32_t last = frame_count(inputs[i].get()) - 1;
+      const int32_t keys[] = {0, last / 2, last};
+      mf_motion* out = nullptr;
+      const int status = mf_inbetween(model.get(), inputs[i].get(), keys, 3, &options, &out);
+      return capture(status, out);
+    }, kSolves);
+  }
+  std::error_code ignored;
+  std::filesystem::remove_all(dir, ignored);
 }
 
 }  // namespace

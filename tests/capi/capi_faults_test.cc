@@ -6,9 +6,11 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 
 #include "tests/capi/capi_test_util.h"
 #include "tests/test_util.h"
@@ -113,6 +115,28 @@ TEST(CApiFaults, HugeFilesAreRefusedByTheirSize) {
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(1));
   EXPECT_EQ(std::string(mf_last_error_message()),
             "cannot read BVH file " + huge + ": larger than the limit of 512 MiB for a BVH file");
+}
+
+// Item 2: a FIFO (or pipe) is read up to the limit, then refused: the same
+// reader as BVH and model files, shown with a path CSV (64 MiB limit).
+TEST(CApiFaults, AnEndlessFifoIsCutAtTheLimit) {
+  ScratchDir d;
+  const std::string fifo = d.path + "/endless.csv";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  std::thread writer([&] {
+    const int fd = ::open(fifo.c_str(), O_WRONLY);
+    if (fd < 0) return;
+    const std::string chunk(1 << 16, '0');
+    for (int i = 0; i < 70 * 16; ++i)  // 70 MiB, or until the reader closes its end
+      if (::write(fd, chunk.data(), chunk.size()) < 0) break;
+    ::close(fd);
+  });
+  std::signal(SIGPIPE, SIG_IGN);
+  size_t needed = 0;
+  EXPECT_EQ(mf_path_load_csv(fifo.c_str(), nullptr, 0, &needed), MF_ERROR_IO);
+  EXPECT_EQ(std::string(mf_last_error_message()),
+            "cannot read path file " + fifo + ": larger than the limit of 64 MiB for a path file");
+  writer.join();
 }
 
 // Item 3: bytes of the input reach messages escaped.

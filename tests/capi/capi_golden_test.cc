@@ -25,7 +25,7 @@ namespace {
 const std::string kGoldenFile = "tests/golden/shipped_models.txt";
 const std::string kUpdateCommand = "scripts/update-golden.sh";
 
-enum class Task { Inbetween, Resample };
+enum class Task { Inbetween, Fill, Resample };
 
 struct GoldenCase {
   std::string name;
@@ -47,6 +47,7 @@ const std::vector<GoldenCase>& golden_cases() {
       {"inbetween_detail", Task::Inbetween, "detail", {kSample, kTwoStage, kRig}},
       {"inbetween_citl", Task::Inbetween, "citl", {kSample, kCitl, kRig}},
       {"resample_default", Task::Resample, nullptr, {kSample, kPrior, kRig}},
+      {"fill_default", Task::Fill, nullptr, {kSample, kPrior, kTwoStage, kRig}},
   };
   return cases;
 }
@@ -109,6 +110,8 @@ Output run(const GoldenCase& c, int threads) {
   if (c.task == Task::Inbetween) {
     const int32_t keys[] = {0, 20, 40, 60};
     status = mf_inbetween(shipped_model(), input, keys, 4, &options, &raw);
+  } else if (c.task == Task::Fill) {
+    status = mf_fill(shipped_model(), input, 15, 45, &options, &raw);
   } else {
     status = mf_resample(shipped_model(), input, 60.0, &options, &raw);
   }
