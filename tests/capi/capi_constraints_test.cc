@@ -68,13 +68,7 @@ MotionPtr motion_of(const mf_solution* s, int index) {
   return MotionPtr(m);
 }
 
-std::vector<float> positions(const mf_motion* m) {
-  size_t n = 0;
-  mf_motion_get_global_positions(m, nullptr, 0, &n);
-  std::vector<float> p(n);
-  EXPECT_EQ(mf_motion_get_global_positions(m, p.data(), p.size(), &n), MF_OK);
-  return p;
-}
+std::vector<float> positions(const mf_motion* m) { return global_positions(m); }
 
 int joints_of(const mf_motion* m) {
   int32_t J = 0;

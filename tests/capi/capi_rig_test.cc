@@ -237,14 +237,6 @@ TEST(CApiRig, LearnedMethodsServeAnotherRig) {
   EXPECT_EQ(rotations(filled.get())[9 * per_frame], rotations(slow.get())[9 * per_frame]);
 }
 
-std::vector<float> global_positions(const mf_motion* m) {
-  size_t n = 0;
-  mf_motion_get_global_positions(m, nullptr, 0, &n);
-  std::vector<float> p(n);
-  EXPECT_EQ(mf_motion_get_global_positions(m, p.data(), p.size(), &n), MF_OK);
-  return p;
-}
-
 int joint_index(const mf_motion* m, const std::string& name) {
   const std::vector<std::string> names = joint_names(m);
   const auto it = std::find(names.begin(), names.end(), name);

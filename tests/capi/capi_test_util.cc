@@ -91,6 +91,14 @@ std::vector<float> root_positions(const mf_motion* m) {
   return out;
 }
 
+std::vector<float> global_positions(const mf_motion* m) {
+  size_t n = 0;
+  EXPECT_EQ(mf_motion_get_global_positions(m, nullptr, 0, &n), MF_OK);
+  std::vector<float> out(n);
+  EXPECT_EQ(mf_motion_get_global_positions(m, out.data(), out.size(), &n), MF_OK);
+  return out;
+}
+
 int frame_count(const mf_motion* m) {
   int32_t n = -1;
   EXPECT_EQ(mf_motion_get_frame_count(m, &n), MF_OK);

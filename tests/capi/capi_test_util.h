@@ -50,6 +50,8 @@ MotionPtr random_capi_motion(int frames, double fps, uint32_t seed);
 
 std::vector<float> rotations(const mf_motion* m);
 std::vector<float> root_positions(const mf_motion* m);
+/// World joint positions [frames * joints * 3], metres (mf_motion_get_global_positions).
+std::vector<float> global_positions(const mf_motion* m);
 int frame_count(const mf_motion* m);
 
 /// Names of registered methods with all of `flags`.
