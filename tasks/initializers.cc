@@ -22,9 +22,18 @@ InitialGuess encode_window(const NemfModel& model, const Motion& window, int anc
   return {z.mu_l.detach().clone(), z.mu_g.detach().clone()};
 }
 
+std::optional<Motion> LatentInitializer::fill_input(const Motion&, const MotionConstraints&, const TaskContext&) const {
+  return std::nullopt;
+}
+
 InitialGuess InterpolationEncoderInitializer::initialize(const InitRequest& r) const {
   if (!r.model || !r.window || !r.constraints) throw std::invalid_argument("InitRequest is incomplete");
   return encode_window(*r.model, fill_by_interpolation(*r.window, *r.constraints), r.anchor);
+}
+
+std::optional<Motion> InterpolationEncoderInitializer::fill_input(const Motion& input, const MotionConstraints& c,
+                                                                  const TaskContext&) const {
+  return fill_by_interpolation(input, c);
 }
 
 InitialGuess ZeroInitializer::initialize(const InitRequest& r) const {
@@ -36,13 +45,22 @@ TransformerEncoderInitializer::TransformerEncoderInitializer(std::string name, s
                                                              std::shared_ptr<const InbetweenModel> bound)
     : name_(std::move(name)), kind_(std::move(kind)), stage_(stage), bound_(std::move(bound)) {}
 
+const InbetweenModel& TransformerEncoderInitializer::transformer(const TaskContext* context) const {
+  const std::string what = "initialiser '" + name_ + "'";
+  if (!bound_ && !context) throw ModelMissingError(missing_inbetweener_message(what, kind_));
+  return bound_ ? *bound_ : require_inbetweener(*context, kind_, what);
+}
+
 InitialGuess TransformerEncoderInitializer::initialize(const InitRequest& r) const {
   if (!r.model || !r.window || !r.constraints) throw std::invalid_argument("InitRequest is incomplete");
-  const std::string what = "initialiser '" + name_ + "'";
-  if (!bound_ && !r.context) throw ModelMissingError(missing_inbetweener_message(what, kind_));
-  const InbetweenModel& transformer = bound_ ? *bound_ : require_inbetweener(*r.context, kind_, what);
-  const Motion filled = inbetweener_fill(transformer, stage_, *r.window, *r.constraints, LongGapPolicy::Interpolate);
+  const Motion filled =
+      inbetweener_fill(transformer(r.context), stage_, *r.window, *r.constraints, LongGapPolicy::Interpolate);
   return encode_window(*r.model, filled, r.anchor);
+}
+
+std::optional<Motion> TransformerEncoderInitializer::fill_input(const Motion& input, const MotionConstraints& c,
+                                                                const TaskContext& context) const {
+  return inbetweener_fill(transformer(&context), stage_, input, c, LongGapPolicy::Interpolate);
 }
 
 std::vector<std::string> initializer_names() {

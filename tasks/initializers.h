@@ -10,6 +10,7 @@
 
 #include <ATen/core/Tensor.h>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,6 +49,15 @@ class LatentInitializer {
   virtual ~LatentInitializer() = default;
   virtual std::string name() const = 0;
   virtual InitialGuess initialize(const InitRequest& request) const = 0;
+  /// For inputs longer than the prior's window: the whole input (world
+  /// coordinates) filled under the whole input's `constraints` the way this
+  /// initialiser fills one window, or nullopt when it has no such fill (then
+  /// every window is initialised by initialize()). complete_motion() encodes
+  /// each window's slice of it instead, so that a window holding no key on its
+  /// far side (the first window of a long gap) still starts from a motion
+  /// that heads for the next key rather than one that holds the last.
+  virtual std::optional<Motion> fill_input(const Motion& input, const MotionConstraints& constraints,
+                                           const TaskContext& context) const;
 };
 
 /// NeMF's initialiser ("interp-encoder"): unknown frames filled by interpolation
@@ -60,6 +70,8 @@ class InterpolationEncoderInitializer : public LatentInitializer {
  public:
   std::string name() const override { return "interp-encoder"; }
   InitialGuess initialize(const InitRequest& request) const override;
+  std::optional<Motion> fill_input(const Motion& input, const MotionConstraints& constraints,
+                                   const TaskContext& context) const override;
 };
 
 /// The prior's mean codes (zeros), for comparison.
@@ -90,9 +102,14 @@ class TransformerEncoderInitializer : public LatentInitializer {
                                 std::shared_ptr<const InbetweenModel> bound = nullptr);
   std::string name() const override { return name_; }
   InitialGuess initialize(const InitRequest& request) const override;
+  /// One pass of the transformer over the whole input (its own windows,
+  /// inbetweener_fill()).
+  std::optional<Motion> fill_input(const Motion& input, const MotionConstraints& constraints,
+                                   const TaskContext& context) const override;
   const std::string& kind() const { return kind_; }
 
  private:
+  const InbetweenModel& transformer(const TaskContext* context) const;
   std::string name_, kind_;
   int stage_;
   std::shared_ptr<const InbetweenModel> bound_;

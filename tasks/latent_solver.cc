@@ -241,15 +241,19 @@ InitialGuess perturbed(InitialGuess g, const LatentSolverOptions& o, int window)
 }
 
 // Solves the windows of `plan` in order (the progress total is the sum of
-// their caps) and joins their solutions.
-SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const std::vector<WindowPlan>& plan,
-                           const LatentSolverOptions& options, const TaskContext& ctx, CompletionReport* rep) {
+// their caps) and joins their solutions. With several windows, each starts
+// from its slice of the initialiser's fill of the whole input when it has one
+// (LatentInitializer::fill_input).
+SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
+                           const std::vector<WindowPlan>& plan, const LatentSolverOptions& options,
+                           const TaskContext& ctx, CompletionReport* rep) {
   const RigInfo& rig = model.rig();
   const int N = input.num_frames(), F = rig.num_feet();
   std::shared_ptr<const LatentInitializer> init = options.initializer;
   if (!init) init = std::make_shared<InterpolationEncoderInitializer>();
   int total = 0;
   for (const WindowPlan& w : plan) total += w.caps.keyed + w.caps.full;
+  const std::optional<Motion> whole = plan.size() > 1 ? init->fill_input(input, constraints, ctx) : std::nullopt;
 
   SolvedMotion out{Motion::identity(input.skeleton, N, input.fps), std::vector<float>(static_cast<size_t>(N) * F, 0.0f),
                    std::vector<char>(N, 0)};
@@ -266,7 +270,10 @@ SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const st
     request.constraints = &w.constraints;
     request.anchor = w.anchor;
     request.context = &ctx;
-    const InitialGuess start = perturbed(init->initialize(request), options, window_ctx.window);
+    const InitialGuess start =
+        perturbed(whole ? encode_window(model, whole->slice(w.start, w.start + w.length), w.anchor)
+                        : init->initialize(request),
+                  options, window_ctx.window);
     LatentSolverOptions window_options = options;
     window_options.keyed_iterations = w.caps.keyed;
     window_options.max_iterations = w.caps.full;
@@ -404,7 +411,7 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
   check_completion(model, input, constraints, options);
   const std::vector<WindowPlan> plan = plan_windows(model.config().window, input.num_frames(), constraints, options);
   CompletionReport rep;
-  SolvedMotion solved = solve_windows(model, input, plan, options, ctx, &rep);
+  SolvedMotion solved = solve_windows(model, input, constraints, plan, options, ctx, &rep);
   make_known_values_exact(model.rig(), input, constraints, options, solved.contacts, &solved.motion, &rep);
   rep.wall_ms = ms_since(t0);
   if (report) *report = std::move(rep);
