@@ -31,6 +31,8 @@ namespace mf {
 
 /// The ramp of contact pins the tasks use (frames on each side).
 inline constexpr int kDefaultContactRamp = 3;
+/// The ramp of foot locking after a solve or a transformer's pass.
+inline constexpr int kFootLockRamp = 3;
 
 /// Locks the feet of `out` (see the top of this file). `contacts` holds the
 /// predictor's contact probabilities [frames, rig.num_feet()] row-major.

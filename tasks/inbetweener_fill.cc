@@ -14,6 +14,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "tasks/baselines.h"
+#include "tasks/foot_locking.h"
 #include "tasks/inbetweener_files.h"
 #include "tasks/residuals.h"
 
@@ -254,10 +255,11 @@ at::Tensor canonical_trajectory(const at::Tensor& world, const GroundTransform& 
 }
 
 Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
-                        const MotionConstraints& constraints, LongGapPolicy policy) {
+                        const MotionConstraints& constraints, LongGapPolicy policy, bool foot_lock) {
   const int used_stage = checked_stage(model, stage, input, constraints);
   // Reads only the constrained values; every frame holds something sensible.
   Motion out = fill_by_interpolation(input, constraints);
+  std::vector<float> contacts;  // [frames, feet] when the feet are locked
   const KeyIndex keys = index_keys(constraints, input.num_frames());
   const std::vector<FillWindow> windows =
       plan_windows(keys.roots, model.window(), policy, inbetweener_title(model.kind()));
@@ -269,6 +271,13 @@ Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& in
     if (used_stage >= static_cast<int>(result.stages.size()))
       throw std::logic_error("the in-betweener returned fewer stages than stage_names() lists");
     const at::Tensor stage_pose = result.stages[static_cast<size_t>(used_stage)].detach().to(at::kFloat).contiguous();
+    // The contact head reads the last stage: its contacts hold for that stage's pose only.
+    const bool lock = foot_lock && result.contact_logits.defined() &&
+                      used_stage == static_cast<int>(result.stages.size()) - 1;
+    const int feet = model.rig().num_feet();
+    const at::Tensor contact =
+        lock ? at::sigmoid(result.contact_logits.detach().to(at::kFloat)).contiguous() : at::Tensor();
+    if (lock) contacts.assign(static_cast<size_t>(input.num_frames()) * feet, 0.0f);
     for (size_t b = 0; b < windows.size(); ++b) {
       const FillWindow& w = windows[b];
       const int T = w.end - w.start + 1;
@@ -279,9 +288,14 @@ Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& in
       write_window(rotations, root, fill.transforms[b], &piece, 0);
       spread_gap_residuals(input, constraints, keys, w, &piece);
       take_owned_frames(piece, w, keys, constraints, &out);
+      if (!lock) continue;
+      const at::Tensor c = contact[static_cast<int64_t>(b)];
+      for (int f = w.owned_from + 1; f <= w.end; ++f)
+        for (int k = 0; k < feet; ++k) contacts[static_cast<size_t>(f) * feet + k] = c[f - w.start][k].item<float>();
     }
   }
   copy_constrained(input, constraints, &out);
+  if (!contacts.empty()) lock_feet(model.rig(), constraints, contacts, kFootLockRamp, &out);
   return out;
 }
 

@@ -39,6 +39,11 @@
 //    are interpolated). Without trajectory rows the batch has none and a
 //    trajectory-conditioned kind interpolates between the known roots itself.
 //    Callers (CLI, C ABI, batch) only fill MotionConstraints::trajectory.
+//  * Foot locking (`foot_lock`): when the model predicts foot contacts (its
+//    contact head reads the last stage, so only when that stage is used),
+//    lock_feet() of tasks/foot_locking.h holds the planted ankles with those
+//    contacts, as after a latent solve (the frames of keys that constrain a
+//    leg untouched). Measured in docs/BENCHMARKS.md ("Long transitions").
 //  * The input's frames are taken as frames of the model (no resampling to
 //    the model's fps). Deterministic for a given input and thread count.
 #pragma once
@@ -65,7 +70,7 @@ enum class LongGapPolicy {
 /// joint count differs from the model's, a stage the model does not have, or
 /// (LongGapPolicy::Throw) a gap longer than the window.
 Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
-                        const MotionConstraints& constraints, LongGapPolicy policy);
+                        const MotionConstraints& constraints, LongGapPolicy policy, bool foot_lock = false);
 
 /// The ground trajectory of every frame of `input`, [frames, 4] float (world:
 /// x, z, forward_x, forward_z as trajectory_features() of

@@ -105,7 +105,7 @@ struct LatentSolverOptions : LatentOptimizerSettings {
 
   /// Foot locking after the overwrite (see the top of this file): the ramp in
   /// frames on each side of a contact; negative disables it.
-  int foot_lock_ramp = 3;
+  int foot_lock_ramp = kFootLockRamp;
 
   /// End-effector IK after the overwrite and the foot locking (see the top of
   /// this file): the falloff in frames on each side of a target; negative

@@ -196,6 +196,10 @@ struct InbetweenerKind {
   /// The network is conditioned on InbetweenBatch::trajectory, so its
   /// methods follow a trajectory the caller gives.
   bool reads_trajectory = false;
+  /// Its methods hold planted feet with the model's contact head (foot
+  /// locking in inbetweener_fill() of tasks/inbetweener_fill.h): set where it
+  /// measured better (docs/BENCHMARKS.md, "Long transitions").
+  bool locks_feet = false;
 };
 
 /// The product's kinds, in a fixed order (two-stage, CITL, keyframe). Adding a kind is

@@ -140,7 +140,9 @@ InbetweenerKind two_stage_kind() {
           "two-stage transformer",
           "motionfield-twostage.mfm",
           {{"context", "Context Transformer only"}, {"detail", "Context + Detail Transformer"}},
-          make_two_stage};
+          make_two_stage,
+          /*reads_trajectory=*/false,
+          /*locks_feet=*/true};
 }
 
 }  // namespace mf
