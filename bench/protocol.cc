@@ -160,10 +160,12 @@ std::vector<TrajectoryPoint> truth_trajectory(const Motion& truth, int a, int b,
   return rows;
 }
 
-// Gap filling of one window, with the ground-truth trajectory of the gap when asked.
+// Gap filling of one window, with the ground-truth trajectory of the gap when
+// asked and the method follows one (the others, the baselines among them, run
+// without it: their rows are the references).
 Motion fill_gap(const Motion& truth, const std::vector<int>& known, int a, int b, const std::string& method,
                 const ProtocolOptions& options, const TaskContext& ctx) {
-  if (!options.trajectory) {
+  if (!options.trajectory || !resolve_method(method, ctx).follows_trajectory) {
     return predict(truth, known, options, [&](const Motion& input, const std::vector<int>& k) {
       const auto gap = std::adjacent_find(k.begin(), k.end(), [](int x, int y) { return y != x + 1; });
       return run_fill(input, *gap + 1, *(gap + 1), method, ctx);
@@ -179,7 +181,7 @@ TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stat
                            const ProtocolOptions& options, const TaskContext& ctx) {
   if (options.context < 1) throw InputError("gap filling needs at least one context frame");
   TaskResult result = start_result(Task::Gap, method);
-  result.trajectory = options.trajectory;
+  result.trajectory = options.trajectory && resolve_method(method, ctx).follows_trajectory;
   result.l2t = options.l2t;
   for (int T : options.gap_lengths) {
     if (T < 1) throw InputError("gap lengths must be positive");

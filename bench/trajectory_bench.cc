@@ -9,12 +9,21 @@
 // solver without a trajectory and for interpolation; it chose the default
 // weights (docs/CONSTRAINTS.md, "Trajectory").
 //
+// With --paths it measures instead how closely methods (by name, through
+// run_constrained) follow trajectories that are not the ground truth: NeMF's
+// test paths drawn between the last context frame's root and the target's
+// (a straight line, loops of 0.5 m and 1.5 m radius, a sinusoid of 0.5 m
+// amplitude; see test_path()), reporting the root's ground and facing error and
+// the foot skating against the ground truth's on the same frames.
+//
 //   trajectory-bench [--model FILE] [--split validation|train] [--max-windows N] [--threads N]
 //                    [--gaps 30,60] [--starts interp-encoder,detail-encoder]
 //                    [--weights 10] [--facing-weights 1] [--source PATH] [--cache-dir DIR] [--out FILE]
+//                    [--paths line,loop-0.5,loop-1.5,sine --methods refine,nemf-refine]
 #include <ATen/Parallel.h>
 
 #include <chrono>
+#include <cmath>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -33,6 +42,7 @@
 #include "prior/util/threads.h"
 #include "tasks/baselines.h"
 #include "tasks/constraint_report.h"
+#include "tasks/jobs.h"
 #include "tasks/latent_solver.h"
 #include "tasks/model_rig.h"
 
@@ -50,6 +60,8 @@ struct Args {
   std::vector<std::string> starts{"interp-encoder", "detail-encoder"};
   std::vector<double> weights{mf::EnergyWeights{}.trajectory};
   std::vector<double> facing_weights{mf::EnergyWeights{}.trajectory_facing};
+  std::vector<std::string> paths;
+  std::vector<std::string> methods{"refine", "nemf-refine"};
   std::string out;
 };
 
@@ -66,6 +78,10 @@ void add_options(CLI::App& app, Args& a) {
       ->delimiter(',');
   app.add_option("--facing-weights", a.facing_weights, "trajectory_facing weights to try (default: the default)")
       ->delimiter(',');
+  app.add_option("--paths", a.paths,
+                 "instead: follow test paths (line, loop-0.5, loop-1.5, sine) drawn between the known roots")
+      ->delimiter(',');
+  app.add_option("--methods", a.methods, "with --paths: the methods (default refine,nemf-refine)")->delimiter(',');
   app.add_option("--out", a.out, "also write the markdown to FILE");
 }
 
@@ -165,6 +181,111 @@ std::string run_gap(const Args& args, int T, const std::vector<mf::Clip>& clips,
   return text;
 }
 
+// A test path for the gap frames a..b-1: from the root's ground position at
+// frame a-1 (A) to the one at frame b (B), progress s = (f - a + 1) / (b - a + 1)
+// uniform in time. "line": A + s (B - A); "sine": the line plus 0.5 m * sin(2 pi s)
+// to its left; "loop-R": the line plus one full circle of radius R metres that
+// leaves A along the line and turns left, R (sin(2 pi s) d + (1 - cos(2 pi s)) n),
+// with d the unit direction A -> B (the facing at A when A and B are less than
+// 20 cm apart) and n its left normal. The facing is the path's unit tangent,
+// turned toward the known facing at frame a-1 over the first 15 frames and
+// toward the target's over the last 15 (raised-cosine weights), so that the
+// path does not contradict the keys that bound it.
+std::vector<mf::TrajectoryPoint> test_path(const std::string& shape, const mf::Motion& truth, int a, int b,
+                                           const Eigen::Vector3d& root_forward) {
+  const Eigen::Vector2d A(truth.root_positions[a - 1].x(), truth.root_positions[a - 1].z());
+  const Eigen::Vector2d B(truth.root_positions[b].x(), truth.root_positions[b].z());
+  const Eigen::Vector3d f3 = truth.rotation(a - 1, 0).normalized() * root_forward;
+  const Eigen::Vector3d fb = truth.rotation(b, 0).normalized() * root_forward;
+  const double yaw_a = std::atan2(f3.x(), f3.z()), yaw_b = std::atan2(fb.x(), fb.z());
+  // Signed angle from y to x, in (-pi, pi].
+  auto turn = [](double x, double y) { return std::remainder(x - y, 2.0 * M_PI); };
+  auto near = [](int frames) { return frames >= 15 ? 0.0 : 0.5 * (1.0 + std::cos(M_PI * frames / 15.0)); };
+  Eigen::Vector2d d = B - A;
+  d = d.norm() >= 0.2 ? Eigen::Vector2d(d.normalized()) : Eigen::Vector2d(Eigen::Vector2d(f3.x(), f3.z()).normalized());
+  // Left of d when y is up and the ground is (x, z): rotating forward +z by +90 deg about y gives +x.
+  const Eigen::Vector2d n(d.y(), -d.x());
+  double radius = 0.0, amplitude = 0.0;
+  if (shape == "sine") {
+    amplitude = 0.5;
+  } else if (shape.rfind("loop-", 0) == 0) {
+    radius = std::stod(shape.substr(5));
+  } else if (shape != "line") {
+    throw mf::InputError("unknown test path '" + shape + "' (line, loop-R with R in metres, sine)");
+  }
+  const double two_pi = 2.0 * M_PI;
+  std::vector<mf::TrajectoryPoint> rows;
+  for (int f = a; f < b; ++f) {
+    const double s = static_cast<double>(f - a + 1) / (b - a + 1);
+    const Eigen::Vector2d p = A + s * (B - A) + radius * (std::sin(two_pi * s) * d + (1 - std::cos(two_pi * s)) * n) +
+                              amplitude * std::sin(two_pi * s) * n;
+    Eigen::Vector2d v = (B - A) + radius * two_pi * (std::cos(two_pi * s) * d + std::sin(two_pi * s) * n) +
+                        amplitude * two_pi * std::cos(two_pi * s) * n;
+    if (v.norm() < 1e-6) v = d;
+    double yaw = std::atan2(v.x(), v.y());
+    yaw += near(f - a + 1) * turn(yaw_a, yaw) + near(b - f) * turn(yaw_b, yaw);
+    rows.push_back({f, p.x(), p.y(), std::sin(yaw), std::cos(yaw)});
+  }
+  return rows;
+}
+
+// What one method did on one path over the windows of one gap.
+struct PathRow {
+  std::string path, method;
+  mf::bench::MetricAccumulator metrics;
+  double cm_sum = 0.0, cm_max = 0.0, deg_sum = 0.0, deg_max = 0.0, seconds = 0.0;
+  int windows = 0, failed = 0;
+  PathRow(std::string p, std::string m, const mf::bench::EvalStats& stats)
+      : path(std::move(p)), method(std::move(m)), metrics(stats) {}
+  std::string cells(int T) const {
+    const mf::bench::MetricSummary m = metrics.summary();
+    const int W = std::max(windows, 1);
+    return "| " + std::to_string(T) + " | " + path + " | " + method + " | " + std::to_string(windows) + " | " +
+           std::to_string(failed) + " | " + fixed(cm_sum / W, 2) + " / " + fixed(cm_max, 2) + " | " +
+           fixed(deg_sum / W, 2) + " / " + fixed(deg_max, 2) + " | " + fixed(m.skating_cm, 3) + " | " +
+           fixed(m.truth_skating_cm, 3) + " | " + fixed(seconds / W, 2) + " |\n";
+  }
+};
+
+std::string run_paths(const Args& args, int T, const std::vector<mf::Clip>& clips, const mf::bench::EvalStats& stats,
+                      const mf::TaskContext& ctx) {
+  const int context = 10, length = context + T + 1, a = context, b = context + T;
+  const std::vector<mf::Window> windows =
+      mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, 40), args.split.max_windows);
+  std::vector<int> evaluated, known;
+  for (int f = 0; f < length; ++f) (f >= a && f < b ? evaluated : known).push_back(f);
+  const Eigen::Vector3d fwd = ctx.model->rig().root_forward;
+  std::vector<PathRow> rows;
+  for (const std::string& p : args.paths)
+    for (const std::string& m : args.methods) rows.emplace_back(p, m, stats);
+  for (const mf::Window& w : windows) {
+    const mf::Motion truth = mf::bench::canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), context - 1);
+    const mf::Motion input = mf::bench::hide_unknown_frames(truth, known);
+    for (PathRow& row : rows) {
+      mf::MotionConstraints c = mf::MotionConstraints::full_pose(known);
+      c.trajectory = test_path(row.path, truth, a, b, fwd);
+      const auto t0 = std::chrono::steady_clock::now();
+      try {
+        const mf::Motion out = mf::run_constrained(input, c, row.method, 0, ctx).motions.front();
+        row.seconds += seconds_since(t0);
+        row.metrics.add(truth, out, evaluated, known);
+        const mf::TrajectoryError e = mf::trajectory_error(out, c, fwd);
+        row.cm_sum += e.mean_cm;
+        row.cm_max = std::max(row.cm_max, e.max_cm);
+        row.deg_sum += e.facing_mean_deg;
+        row.deg_max = std::max(row.deg_max, e.facing_max_deg);
+        ++row.windows;
+      } catch (const mf::InputError& e) {
+        std::cerr << "gap " << T << ", " << row.path << ", " << row.method << ": " << e.what() << "\n";
+        ++row.failed;
+      }
+    }
+  }
+  std::string text;
+  for (const PathRow& row : rows) text += row.cells(T);
+  return text;
+}
+
 int run(Args& args, const std::string& command) {
   if (args.model.empty()) args.model = mf::default_model_path();
   if (args.model.empty()) throw mf::InputError("no default model: pass --model FILE");
@@ -174,11 +295,28 @@ int run(Args& args, const std::string& command) {
   model->set_requires_grad(false);
   ctx.model = model;
   mf::bench::load_transformers(args.transformers, args.model, &ctx, false);
+  ctx.model_anatomy = mf::load_rig_anatomy_next_to(args.model, model->rig().skeleton);  // clips of other root offsets
   const mf::Dataset data = mf::bench::load_data(args.data, false);
   const std::vector<mf::Clip>& clips = args.split.clips(data);
   const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);
 
   std::ostringstream md;
+  if (!args.paths.empty()) {
+    md << "## trajectory-bench: test paths\n\n- command: `" << command << "`\n- model: " << args.model << "\n- "
+       << args.split.split << " split, torch threads: " << at::get_num_threads()
+       << "\n- skating: of the result and of the ground truth on the same frames\n\n"
+       << "| gap | path | method | windows | failed | ground distance mean / max (cm) | facing mean / max (deg) | "
+          "skating (cm) | ground truth's skating (cm) | s / window |\n"
+       << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
+    std::cout << md.str() << std::flush;
+    for (int T : args.gaps) {
+      const std::string rows = run_paths(args, T, clips, stats, ctx);
+      std::cout << rows << std::flush;
+      md << rows;
+    }
+    if (!args.out.empty()) std::ofstream(args.out) << md.str();
+    return 0;
+  }
   md << "## trajectory-bench\n\n- command: `" << command << "`\n- model: " << args.model << "\n- "
      << args.split.split << " split, torch threads: " << at::get_num_threads()
      << "\n- trajectory rows: the ground truth's on every gap frame; weights: trajectory / trajectory_facing\n\n"
