@@ -703,7 +703,7 @@ catalogue "--fps 1e300" "would give more than 10000000 frames" resample --in "$S
 catalogue "a keyframe past 2^31" "bad integer for --keyframes: '2147483648'" inbetween --in "$SAMPLE" --keyframes 0,2147483648 --out "$TMP/bad.bvh"
 catalogue "--gap 1:1e9" "bad integer for --gap" fill --in "$SAMPLE" --gap 1:1e9 --out "$TMP/bad.bvh"
 catalogue "--threads 100000" "--threads: Value 100000 not in range 1 to 1024" --threads 100000 inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh"
-catalogue "--length-scale nan" "must be positive, not nan" --length-scale nan inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --method interp
+catalogue "--length-scale nan" "--units (--length-scale) must be positive, not nan" --length-scale nan inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --method interp
 catalogue "--length-scale 0" "must be positive, not 0" --length-scale 0 inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --method interp
 catalogue "--alternatives -1" "--alternatives: Value -1 not in range 0 to 16" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --alternatives -1
 # Outputs: a directory, an existing file kept unchanged by a failing run.

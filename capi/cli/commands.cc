@@ -152,7 +152,7 @@ int command_rig(const std::string& in, bool json, const Settings& settings) {
   const std::string map = settings.rig_map.empty() ? "" : read_text_file(settings.rig_map, "rig map file");
   Models models(settings.model, settings.transformers());
   const Model& model = models.required("rig");
-  const double length_scale = units_scale(settings.units, "--units");
+  const double length_scale = units_scale(settings.units, "--units (--length-scale)");
   const Motion motion = Motion::load_bvh(in, length_scale);
   std::string text;
   try {
@@ -175,7 +175,7 @@ int command_rig(const std::string& in, bool json, const Settings& settings) {
 int run_command(const CLI::App& app, const Arguments& args) {
   const Settings& settings = args.settings;
   if (args.version) return command_version(settings);
-  units_scale(settings.units, "--units");
+  units_scale(settings.units, "--units (--length-scale)");
   const std::vector<CLI::App*> chosen = app.get_subcommands();
   if (chosen.empty()) {
     std::fputs(app.help().c_str(), stderr);

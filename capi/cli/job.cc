@@ -208,7 +208,8 @@ JobReport run_job(const BatchJob& job, const Settings& settings, Models& models,
   // Standard input through its device file: the library reads pipes and
   // redirected files with its size limit, and refuses a terminal.
   const Motion input = Motion::load_bvh(job.in == kStdio ? "/dev/stdin" : job.in,
-                                        units_scale(job.units.empty() ? settings.units : job.units, "--units"));
+                                        units_scale(job.units.empty() ? settings.units : job.units,
+                                                    job.units.empty() ? "--units (--length-scale)" : "\"units\""));
   const auto t1 = Clock::now();
   const Solved solved = export_only ? Solved{} : solve(job, settings, model, input, progress);
   const Motion& result = export_only ? input : solved.motion;

@@ -114,13 +114,20 @@ T read_options(const T* user, const char* type_name) {
   return out;
 }
 
+/// The argument checks of write_buffer() alone (a NULL buffer with a non-zero
+/// capacity; a size query without `needed`), for functions that should refuse
+/// them before doing expensive work.
+inline void check_buffer_arguments(const void* out, size_t capacity, const size_t* needed) {
+  if (!out && capacity != 0) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the output buffer is NULL but its capacity is not 0");
+  if (!out && !needed) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "a size query (NULL buffer) needs a non-NULL `needed`");
+}
+
 /// The common part of every buffer getter: checks out/capacity against the
 /// result's size and copies. See "Arrays" in motionfield.h.
 template <class T>
 void write_buffer(const T* data, size_t count, T* out, size_t capacity, size_t* needed) {
-  if (!out && capacity != 0) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the output buffer is NULL but its capacity is not 0");
+  check_buffer_arguments(out, capacity, needed);
   if (!out) {
-    if (!needed) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "a size query (NULL buffer) needs a non-NULL `needed`");
     *needed = count;
     return;
   }

@@ -53,6 +53,7 @@ int mf_rig_describe(const mf_model* model, const mf_motion* motion, const char* 
     if (!model)
       throw ApiError(MF_ERROR_MODEL, "describing a rig needs a model (the rig to map onto), and none was given");
     require(motion, "motion");
+    mf::capi::check_buffer_arguments(out, capacity, needed);  // before the mapping, which is not free
     const std::string text = mf::capi::describe_rig(*model, *motion, rig_map_json ? rig_map_json : "");
     mf::capi::write_string(text, out, capacity, needed);
   });

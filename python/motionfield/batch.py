@@ -924,7 +924,8 @@ def run_job(job: BatchJob, settings: Settings, models: Models) -> Outcome:
         if not job.method and model is not None:
             outcome.asked_load_warnings = True
             outcome.load_warnings = models.load_warnings()
-        motion = mf.Motion.load_bvh(job.in_path, units=units_scale(job.units or settings.units, "--units"))
+        motion = mf.Motion.load_bvh(job.in_path, units=units_scale(job.units or settings.units,
+                                                                    '"units"' if job.units else "--units (--length-scale)"))
         t1 = time.perf_counter()
         solved = _solve(job, settings, model, motion)
         result = solved.motion if isinstance(solved, mf.Solution) else solved

@@ -196,6 +196,11 @@ TEST(CApiRig, DescribeShowsTheUnitAndTheMap) {
   EXPECT_TRUE(Fails(mf_rig_describe(nullptr, user.get(), nullptr, nullptr, 0, &needed), MF_ERROR_MODEL, "model"));
   EXPECT_TRUE(Fails(mf_rig_describe(default_model(), user.get(), "{not json", nullptr, 0, &needed),
                     MF_ERROR_INVALID_ARGUMENT, "rig map: not valid JSON"));
+  // Bad buffer arguments are refused before the map is read: the broken map is not what the error names.
+  EXPECT_TRUE(Fails(mf_rig_describe(default_model(), user.get(), "{not json", nullptr, 10, &needed),
+                    MF_ERROR_INVALID_ARGUMENT, "the output buffer is NULL but its capacity is not 0"));
+  EXPECT_TRUE(Fails(mf_rig_describe(default_model(), user.get(), "{not json", nullptr, 0, nullptr),
+                    MF_ERROR_INVALID_ARGUMENT, "needs a non-NULL `needed`"));
 }
 
 TEST(CApiRig, LearnedMethodsServeAnotherRig) {
