@@ -138,15 +138,19 @@ std::vector<std::string> available_methods() {
 // solver from interpolation, which beats interpolation, on L2P, L2Q, NPSS and
 // foot skating at gaps of 15+ frames and keys 15+ frames apart (and ties it
 // below).
-std::string default_method(const TaskContext& ctx) {
+// With a trajectory (docs/BENCHMARKS.md, "Long transitions"): the solver
+// started from RefineNet, which reads the trajectory, follows it and drawn
+// paths more closely and is the best or level on L2P from 60 to 180 frames.
+std::string default_method(const TaskContext& ctx, bool trajectory) {
+  if (trajectory && ctx.model && ctx.inbetweener(kKeyframeKind)) return "nemf-refine";
   if (ctx.model && ctx.inbetweener(kTwoStageKind)) return "nemf-detail";
   return ctx.model ? "nemf" : "interp";
 }
 
 std::string default_resample_method(const TaskContext& ctx) { return ctx.model ? "prior" : "interp"; }
 
-const Method& resolve_method(const std::string& method, const TaskContext& ctx) {
-  const std::string m = method.empty() ? default_method(ctx) : method;
+const Method& resolve_method(const std::string& method, const TaskContext& ctx, bool trajectory) {
+  const std::string m = method.empty() ? default_method(ctx, trajectory) : method;
   for (const Method& a : registered_methods()) {
     if (a.name != m) continue;
     if (a.needs_model) require_prior(ctx, "method '" + m + "'");
@@ -234,8 +238,10 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
   const Eigen::Vector3d root_forward = ctx.model ? ctx.model->rig().root_forward : Eigen::Vector3d::UnitZ();
   if (!constraints.beyond_full_poses() && alternatives == 0) {
     result.motions.push_back(run_known_frames(input, key_frames(constraints), method, ctx));
+    result.method = resolve_method(method, ctx).name;
   } else {
-    const Method& m = resolve_method(method, ctx);
+    const Method& m = resolve_method(method, ctx, !constraints.trajectory.empty());
+    result.method = m.name;
     check_motion(input);
     check_follows_trajectory(m, constraints);
     if (!m.complete_constrained)

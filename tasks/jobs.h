@@ -33,8 +33,9 @@ std::vector<std::string> available_methods();
 /// What runs when no method is given for in-betweening and gap filling: the
 /// best measured method that can run in this context ("nemf-detail" with the
 /// prior and the two-stage transformer, "nemf" with the prior alone, "interp"
-/// without a model).
-std::string default_method(const TaskContext& ctx = {});
+/// without a model). With `trajectory` (constraints that carry one) and the
+/// keyframe transformer: "nemf-refine".
+std::string default_method(const TaskContext& ctx = {}, bool trajectory = false);
 /// The same for resampling: "prior" with a model, "interp" without one.
 std::string default_resample_method(const TaskContext& ctx = {});
 
@@ -42,7 +43,7 @@ std::string default_resample_method(const TaskContext& ctx = {});
 /// the context: InputError listing the available methods for an unknown
 /// name, ModelMissingError when it needs the prior or a transformer that
 /// `ctx` does not hold.
-const Method& resolve_method(const std::string& method, const TaskContext& ctx);
+const Method& resolve_method(const std::string& method, const TaskContext& ctx, bool trajectory = false);
 
 /// Throws InputError unless: at least two keyframes, strictly increasing (so
 /// sorted and unique), every one in [0, frames). The message names the
@@ -100,6 +101,7 @@ inline constexpr int kMaxAlternatives = 16;
 /// warning for each constraint that could not hold exactly (a target out of
 /// reach, a pin that contradicts keys), naming the frames involved.
 struct ConstrainedResult {
+  std::string method;  ///< the method that ran (the default one when none was named)
   std::vector<Motion> motions;
   std::vector<ConstraintReport> reports;
   std::vector<std::string> warnings;

@@ -608,6 +608,13 @@ grep -q '"rows": 21' "$TMP/t-report.json" && pass || fail "the report measures t
 printf '%s\n' "{\"task\": \"fill\", \"in\": \"$SAMPLE\", \"out\": \"$TMP/bt.bvh\", \"gap\": [15, 45], \"method\": \"nemf\", \"trajectory\": \"$TMP/t.csv\", \"report\": \"$TMP/bt-report.json\"}" \
   "{\"task\": \"fill\", \"in\": \"$SAMPLE\", \"out\": \"$TMP/bt2.bvh\", \"gap\": [15, 45], \"trajectory\": 3}" \
   >"$TMP/tjobs.jsonl"
+# Without a method, a job with a trajectory runs the default for trajectories
+# (nemf-refine with the bundled keyframe transformer), one without the plain default.
+printf '%s\n' "{\"task\": \"fill\", \"in\": \"$SAMPLE\", \"out\": \"$TMP/td.bvh\", \"gap\": [15, 45], \"trajectory\": \"$TMP/t.csv\"}" \
+  "{\"task\": \"fill\", \"in\": \"$SAMPLE\", \"out\": \"$TMP/te.bvh\", \"gap\": [15, 45]}" >"$TMP/tdefault.jsonl"
+expect_rc 0 "batch: default methods with and without a trajectory" -- "$MF" --threads 1 batch --json "$TMP/tdefault.jsonl"
+grep -q '"line":1,.*"method":"nemf-refine"' "$TMP/out" && grep -q '"line":2,.*"method":"nemf-detail"' "$TMP/out" && pass ||
+  fail "the default method is nemf-refine with a trajectory and nemf-detail without"
 expect_rc 2 "batch with a trajectory (one bad line)" -- "$MF" --threads 1 batch "$TMP/tjobs.jsonl"
 expect_stderr 'line 2: error: "trajectory" must be a string' "batch names a bad trajectory value"
 cmp -s "$TMP/bt.bvh" "$TMP/t.bvh" && pass || fail "batch trajectory = --trajectory"

@@ -100,6 +100,7 @@ struct Solved {
   Motion motion;
   std::vector<Motion> alternatives;
   std::string report;
+  std::string method;  ///< the method that ran, when the solve says (constrained jobs)
 };
 
 // The plain tasks (whole-pose keys, a gap, resampling, re-navigation).
@@ -125,11 +126,11 @@ Solved solve(const BatchJob& job, const Settings& settings, const Model& model, 
   if (progress.enabled()) options.progress = [&progress](const mf_progress& p) { return progress.update(p); };
   if (job.constrained()) {
     const Solution s = motionfield::solve(model, input, job_constraints(job, input), job.alternatives, options);
-    Solved out{s.motion(0), {}, s.report_json()};
+    Solved out{s.motion(0), {}, s.report_json(), s.method()};
     for (int i = 1; i < s.count(); ++i) out.alternatives.push_back(s.motion(i));
     return out;
   }
-  return {solve_task(job, model, input, options), {}, ""};
+  return {solve_task(job, model, input, options), {}, "", ""};
 }
 
 // The method that ran.
@@ -224,7 +225,7 @@ JobReport run_job(const BatchJob& job, const Settings& settings, Models& models,
   report.constraints = solved.report;
   const auto t3 = Clock::now();
 
-  report.method = method_name(job, model);
+  report.method = solved.method.empty() ? method_name(job, model) : solved.method;
   report.model = model ? models.path() : "";
   report.frames_in = input.frame_count();
   report.frames_out = result.frame_count();

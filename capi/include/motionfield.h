@@ -232,7 +232,9 @@ MF_API int mf_method_find(const char *name, int32_t *index);
  *  be NULL: then a method that does not need one): "nemf-detail" when the
  *  model has the two-stage transformer, "nemf" with the prior alone, "interp"
  *  without a model. Resampling without a method uses "prior" with a model and
- *  "interp" without. The string is static. */
+ *  "interp" without. mf_solve with constraints that carry a trajectory uses
+ *  "nemf-refine" instead when the model has the keyframe transformer
+ *  (mf_solution_get_method says which ran). The string is static. */
 MF_API int mf_default_method(const mf_model *model, const char **name);
 
 /* ================================================================ model */
@@ -771,6 +773,12 @@ MF_API int mf_constraints_add_trajectory(mf_constraints *constraints, const int3
  *  docs/CONSTRAINTS.md): MF_ERROR_IO if it cannot be read,
  *  MF_ERROR_INVALID_ARGUMENT "<path>:<line>: ..." on a malformed file. */
 MF_API int mf_constraints_load_trajectory_csv(mf_constraints *constraints, const char *path);
+
+/** The name of the method that produced `solution` (static string): the one
+ *  the options named, else the default method for these constraints (with a
+ *  trajectory and the keyframe transformer loaded that is "nemf-refine", see
+ *  mf_default_method). */
+MF_API int mf_solution_get_method(const mf_solution *solution, const char **name);
 
 #ifdef __cplusplus
 }

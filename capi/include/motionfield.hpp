@@ -670,6 +670,12 @@ class Solution : public detail::Handle<mf_solution, mf_solution_destroy> {
     check(mf_solution_get_report(get(), index, &r));
     return r;
   }
+  /// mf_solution_get_method: the method that ran.
+  std::string method() const {
+    const char* name = nullptr;
+    check(mf_solution_get_method(get(), &name));
+    return name;
+  }
   /// mf_solution_get_report_json: every solution's report and the warnings.
   std::string report_json() const {
     return detail::read_string([&](char* out, size_t capacity, size_t* needed) {

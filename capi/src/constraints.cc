@@ -26,6 +26,7 @@ struct mf_solution {
   double length_scale = 0.01;  ///< metres per input unit
   std::string unit;
   bool trajectory = false;  ///< the constraints had a trajectory (its report fields are written)
+  const char* method = "";  ///< the registered method's name (static storage)
 };
 
 namespace mf::capi {
@@ -204,6 +205,8 @@ int mf_solve(const mf_model* model, const mf_motion* input, const mf_constraints
     s->length_scale = input->length_scale;
     s->unit = input->unit;
     s->trajectory = !c.trajectory.empty();
+    for (const mf::Method& m : mf::registered_methods())
+      if (m.name == r.method) s->method = m.name.c_str();
     *out = s.release();
   });
 }
@@ -310,6 +313,14 @@ int mf_constraints_load_trajectory_csv(mf_constraints* constraints, const char* 
     require(path, "path");
     const std::vector<mf::TrajectoryPoint> rows = mf::read_trajectory_csv(path);
     constraints->spec.trajectory.insert(constraints->spec.trajectory.end(), rows.begin(), rows.end());
+  });
+}
+
+int mf_solution_get_method(const mf_solution* solution, const char** name) {
+  return guard([&] {
+    require(solution, "solution");
+    require(name, "name");
+    *name = solution->method;
   });
 }
 

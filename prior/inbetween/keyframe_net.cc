@@ -341,7 +341,8 @@ InbetweenerKind keyframe_net_kind() {
           {{"keyframe", "KeyframeNet's keyframes, interpolated"},
            {"refine", "KeyframeNet + RefineNet (trajectory-conditioned)"}},
           make_keyframe_net,
-          /*reads_trajectory=*/true};
+          /*reads_trajectory=*/true,
+          /*locks_feet=*/true};
 }
 
 }  // namespace mf

@@ -551,6 +551,8 @@ def default_method(*, model: Optional["Model"] = None) -> str:
     "nemf-detail" when it has the two-stage transformer, "nemf" with the
     prior alone, "interp" without a model. Resampling without a method uses
     "prior" with a model and "interp" without; re-navigation uses "nemf".
+    solve() with a trajectory uses "nemf-refine" instead when the model has the
+    keyframe transformer (Solution.method says which ran).
 
     Parameters
     ----------
@@ -1710,12 +1712,17 @@ class Solution(NamedTuple):
         Constraints that could not hold exactly, with the frames involved.
     report_json : str
         The report as the library formats it (what ``--report FILE`` holds).
+    method : str
+        The method that ran (mf_solution_get_method): the one named, else the
+        default for these constraints ("nemf-refine" with a trajectory when the
+        keyframe transformer is loaded; see default_method()).
     """
 
     motions: List[Motion]
     report: Dict[str, Any]
     warnings: List[str]
     report_json: str
+    method: str = ""
 
     @property
     def motion(self) -> Motion:
@@ -1814,10 +1821,12 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
             _check(_c.mf_solution_get_motion(handle, i, ctypes.byref(m)))
             motions.append(Motion._wrap(m))
         text = _read_string(_c.mf_solution_get_report_json, handle)
+        name = ctypes.c_char_p()
+        _check(_c.mf_solution_get_method(handle, ctypes.byref(name)))
     finally:
         _c.mf_solution_destroy(handle)
     report = json.loads(text)
-    return Solution(motions, report, list(report.get("warnings", [])), text)
+    return Solution(motions, report, list(report.get("warnings", [])), text, name.value.decode())
 
 
 def resample_frame_count(frames: int, fps_in: float, fps_out: float) -> Tuple[int, bool]:

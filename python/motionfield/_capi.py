@@ -342,6 +342,7 @@ _declare("mf_solution_get_motion", _int, _solution, _i32, _P(_motion))
 _declare("mf_constraint_report_init", _int, _P(MfConstraintReport))
 _declare("mf_solution_get_report", _int, _solution, _i32, _P(MfConstraintReport))
 _declare("mf_solution_get_report_json", _int, _solution, ctypes.c_char_p, _size, _P(_size))
+_declare("mf_solution_get_method", _int, _solution, _P(_str))
 _declare("mf_constraints_add_trajectory", _int, _constraints, _P(_i32), _P(_f32), _size)
 _declare("mf_constraints_load_trajectory_csv", _int, _constraints, _str)
 

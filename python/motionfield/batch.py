@@ -939,7 +939,8 @@ def run_job(job: BatchJob, settings: Settings, models: Models) -> Outcome:
             if job.report_file:
                 _write_atomically(job.report_file, solved.report_json + "\n")
         t3 = time.perf_counter()
-        r = JobReport(method=_method_name(job, model), model=models.path if model is not None else "",
+        ran = solved.method if isinstance(solved, mf.Solution) and solved.method else _method_name(job, model)
+        r = JobReport(method=ran, model=models.path if model is not None else "",
                       frames_in=motion.frame_count, frames_out=result.frame_count, read_ms=(t1 - t0) * 1e3,
                       solve_ms=(t2 - t1) * 1e3, write_ms=(t3 - t2) * 1e3, warnings=result.warnings,
                       constraints=solved.report_json if isinstance(solved, mf.Solution) else "",

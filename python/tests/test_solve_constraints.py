@@ -93,6 +93,13 @@ class ConstraintsTest(unittest.TestCase):
                 f.write("%d,%r,%r,%r,%r\n" % (int(row[0]), float(row[1]), float(row[2]), float(row[3]), float(row[4])))
         c = mf.solve(self.motion, keys, trajectory=path, method="nemf", model=model)
         np.testing.assert_array_equal(c.motion.rotations, s.motion.rotations)
+        self.assertEqual(c.method, "nemf")
+        # Without a method: the default for a trajectory, which follows it too.
+        d = mf.solve(self.motion, keys, trajectory=t, model=model)
+        self.assertEqual(d.method, "nemf-refine")
+        ground = d.motion.root_positions[t[:, 0].astype(int)][:, [0, 2]] / self.motion.length_scale
+        self.assertLess(np.linalg.norm(ground - t[:, 1:3], axis=1).max(), 5.0)
+        self.assertEqual(mf.solve(self.motion, keys, model=model).method, "nemf-detail")
 
     def _tmp(self):
         import tempfile

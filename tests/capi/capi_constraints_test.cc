@@ -396,10 +396,14 @@ TEST(CApiConstraints, TrajectoryIsFollowed) {
   const double lerp_cm = max_ground_distance(lerp.get(), scale, frames, rows) * 100;
   EXPECT_GT(lerp_cm, 25.0) << "the trajectory must differ from the interpolation";
 
-  // From interpolation and from the two-stage transformer (measured: 1.7 and 3.5 cm at worst).
-  for (const char* method : {"nemf-detail", "nemf"}) {
-    SCOPED_TRACE(method);
+  // From interpolation, the two-stage transformer and RefineNet (nullptr: the
+  // default with a trajectory, nemf-refine; measured 1.7, 3.5 and 1.5 cm at worst).
+  for (const char* method : {"nemf-detail", "nemf", static_cast<const char*>(nullptr)}) {
+    SCOPED_TRACE(method ? method : "default");
     SolutionPtr s = solve(in.get(), c.get(), method);
+    const char* ran = nullptr;
+    ASSERT_EQ(mf_solution_get_method(s.get(), &ran), MF_OK);
+    EXPECT_STREQ(ran, method ? method : "nemf-refine");
     MotionPtr out = motion_of(s.get(), 0);
     const double cm = max_ground_distance(out.get(), scale, frames, rows) * 100;
     EXPECT_LT(cm, 5.0) << "interpolation misses it by " << lerp_cm << " cm";

@@ -358,6 +358,11 @@ TEST_F(CApiNull, ConstraintsAndSolutions) {
   EXPECT_REFUSES_NULL(mf_solution_get_report(s, 0, nullptr));
   EXPECT_REFUSES_NULL(mf_solution_get_report_json(nullptr, text_, sizeof text_, &needed_));
   EXPECT_REFUSES_NULL(mf_solution_get_report_json(s, nullptr, 10, &needed_));
+  const char* name = nullptr;
+  EXPECT_REFUSES_NULL(mf_solution_get_method(nullptr, &name));
+  EXPECT_REFUSES_NULL(mf_solution_get_method(s, nullptr));
+  EXPECT_ACCEPTS(mf_solution_get_method(s, &name));
+  EXPECT_STREQ(name, "interp");
   mf_solution_destroy(s);
   mf_solution_destroy(nullptr);
   mf_constraints_destroy(c);
