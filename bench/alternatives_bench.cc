@@ -203,13 +203,8 @@ int run(Args& args, const std::string& command) {
      << "| gap | windows | solution | L2P | L2Q | NPSS | skating (cm) | diversity (cm) | alternatives within 10 % "
         "of the method's L2P | constraints (largest error of any solution), time |\n"
      << "|---:|---:|---|---:|---:|---:|---:|---:|---:|---|\n";
-  std::cout << md.str() << std::flush;
-  for (int T : args.gaps) {
-    const std::string rows = run_gap(args, T, clips, stats, ctx);
-    std::cout << rows << std::flush;
-    md << rows;
-  }
-  if (!args.out.empty()) std::ofstream(args.out) << md.str();
+  mf::bench::stream_gap_table(md.str(), args.gaps, [&](int T) { return run_gap(args, T, clips, stats, ctx); },
+                              args.out);
   return 0;
 }
 

@@ -308,13 +308,8 @@ int run(Args& args, const std::string& command) {
        << "| gap | path | method | windows | failed | ground distance mean / max (cm) | facing mean / max (deg) | "
           "skating (cm) | ground truth's skating (cm) | s / window |\n"
        << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
-    std::cout << md.str() << std::flush;
-    for (int T : args.gaps) {
-      const std::string rows = run_paths(args, T, clips, stats, ctx);
-      std::cout << rows << std::flush;
-      md << rows;
-    }
-    if (!args.out.empty()) std::ofstream(args.out) << md.str();
+    mf::bench::stream_gap_table(md.str(), args.gaps, [&](int T) { return run_paths(args, T, clips, stats, ctx); },
+                                args.out);
     return 0;
   }
   md << "## trajectory-bench\n\n- command: `" << command << "`\n- model: " << args.model << "\n- "
@@ -323,13 +318,8 @@ int run(Args& args, const std::string& command) {
      << "| gap | windows | solution | L2P | L2Q | NPSS | skating (cm) | ground distance mean / max (cm) | "
         "facing mean / max (deg) | s / window |\n"
      << "|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
-  std::cout << md.str() << std::flush;
-  for (int T : args.gaps) {
-    const std::string rows = run_gap(args, T, clips, stats, ctx);
-    std::cout << rows << std::flush;
-    md << rows;
-  }
-  if (!args.out.empty()) std::ofstream(args.out) << md.str();
+  mf::bench::stream_gap_table(md.str(), args.gaps, [&](int T) { return run_gap(args, T, clips, stats, ctx); },
+                              args.out);
   return 0;
 }
 

@@ -289,9 +289,9 @@ Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& in
       spread_gap_residuals(input, constraints, keys, w, &piece);
       take_owned_frames(piece, w, keys, constraints, &out);
       if (!lock) continue;
-      const at::Tensor c = contact[static_cast<int64_t>(b)];
+      const auto c = contact.accessor<float, 3>();
       for (int f = w.owned_from + 1; f <= w.end; ++f)
-        for (int k = 0; k < feet; ++k) contacts[static_cast<size_t>(f) * feet + k] = c[f - w.start][k].item<float>();
+        for (int k = 0; k < feet; ++k) contacts[static_cast<size_t>(f) * feet + k] = c[b][f - w.start][k];
     }
   }
   copy_constrained(input, constraints, &out);
