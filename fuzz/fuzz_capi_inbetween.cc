@@ -15,10 +15,9 @@
 //
 // About "any struct_size": the options buffer is always struct_size bytes
 // (the caller's promise); pointer fields wholly inside struct_size hold valid
-// pointers or NULL, and a pointer field that struct_size cuts is zero. A
-// struct_size that ends inside a non-zero pointer is no version of the struct
-// any caller could compile, and would hand the library half a pointer (see
-// docs/RELIABILITY.md).
+// pointers or NULL. A struct_size that ends inside a pointer field is no
+// version of the struct any caller could compile: the library must refuse it
+// (MF_ERROR_INVALID_ARGUMENT) rather than read half a pointer.
 //
 // Contract checked: every status is documented and never MF_ERROR_INTERNAL; on
 // failure `out` is untouched; a result has the expected frame count and reads
@@ -175,12 +174,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   unsigned char* buffer = reinterpret_cast<unsigned char*>(storage.data());
   std::memcpy(buffer, &base, sizeof base);
   std::memcpy(buffer, &struct_size, sizeof struct_size);
-  // Zero every pointer field that struct_size cuts (see the top of the file).
+  // A struct_size cutting a pointer field must be refused (see the top of the file).
   const size_t pointer_fields[] = {offsetof(mf_task_options, method),    offsetof(mf_task_options, progress),
                                    offsetof(mf_task_options, user_data), offsetof(mf_task_options, cancel),
                                    offsetof(mf_task_options, rig_map),   offsetof(mf_task_options, rig_map_path)};
-  for (size_t off : pointer_fields)
-    if (struct_size > off && struct_size < off + sizeof(void*)) std::memset(buffer + off, 0, sizeof(void*));
+  bool cuts_pointer = false;
+  for (size_t off : pointer_fields) cuts_pointer |= struct_size > off && struct_size < off + sizeof(void*);
+  cuts_pointer &= !options_null;
   if (struct_size > sizeof(mf_task_options) && in.range(0, 3) == 0 && struct_size <= 65536)
     buffer[sizeof(mf_task_options) + in.range(0, struct_size - sizeof(mf_task_options) - 1)] = in.u8() | 1;
   const bool progress_read = !options_null && struct_size <= 65536 &&
@@ -231,6 +231,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       break;
     }
   }
+  if (cuts_pointer) MF_FUZZ_CHECK(status == MF_ERROR_INVALID_ARGUMENT);
   if (status == MF_OK) {
     int32_t n = 0;
     MF_FUZZ_CHECK(mf_motion_get_frame_count(out, &n) == MF_OK && n == expected_frames);

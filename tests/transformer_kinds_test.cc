@@ -12,6 +12,7 @@
 #include "prior/inbetween/citl.h"
 #include "prior/inbetween/keyframe_net.h"
 #include "prior/inbetween/two_stage.h"
+#include "prior/model/model_file.h"
 #include "prior/motion/errors.h"
 #include "tests/test_util.h"
 
@@ -304,6 +305,51 @@ TEST_P(TransformerKind, BadHyperparametersThrow) {
   bad.insert(bad.end(), kind.bad_for_kind.begin(), kind.bad_for_kind.end());
   for (const auto& [key, value] : bad) EXPECT_THROW(kind.make(with(key, value), rig), InputError) << key << " " << value;
   EXPECT_NO_THROW(kind.make(with("heads", 4), rig));
+}
+
+TEST_P(TransformerKind, ParameterCountMatchesTheBuiltNetwork) {
+  const Kind& kind = GetParam();
+  const InbetweenerKind& product_kind = inbetweener_kind(kind.name);
+  ASSERT_TRUE(product_kind.count_parameters);
+  const RigInfo rig = test::tiny_rig();
+  std::vector<std::map<std::string, double>> sizes = {kind.tiny, {}};
+  for (const auto& [key, value] : std::vector<std::pair<std::string, double>>{
+           {"layers", 3}, {"ffn", 20}, {"heads", 8}, {"width", 48}}) {
+    auto h = kind.tiny;
+    h[key] = value;
+    sizes.push_back(h);
+  }
+  for (const auto& h : sizes) {
+    EXPECT_EQ(product_kind.count_parameters(h, rig), kind.make(h, rig)->num_parameters())
+        << ::testing::PrintToString(h);
+  }
+  EXPECT_THROW(product_kind.count_parameters({{"heads", 3}}, rig), InputError);
+}
+
+// A file whose hyperparameters are within their bounds but describe a network
+// of billions of parameters is refused from the count, before that network
+// is built (building it took 22 s and gigabytes).
+TEST_P(TransformerKind, AHugeNetworkIsRefusedBeforeItIsBuilt) {
+  const Kind& kind = GetParam();
+  auto model = tiny(kind, 3);
+  std::vector<std::pair<std::string, at::Tensor>> tensors = {{"stats.pose_mean", model->stats().pose_mean},
+                                                             {"stats.pose_std", model->stats().pose_std}};
+  for (auto& named : model->named_parameters()) tensors.push_back(named);
+  auto h = model->hyperparameters();
+  h["width"] = 2048;
+  h["layers"] = 32;
+  h["ffn"] = 16384;
+  const std::vector<uint8_t> bytes = serialize_model_file(kind.name, h, model->rig(), tensors);
+  try {
+    deserialize_inbetweener(bytes.data(), bytes.size(), "huge.mfm");
+    FAIL() << "a file describing a huge network was loaded";
+  } catch (const InputError& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("huge.mfm: invalid hyperparameters"), std::string::npos) << message;
+    EXPECT_NE(message.find("parameters, but the file holds " + std::to_string(model->num_parameters() + 2 * model->pose_size()) + " values"),
+              std::string::npos)
+        << message;
+  }
 }
 
 TEST_P(TransformerKind, OverfitsOneBatch) {

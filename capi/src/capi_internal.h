@@ -86,6 +86,25 @@ inline void require(const void* p, const char* what) {
   if (!p) throw ApiError(MF_ERROR_INVALID_ARGUMENT, std::string(what) + " is NULL");
 }
 
+/// Byte offsets of the pointer fields of an options struct. A struct_size that
+/// ends inside one is no version of the struct a caller could compile
+/// (published versions end between fields) and would hand the library half a
+/// pointer, so read_options refuses it.
+template <class T>
+struct OptionPointerFields {
+  static constexpr size_t offsets[1] = {0};  // struct_size itself: no pointer
+  static constexpr size_t count = 0;
+};
+template <>
+struct OptionPointerFields<mf_task_options> {
+  static constexpr size_t offsets[6] = {offsetof(mf_task_options, method),    offsetof(mf_task_options, progress),
+                                        offsetof(mf_task_options, user_data), offsetof(mf_task_options, cancel),
+                                        offsetof(mf_task_options, rig_map),   offsetof(mf_task_options, rig_map_path)};
+  static constexpr size_t count = 6;
+};
+static_assert(sizeof(mf_task_options) == 72,
+              "mf_task_options changed: list its pointer fields in OptionPointerFields");
+
 /// Copies a caller's options struct of type T into a default-initialised T,
 /// reading only what fits in its struct_size; larger (newer) structs must have
 /// zeros in the part this library does not know. Every default is zero.
@@ -99,6 +118,14 @@ T read_options(const T* user, const char* type_name) {
   if (size < sizeof(uint32_t) || size > 65536)
     throw ApiError(MF_ERROR_INVALID_ARGUMENT, std::string(type_name) + ".struct_size is " + std::to_string(size) +
                                                   ": call " + type_name + "_init() first");
+  for (size_t i = 0; i < OptionPointerFields<T>::count; ++i) {
+    const size_t at = OptionPointerFields<T>::offsets[i];
+    if (size > at && size < at + sizeof(void*))
+      throw ApiError(MF_ERROR_INVALID_ARGUMENT, std::string(type_name) + ".struct_size is " + std::to_string(size) +
+                                                    ": it ends inside a pointer field (bytes " + std::to_string(at) +
+                                                    " to " + std::to_string(at + sizeof(void*) - 1) +
+                                                    "); call " + type_name + "_init() first");
+  }
   std::memcpy(&out, user, size < sizeof(T) ? size : sizeof(T));
   if (size > sizeof(T)) {
     const unsigned char* tail = reinterpret_cast<const unsigned char*>(user) + sizeof(T);

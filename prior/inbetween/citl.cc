@@ -284,8 +284,20 @@ std::unique_ptr<InbetweenModel> make_citl(const std::map<std::string, double>& h
   return std::make_unique<CitlModel>(parse_config(hyperparameters), rig);
 }
 
+int64_t citl_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {
+  const CitlConfig c = parse_config(hyperparameters);
+  const int64_t W = c.width, pose_size = rig.num_joints() * 6 + 3;
+  auto linear = [](int64_t in, int64_t out) { return in * out + out; };
+  const int64_t feed_forward = linear(W, c.ffn) + linear(c.ffn, W);
+  // Self- and cross-attention layers hold the same count: qkv (W -> 3W) or q + kv.
+  const int64_t layer = 2 * W + linear(W, 3 * W) + linear(W, W) + feed_forward;
+  return linear(pose_size + rig.num_joints() + 1, W - c.time_dim) + 3 * c.layers * layer + 3 * W +
+         linear(c.time_dim, W) + feed_forward + (3 * W * W + W) + (3 * W * pose_size + pose_size);
+}
+
 InbetweenerKind citl_kind() {
-  return {kCitlKind, "CITL transformer", "motionfield-citl.mfm", {{"citl", "CITL transformer"}}, make_citl};
+  return {kCitlKind, "CITL transformer", "motionfield-citl.mfm", {{"citl", "CITL transformer"}},
+          make_citl, citl_parameter_count};
 }
 
 }  // namespace mf

@@ -44,6 +44,9 @@ namespace mf {
 /// defaults above; unknown keys or invalid values throw mf::InputError.
 std::unique_ptr<InbetweenModel> make_citl(const std::map<std::string, double>& hyperparameters, const RigInfo& rig);
 
+/// The parameters make_citl would allocate, counted without building it.
+int64_t citl_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig);
+
 /// The kind's entry in the registry (inbetweener_kinds()): name, title, model
 /// file, stages, and make_citl as its factory.
 InbetweenerKind citl_kind();

@@ -271,6 +271,24 @@ std::unique_ptr<InbetweenModel> deserialize_inbetweener(const uint8_t* data, siz
       throw InputError(source + ": invalid hyperparameters: '" + key + "' missing or not positive");
     }
   }
+  // Hyperparameters within their bounds can still describe a network of
+  // billions of parameters; building it would take minutes and gigabytes
+  // before the first tensor's shape is found wrong, so the count comes first.
+  const InbetweenerKind* kind = find_inbetweener_kind(c.kind);
+  if (kind && kind->count_parameters) {
+    int64_t wanted = 0, held = 0;
+    try {
+      wanted = kind->count_parameters(c.hyperparameters, c.rig);
+    } catch (const InputError& e) {
+      throw InputError(source + ": invalid hyperparameters: " + e.what());
+    }
+    for (const auto& [name, tensor] : c.tensors) held += tensor.numel();
+    if (wanted > held) {
+      throw InputError(source + ": invalid hyperparameters: they describe a " + kind->title + " of " +
+                       std::to_string(wanted) + " parameters, but the file holds " + std::to_string(held) +
+                       " values");
+    }
+  }
   std::unique_ptr<InbetweenModel> model;
   try {
     model = make_inbetweener(c.kind, c.hyperparameters, c.rig);

@@ -174,6 +174,11 @@ class HyperparameterReader {
 /// the kind's defaults; InputError for invalid ones).
 using InbetweenFactory =
     std::function<std::unique_ptr<InbetweenModel>(const std::map<std::string, double>&, const RigInfo&)>;
+/// The number of parameters the factory of the same kind would allocate for
+/// these hyperparameters and rig, computed without allocating them
+/// (InputError for invalid hyperparameters).
+using InbetweenParameterCount =
+    std::function<int64_t(const std::map<std::string, double>&, const RigInfo&)>;
 
 /// One output stage of a kind, as the product offers it: the stage alone is
 /// the method `name` (one pass), its output encoded by the prior is the
@@ -193,6 +198,9 @@ struct InbetweenerKind {
   std::string file_name;                 ///< "motionfield-twostage.mfm", next to the prior's file
   std::vector<InbetweenerStage> stages;  ///< in the model's stage_names() order
   InbetweenFactory make;
+  /// make's parameter count: a model file whose hyperparameters ask for more
+  /// parameters than it holds values is refused before the network is built.
+  InbetweenParameterCount count_parameters;
   /// The network is conditioned on InbetweenBatch::trajectory, so its
   /// methods follow a trajectory the caller gives.
   bool reads_trajectory = false;

@@ -334,6 +334,13 @@ std::unique_ptr<InbetweenModel> make_keyframe_net(const std::map<std::string, do
   return std::make_unique<KeyframeModel>(parse_config(hyperparameters), rig);
 }
 
+int64_t keyframe_net_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {
+  const KeyframeConfig c = parse_config(hyperparameters);
+  const int pose_size = rig.num_joints() * 6 + 3, inputs = pose_size + rig.num_joints() + 1 + kTrajectorySize;
+  return blocks::stage_parameter_count(c.trunk(), inputs, pose_size + 1, true) +
+         blocks::stage_parameter_count(c.trunk(), inputs + 1, pose_size + rig.num_feet(), false);
+}
+
 InbetweenerKind keyframe_net_kind() {
   return {kKeyframeKind,
           "keyframe transformer (KeyframeNet + RefineNet)",
@@ -341,6 +348,7 @@ InbetweenerKind keyframe_net_kind() {
           {{"keyframe", "KeyframeNet's keyframes, interpolated"},
            {"refine", "KeyframeNet + RefineNet (trajectory-conditioned)"}},
           make_keyframe_net,
+          keyframe_net_parameter_count,
           /*reads_trajectory=*/true,
           /*locks_feet=*/true};
 }

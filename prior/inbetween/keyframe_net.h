@@ -77,6 +77,9 @@ namespace mf {
 std::unique_ptr<InbetweenModel> make_keyframe_net(const std::map<std::string, double>& hyperparameters,
                                                   const RigInfo& rig);
 
+/// The parameters make_keyframe_net would allocate, counted without building it.
+int64_t keyframe_net_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig);
+
 /// The kind's entry in the registry (inbetweener_kinds()).
 InbetweenerKind keyframe_net_kind();
 

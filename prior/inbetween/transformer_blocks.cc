@@ -21,6 +21,23 @@ FeedForwardImpl::FeedForwardImpl(int width, int hidden) {
 
 at::Tensor FeedForwardImpl::forward(const at::Tensor& x) { return fc2->forward(at::relu(fc1->forward(x))); }
 
+namespace {
+
+int64_t linear_count(int64_t in, int64_t out) { return in * out + out; }
+// Linear, PReLU (one slope), Linear.
+int64_t mlp_count(int64_t in, int64_t hidden, int64_t out) { return linear_count(in, hidden) + 1 + linear_count(hidden, out); }
+int64_t layer_norm_count(int64_t width) { return 2 * width; }
+
+}  // namespace
+
+int64_t stage_parameter_count(const TrunkSize& c, int inputs, int outputs, bool keyframe_encoding) {
+  const int64_t w = c.width;
+  const int64_t attention = 4 * linear_count(w, w) + mlp_count(kDistanceFeatures, kRelativeHidden, c.heads);
+  const int64_t layer = 2 * layer_norm_count(w) + attention + linear_count(w, c.ffn) + linear_count(c.ffn, w);
+  return mlp_count(inputs, w, w) + (keyframe_encoding ? mlp_count(kKeyFeatures, w, w) : 0) + c.layers * layer +
+         layer_norm_count(w) + mlp_count(w, w, outputs);
+}
+
 at::Tensor distance_features(const at::Tensor& frames, int window) {
   at::Tensor i = at::arange(kFrequencies, frames.options());
   const double ratio = std::log(2.0 * window / 4.0) / (kFrequencies - 1);

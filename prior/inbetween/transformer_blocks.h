@@ -14,6 +14,7 @@
 #include <torch/nn/modules/linear.h>
 #include <torch/nn/modules/normalization.h>
 
+#include <cstdint>
 #include <vector>
 
 namespace mf::blocks {
@@ -107,6 +108,11 @@ struct StageImpl : torch::nn::Module {
   torch::nn::LayerNorm norm{nullptr};
 };
 TORCH_MODULE(Stage);
+
+/// The parameters a Stage(size, inputs, outputs, keyframe_encoding) holds,
+/// counted without building it (model files are checked against this before a
+/// network is allocated; tests compare it with the built module's count).
+int64_t stage_parameter_count(const TrunkSize& size, int inputs, int outputs, bool keyframe_encoding);
 
 /// Index of the last frame at or before t where `flag` holds ([B, T] bool ->
 /// [B, T] long), `none` where there is none. With `forward` false: the first

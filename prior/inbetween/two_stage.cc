@@ -135,12 +135,20 @@ std::unique_ptr<InbetweenModel> make_two_stage(const std::map<std::string, doubl
   return std::make_unique<TwoStageModel>(parse_config(hyperparameters), rig);
 }
 
+int64_t two_stage_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {
+  const TwoStageConfig c = parse_config(hyperparameters);
+  const int pose_size = rig.num_joints() * 6 + 3, inputs = pose_size + rig.num_joints() + 1;
+  return blocks::stage_parameter_count(c.trunk(), inputs, pose_size, true) +
+         blocks::stage_parameter_count(c.trunk(), inputs, pose_size + rig.num_feet(), false);
+}
+
 InbetweenerKind two_stage_kind() {
   return {kTwoStageKind,
           "two-stage transformer",
           "motionfield-twostage.mfm",
           {{"context", "Context Transformer only"}, {"detail", "Context + Detail Transformer"}},
           make_two_stage,
+          two_stage_parameter_count,
           /*reads_trajectory=*/false,
           /*locks_feet=*/true};
 }

@@ -54,6 +54,9 @@ namespace mf {
 /// defaults above; unknown keys or invalid values throw mf::InputError.
 std::unique_ptr<InbetweenModel> make_two_stage(const std::map<std::string, double>& hyperparameters, const RigInfo& rig);
 
+/// The parameters make_two_stage would allocate, counted without building it.
+int64_t two_stage_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig);
+
 /// The kind's entry in the registry (inbetweener_kinds()): name, title, model
 /// file, stages, and make_two_stage as its factory.
 InbetweenerKind two_stage_kind();

@@ -433,6 +433,26 @@ TEST(CApiBadInput, OptionsFromOlderAndNewerCallers) {
                     "does not know"));
   EXPECT_EQ(out, kMotionSentinel);
 
+  // A struct_size ending inside a pointer field (no published version does)
+  // is refused: the library would otherwise read half of a non-NULL pointer.
+  old_struct->struct_size = offsetof(mf_task_options, method) + 4;
+  old_struct->method = "zerovel";
+  out = kMotionSentinel;
+  EXPECT_TRUE(Fails(mf_inbetween(nullptr, input.get(), keys, 3, old_struct, &out), MF_ERROR_INVALID_ARGUMENT,
+                    "ends inside a pointer field (bytes 8 to 15)"));
+  old_struct->struct_size = offsetof(mf_task_options, rig_map_path) + 1;
+  EXPECT_TRUE(Fails(mf_inbetween(nullptr, input.get(), keys, 3, old_struct, &out), MF_ERROR_INVALID_ARGUMENT,
+                    "ends inside a pointer field"));
+  EXPECT_EQ(out, kMotionSentinel);
+  // Ending after the last int32 field, before the struct's tail padding, is a real layout.
+  mf_task_options padded;
+  mf_task_options_init(&padded);
+  padded.method = "zerovel";
+  padded.struct_size = offsetof(mf_task_options, max_iterations) + sizeof(int32_t);
+  ASSERT_EQ(mf_inbetween(nullptr, input.get(), keys, 3, &padded, &out), MF_OK) << mf_last_error_message();
+  mf_motion_destroy(out);
+  out = kMotionSentinel;
+
   // Uninitialised or absurd sizes.
   mf_task_options zero;
   std::memset(&zero, 0, sizeof zero);
