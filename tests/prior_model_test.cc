@@ -199,6 +199,46 @@ TEST(PriorTraining, AFewStepsRunCheckpointAndResume) {
   EXPECT_GT(r2.steps, r.steps);
   NemfModel m = load_nemf(r2.best_path);
   EXPECT_EQ(m.config().zl, 8);
+
+  // --init: a new run starts from that model's weights and statistics (with a
+  // zero learning rate they come out unchanged), not from random ones.
+  PriorTrainingOptions f = o;
+  f.resume = false;
+  f.init_from = r2.best_path;
+  f.out_dir = dir + "/finetune";
+  f.max_epochs = 1;
+  f.lr = f.lr_final = 0.0;
+  train_prior(f);
+  NemfModel tuned = load_nemf(f.out_dir + "/last.mfm");
+  std::vector<at::Tensor> a = m.parameters(), b = tuned.parameters();
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(at::equal(a[i], b[i])) << "parameter " << i;
+  EXPECT_TRUE(at::equal(m.stats().feature_mean, tuned.stats().feature_mean));
+  EXPECT_TRUE(at::equal(m.stats().gmp_out_std, tuned.stats().gmp_out_std));
+
+  // Other sizes, or data on another skeleton, are refused before training.
+  PriorTrainingOptions other_size = f;
+  other_size.out_dir = dir + "/other-size";
+  other_size.config.zl = 16;
+  EXPECT_THROW(train_prior(other_size), InputError);
+  std::string renamed = dir + "/renamed";
+  fs::create_directories(renamed);
+  Skeleton t = s;
+  t.names[1] = "SomethingElse";
+  for (int i = 0; i < 4; ++i) {
+    write_motion(renamed + "/clip" + std::to_string(i) + ".bvh", test::random_motion(t, 40, 30.0, 200 + i),
+                 default_bvh_layout(t));
+  }
+  PriorTrainingOptions other_rig = f;
+  other_rig.data = renamed;
+  other_rig.cache_dir = renamed + "/cache";
+  other_rig.out_dir = dir + "/other-rig";
+  try {
+    train_prior(other_rig);
+    ADD_FAILURE() << "a prior on another skeleton was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("another skeleton"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

@@ -91,6 +91,8 @@ void add_run_options(CLI::App& cmd, Options& o, RunArgs& run) {
 void add_prior_options(CLI::App& cmd, mf::PriorTrainingOptions& o, RunArgs& run) {
   cmd.add_option("--config", run.config, "key = value lines, same keys as the options without '--'");
   add_run_options(cmd, o, run);
+  cmd.add_option("--init", o.init_from,
+                 "start from this prior's weights and statistics (same sizes and skeleton), not random weights");
   mf::NemfConfig& c = o.config;
   const std::string sizes = "Model sizes (prior/model/nemf.h)";
   cmd.add_option("--width", c.decoder_width, "decoder width")->group(sizes);

@@ -233,14 +233,23 @@ void check_options(const PriorTrainingOptions& o) {
   if (!problem.empty()) throw InputError("train: " + problem);
 }
 
-// A new model of o.config, or the checkpoint's when resuming (same sizes).
+// A new model of o.config, the checkpoint's when resuming, or o.init_from's (same sizes).
 NemfModel load_or_make_model(const PriorTrainingOptions& o, const Dataset& data, const training::RunFiles& files,
                              bool resuming) {
   at::manual_seed(o.seed);
-  if (!resuming) return NemfModel(o.config, training::measure_training_rig(data));
-  NemfModel model = load_nemf(files.last_model);
+  if (!resuming && o.init_from.empty()) return NemfModel(o.config, training::measure_training_rig(data));
+  const std::string what = resuming ? "--resume" : "--init " + o.init_from;
+  NemfModel model = load_nemf(resuming ? files.last_model : o.init_from);
   if (model.config().to_map() != o.config.to_map()) {
-    throw InputError("train: --resume with different sizes than the checkpoint (" + model.config().describe() + ")");
+    throw InputError("train: " + what + " has other sizes than the options (" + model.config().describe() +
+                     "; give the same sizes)");
+  }
+  const Skeleton& have = model.rig().skeleton;
+  if (!resuming && (have.names != data.skeleton.names || have.parents != data.skeleton.parents)) {
+    throw InputError("train: --init " + o.init_from + " is on another skeleton than the training data (" +
+                     std::to_string(have.num_joints()) + " joints from " + have.names[0] + " vs " +
+                     std::to_string(data.skeleton.num_joints()) + " from " + data.skeleton.names[0] +
+                     "; joint names and parents must match)");
   }
   return model;
 }
@@ -320,7 +329,8 @@ PriorRun::PriorRun(const PriorTrainingOptions& o)
   train_pre_ = precompute(data_.train, model_.rig(), model_.config().fps);
   val_pre_ = precompute(data_.validation, model_.rig(), model_.config().fps);
   if (o.verbose) std::fprintf(stderr, "train: per-clip features in %.1f s\n", seconds_between(p0, Clock::now()));
-  if (!resuming_) compute_stats(model_, data_.train, train_pre_);
+  // An --init model keeps its statistics: its weights were trained on them.
+  if (!resuming_ && o.init_from.empty()) compute_stats(model_, data_.train, train_pre_);
   model_.set_requires_grad(true);
   model_.train(true);
   if (resuming_) {

@@ -45,6 +45,11 @@ struct PriorTrainingOptions {
   double kl_weight = 1e-5;
   double kl_warmup = 0.2;
   bool resume = false;              ///< continue from out_dir/last.* when present
+  /// Start a new run from this prior's weights and normalisation statistics
+  /// instead of random weights (fine-tuning, or continuing a finished run with
+  /// a new schedule). Its sizes must equal `config` and its skeleton the data's
+  /// (names and parents); its rig and statistics are kept. Ignored when resuming.
+  std::string init_from;
   int max_train_clips = 0;          ///< 0 = all (small values for smoke tests)
   bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
   int max_steps = 0;                ///< 0 = unlimited (for tests)
