@@ -197,15 +197,13 @@ WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int 
 
 namespace {
 
-// The GMP's root path of a dense decode, its ground position at the anchor moved
-// to the anchor key's (the canonical origin).
+// The root path of a dense decode from its GMP output, its ground position at
+// the anchor moved to the anchor key's (the canonical origin).
 at::Tensor aligned_root_path(const NemfModel& model, const WindowProblem& problem, const at::Tensor& rotations,
-                             GmpOutput* gmp_out) {
-  GmpOutput gmp = model.predict_global(rotations);
+                             const GmpOutput& gmp) {
   at::Tensor path = model.root_positions(rotations, gmp);  // [1, T, 3], starts at the origin
   at::Tensor xz_mask = at::tensor({1.0f, 0.0f, 1.0f}, path.options());
   at::Tensor shift = path.select(1, problem.anchor) * xz_mask;  // [1, 3]
-  if (gmp_out) *gmp_out = gmp;
   return path - shift.unsqueeze(1);
 }
 
@@ -347,9 +345,11 @@ void add_term(EnergyTerms* out, const char* name, double weight, const at::Tenso
 }
 
 // The terms at the key frames: rotation, root orientation, position.
-// key_rot [K, J, 3, 3] decoded at the key frames.
+// key_rot [K, J, 3, 3] decoded at the key frames; key_pos [K, J, 3] their
+// joint positions with the root at the origin when already computed (else
+// undefined).
 void add_key_terms(const Skeleton& skel, const WindowProblem& problem, const EnergyWeights& w, const ActiveTerms& a,
-                   const at::Tensor& key_rot, const at::Tensor& offsets, EnergyTerms* out) {
+                   const at::Tensor& key_rot, const at::Tensor& key_pos, const at::Tensor& offsets, EnergyTerms* out) {
   const int J = skel.num_joints(), K = problem.num_keys();
   const at::TensorOptions opt = offsets.options();  // the codes' (evaluate_energy)
   if (a.rot || a.root_rot) {
@@ -364,7 +364,8 @@ void add_key_terms(const Skeleton& skel, const WindowProblem& problem, const Ene
     }
   }
   if (a.pos) {
-    at::Tensor p = forward_kinematics(skel.parents, offsets, key_rot, at::zeros({K, 3}, opt)).positions;
+    at::Tensor p =
+        key_pos.defined() ? key_pos : forward_kinematics(skel.parents, offsets, key_rot, at::zeros({K, 3}, opt)).positions;
     at::Tensor d2 = (p - problem.key_positions).square().sum(-1);  // [K, J]
     add_term(out, "position", w.position,
              masked_mean(penalty_of_squared(d2, w.penalty), problem.key_position_mask, a.n_pos));
@@ -389,16 +390,20 @@ void add_trajectory_terms(const RigInfo& rig, const WindowProblem& problem, cons
 }
 
 // The terms on the output motion (see EnergyWeights::on_output): effector,
-// foot skating, smoothness. rotations [1, T, J, 3, 3], path [1, T, 3].
+// foot skating, smoothness. rotations [1, T, J, 3, 3], path [1, T, 3];
+// positions_at_origin [1, T, J, 3] the FK of rotations with the root at the origin.
 void add_output_terms(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& w,
-                      const ActiveTerms& a, const at::Tensor& rotations, const at::Tensor& path, const GmpOutput& gmp,
-                      const at::Tensor& offsets, EnergyTerms* out) {
+                      const ActiveTerms& a, const at::Tensor& rotations, const at::Tensor& path,
+                      const at::Tensor& positions_at_origin, const GmpOutput& gmp, const at::Tensor& offsets,
+                      EnergyTerms* out) {
   const RigInfo& rig = model.rig();
   const int J = rig.num_joints(), T = problem.length, E = problem.num_effectors();
   const double fps = model.config().fps;
   at::Tensor out_rot = rotations, out_path = path;
-  if (w.on_output) blend_residuals(problem, rotations, path, &out_rot, &out_path);
-  at::Tensor pos = forward_kinematics(rig.skeleton.parents, offsets, out_rot, out_path).positions;  // [1, T, J, 3]
+  const bool blended = w.on_output && problem.num_keys() > 0;
+  if (blended) blend_residuals(problem, rotations, path, &out_rot, &out_path);
+  at::Tensor pos = blended ? forward_kinematics(rig.skeleton.parents, offsets, out_rot, out_path).positions
+                           : positions_at_origin + out_path.unsqueeze(2);  // [1, T, J, 3]
   if (a.eff) {
     at::Tensor idx = problem.effector_frames * J + problem.effector_joints;
     at::Tensor p = pos.reshape({T * J, 3}).index_select(0, idx);
@@ -427,17 +432,19 @@ void add_output_terms(const NemfModel& model, const WindowProblem& problem, cons
 }
 
 // The terms on the whole window: root translation, then the output terms.
-// dense_rot [1, T, J, 3, 3] decoded at every frame.
+// dense_rot [1, T, J, 3, 3] decoded at every frame, dense_pos [1, T, J, 3] its
+// FK with the root at the origin.
 void add_dense_terms(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& w,
-                     const ActiveTerms& a, const at::Tensor& dense_rot, const at::Tensor& offsets, EnergyTerms* out) {
-  GmpOutput gmp;
-  at::Tensor path = aligned_root_path(model, problem, dense_rot, &gmp);  // [1, T, 3]
+                     const ActiveTerms& a, const at::Tensor& dense_rot, const at::Tensor& dense_pos,
+                     const at::Tensor& offsets, EnergyTerms* out) {
+  GmpOutput gmp = model.predict_global_from_inputs(gmp_inputs(dense_rot, dense_pos, model.rig()));
+  at::Tensor path = aligned_root_path(model, problem, dense_rot, gmp);  // [1, T, 3]
   if (a.root) {
     at::Tensor d2 = (path.squeeze(0).index_select(0, problem.key_frames) - problem.key_root).square().sum(-1);
     add_term(out, "root_translation", w.root_translation,
              masked_mean(penalty_of_squared(d2, w.penalty), problem.key_root_mask, a.n_root));
   }
-  if (a.eff || a.pin || a.traj || a.facing || a.skate || a.smooth) add_output_terms(model, problem, w, a, dense_rot, path, gmp, offsets, out);
+  if (a.eff || a.pin || a.traj || a.facing || a.skate || a.smooth) add_output_terms(model, problem, w, a, dense_rot, path, dense_pos, gmp, offsets, out);
 }
 
 }  // namespace
@@ -449,17 +456,24 @@ EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem
   const at::TensorOptions opt = z_l.options();
   EnergyTerms out;
   // Decode the whole window when a dense term needs it (the key frames then
-  // gathered from it), else only the key frames.
-  at::Tensor dense_rot, key_rot;
+  // gathered from it), else only the key frames. One FK pass of the dense
+  // decode serves the GMP's input, the key positions and the output terms:
+  // the tree-level FK is many small ops, a large share of an evaluation.
+  const at::Tensor offsets = offsets_tensor(rig.skeleton).to(opt);
+  at::Tensor dense_rot, dense_pos, key_rot, key_pos;
   if (a.dense) {
     dense_rot = model.decode(at::arange(problem.length, at::kFloat), z_l, z_g);  // [1, T, J, 3, 3]
-    if (a.keyed) key_rot = dense_rot.index_select(1, problem.key_frames).squeeze(0);
+    dense_pos = forward_kinematics(rig.skeleton.parents, offsets, dense_rot, at::zeros({1, problem.length, 3}, opt))
+                    .positions;  // [1, T, J, 3]
+    if (a.keyed) {
+      key_rot = dense_rot.index_select(1, problem.key_frames).squeeze(0);
+      key_pos = dense_pos.index_select(1, problem.key_frames).squeeze(0);
+    }
   } else if (a.keyed) {
     key_rot = model.decode(problem.key_frames.to(at::kFloat), z_l, z_g).squeeze(0);  // [K, J, 3, 3]
   }
-  const at::Tensor offsets = offsets_tensor(rig.skeleton).to(opt);
-  if (a.keyed) add_key_terms(rig.skeleton, problem, w, a, key_rot, offsets, &out);
-  if (a.dense) add_dense_terms(model, problem, w, a, dense_rot, offsets, &out);
+  if (a.keyed) add_key_terms(rig.skeleton, problem, w, a, key_rot, key_pos, offsets, &out);
+  if (a.dense) add_dense_terms(model, problem, w, a, dense_rot, dense_pos, offsets, &out);
   if (w.latent_prior > 0) add_term(&out, "latent_prior", w.latent_prior, 0.5 * (z_l.square().sum() + z_g.square().sum()));
   out.total = at::zeros({}, opt);
   for (const auto& t : out.terms) out.total = out.total + t.second;
@@ -471,8 +485,8 @@ DecodedWindow decode_window(const NemfModel& model, const WindowProblem& problem
   at::NoGradGuard no_grad;
   DecodedWindow d;
   d.local_rotations = model.decode(at::arange(problem.length, at::kFloat), z_l, z_g);
-  GmpOutput gmp;
-  d.root_positions = aligned_root_path(model, problem, d.local_rotations, &gmp);
+  GmpOutput gmp = model.predict_global(d.local_rotations);
+  d.root_positions = aligned_root_path(model, problem, d.local_rotations, gmp);
   d.contacts = at::sigmoid(gmp.contact_logits);
   return d;
 }

@@ -12,7 +12,9 @@
 #include "prior/model/nemf.h"
 #include "prior/model/representation.h"
 #include "prior/motion/errors.h"
+#include "prior/motion/kinematics_torch.h"
 #include "prior/motion/motion_bvh.h"
+#include "prior/motion/rotations_torch.h"
 #include "tests/test_util.h"
 #include "training/prior_trainer.h"
 
@@ -59,6 +61,24 @@ TEST(PriorModel, GmpTargetsIntegrateBackToTheRootPath) {
   at::Tensor start = ground_xz(w.root_positions.select(1, 0));
   at::Tensor p = integrate_root(t.velocity, t.height, h, 30.0, start);
   EXPECT_LT((p - w.root_positions).abs().max().item<float>(), 1e-4);
+}
+
+// The GMP's input from positions the caller already has (the solver's one FK
+// pass) equals the one computed from the rotations alone.
+TEST(PriorModel, GmpInputsFromPositionsAtTheOriginMatch) {
+  RigInfo rig = tiny_rig();
+  Motion m = test::random_motion(rig.skeleton, 30, 30.0, 11);
+  WindowTensors w = window_tensors(m, 0, 30, rig, 0);
+  // A heading that is not the canonical one at every frame.
+  at::Tensor rot = w.local_rotations.clone();
+  at::Tensor turn = torch_rot::quat_to_matrix(at::tensor({0.8f, 0.0f, 0.6f, 0.0f}));
+  rot.select(-3, 0).copy_(at::matmul(turn, rot.select(-3, 0)));
+  at::Tensor offsets = offsets_tensor(rig.skeleton);
+  at::Tensor pos = forward_kinematics(rig.skeleton.parents, offsets, rot, at::zeros({1, 30, 3})).positions;
+  at::Tensor a = gmp_inputs(rot, rig), b = gmp_inputs(rot, pos, rig);
+  ASSERT_EQ(a.sizes(), b.sizes());
+  EXPECT_LT((a - b).abs().max().item<float>(), 1e-5);
+  EXPECT_GT(a.abs().max().item<float>(), 0.1f);
 }
 
 TEST(PriorModel, EncodeDecodeShapesShortWindowsAndContinuousTime) {

@@ -226,6 +226,16 @@ at::Tensor gmp_inputs(const at::Tensor& local_rotations, const RigInfo& rig) {
   return at::cat({pos, root_free}, -1);
 }
 
+at::Tensor gmp_inputs(const at::Tensor& local_rotations, const at::Tensor& positions_at_origin, const RigInfo& rig) {
+  at::Tensor root = local_rotations.select(-3, 0);
+  at::Tensor h_inv = heading_rotation(root, rig.root_forward).transpose(-1, -2);  // [B, T, 3, 3]
+  at::Tensor root_free = torch_rot::matrix_to_sixd(torch_rot::matmul3(h_inv, root));
+  // The heading is a rotation about the vertical through the origin, where the
+  // root is: removing it from the root removes it from every joint's position.
+  at::Tensor pos = at::matmul(positions_at_origin, h_inv.transpose(-1, -2)).flatten(-2);  // p h_inv^T = (h_inv p^T)^T
+  return at::cat({pos, root_free}, -1);
+}
+
 at::Tensor local_features(const at::Tensor& local_rotations, const RigInfo& rig, double fps, at::Tensor* root6d) {
   FkTensors fk = heading_free_fk(local_rotations, rig);
   at::Tensor vel = time_derivative(fk.positions, fps);

@@ -102,6 +102,11 @@ at::Tensor heading_relative_positions(const at::Tensor& local_rotations, const R
 /// positions and the 6D of the root rotation with the heading removed.
 at::Tensor gmp_inputs(const at::Tensor& local_rotations, const RigInfo& rig);
 
+/// The same from the joint positions [B, T, J, 3] that forward kinematics of
+/// `local_rotations` gives with the root at the origin (its orientation kept):
+/// a caller that needs those positions anyway saves a second FK pass.
+at::Tensor gmp_inputs(const at::Tensor& local_rotations, const at::Tensor& positions_at_origin, const RigInfo& rig);
+
 /// GMP targets from ground truth: root velocity in the heading frame (m/s,
 /// forward differences, the last frame repeats) [B, T, 3], root height [B, T, 1]
 /// and foot contacts in {0, 1} [B, T, F].
