@@ -104,6 +104,29 @@ TEST(InbetweenTraining, LossDecreasesCheckpointAndResume) {
   o.hyperparameters = {};
   o.kind = kCitlKind;
   EXPECT_THROW(train_inbetweener(o), InputError);
+
+  // --init: a new run starts from the best model's weights and statistics
+  // (with a zero learning rate they come out unchanged).
+  InbetweenTrainingOptions f = tiny_options(data, "test-linear");
+  f.out_dir = data + "/finetune";
+  f.init_from = r2.best_path;
+  f.lr = 1e-12;
+  f.max_epochs = 1;
+  train_inbetweener(f);
+  auto tuned = load_inbetweener(f.out_dir + "/last.mfm");
+  auto from = load_inbetweener(r2.best_path);
+  std::vector<at::Tensor> a = from->parameters(), b = tuned->parameters();
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(at::allclose(a[i], b[i], 0.0, 1e-9)) << "parameter " << i;
+  EXPECT_TRUE(at::equal(from->stats().pose_std, tuned->stats().pose_std));
+  // Another kind or other hyperparameters than the file's are refused.
+  InbetweenTrainingOptions other = f;
+  other.out_dir = data + "/finetune-other";
+  other.hyperparameters = {{"window", 32}};
+  EXPECT_THROW(train_inbetweener(other), InputError);
+  other.hyperparameters = {};
+  other.kind = kCitlKind;
+  EXPECT_THROW(train_inbetweener(other), InputError);
 }
 
 TEST(InbetweenTraining, RealKindsTrainAFewSteps) {

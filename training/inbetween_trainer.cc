@@ -299,20 +299,24 @@ void check_options(const InbetweenTrainingOptions& o) {
   }
 }
 
-// A new model of o.kind, or the checkpoint's when resuming (checked against the options).
+// A new model of o.kind, the checkpoint's when resuming, or o.init_from's
+// (checked against the options).
 std::unique_ptr<InbetweenModel> load_or_make_model(const InbetweenTrainingOptions& o, const Dataset& data,
                                                    const training::RunFiles& files, bool resuming) {
   at::manual_seed(o.seed);
-  if (!resuming) return make_inbetweener(o.kind, o.hyperparameters, training::measure_training_rig(data));
-  std::unique_ptr<InbetweenModel> model = load_inbetweener(files.last_model);
+  if (!resuming && o.init_from.empty()) {
+    return make_inbetweener(o.kind, o.hyperparameters, training::measure_training_rig(data));
+  }
+  const std::string what = resuming ? "--resume" : "--init " + o.init_from;
+  std::unique_ptr<InbetweenModel> model = load_inbetweener(resuming ? files.last_model : o.init_from);
   if (model->kind() != o.kind) {
-    throw InputError("train: --resume: the checkpoint holds a '" + model->kind() + "' model, not '" + o.kind + "'");
+    throw InputError("train: " + what + ": the file holds a '" + model->kind() + "' model, not '" + o.kind + "'");
   }
   const auto hp = model->hyperparameters();
   for (const auto& [k, v] : o.hyperparameters) {
     auto it = hp.find(k);
     if (it == hp.end() || it->second != v) {
-      throw InputError("train: --resume with other hyperparameters than the checkpoint (" + model->describe() + ")");
+      throw InputError("train: " + what + " with other hyperparameters than the file's (" + model->describe() + ")");
     }
   }
   return model;
@@ -327,7 +331,7 @@ void check_data_fits(const InbetweenModel& model, const Dataset& data) {
     }
   }
   if (!model.rig().skeleton.same_as(data.skeleton)) {
-    throw InputError("train: the checkpoint's skeleton differs from the data's");
+    throw InputError("train: the skeleton of the model to continue (--resume or --init) differs from the data's");
   }
 }
 
@@ -428,7 +432,8 @@ InbetweenRun::InbetweenRun(const InbetweenTrainingOptions& o)
   if (train_sampler_.empty()) throw InputError("train: no training clip has 2 frames or more");
   train_contacts_ = clip_contacts(data_.train, model_->rig(), model_->fps());
   val_contacts_ = clip_contacts(data_.validation, model_->rig(), model_->fps());
-  if (!resuming_) measure_pose_statistics();
+  // An --init model keeps its statistics: its weights were trained on them.
+  if (!resuming_ && o.init_from.empty()) measure_pose_statistics();
   make_validation_set();
   model_->set_requires_grad(true);
   model_->train(true);

@@ -78,6 +78,11 @@ struct InbetweenTrainingOptions {
   int epoch_steps = 0;              ///< 0 = about one pass over the training frames
   int validation_windows = 256;
   bool resume = false;              ///< continue from out_dir/last.* when present
+  /// Start a new run from this model's weights and pose statistics instead of
+  /// random weights (fine-tuning, or continuing a finished run with a new
+  /// schedule): the same kind, the hyperparameters given must match it, and its
+  /// skeleton must be the data's. Ignored when resuming.
+  std::string init_from;
   int max_train_clips = 0;          ///< 0 = all
   bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
   bool verbose = true;

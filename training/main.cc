@@ -83,6 +83,8 @@ void add_run_options(CLI::App& cmd, Options& o, RunArgs& run) {
   cmd.add_flag("--mirror", o.mirror,
                "also train on every training clip's left/right mirror (doubles the data; give it again on --resume)");
   cmd.add_flag("--resume", o.resume, "continue from DIR/last.* if present");
+  cmd.add_option("--init", o.init_from,
+                 "start a new run from this model's weights and statistics (same sizes and skeleton), not random ones");
   cmd.add_option("--export", run.export_path, "copy the best checkpoint to PATH at the end");
   cmd.add_flag("--quiet", run.quiet, "no progress lines on stderr");
   add_distributed_options(cmd, o.distributed);
@@ -91,8 +93,6 @@ void add_run_options(CLI::App& cmd, Options& o, RunArgs& run) {
 void add_prior_options(CLI::App& cmd, mf::PriorTrainingOptions& o, RunArgs& run) {
   cmd.add_option("--config", run.config, "key = value lines, same keys as the options without '--'");
   add_run_options(cmd, o, run);
-  cmd.add_option("--init", o.init_from,
-                 "start from this prior's weights and statistics (same sizes and skeleton), not random weights");
   mf::NemfConfig& c = o.config;
   const std::string sizes = "Model sizes (prior/model/nemf.h)";
   cmd.add_option("--width", c.decoder_width, "decoder width")->group(sizes);
