@@ -244,12 +244,8 @@ NemfModel load_or_make_model(const PriorTrainingOptions& o, const Dataset& data,
     throw InputError("train: " + what + " has other sizes than the options (" + model.config().describe() +
                      "; give the same sizes)");
   }
-  const Skeleton& have = model.rig().skeleton;
-  if (!resuming && (have.names != data.skeleton.names || have.parents != data.skeleton.parents)) {
-    throw InputError("train: --init " + o.init_from + " is on another skeleton than the training data (" +
-                     std::to_string(have.num_joints()) + " joints from " + have.names[0] + " vs " +
-                     std::to_string(data.skeleton.num_joints()) + " from " + data.skeleton.names[0] +
-                     "; joint names and parents must match)");
+  if (!resuming && !model.rig().skeleton.same_as(data.skeleton)) {
+    throw InputError("train: --init " + o.init_from + " is on another skeleton than the training data");
   }
   return model;
 }

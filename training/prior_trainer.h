@@ -48,7 +48,8 @@ struct PriorTrainingOptions {
   /// Start a new run from this prior's weights and normalisation statistics
   /// instead of random weights (fine-tuning, or continuing a finished run with
   /// a new schedule). Its sizes must equal `config` and its skeleton the data's
-  /// (names and parents); its rig and statistics are kept. Ignored when resuming.
+  /// (Skeleton::same_as, as the in-betweener trainer checks); its rig and
+  /// statistics are kept. Ignored when resuming.
   std::string init_from;
   int max_train_clips = 0;          ///< 0 = all (small values for smoke tests)
   bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
