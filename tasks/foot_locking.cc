@@ -147,21 +147,59 @@ void warn_conflicts(const std::string& what, const GlobalPose& pose, int joint, 
 void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector<float>& contacts, int ramp,
                Motion* out) {
   const int N = out->num_frames(), F = rig.num_feet();
-  for (int k = 0; k < F; ++k) {
-    Leg leg;
-    if (!leg_above(out->skeleton, rig.foot_joints[k], &leg)) continue;
-    std::vector<char> fixed, known;
-    protected_frames(c, out->skeleton, leg, N, &fixed, &known);
-    GlobalPose pose = forward_kinematics(*out);
-    // In contact: the predictor says so and the output's ankle is low enough.
+  const Skeleton& skel = out->skeleton;
+  auto in_contact = [&](int k, const GlobalPose& pose) {
+    // The predictor says so and the output's joint is low enough.
     const double low = rig.foot_heights[k] + rig.foot_thresholds[k];
     std::vector<char> on(N);
     for (int f = 0; f < N; ++f)
-      on[f] = contacts[static_cast<size_t>(f) * F + k] > 0.5f && pose.position(f, leg.ankle).y() < low;
+      on[f] = contacts[static_cast<size_t>(f) * F + k] > 0.5f && pose.position(f, rig.foot_joints[k]).y() < low;
+    return on;
+  };
+  std::vector<std::vector<double>> ankle_weight(skel.num_joints());
+  for (int k = 0; k < F; ++k) {
+    Leg leg;
+    if (!leg_above(skel, rig.foot_joints[k], &leg)) continue;
+    std::vector<char> fixed, known;
+    protected_frames(c, skel, leg, N, &fixed, &known);
+    GlobalPose pose = forward_kinematics(*out);
+    std::vector<Eigen::Vector3d> goal;
+    contact_goals(pose, leg.ankle, in_contact(k, pose), known, ramp, &goal, &ankle_weight[leg.ankle]);
+    hold(leg, goal, ankle_weight[leg.ankle], fixed, /*height=*/false, out, &pose);
+  }
+  for (int k = 0; k < F; ++k) {
+    const int toe = rig.foot_joints[k];
+    Leg leg;
+    if (skel.parents[toe] <= 0 || leg_above(skel, toe, &leg) || !leg_above(skel, skel.parents[toe], &leg)) continue;
+    std::vector<char> fixed, known;
+    protected_frames(c, skel, leg, N, &fixed, &known);
+    for (size_t i = 0; i < c.keys.size(); ++i) {
+      if (c.key_has_joint(i, toe)) fixed[c.keys[i].frame] = 1;
+    }
+    GlobalPose pose = forward_kinematics(*out);
     std::vector<Eigen::Vector3d> goal;
     std::vector<double> weight;
-    contact_goals(pose, leg.ankle, on, known, ramp, &goal, &weight);
-    hold(leg, goal, weight, fixed, /*height=*/false, out, &pose);
+    contact_goals(pose, toe, in_contact(k, pose), known, ramp, &goal, &weight);
+    const std::vector<double>& planted = ankle_weight[leg.ankle];
+    for (int f = 0; f < N; ++f) {
+      if (weight[f] <= 0.0 || fixed[f]) continue;
+      const Eigen::Vector3d t = pose.position(f, toe);
+      Eigen::Vector3d step = weight[f] * (goal[f] - t);
+      step.y() = 0.0;
+      // A planted heel stays where it is and the foot turns about it; a lifted
+      // heel follows the toe, the foot keeping its orientation.
+      const double w_heel = planted.empty() ? 0.0 : planted[f];
+      const Eigen::Vector3d a0 = pose.position(f, leg.ankle);
+      two_bone_ik(out, &pose, f, leg.hip, leg.knee, leg.ankle, a0 + (1.0 - w_heel) * step);
+      const Eigen::Vector3d a = pose.position(f, leg.ankle);
+      const Eigen::Vector3d from = t + (a - a0) - a, to = t + step - a;
+      if (from.norm() < 1e-6 || to.norm() < 1e-6) continue;
+      const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(from, to);
+      const int J = out->num_joints();
+      Eigen::Quaterniond& ankle_global = pose.rotations[static_cast<size_t>(f) * J + leg.ankle];
+      ankle_global = (turn * ankle_global).normalized();
+      out->rotation(f, leg.ankle) = (pose.rotation(f, leg.knee).conjugate() * ankle_global).normalized();
+    }
   }
 }
 

@@ -8,9 +8,16 @@
 // the ankle's positions at the known frames inside the contact, interpolated
 // between them (so that nothing jumps at a known frame), else at the
 // contact's mean position, with a linear ramp of `ramp` frames on each side.
-// Frames whose leg joints a key constrains, or that carry an end-effector
-// target on the leg or on the joints above its hip, are not touched; toe
-// joints and feet without a thigh and a shin below the root are skipped.
+// Then each toe joint (its name contains "toe") below such an ankle is held
+// the same way, in (x, z), while the predictor says it is in contact and it is
+// low: with the heel planted (the ankle's lock weight) the foot turns about the
+// ankle, with the heel lifted the leg carries the ankle by the toe's step and
+// the foot keeps its orientation, in between a mix of the two. Holding the
+// toes too took foot skating at a 30-frame gap from 1.24x to 1.12x the ground
+// truth's on the validation split at equal L2P (docs/BENCHMARKS.md).
+// Frames whose leg joints (or toe) a key constrains, or that carry an
+// end-effector target on the leg or on the joints above its hip, are not
+// touched; feet without a thigh and a shin below the root are skipped.
 //
 // Contacts the caller pins (MotionConstraints::contacts) are held the same way,
 // on any joint with two bones above it below the root (a foot, a hand), in all
