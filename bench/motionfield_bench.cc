@@ -64,6 +64,7 @@ struct Args {
   bool l2p_axes = false;
   bool print_stats = false;
   std::vector<int> gaps;    // gap lengths (default: the protocol's)
+  std::vector<int> resample_factors;  // resampling: every k-th frame kept (default: the protocol's)
   bool trajectory = false;  // gap filling with the ground-truth trajectory
   bool l2t = false;
 };
@@ -91,6 +92,9 @@ void add_options(CLI::App& app, Args& args) {
   app.add_option("--out", args.out, "also write the markdown to FILE");
   app.add_flag("--l2p-axes", args.l2p_axes, "add columns splitting L2P into horizontal (x, z) and vertical (y) parts");
   mf::bench::add_list_option(app, "--gaps", args.gaps, "gap lengths of the gap task (default: 5, 15, 30, 45, 90)");
+  mf::bench::add_list_option(app, "--resample-factors", args.resample_factors,
+                             "resampling: keep every k-th frame of a 65-frame window, bring it back to the full rate "
+                             "(default: 2; 65 frames allow 2, 4, 8, 16, 32, 64)");
   app.add_flag("--trajectory", args.trajectory,
                "gap filling with the ground truth's trajectory of the gap (through the constrained path; methods "
                "without it are skipped)");
@@ -198,6 +202,7 @@ int run(Args& args, const std::string& command) {
   options.rig = args.rig;
   options.rig_anatomy = ctx.model_anatomy;
   if (!args.gaps.empty()) options.gap_lengths = args.gaps;
+  if (!args.resample_factors.empty()) options.resample_factors = args.resample_factors;
   options.trajectory = args.trajectory;
   options.l2t = args.l2t || args.trajectory;
   if (!args.rig.empty()) emit("- rig: " + args.rig + " (bench/synthetic_rigs.h)\n\n");

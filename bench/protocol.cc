@@ -252,33 +252,36 @@ TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats&
 TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
                           const ProtocolOptions& options, const TaskContext& ctx) {
   const int length = options.resample_window;
-  if (length < 3 || length % 2 == 0) throw InputError("the resampling window must be odd and at least 3 frames");
   TaskResult result = start_result(Task::Resample, method);
   const std::vector<Window> windows = cap_windows(protocol_windows(clips, length, options.stride), options.max_windows);
-  std::vector<int> evaluated, known;
-  for (int f = 0; f < length; ++f) (f % 2 ? evaluated : known).push_back(f);
-  MetricAccumulator acc(stats);
-  double ms = 0.0;
-  double fps = clips.empty() ? 0.0 : clips.front().motion.fps;
-  for (const Window& w : windows) {
-    const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, options.root_forward);
-    fps = truth.fps;
-    Motion input = Motion::identity(truth.skeleton, static_cast<int>(known.size()), truth.fps / 2.0);
-    for (size_t i = 0; i < known.size(); ++i) {
-      input.root_positions[i] = truth.root_positions[known[i]];
-      for (int j = 0; j < truth.num_joints(); ++j) input.rotation(static_cast<int>(i), j) = truth.rotation(known[i], j);
+  for (const int factor : options.resample_factors) {
+    if (factor < 2 || length < factor + 1 || (length - 1) % factor != 0)
+      throw InputError("the resampling window (" + std::to_string(length) + " frames) must be 1 + a multiple of " +
+                       "each factor, and the factors at least 2; not " + std::to_string(factor));
+    std::vector<int> evaluated, known;
+    for (int f = 0; f < length; ++f) (f % factor ? evaluated : known).push_back(f);
+    MetricAccumulator acc(stats);
+    double ms = 0.0;
+    for (const Window& w : windows) {
+      const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, options.root_forward);
+      Motion input = Motion::identity(truth.skeleton, static_cast<int>(known.size()), truth.fps / factor);
+      for (size_t i = 0; i < known.size(); ++i) {
+        input.root_positions[i] = truth.root_positions[known[i]];
+        for (int j = 0; j < truth.num_joints(); ++j)
+          input.rotation(static_cast<int>(i), j) = truth.rotation(known[i], j);
+      }
+      const auto t0 = Clock::now();
+      const Motion pred = run_resample(input, truth.fps, method, nullptr, ctx);
+      ms += ms_since(t0);
+      check_prediction(pred, truth, method);
+      acc.add(truth, pred, evaluated, known);
     }
-    const auto t0 = Clock::now();
-    const Motion pred = run_resample(input, truth.fps, method, nullptr, ctx);
-    ms += ms_since(t0);
-    check_prediction(pred, truth, method);
-    acc.add(truth, pred, evaluated, known);
+    RowResult row;
+    row.parameter = factor;
+    row.metrics = acc.summary();
+    row.ms_per_window = windows.empty() ? 0.0 : ms / windows.size();
+    result.rows.push_back(row);
   }
-  RowResult row;
-  row.parameter = static_cast<int>(std::lround(fps));
-  row.metrics = acc.summary();
-  row.ms_per_window = windows.empty() ? 0.0 : ms / windows.size();
-  result.rows.push_back(row);
   return result;
 }
 
@@ -314,8 +317,8 @@ std::string format_table(const TaskResult& result, bool l2p_axes) {
       param = "k";
       break;
     case Task::Resample:
-      title = "Resampling (every other frame -> full rate)";
-      param = "fps out";
+      title = "Resampling (every k-th frame -> full rate)";
+      param = "k";
       break;
   }
   out << "### " << title << "\n\n";

@@ -58,7 +58,10 @@ struct ProtocolOptions {
   int context = 10;            ///< gap filling: known frames before the gap
   int stride = 40;             ///< window start every `stride` frames
   int sparse_window = 128;
-  int resample_window = 65;    ///< odd, so that both ends are input frames
+  int resample_window = 65;    ///< 1 + a multiple of every factor, so that both ends are input frames
+  /// Resampling rows: every k-th frame of the window is the input (at fps / k),
+  /// the method brings it back to the full rate.
+  std::vector<int> resample_factors{2};
   int max_windows = 0;         ///< cap per table row (spread evenly over the windows); 0 = all
   Eigen::Vector3d root_forward = Eigen::Vector3d::UnitZ();
   /// Gap filling and sparse keyframes on a synthetic rig (bench/synthetic_rigs.h,

@@ -53,6 +53,32 @@ void blend_frames(const Motion& from, int a, int b, double t, Motion& to, int f_
   for (int j = 0; j < J; ++j) to.rotation(f_to, j) = slerp(from.rotation(a, j), from.rotation(b, j), t);
 }
 
+// Frame f_to of `to` = uniform Catmull-Rom spline through frames a - 1, a,
+// a + 1, a + 2 of `from` (clamped to the clip) at t in (0, 1): root positions
+// per coordinate; rotations per quaternion component, the four brought into
+// the hemisphere of frame a's, then normalised.
+void cubic_frame(const Motion& from, int a, double t, Motion& to, int f_to) {
+  const int last = from.num_frames() - 1;
+  const int idx[4] = {std::max(a - 1, 0), a, std::min(a + 1, last), std::min(a + 2, last)};
+  const double t2 = t * t, t3 = t2 * t;
+  const double w[4] = {0.5 * (-t3 + 2 * t2 - t), 0.5 * (3 * t3 - 5 * t2 + 2), 0.5 * (-3 * t3 + 4 * t2 + t),
+                       0.5 * (t3 - t2)};
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (int k = 0; k < 4; ++k) p += w[k] * from.root_positions[idx[k]];
+  to.root_positions[f_to] = p;
+  for (int j = 0; j < from.num_joints(); ++j) {
+    const Eigen::Vector4d ref = from.rotation(a, j).coeffs();
+    Eigen::Vector4d q = Eigen::Vector4d::Zero();
+    for (int k = 0; k < 4; ++k) {
+      const Eigen::Vector4d c = from.rotation(idx[k], j).coeffs();
+      q += w[k] * (c.dot(ref) < 0 ? -c : c);
+    }
+    Eigen::Quaterniond r;
+    r.coeffs() = q.norm() > 1e-12 ? Eigen::Vector4d(q.normalized()) : ref;
+    to.rotation(f_to, j) = r;
+  }
+}
+
 // Input frame position (in input frames, possibly fractional) of output
 // frame i, snapped (snap_frame_position) and held at the last frame.
 double source_position(int i, double fps_in, double fps_out, int frames_in) {
@@ -122,6 +148,23 @@ Motion resample_interpolate(const Motion& input, double new_fps, int frames) {
   return out;
 }
 
+Motion resample_cubic(const Motion& input, double new_fps, int frames) {
+  check_resample(input, new_fps, frames);
+  const int N = input.num_frames();
+  Motion out = Motion::identity(input.skeleton, frames, new_fps);
+  for (int i = 0; i < frames; ++i) {
+    const double s = source_position(i, input.fps, new_fps, N);
+    const int a = static_cast<int>(std::floor(s));
+    const double t = s - a;
+    if (t == 0.0) {
+      copy_frame(input, a, out, i);
+    } else {
+      cubic_frame(input, a, t, out, i);
+    }
+  }
+  return out;
+}
+
 Motion resample_zero_velocity(const Motion& input, double new_fps, int frames) {
   check_resample(input, new_fps, frames);
   const int N = input.num_frames();
@@ -163,7 +206,13 @@ std::vector<Method> baseline_methods() {
   zerovel.resample = [](const Motion& in, double fps, int frames, const TaskContext&) {
     return resample_zero_velocity(in, fps, frames);
   };
-  return {interp, zerovel};
+  Method cubic;
+  cubic.name = "cubic";
+  cubic.description = "Catmull-Rom spline through the input frames (resampling)";
+  cubic.resample = [](const Motion& in, double fps, int frames, const TaskContext&) {
+    return resample_cubic(in, fps, frames);
+  };
+  return {interp, zerovel, cubic};
 }
 
 namespace {

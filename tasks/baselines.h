@@ -50,6 +50,13 @@ double snap_frame_position(double s);
 /// `new_fps`.
 Motion resample_interpolate(const Motion& input, double new_fps, int frames);
 
+/// Resampling by a uniform Catmull-Rom spline through the input frames (C1;
+/// the end frames repeated as the missing neighbours): the same frame times,
+/// exact copies and held end as resample_interpolate(); root positions per
+/// coordinate, rotations per quaternion component (the four neighbours brought
+/// into one hemisphere, the result normalised).
+Motion resample_cubic(const Motion& input, double new_fps, int frames);
+
 /// Resampling by holding the most recent input frame (zero velocity): output
 /// frame i copies input frame floor(s), s as above.
 Motion resample_zero_velocity(const Motion& input, double new_fps, int frames);

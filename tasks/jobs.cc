@@ -147,7 +147,7 @@ std::string default_method(const TaskContext& ctx, bool trajectory) {
   return ctx.model ? "nemf" : "interp";
 }
 
-std::string default_resample_method(const TaskContext& ctx) { return ctx.model ? "prior" : "interp"; }
+std::string default_resample_method(const TaskContext& ctx) { return ctx.model ? "prior" : "cubic"; }
 
 const Method& resolve_method(const std::string& method, const TaskContext& ctx, bool trajectory) {
   const std::string m = method.empty() ? default_method(ctx, trajectory) : method;

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -15,9 +16,16 @@ namespace {
 // Upsampling by a whole factor r = model fps / input fps (15 -> 30 with a
 // 30 fps model): the input frames are every r-th frame of a motion at the
 // model's rate, so the frames between them are an in-betweening problem with
-// dense keys, which the latent solver answers better than encoding the
-// interpolated motion (docs/BENCHMARKS.md, "Resampling with the prior").
-// Returns false when the rates are not in such a ratio.
+// dense keys. The answer is a blend of a Catmull-Rom spline through the input
+// frames (resample_cubic) and the latent solver's solution started from that
+// spline, with the prior's weight growing with the distance between input
+// frames: clamp((log2 r - 1) / 2, 0, 1), i.e. 0 at r = 2 (the spline alone,
+// no solve), 0.5 at r = 4, 1 at r = 8 and beyond. Chosen on the training split
+// (docs/BENCHMARKS.md, "Session 12: resampling"): at r = 2 the spline's error
+// is below the prior's reconstruction error and every prior weight loses (L2P
+// 0.071 / 0.077 / 0.097 at 0 / 0.25 / 0.5); at r = 4 the blend wins (0.335 /
+// 0.267 / 0.292 at 0 / 0.5 / 1); at r = 8 the solution alone does (1.348 /
+// 0.875 / 0.596). Returns false when the rates are not in such a ratio.
 bool upsample_by_solving(const Motion& in, double fps, int frames, const TaskContext& ctx,
                          const PriorResampleOptions& options, Motion* out) {
   const double model_fps = ctx.model->config().fps;
@@ -25,32 +33,27 @@ bool upsample_by_solving(const Motion& in, double fps, int frames, const TaskCon
   const long r = std::lround(ratio);
   if (r < 2 || std::abs(ratio - static_cast<double>(r)) > 1e-5 * ratio || in.num_frames() < 2) return false;
   const int n = (in.num_frames() - 1) * static_cast<int>(r) + 1;
-  const Motion dense = resample_interpolate(in, model_fps, n);
-  std::vector<int> known;
-  for (int i = 0; i < n; i += static_cast<int>(r)) known.push_back(i);
-  // 20 iterations: the setting the blend below was chosen and measured with
-  // (the solver's default rose to 40 later, not re-measured for resampling).
-  LatentSolverOptions solver = default_solver_options(SolverMethod::Lbfgs);
-  solver.max_iterations = ctx.max_iterations > 0 ? ctx.max_iterations : 20;
-  const Motion solved_raw = complete_motion(*ctx.model, dense, MotionConstraints::full_pose(known), solver, ctx);
-  // Half-way between the interpolation and the solution (SLERP / LERP): the
-  // solution's frames between keys carry the prior's reconstruction error
-  // (about 4 degrees), which on its own loses to interpolation on L2Q; the
-  // blend beats both. Weight chosen on the training split (0.35 / 0.5 / 0.65:
-  // L2P 0.138 / 0.134 / 0.134, L2Q 0.035 / 0.036 / 0.036, NPSS 0.0079 / 0.0070 /
-  // 0.0062; interpolation 0.165 / 0.037 / 0.0103; the solution alone 0.150 /
-  // 0.039 / 0.0053). Key frames are equal in both, so they stay exact.
-  constexpr double kPriorWeight = 0.5;
-  Motion solved = solved_raw;
-  for (int f = 0; f < n; ++f) {
-    for (int j = 0; j < solved.num_joints(); ++j)
-      solved.rotation(f, j) = dense.rotation(f, j).slerp(kPriorWeight, solved_raw.rotation(f, j));
-    solved.root_positions[f] = dense.root_positions[f] * (1 - kPriorWeight) + solved_raw.root_positions[f] * kPriorWeight;
+  const Motion spline = resample_cubic(in, model_fps, n);
+  const double prior_weight = std::clamp((std::log2(static_cast<double>(r)) - 1.0) / 2.0, 0.0, 1.0);
+  Motion dense = spline;
+  if (prior_weight > 0.0) {
+    std::vector<int> known;
+    for (int i = 0; i < n; i += static_cast<int>(r)) known.push_back(i);
+    // 20 iterations: the setting the weights above were chosen with.
+    LatentSolverOptions solver = default_solver_options(SolverMethod::Lbfgs);
+    solver.max_iterations = ctx.max_iterations > 0 ? ctx.max_iterations : 20;
+    const Motion solved = complete_motion(*ctx.model, spline, MotionConstraints::full_pose(known), solver, ctx);
+    // Key frames are equal in both, so they stay exact.
+    for (int f = 0; f < n; ++f) {
+      for (int j = 0; j < dense.num_joints(); ++j)
+        dense.rotation(f, j) = spline.rotation(f, j).slerp(prior_weight, solved.rotation(f, j));
+      dense.root_positions[f] = spline.root_positions[f] * (1 - prior_weight) + solved.root_positions[f] * prior_weight;
+    }
   }
   if (same_frame_rate(fps, model_fps)) {
-    *out = resample_interpolate(solved, fps, frames);  // copies the solved frames, holds past the end
+    *out = resample_interpolate(dense, fps, frames);  // copies the dense frames, holds past the end
   } else {
-    *out = resample_with_prior(solved, fps, frames, ctx, options);
+    *out = resample_with_prior(dense, fps, frames, ctx, options);
   }
   return true;
 }
@@ -60,16 +63,17 @@ bool upsample_by_solving(const Motion& in, double fps, int frames, const TaskCon
 std::vector<Method> prior_methods() {
   // Resampling with the prior: encode, decode at the new times, add the input's
   // residual so the input frames come out exactly; when the model's rate is a
-  // whole multiple of the input's, the frames in between are first solved for
-  // with the latent solver (above). The variants were chosen by measurement
+  // whole multiple of the input's, the frames in between come from a spline
+  // and the latent solver (above). The variants were chosen by measurement
   // (docs/BENCHMARKS.md, "Resampling with the prior"): the residual is
   // essential; the root path from the input (LERP plus the zero residual)
   // scored as well as the global motion predictor's and skips it.
   Method prior;
   prior.name = "prior";
   prior.description =
-      "the prior at the new times: latent solve through the input frames when the model's rate is a multiple of "
-      "the input's, else encode/decode corrected to pass through every input frame (resampling)";
+      "the prior at the new times: when the model's rate is a multiple of the input's, a Catmull-Rom spline through "
+      "the input frames blended with a latent solve through them (the solve's weight growing with the ratio), else "
+      "encode/decode corrected to pass through every input frame (resampling)";
   prior.needs_model = true;
   prior.resample = [](const Motion& in, double fps, int frames, const TaskContext& ctx) {
     require_prior(ctx, "method 'prior'");

@@ -164,6 +164,42 @@ TEST(BaselinesTest, ResampleTo24InterpolatesAtFractionalPositions) {
   expect_frame_equal(in, 30, out, 24);  // the last output frame is the last input frame
 }
 
+TEST(BaselinesTest, ResampleCubicFollowsCurvedMotionThatInterpolationCuts) {
+  // 21 frames at 15 fps -> 41 at 30: a root on a parabola and a joint turning
+  // about y at an accelerating rate. Catmull-Rom reproduces quadratics exactly
+  // away from the ends (its tangents are central differences); LERP and SLERP
+  // cut the curve.
+  const auto x = [](double s) { return 0.02 * s * s; };
+  const auto angle = [](double s) { return 0.3 * s * s; };  // degrees (angle_between gives radians)
+  const Motion in = one_joint(
+      [&] {
+        std::vector<Eigen::Vector3d> p;
+        for (int f = 0; f < 21; ++f) p.emplace_back(x(f), 1.0, 0.1 * f);
+        return p;
+      }(),
+      [&] {
+        std::vector<Eigen::Quaterniond> q;
+        for (int f = 0; f < 21; ++f) q.push_back(about_y(angle(f)));
+        return q;
+      }(),
+      15.0);
+  const Motion cubic = resample_cubic(in, 30.0, 41), lerp = resample_interpolate(in, 30.0, 41);
+  ASSERT_EQ(cubic.num_frames(), 41);
+  EXPECT_DOUBLE_EQ(cubic.fps, 30.0);
+  for (int k = 0; k <= 20; ++k) expect_frame_equal(in, k, cubic, 2 * k);
+  for (int i = 3; i < 38; i += 2) {  // midpoints with two input frames on each side
+    const double s = i / 2.0;
+    EXPECT_NEAR((cubic.root_positions[i] - Eigen::Vector3d(x(s), 1.0, 0.1 * s)).norm(), 0.0, 1e-12) << i;
+    EXPECT_NEAR(lerp.root_positions[i].x() - x(s), 0.005, 1e-12) << i;  // the chord's sag, 0.02 / 4
+    const double cubic_deg = angle_between(cubic.rotation(i, 0), about_y(angle(s)));
+    const double lerp_deg = angle_between(lerp.rotation(i, 0), about_y(angle(s)));
+    EXPECT_NEAR(lerp_deg, 0.075 * 3.14159265358979323846 / 180.0, 1e-9) << i;  // radians
+    EXPECT_LT(cubic_deg, 0.2 * lerp_deg) << i;
+  }
+  EXPECT_THROW(resample_cubic(in, 0.0, 3), InputError);
+  EXPECT_THROW(resample_cubic(in, 30.0, 0), InputError);
+}
+
 TEST(BaselinesTest, ResampleZeroVelocityHoldsThePreviousInputFrame) {
   const Motion in = test::random_motion(test::small_skeleton(), 31, 30.0, 11);
   const Motion out = resample_zero_velocity(in, 24.0, 25);

@@ -149,7 +149,7 @@ TEST(ProtocolTest, BaselinesKeepKnownFramesAndInterpBeatsZeroVelocity) {
   EXPECT_EQ(run_sparse_keyframes(val, stats, "interp", options).rows[0].metrics.windows, 3);
   const TaskResult res = run_resampling(val, stats, "interp", options);
   ASSERT_EQ(res.rows.size(), 1u);
-  EXPECT_EQ(res.rows[0].parameter, 30);
+  EXPECT_EQ(res.rows[0].parameter, 2);  // every other frame kept
   EXPECT_EQ(res.rows[0].metrics.windows, 6);
 }
 
@@ -220,6 +220,28 @@ TEST(ProtocolTest, TheContextReachesMethodsThatNeedTheModel) {
   EXPECT_LT(r.rows[0].metrics.known.position_max_cm, 1e-6);
   EXPECT_LT(r.rows[0].metrics.known.rotation_max_deg, 1e-6);
   EXPECT_GT(r.rows[0].metrics.mpjpe_cm, 0.0);
+}
+
+TEST(ProtocolTest, ResamplingRowsPerFactorKeepEveryKthFrame) {
+  const EvalStats stats = small_stats();
+  std::vector<Clip> val = {make_clip("v", test::random_motion(test::small_skeleton(), 110, 30.0, 51))};
+  ProtocolOptions o;
+  o.resample_factors = {2, 4};
+  const TaskResult interp = run_resampling(val, stats, "interp", o), cubic = run_resampling(val, stats, "cubic", o);
+  ASSERT_EQ(interp.rows.size(), 2u);
+  ASSERT_EQ(cubic.rows.size(), 2u);
+  for (size_t r = 0; r < 2; ++r) {
+    EXPECT_EQ(interp.rows[r].parameter, o.resample_factors[r]);
+    EXPECT_EQ(interp.rows[r].metrics.windows, 2);
+    EXPECT_LT(cubic.rows[r].metrics.known.position_max_cm, 1e-6);
+    // The smooth sinusoids of the test motion: the spline beats the chords.
+    EXPECT_LT(cubic.rows[r].metrics.l2p, interp.rows[r].metrics.l2p);
+  }
+  // Fewer input frames, larger errors.
+  EXPECT_GT(interp.rows[1].metrics.l2p, interp.rows[0].metrics.l2p);
+  EXPECT_NE(format_table(cubic, false).find("every k-th frame"), std::string::npos);
+  o.resample_factors = {3};  // 64 frames between the ends are not a multiple of 3
+  EXPECT_THROW(run_resampling(val, stats, "interp", o), InputError);
 }
 
 }  // namespace

@@ -136,7 +136,7 @@ Solved solve(const BatchJob& job, const Settings& settings, const Model& model, 
 // The method that ran.
 std::string method_name(const BatchJob& job, const Model& model) {
   if (!job.method.empty() || job.task == "export") return job.method;
-  if (job.task == "resample") return model ? "prior" : "interp";
+  if (job.task == "resample") return model ? "prior" : "cubic";
   if (job.task == "renav") return "nemf";
   return default_method(model);
 }

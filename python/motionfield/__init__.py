@@ -550,7 +550,7 @@ def default_method(*, model: Optional["Model"] = None) -> str:
     The best measured method that can run with the model (mf_default_method):
     "nemf-detail" when it has the two-stage transformer, "nemf" with the
     prior alone, "interp" without a model. Resampling without a method uses
-    "prior" with a model and "interp" without; re-navigation uses "nemf".
+    "prior" with a model and "cubic" without; re-navigation uses "nemf".
     solve() with a trajectory uses "nemf-refine" instead when the model has the
     keyframe transformer (Solution.method says which ran).
 
@@ -1420,7 +1420,7 @@ def resample(motion: Motion, fps: float, *, method: Optional[str] = None, model:
     """Resampling to another frame rate, keeping the time span.
 
     Without a method: "prior" with a model (the default one unless given),
-    "interp" without, as the CLI does.
+    "cubic" (a Catmull-Rom spline) without, as the CLI does.
 
     Parameters
     ----------

@@ -53,7 +53,7 @@ class InputError(Exception):
 class Settings:
     """The options of a batch run (the CLI's global options)."""
 
-    threads: int = 2           # --threads: intra-op threads (the CLI's default 2)
+    threads: int = 1           # --threads: intra-op threads (the CLI's default 1)
     verbose: bool = False
     quiet: bool = False
     json: bool = False
@@ -869,7 +869,7 @@ def _method_name(job: BatchJob, model: Optional[mf.Model]) -> str:
     if job.method:
         return job.method
     if job.task == "resample":
-        return "prior" if model is not None else "interp"
+        return "prior" if model is not None else "cubic"
     if job.task == "renav":
         return "nemf"
     return mf.default_method(model=model)
