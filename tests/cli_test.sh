@@ -284,7 +284,7 @@ if [ -n "$TINY" ]; then
   expect_rc 0 "batch renav --polyline = renav --polyline" -- "$DIFF" "$TMP/b-renav-poly.bvh" "$TMP/renav-poly.bvh" --tol 1e-9
   expect_absent "$TMP/b-bad.bvh"
   # --jobs 2: the same files bit for bit and the same messages and --json lines, in line order.
-  "$MF" --model "$TINY" --threads 1 --json batch "$TMP/renav.jsonl" >"$TMP/serial.json" 2>"$TMP/serial.err"
+  "$MF" --model "$TINY" --threads 1 --json batch --jobs 1 "$TMP/renav.jsonl" >"$TMP/serial.json" 2>"$TMP/serial.err"
   sed "s|b-renav|p-renav|g" "$TMP/renav.jsonl" >"$TMP/renav-par.jsonl"
   expect_rc 2 "batch --jobs 2 with one bad line" -- "$MF" --model "$TINY" --threads 1 --json batch --jobs 2 "$TMP/renav-par.jsonl"
   cmp -s "$TMP/p-renav.bvh" "$TMP/b-renav.bvh" && pass || fail "batch --jobs 2 output differs from the serial run's"
@@ -296,6 +296,13 @@ if [ -n "$TINY" ]; then
   sed "s|renav-par.jsonl|renav.jsonl|g" "$TMP/err" | cmp -s - "$TMP/serial.err" && pass ||
     fail "batch --jobs 2 messages differ from the serial run's"
   bad "batch --jobs 0" batch --jobs 0 "$TMP/renav.jsonl"
+  # Without --jobs: the cores divided by --threads, 1 to 8.
+  cores=$(nproc)
+  for t in 1 2; do
+    want=$((cores / t)); [ "$want" -lt 1 ] && want=1; [ "$want" -gt 8 ] && want=8
+    "$MF" --model "$TINY" --threads $t --verbose batch "$TMP/renav-par.jsonl" >/dev/null 2>"$TMP/err"
+    grep -q "batch: $want jobs\? at once" "$TMP/err" && pass || fail "batch --threads $t runs $want jobs at once by default"
+  done
 else
   fail "no tiny model (mf_capi_tiny_model not built, MF_TEST_MODEL unset): the renav runs could not run"
 fi

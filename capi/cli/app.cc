@@ -106,7 +106,7 @@ void add_constraints(CLI::App* cmd, BatchJob& job) {
 void define_global_options(CLI::App& app, Settings& s, bool& version_flag) {
   app.option_defaults()->group("global options");
   app.set_help_flag("-h,--help", "this help; `motionfield <command> --help` for a command");
-  app.add_option("--threads", s.threads, "intra-op threads for the solvers (default 2)")
+  app.add_option("--threads", s.threads, "intra-op threads of each job's solver (default 1:\na single solve runs faster on one thread than on two)")
       ->type_name("N")
       ->check(quiet(CLI::Range(1, 1024)));
   app.add_option("--model", s.model,
@@ -253,12 +253,13 @@ void define_batch(CLI::App& app, HelpFormatter& help, Arguments& a) {
       "A failed job is reported on stderr (line number, id, reason) and the others\n"
       "still run. Exit code: 0 if every job succeeded, 1 if any job hit an internal\n"
       "error, otherwise 2 if any job had bad input. Progress is shown on stderr when\n"
-      "it is a terminal (with --jobs 1).\n"
+      "it is a terminal (with more than one job at once: how many jobs are done).\n"
       "--jobs N runs N jobs at once on the one model (threads; each job still uses\n"
       "--threads intra-op threads): the outputs and messages are those of a serial\n"
-      "run, in line order.");
+      "run, in line order. Without --jobs: the processor's cores divided by\n"
+      "--threads, at least 1 and at most 8.");
   cmd->add_option("jobs", a.file, "the jobs, one JSON object per line")->required()->type_name("JOBS.jsonl");
-  cmd->add_option("-j,--jobs", a.settings.jobs, "jobs run at once (default 1)")
+  cmd->add_option("-j,--jobs", a.settings.jobs, "jobs run at once (default: cores / --threads, 1 to 8)")
       ->check(CLI::Range(1, 256))
       ->type_name("N");
   cmd->footer(kGlobalOptionsNote);

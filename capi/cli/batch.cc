@@ -2,6 +2,8 @@
 // reported with its line, the others still run; N jobs at once on one model.
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <map>
@@ -95,12 +97,24 @@ void print_outcome(const Outcome& o, size_t line, const Settings& settings) {
   if (settings.json) std::fflush(stdout);
 }
 
+// --jobs, else one job per core's worth of --threads: a single solve is
+// fastest on one intra-op thread, so the cores are best used by jobs side by
+// side (docs/BENCHMARKS.md, "Session 12"). At most 8 by default: every job
+// holds its own solver's tensors.
+int batch_workers(const Settings& settings) {
+  if (settings.jobs > 0) return settings.jobs;
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  return std::clamp(cores / std::max(1, settings.threads), 1, 8);
+}
+
 }  // namespace
 
 int command_batch(const std::string& path, const Settings& settings) {
   const std::vector<std::string> lines = read_lines(path);
   Models models(settings.model, settings.transformers());
   models.load_explicit();
+  const int workers = batch_workers(settings);
+  if (settings.verbose) std::fprintf(stderr, "motionfield: batch: %d job%s at once\n", workers, workers == 1 ? "" : "s");
 
   // Every line parsed and its output claimed first, in line order (so that
   // which of two jobs writing one file is refused does not depend on timing);
@@ -117,7 +131,7 @@ int command_batch(const std::string& path, const Settings& settings) {
     try {
       o.job = parse_line(lines[i], &o.label);
       outputs.claim(o.job.out, i + 1);
-      if (settings.jobs > 1) models.for_method(o.job.task == "renav" && o.job.method.empty() ? "nemf" : o.job.method);
+      if (workers > 1) models.for_method(o.job.task == "renav" && o.job.method.empty() ? "nemf" : o.job.method);
       ready = true;
     } catch (...) {
       o.failure = current_failure();
@@ -128,7 +142,7 @@ int command_batch(const std::string& path, const Settings& settings) {
   }
   const int total = static_cast<int>(outcomes.size());
 
-  ProgressLine progress(settings.jobs == 1 && ProgressLine::stderr_is_terminal() && !settings.quiet);
+  ProgressLine progress(ProgressLine::stderr_is_terminal() && !settings.quiet);
   const auto run = [&](size_t k, ProgressLine& line) {
     if (!runnable[k]) return;
     try {
@@ -139,7 +153,7 @@ int command_batch(const std::string& path, const Settings& settings) {
     }
     line.clear();
   };
-  if (settings.jobs <= 1) {
+  if (workers <= 1) {
     for (size_t k = 0; k < outcomes.size(); ++k) {
       progress.start("[" + std::to_string(k + 1) + "/" + std::to_string(total) + "] line " + std::to_string(line_of[k]));
       run(k, progress);
@@ -152,19 +166,29 @@ int command_batch(const std::string& path, const Settings& settings) {
     std::atomic<size_t> next{0};
     std::mutex mutex;
     std::vector<char> finished(outcomes.size(), 0);
-    size_t printed = 0;
+    size_t printed = 0, done = 0;
+    const auto started = std::chrono::steady_clock::now();
+    const auto jobs_done = [&] {
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+      progress.show("[" + std::to_string(done) + "/" + std::to_string(total) + " jobs done, " +
+                    std::to_string(workers) + " at once] " + std::to_string(std::lround(s)) + "s");
+    };
+    jobs_done();
     const auto worker = [&] {
       ProgressLine silent(false);
       for (size_t k; (k = next++) < outcomes.size();) {
         run(k, silent);
         const std::lock_guard<std::mutex> lock(mutex);
         finished[k] = 1;
+        ++done;
+        progress.clear();
         for (; printed < outcomes.size() && finished[printed]; ++printed)
           print_outcome(outcomes[printed], line_of[printed], settings);
+        jobs_done();
       }
     };
     std::vector<std::thread> pool;
-    const int n = std::min(settings.jobs, std::max(total, 1));
+    const int n = std::min(workers, std::max(total, 1));
     for (int w = 0; w < n; ++w) pool.emplace_back(worker);
     for (std::thread& t : pool) t.join();
   }

@@ -13,11 +13,11 @@ constexpr int kExitBadInput = 2;
 
 /// The global options (motionfield --help).
 struct Settings {
-  int threads = 2;
+  int threads = 1;                    ///< --threads: intra-op threads of each job
   bool verbose = false;
   bool quiet = false;                 ///< --quiet: no progress bar, no warnings
   bool json = false;                  ///< --json: a JSON summary of each job on stdout
-  int jobs = 1;                       ///< batch --jobs: jobs run at once
+  int jobs = 0;                       ///< batch --jobs: jobs run at once; 0: batch_workers() decides
   std::string model;                  ///< --model PATH, "" for the default model
   std::vector<std::string> twostage;  ///< --twostage PATH (repeatable)
   std::vector<std::string> citl;      ///< --citl PATH (repeatable)

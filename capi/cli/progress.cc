@@ -74,6 +74,13 @@ void ProgressLine::draw(const mf_progress& p) {
   drawn_ = true;
 }
 
+void ProgressLine::show(const std::string& text) {
+  if (!enabled_) return;
+  std::fprintf(stderr, "\r\033[K%s", printable(text).c_str());
+  std::fflush(stderr);
+  drawn_ = true;
+}
+
 void ProgressLine::clear() {
   if (!drawn_) return;
   std::fputs("\r\033[K", stderr);

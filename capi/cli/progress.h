@@ -28,6 +28,10 @@ class ProgressLine {
   /// ten times a second. Always returns true (never cancels).
   bool update(const mf_progress& p);
 
+  /// Draws `text` as the whole line (no bar, no clock), e.g. how many jobs of
+  /// a parallel batch are done.
+  void show(const std::string& text);
+
   /// Clears the line (before a message, and at the end).
   void clear();
 
