@@ -109,7 +109,8 @@ void add_options(CLI::App& app, Args& a) {
                                  {"w-joints", "weight of the soft-DTW divergence of the joints"},
                                  {"w-heading", "weight of the soft-DTW divergence of the heading"},
                                  {"w-skate", "weight of foot skating"},
-                                 {"w-continuity", "weight of the continuity with the previous window"}},
+                                 {"w-continuity", "weight of the continuity with the previous window"},
+                                 {"lock-ramp", "foot locking ramp in frames (negative: no foot locking)"}},
                                 "Solver settings (default: tasks/renav.h)");
 }
 
@@ -136,6 +137,7 @@ mf::RenavOptions options_for(const Args& a, const std::string& method) {
   take("w-skate", &o.weights.foot_skating);
   take("w-continuity", &o.weights.continuity);
   take("overlap", &o.overlap);
+  take("lock-ramp", &o.foot_lock_ramp);
   if (!n.empty()) throw mf::InputError("unknown option --" + n.begin()->first);
   o.inits = a.inits;
   return o;

@@ -471,6 +471,8 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
 
   RenavReport rep;
   Motion out = Motion::identity(reference.skeleton, M, fm);
+  const int F = model.rig().num_feet();
+  std::vector<float> contacts(static_cast<size_t>(M) * F, 0.0f);
   int iterations = 0;
   TaskContext window_ctx = ctx;  // reports carry the window
   window_ctx.window_count = windows;
@@ -501,14 +503,21 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
     const RenavDecoded dec = decode_renav_window(model, window, energy.z_l(x), energy.z_g(x));
     Motion piece = Motion::identity(reference.skeleton, span.length, fm);
     write_window(dec.local_rotations, dec.root_positions, window.transform, &piece, 0);
+    const at::Tensor c = dec.contacts.reshape({-1, F}).to(at::kFloat).contiguous();
+    const float* cp = c.data_ptr<float>();
     for (int f = 0; f < span.length; ++f) {
       const double wn = f < span.shared ? static_cast<double>(f + 1) / (span.shared + 1) : 1.0;
       cross_fade_frame(piece, f, wn, &out, span.begin + f);
+      for (int k = 0; k < F; ++k) {
+        float& v = contacts[static_cast<size_t>(span.begin + f) * F + k];
+        v = static_cast<float>((1.0 - wn) * v + wn * cp[static_cast<size_t>(f) * F + k]);
+      }
     }
     sum.wall_ms = ms_since(tw);
     rep.windows.push_back(std::move(sum));
   }
 
+  if (options.foot_lock_ramp >= 0 && F > 0) lock_feet(model.rig(), MotionConstraints{}, contacts, options.foot_lock_ramp, &out);
   const int N = static_cast<int>(path.size());
   Motion result = same_frame_rate(path_fps, fm) ? out : resample_interpolate(out, path_fps, N);
   result.fps = path_fps;

@@ -56,6 +56,9 @@
 // (window k of K starts at reference frame round(s_k (R - T) / (M - T))), so
 // a short reference is replayed with overlaps; a reference shorter than one
 // window is used whole (soft-DTW aligns sequences of different lengths).
+// After the last window the feet are locked where the global motion
+// predictor says they are in contact (RenavOptions::foot_lock_ramp,
+// tasks/foot_locking.h), before the result goes back to the path's rate.
 //
 // Canonical frame of a window: origin at the path's first point (later
 // windows: the previous solution's root there), turned about +Y so that the
@@ -90,6 +93,7 @@
 #include "prior/motion/motion.h"
 #include "tasks/ground_path.h"
 #include "tasks/latent_energy.h"
+#include "tasks/foot_locking.h"
 #include "tasks/latent_optimizer.h"
 #include "tasks/path_csv.h"  // parse_path_csv(), read_path_csv() for the callers
 #include "tasks/soft_dtw.h"
@@ -194,6 +198,10 @@ struct RenavOptions : LatentOptimizerSettings {
   /// Frames shared by consecutive windows (at most half the model's window);
   /// 0 = a quarter of the model's window.
   int overlap = 0;
+  /// Foot locking after the solve (tasks/foot_locking.h, with the global
+  /// motion predictor's contacts of the decoded windows, cross-faded as the
+  /// poses are), with a ramp of this many frames; negative: off.
+  int foot_lock_ramp = kFootLockRamp;
 
   /// Empty when valid, else what is wrong.
   std::string validate() const;
