@@ -237,11 +237,11 @@ Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known,
     result = complete(on_model, known);
   } else {
     const int frames = model_rate_frames(input.num_frames(), input.fps, model_fps);
-    Motion at_rate = resample_interpolate(on_model, model_fps, frames);
+    Motion at_rate = resample_cubic(on_model, model_fps, frames);
     const std::vector<int> rate_known =
         model_rate_known(known, input.fps, model_fps, frames, on_model, &at_rate);
     const Motion solved = complete(at_rate, rate_known);
-    result = resample_interpolate(solved, input.fps, input.num_frames());
+    result = resample_cubic(solved, input.fps, input.num_frames());
   }
   Motion back = native ? result : rig->to_user(result, reference);
   back.skeleton = input.skeleton;
@@ -274,10 +274,10 @@ Motion complete_constrained_on_model_rig(const Motion& input, const MotionConstr
   mapping.user = &input.skeleton;
   if (!native) mapping.map = &rig->map();
   const MotionConstraints on_model_constraints = map_constraints(constraints, mapping);
-  if (!same_rate) on_model = resample_interpolate(on_model, model_fps, mapping.model_frames);
+  if (!same_rate) on_model = resample_cubic(on_model, model_fps, mapping.model_frames);
 
   Motion result = complete(on_model, on_model_constraints);
-  if (!same_rate) result = resample_interpolate(result, input.fps, input.num_frames());
+  if (!same_rate) result = resample_cubic(result, input.fps, input.num_frames());
   Motion back = native ? result : rig->to_user(result, reference);
   back.skeleton = input.skeleton;
   back.fps = input.fps;
@@ -292,7 +292,7 @@ Motion resample_on_model_rig(const Motion& input, double fps, int frames, const 
   if (!ctx.model || input.skeleton.same_as(ctx.model->rig().skeleton)) return resample(input, fps, frames);
   const Retargeter rig = model_retargeter(input, {}, ctx);
   const Motion result = resample(rig.to_model(input), fps, frames);
-  Motion back = rig.to_user(result, resample_interpolate(input, fps, frames));
+  Motion back = rig.to_user(result, resample_cubic(input, fps, frames));
   back.skeleton = input.skeleton;
   return back;
 }
