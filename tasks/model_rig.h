@@ -3,7 +3,8 @@
 // unit (the motion is in metres already) and at any frame rate: the input is
 // retargeted to the model's rig (prior/rig/retarget.h) and resampled to the
 // model's rate, the method runs, and its result comes back on the user's rig at
-// the input's rate. Joints the model lacks (fingers, twist bones, props) come
+// the input's rate (both resamplings by the Catmull-Rom spline of
+// resample_cubic(), tasks/baselines.h). Joints the model lacks (fingers, twist bones, props) come
 // back interpolated between the known frames; known frames are returned exactly
 // as given; unknown input frames are never read.
 #pragma once
