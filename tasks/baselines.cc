@@ -131,7 +131,13 @@ Motion zero_velocity_motion(const Motion& input, const std::vector<int>& known) 
   return out;
 }
 
-Motion resample_interpolate(const Motion& input, double new_fps, int frames) {
+namespace {
+
+// Resampling at continuous times (resample_interpolate()'s frame times and
+// snapping): output frames on an input frame copy it, the others are
+// `between(a, t, out, i)` at t in (0, 1) past input frame a.
+template <class Between>
+Motion resample_at_times(const Motion& input, double new_fps, int frames, Between between) {
   check_resample(input, new_fps, frames);
   const int N = input.num_frames();
   Motion out = Motion::identity(input.skeleton, frames, new_fps);
@@ -142,27 +148,22 @@ Motion resample_interpolate(const Motion& input, double new_fps, int frames) {
     if (t == 0.0) {
       copy_frame(input, a, out, i);
     } else {
-      blend_frames(input, a, a + 1, t, out, i);
+      between(a, t, out, i);
     }
   }
   return out;
 }
 
+}  // namespace
+
+Motion resample_interpolate(const Motion& input, double new_fps, int frames) {
+  return resample_at_times(input, new_fps, frames,
+                           [&](int a, double t, Motion& out, int i) { blend_frames(input, a, a + 1, t, out, i); });
+}
+
 Motion resample_cubic(const Motion& input, double new_fps, int frames) {
-  check_resample(input, new_fps, frames);
-  const int N = input.num_frames();
-  Motion out = Motion::identity(input.skeleton, frames, new_fps);
-  for (int i = 0; i < frames; ++i) {
-    const double s = source_position(i, input.fps, new_fps, N);
-    const int a = static_cast<int>(std::floor(s));
-    const double t = s - a;
-    if (t == 0.0) {
-      copy_frame(input, a, out, i);
-    } else {
-      cubic_frame(input, a, t, out, i);
-    }
-  }
-  return out;
+  return resample_at_times(input, new_fps, frames,
+                           [&](int a, double t, Motion& out, int i) { cubic_frame(input, a, t, out, i); });
 }
 
 Motion resample_zero_velocity(const Motion& input, double new_fps, int frames) {
