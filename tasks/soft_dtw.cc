@@ -66,9 +66,13 @@ void require_finite(const at::Tensor& contiguous, const char* fn, const char* wh
   if (!ok) throw InputError(std::string(fn) + ": " + what + " has non-finite values (NaN or infinity)");
 }
 
-void require_finite_value(double v, const char* fn) {
-  if (!std::isfinite(v))
-    throw InputError(std::string(fn) + ": the accumulated cost overflowed (costs too large for double)");
+// The values [B] as a tensor of `options`' type, each checked for overflow.
+at::Tensor checked_values(const std::vector<double>& values, const at::TensorOptions& options, const char* fn) {
+  for (double v : values) {
+    if (!std::isfinite(v))
+      throw InputError(std::string(fn) + ": the accumulated cost overflowed (costs too large for double)");
+  }
+  return at::tensor(values, at::TensorOptions().dtype(at::kDouble)).to(options.dtype());
 }
 
 // Sizes of one cost matrix and of its working memory. R is (m+1) x (n+1); P (the
@@ -266,15 +270,7 @@ class SoftDtwFunction : public torch::autograd::Function<SoftDtwFunction> {
                                  plan.wavefront_for(dm));
       });
     });
-    at::Tensor out = at::empty({B}, cost.options().requires_grad(false));
-    AT_DISPATCH_FLOATING_TYPES(cost.scalar_type(), "soft_dtw_values", [&] {
-      scalar_t* o = out.data_ptr<scalar_t>();
-      for (int64_t b = 0; b < B; ++b) {
-        require_finite_value(values[b], "soft_dtw");
-        o[b] = static_cast<scalar_t>(values[b]);
-      }
-    });
-    return out;
+    return checked_values(values, cost.options(), "soft_dtw");
   }
 
   static at::Tensor forward(torch::autograd::AutogradContext* ctx, const at::Tensor& cost, double gamma) {
@@ -450,15 +446,7 @@ class SoftDtwSequenceFunction : public torch::autograd::Function<SoftDtwSequence
         values[b] = total;
       });
     });
-    at::Tensor out = at::empty({B}, x.options().requires_grad(false));
-    AT_DISPATCH_FLOATING_TYPES(x.scalar_type(), "soft_dtw_sequences_values", [&] {
-      scalar_t* o = out.data_ptr<scalar_t>();
-      for (int64_t b = 0; b < B; ++b) {
-        require_finite_value(values[b], "soft_dtw_sequences");
-        o[b] = static_cast<scalar_t>(values[b]);
-      }
-    });
-    return out;
+    return checked_values(values, x.options(), "soft_dtw_sequences");
   }
 
   static at::Tensor forward(torch::autograd::AutogradContext* ctx, const at::Tensor& x, const at::Tensor& y,

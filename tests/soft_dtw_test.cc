@@ -437,6 +437,10 @@ TEST(SoftDtw, BadInputThrowsInputError) {
   EXPECT_THROW(soft_dtw_sequences(x, xn, 0.1), InputError);
   // An empty batch is not an error.
   EXPECT_EQ(soft_dtw(at::rand({0, 3, 4}, kF64), 0.1).numel(), 0);
+  // Finite costs whose sum along every path overflows double.
+  EXPECT_THROW(soft_dtw(at::full({2, 3, 4}, 1e308, kF64), 0.1), InputError);
+  EXPECT_THROW(soft_dtw_sequences(at::full({1, 3, 2}, 1e154, kF64), at::full({1, 4, 2}, -1e154, kF64), 0.1),
+               InputError);
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "prior/inbetween/transformer_blocks.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations_torch.h"
+#include "prior/util/module_parameters.h"
 
 namespace mf {
 
@@ -315,9 +316,7 @@ class KeyframeModel final : public InbetweenModel {
   }
 
   std::vector<std::pair<std::string, at::Tensor>> named_parameters() const override {
-    std::vector<std::pair<std::string, at::Tensor>> out;
-    for (const auto& item : net_->named_parameters(true)) out.emplace_back(item.key(), item.value());
-    return out;
+    return named_parameters_of(*net_);
   }
   void train(bool on) override { net_->train(on); }
 

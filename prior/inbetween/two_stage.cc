@@ -7,6 +7,7 @@
 
 #include "prior/inbetween/transformer_blocks.h"
 #include "prior/motion/errors.h"
+#include "prior/util/module_parameters.h"
 
 namespace mf {
 
@@ -116,9 +117,7 @@ class TwoStageModel final : public InbetweenModel {
   }
 
   std::vector<std::pair<std::string, at::Tensor>> named_parameters() const override {
-    std::vector<std::pair<std::string, at::Tensor>> out;
-    for (const auto& item : net_->named_parameters(true)) out.emplace_back(item.key(), item.value());
-    return out;
+    return named_parameters_of(*net_);
   }
   void train(bool on) override { net_->train(on); }
 

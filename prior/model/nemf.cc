@@ -14,6 +14,7 @@
 
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations_torch.h"
+#include "prior/util/module_parameters.h"
 
 namespace mf {
 
@@ -368,9 +369,7 @@ at::Tensor NemfModel::root_positions(const at::Tensor& local_rotations, const Gm
 }
 
 std::vector<std::pair<std::string, at::Tensor>> NemfModel::named_parameters() const {
-  std::vector<std::pair<std::string, at::Tensor>> out;
-  for (const auto& item : impl_->net->named_parameters(true)) out.emplace_back(item.key(), item.value());
-  return out;
+  return named_parameters_of(*impl_->net);
 }
 
 std::vector<at::Tensor> NemfModel::parameters() const { return impl_->net->parameters(true); }

@@ -619,8 +619,49 @@ class _Handle:
             raise InvalidArgumentError("%s is closed" % type(self).__name__)
         return self._handle
 
+    def _i32(self, getter: Any) -> int:
+        v = ctypes.c_int32(0)
+        _check(getter(self._live(), ctypes.byref(v)))
+        return v.value
 
-class Model(_Handle):
+    def _f64(self, getter: Any) -> float:
+        v = ctypes.c_double(0)
+        _check(getter(self._live(), ctypes.byref(v)))
+        return v.value
+
+
+class _Skeletal(_Handle):
+    # The skeleton accessors of Model and Motion: the subclass names its C getters.
+    _get_joint_count: Any = None
+    _get_joint_name: Any = None
+    _get_parents: Any = None
+    _get_offsets: Any = None
+
+    @property
+    def joint_count(self) -> int:
+        """Number of joints of the skeleton."""
+        return self._i32(type(self)._get_joint_count)
+
+    @property
+    def joint_names(self) -> List[str]:
+        """Joint names of the skeleton."""
+        return [_read_string(type(self)._get_joint_name, self._live(), j) for j in range(self.joint_count)]
+
+    @property
+    def parents(self) -> npt.NDArray[np.int32]:
+        """[joints] int32 parent indices, -1 for the root."""
+        n = self.joint_count
+        out = (ctypes.c_int32 * n)()
+        _check(type(self)._get_parents(self._live(), out, n, None))
+        return np.array(out, dtype=np.int32)
+
+    @property
+    def offsets(self) -> FloatArray:
+        """[joints, 3] float32 bone offsets, metres."""
+        return _read_floats(type(self)._get_offsets, self._live(), (-1, 3))
+
+
+class Model(_Skeletal):
     """A loaded prior. Immutable; share one between threads.
 
     Parameters
@@ -656,6 +697,10 @@ class Model(_Handle):
     """
 
     _destroy = staticmethod(_c.mf_model_destroy)
+    _get_joint_count = staticmethod(_c.mf_model_get_joint_count)
+    _get_joint_name = staticmethod(_c.mf_model_get_joint_name)
+    _get_parents = staticmethod(_c.mf_model_get_parents)
+    _get_offsets = staticmethod(_c.mf_model_get_offsets)
 
     def __init__(self, path: Optional[PathLike] = None) -> None:
         handle = ctypes.POINTER(_c.MfModel)()
@@ -743,40 +788,10 @@ class Model(_Handle):
         _check(_c.mf_model_has_inbetweener(self._live(), str(kind).encode(), ctypes.byref(v)))
         return v.value != 0
 
-    def _i32(self, getter: Any) -> int:
-        v = ctypes.c_int32(0)
-        _check(getter(self._live(), ctypes.byref(v)))
-        return v.value
-
-    @property
-    def joint_count(self) -> int:
-        """Number of joints of the model's skeleton."""
-        return self._i32(_c.mf_model_get_joint_count)
-
-    @property
-    def joint_names(self) -> List[str]:
-        """Joint names of the model's skeleton."""
-        return [_read_string(_c.mf_model_get_joint_name, self._live(), j) for j in range(self.joint_count)]
-
-    @property
-    def parents(self) -> npt.NDArray[np.int32]:
-        """[joints] int32 parent indices, -1 for the root."""
-        n = self.joint_count
-        out = (ctypes.c_int32 * n)()
-        _check(_c.mf_model_get_parents(self._live(), out, n, None))
-        return np.array(out, dtype=np.int32)
-
-    @property
-    def offsets(self) -> FloatArray:
-        """[joints, 3] float32 bone offsets, metres."""
-        return _read_floats(_c.mf_model_get_offsets, self._live(), (-1, 3))
-
     @property
     def fps(self) -> float:
         """The frame rate the model works at."""
-        v = ctypes.c_double(0)
-        _check(_c.mf_model_get_fps(self._live(), ctypes.byref(v)))
-        return v.value
+        return self._f64(_c.mf_model_get_fps)
 
     @property
     def window(self) -> int:
@@ -810,7 +825,7 @@ class Model(_Handle):
         return zl.value, zg.value
 
 
-class Motion(_Handle):
+class Motion(_Skeletal):
     """A skeleton with per-frame local rotations and root positions. Immutable.
 
     Made by Motion.from_arrays(), Motion.load_bvh(), Motion.from_bvh_text()
@@ -845,6 +860,10 @@ class Motion(_Handle):
     """
 
     _destroy = staticmethod(_c.mf_motion_destroy)
+    _get_joint_count = staticmethod(_c.mf_motion_get_joint_count)
+    _get_joint_name = staticmethod(_c.mf_motion_get_joint_name)
+    _get_parents = staticmethod(_c.mf_motion_get_parents)
+    _get_offsets = staticmethod(_c.mf_motion_get_offsets)
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         raise TypeError("use Motion.from_arrays, Motion.load_bvh or Motion.from_bvh_text")
@@ -1081,25 +1100,10 @@ class Motion(_Handle):
                                                 ctypes.byref(needed)))
         return bytes(buf)
 
-    def _i32(self, getter: Any) -> int:
-        v = ctypes.c_int32(0)
-        _check(getter(self._live(), ctypes.byref(v)))
-        return v.value
-
-    def _f64(self, getter: Any) -> float:
-        v = ctypes.c_double(0)
-        _check(getter(self._live(), ctypes.byref(v)))
-        return v.value
-
     @property
     def frame_count(self) -> int:
         """Number of frames."""
         return self._i32(_c.mf_motion_get_frame_count)
-
-    @property
-    def joint_count(self) -> int:
-        """Number of joints."""
-        return self._i32(_c.mf_motion_get_joint_count)
 
     @property
     def fps(self) -> float:
@@ -1123,24 +1127,6 @@ class Motion(_Handle):
     def frame_time(self) -> float:
         """Seconds between frames as a BVH file of this motion says them."""
         return self._f64(_c.mf_motion_get_frame_time)
-
-    @property
-    def joint_names(self) -> List[str]:
-        """Joint names."""
-        return [_read_string(_c.mf_motion_get_joint_name, self._live(), j) for j in range(self.joint_count)]
-
-    @property
-    def parents(self) -> npt.NDArray[np.int32]:
-        """[joints] int32 parent indices, -1 for the root."""
-        n = self.joint_count
-        out = (ctypes.c_int32 * n)()
-        _check(_c.mf_motion_get_parents(self._live(), out, n, None))
-        return np.array(out, dtype=np.int32)
-
-    @property
-    def offsets(self) -> FloatArray:
-        """[joints, 3] float32 bone offsets, metres."""
-        return _read_floats(_c.mf_motion_get_offsets, self._live(), (-1, 3))
 
     @property
     def rotations(self) -> FloatArray:
