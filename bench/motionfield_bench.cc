@@ -65,6 +65,7 @@ struct Args {
   bool print_stats = false;
   std::vector<int> gaps;    // gap lengths (default: the protocol's)
   std::vector<int> resample_factors;  // resampling: every k-th frame kept (default: the protocol's)
+  std::vector<std::string> resample_ratios;  // resampling: a:b rows
   bool trajectory = false;  // gap filling with the ground-truth trajectory
   bool l2t = false;
 };
@@ -95,6 +96,12 @@ void add_options(CLI::App& app, Args& args) {
   mf::bench::add_list_option(app, "--resample-factors", args.resample_factors,
                              "resampling: keep every k-th frame of a 65-frame window, bring it back to the full rate "
                              "(default: 2; 65 frames allow 2, 4, 8, 16, 32, 64)");
+  app.add_option("--resample-ratios", args.resample_ratios,
+                 "resampling rows a:b: every a-th frame of the window is the input, the result is scored at every "
+                 "b-th (5:4 is a 1.25 upsampling like 24 -> 30 fps, 4:5 a downsampling like 30 -> 24); added to "
+                 "--resample-factors")
+      ->delimiter(',')
+      ->each([](const std::string& r) { mf::bench::parse_resample_ratio(r); });  // validates
   app.add_flag("--trajectory", args.trajectory,
                "gap filling with the ground truth's trajectory of the gap (through the constrained path; methods "
                "without it are skipped)");
@@ -202,7 +209,11 @@ int run(Args& args, const std::string& command) {
   options.rig = args.rig;
   options.rig_anatomy = ctx.model_anatomy;
   if (!args.gaps.empty()) options.gap_lengths = args.gaps;
-  if (!args.resample_factors.empty()) options.resample_factors = args.resample_factors;
+  if (!args.resample_factors.empty() || !args.resample_ratios.empty()) {
+    options.resample_ratios.clear();
+    for (int k : args.resample_factors) options.resample_ratios.push_back({k, 1});
+    for (const std::string& r : args.resample_ratios) options.resample_ratios.push_back(mf::bench::parse_resample_ratio(r));
+  }
   options.trajectory = args.trajectory;
   options.l2t = args.l2t || args.trajectory;
   if (!args.rig.empty()) emit("- rig: " + args.rig + " (bench/synthetic_rigs.h)\n\n");

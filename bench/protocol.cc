@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <cstdio>
 #include <sstream>
 
@@ -249,27 +250,57 @@ TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats&
   return result;
 }
 
+ResampleRatio parse_resample_ratio(const std::string& text) {
+  ResampleRatio r;
+  const size_t colon = text.find(':');
+  auto whole = [&](const std::string& t) {
+    size_t used = 0;
+    int v = 0;
+    try {
+      v = std::stoi(t, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != t.size() || v < 1 || v > 1000)
+      throw InputError("a resampling ratio is k or a:b with whole numbers from 1 to 1000, not '" + text + "'");
+    return v;
+  };
+  r.in_step = whole(text.substr(0, colon));
+  r.out_step = colon == std::string::npos ? 1 : whole(text.substr(colon + 1));
+  if (r.in_step == r.out_step) throw InputError("a resampling ratio must change the frame rate, not '" + text + "'");
+  return r;
+}
+
+std::string ResampleRatio::label() const {
+  return out_step == 1 ? std::to_string(in_step) : std::to_string(in_step) + ":" + std::to_string(out_step);
+}
+
 TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
                           const ProtocolOptions& options, const TaskContext& ctx) {
-  const int length = options.resample_window;
   TaskResult result = start_result(Task::Resample, method);
-  const std::vector<Window> windows = cap_windows(protocol_windows(clips, length, options.stride), options.max_windows);
-  for (const int factor : options.resample_factors) {
-    if (factor < 2 || length < factor + 1 || (length - 1) % factor != 0)
-      throw InputError("the resampling window (" + std::to_string(length) + " frames) must be 1 + a multiple of " +
-                       "each factor, and the factors at least 2; not " + std::to_string(factor));
+  for (const ResampleRatio& ratio : options.resample_ratios) {
+    const int a = ratio.in_step, b = ratio.out_step;
+    if (a < 1 || b < 1 || a == b)
+      throw InputError("resampling steps must be at least 1 and differ, not " + ratio.label());
+    const int period = std::lcm(a, b);
+    const int length = 1 + period * std::max(1, (options.resample_window - 1 + period - 1) / period);
+    const std::vector<Window> windows = cap_windows(protocol_windows(clips, length, options.stride), options.max_windows);
+    // Output frame k is ground-truth frame k * b; it is an input frame when k * b is a multiple of a.
     std::vector<int> evaluated, known;
-    for (int f = 0; f < length; ++f) (f % factor ? evaluated : known).push_back(f);
+    for (int k = 0; k * b < length; ++k) ((k * b) % a ? evaluated : known).push_back(k);
     MetricAccumulator acc(stats);
     double ms = 0.0;
     for (const Window& w : windows) {
-      const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, options.root_forward);
-      Motion input = Motion::identity(truth.skeleton, static_cast<int>(known.size()), truth.fps / factor);
-      for (size_t i = 0; i < known.size(); ++i) {
-        input.root_positions[i] = truth.root_positions[known[i]];
-        for (int j = 0; j < truth.num_joints(); ++j)
-          input.rotation(static_cast<int>(i), j) = truth.rotation(known[i], j);
-      }
+      const Motion full = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, options.root_forward);
+      auto every = [&](int step) {
+        Motion m = Motion::identity(full.skeleton, (length - 1) / step + 1, full.fps / step);
+        for (int i = 0; i < m.num_frames(); ++i) {
+          m.root_positions[i] = full.root_positions[i * step];
+          for (int j = 0; j < full.num_joints(); ++j) m.rotation(i, j) = full.rotation(i * step, j);
+        }
+        return m;
+      };
+      const Motion input = every(a), truth = every(b);
       const auto t0 = Clock::now();
       const Motion pred = run_resample(input, truth.fps, method, nullptr, ctx);
       ms += ms_since(t0);
@@ -277,7 +308,8 @@ TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats
       acc.add(truth, pred, evaluated, known);
     }
     RowResult row;
-    row.parameter = factor;
+    row.parameter = a;
+    row.label = ratio.label();
     row.metrics = acc.summary();
     row.ms_per_window = windows.empty() ? 0.0 : ms / windows.size();
     result.rows.push_back(row);
@@ -317,7 +349,7 @@ std::string format_table(const TaskResult& result, bool l2p_axes) {
       param = "k";
       break;
     case Task::Resample:
-      title = "Resampling (every k-th frame -> full rate)";
+      title = "Resampling (every k-th frame -> full rate; a:b: every a-th frame -> every b-th)";
       param = "k";
       break;
   }
@@ -330,7 +362,7 @@ std::string format_table(const TaskResult& result, bool l2p_axes) {
   out << "|---:|---:|---:|" << (l2p_axes ? "---:|---:|" : "") << (result.l2t ? "---:|" : "") << "---:|---:|---:|---:|---:|---:|---:|---:|\n";
   for (const RowResult& row : result.rows) {
     const MetricSummary& m = row.metrics;
-    out << "| " << row.parameter << " | " << m.windows << " | " << fixed(m.l2p, 3);
+    out << "| " << (row.label.empty() ? std::to_string(row.parameter) : row.label) << " | " << m.windows << " | " << fixed(m.l2p, 3);
     if (l2p_axes) out << " | " << fixed(m.l2p_horizontal, 3) << " | " << fixed(m.l2p_vertical, 3);
     if (result.l2t) out << " | " << fixed(m.l2t, 3);
     out << " | " << fixed(m.l2q, 3)

@@ -52,16 +52,32 @@ Task task_from_name(const std::string& name);
 /// Every task in the order of the tables.
 std::vector<Task> all_tasks();
 
+/// One resampling row: the input is every `in_step`-th frame of the ground
+/// truth (at fps / in_step), the method brings it to fps / out_step and is
+/// scored on every out_step-th frame of the ground truth. {k, 1}: back to the
+/// full rate ("k"); {5, 4}: a 1.25 ratio (6 -> 7.5 fps at 30, as 24 -> 30);
+/// {4, 5}: downsampling by 0.8 (as 30 -> 24).
+struct ResampleRatio {
+  int in_step = 2, out_step = 1;
+  /// "k" when out_step is 1, else "in_step:out_step".
+  std::string label() const;
+};
+
+/// Parses "k" or "a:b" (whole numbers >= 1, not both 1); throws mf::InputError.
+ResampleRatio parse_resample_ratio(const std::string& text);
+
 struct ProtocolOptions {
   std::vector<int> gap_lengths{5, 15, 30, 45, 90};
   std::vector<int> keyframe_spacings{5, 10, 15, 20, 30};
   int context = 10;            ///< gap filling: known frames before the gap
   int stride = 40;             ///< window start every `stride` frames
   int sparse_window = 128;
-  int resample_window = 65;    ///< 1 + a multiple of every factor, so that both ends are input frames
-  /// Resampling rows: every k-th frame of the window is the input (at fps / k),
-  /// the method brings it back to the full rate.
-  std::vector<int> resample_factors{2};
+  /// Resampling windows: the smallest 1 + a multiple of lcm(in_step,
+  /// out_step) frames that is at least this, so that both ends are input and
+  /// output frames (65 for steps dividing 64).
+  int resample_window = 65;
+  /// Resampling rows (ResampleRatio): the default 15 -> 30 fps.
+  std::vector<ResampleRatio> resample_ratios{{2, 1}};
   int max_windows = 0;         ///< cap per table row (spread evenly over the windows); 0 = all
   Eigen::Vector3d root_forward = Eigen::Vector3d::UnitZ();
   /// Gap filling and sparse keyframes on a synthetic rig (bench/synthetic_rigs.h,
@@ -105,7 +121,8 @@ Motion hide_unknown_frames(const Motion& motion, const std::vector<int>& known);
 
 /// One table row: one gap length / keyframe spacing.
 struct RowResult {
-  int parameter = 0;           ///< T, k, or the output frame rate for resampling
+  int parameter = 0;           ///< T, k, or the input step for resampling
+  std::string label;           ///< resampling: ResampleRatio::label(); else empty (the table shows `parameter`)
   MetricSummary metrics;
   double ms_per_window = 0.0;  ///< wall time of the method call per window
 };

@@ -254,6 +254,42 @@ TEST(PriorCodec, ResidualMakesTheReconstructionExactAtInputFrames) {
   EXPECT_LT(fixed_err, 0.01);  // times ~3e-3 frames off, residual interpolated
 }
 
+// Method "prior" at ratios that are not whole: dense input takes the spline
+// (the codec lost to it at every input up to 6 times sparser than the model's
+// rate), very sparse input the codec with its residual.
+TEST(PriorCodec, PriorResamplingTakesTheSplineOrTheCodecByTheRatio) {
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
+  ASSERT_DOUBLE_EQ(model->config().fps, 30.0);
+  TaskContext ctx;
+  ctx.model = model;
+  const std::pair<double, double> dense[] = {{24.0, 30.0}, {30.0, 60.0}, {30.0, 24.0}, {25.0, 120.0}};
+  for (const auto& [in_fps, out_fps] : dense) {
+    const Motion m = test::random_motion(model->rig().skeleton, 25, in_fps, 3);
+    const Motion prior = run_resample(m, out_fps, "prior", nullptr, ctx);
+    const Motion cubic = run_resample(m, out_fps, "cubic", nullptr, ctx);
+    ASSERT_EQ(prior.num_frames(), cubic.num_frames()) << in_fps << " -> " << out_fps;
+    for (int f = 0; f < prior.num_frames(); ++f) {
+      EXPECT_TRUE(prior.root_positions[f] == cubic.root_positions[f]) << f;
+      for (int j = 0; j < prior.num_joints(); ++j) EXPECT_TRUE(prior.rotation(f, j).coeffs() == cubic.rotation(f, j).coeffs());
+    }
+  }
+  // 4 fps -> 30 (7.5 times sparser): the codec, through every input frame.
+  const Motion m = test::random_motion(model->rig().skeleton, 9, 4.0, 4);
+  const Motion prior = run_resample(m, 30.0, "prior", nullptr, ctx);
+  const Motion cubic = run_resample(m, 30.0, "cubic", nullptr, ctx);
+  ASSERT_EQ(prior.num_frames(), 61);
+  double differs = 0.0;
+  for (int f = 0; f < prior.num_frames(); ++f) {
+    for (int j = 0; j < prior.num_joints(); ++j)
+      differs = std::max(differs, geodesic_angle(prior.rotation(f, j), cubic.rotation(f, j)));
+  }
+  EXPECT_GT(differs, 1e-3);
+  for (int k = 0; k < m.num_frames(); k += 2) {  // input frame k is output frame 7.5 k
+    for (int j = 0; j < m.num_joints(); ++j)
+      EXPECT_LT(geodesic_angle(prior.rotation(15 * k / 2, j), m.rotation(k, j)), 1e-5) << k << " " << j;
+  }
+}
+
 TEST(PriorCodec, RejectsBadInput) {
   auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   TaskContext none;

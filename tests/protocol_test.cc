@@ -226,12 +226,12 @@ TEST(ProtocolTest, ResamplingRowsPerFactorKeepEveryKthFrame) {
   const EvalStats stats = small_stats();
   std::vector<Clip> val = {make_clip("v", test::random_motion(test::small_skeleton(), 110, 30.0, 51))};
   ProtocolOptions o;
-  o.resample_factors = {2, 4};
+  o.resample_ratios = {{2, 1}, {4, 1}};
   const TaskResult interp = run_resampling(val, stats, "interp", o), cubic = run_resampling(val, stats, "cubic", o);
   ASSERT_EQ(interp.rows.size(), 2u);
   ASSERT_EQ(cubic.rows.size(), 2u);
   for (size_t r = 0; r < 2; ++r) {
-    EXPECT_EQ(interp.rows[r].parameter, o.resample_factors[r]);
+    EXPECT_EQ(interp.rows[r].parameter, o.resample_ratios[r].in_step);
     EXPECT_EQ(interp.rows[r].metrics.windows, 2);
     EXPECT_LT(cubic.rows[r].metrics.known.position_max_cm, 1e-6);
     // The smooth sinusoids of the test motion: the spline beats the chords.
@@ -240,8 +240,42 @@ TEST(ProtocolTest, ResamplingRowsPerFactorKeepEveryKthFrame) {
   // Fewer input frames, larger errors.
   EXPECT_GT(interp.rows[1].metrics.l2p, interp.rows[0].metrics.l2p);
   EXPECT_NE(format_table(cubic, false).find("every k-th frame"), std::string::npos);
-  o.resample_factors = {3};  // 64 frames between the ends are not a multiple of 3
+  o.resample_ratios = {{2, 2}};
   EXPECT_THROW(run_resampling(val, stats, "interp", o), InputError);
+}
+
+TEST(ProtocolTest, ResamplingByRatiosThatAreNotWhole) {
+  const EvalStats stats = small_stats();
+  std::vector<Clip> val = {make_clip("v", test::random_motion(test::small_skeleton(), 110, 30.0, 51))};
+  ProtocolOptions o;
+  // 3:2 upsamples 10 -> 15 fps in 67-frame windows (1 + a multiple of 6); 4:5
+  // downsamples 7.5 -> 6 fps in 81-frame windows; 3 alone needs 67 frames too.
+  o.resample_ratios = {{3, 2}, {4, 5}, {3, 1}};
+  const TaskResult interp = run_resampling(val, stats, "interp", o), cubic = run_resampling(val, stats, "cubic", o);
+  ASSERT_EQ(cubic.rows.size(), 3u);
+  EXPECT_EQ(cubic.rows[0].label, "3:2");
+  EXPECT_EQ(cubic.rows[1].label, "4:5");
+  EXPECT_EQ(cubic.rows[2].label, "3");
+  EXPECT_EQ(cubic.rows[0].metrics.windows, 2);  // 67-frame windows at 0 and 40
+  EXPECT_EQ(cubic.rows[1].metrics.windows, 1);  // 81 frames fit once
+  for (size_t r = 0; r < 3; ++r) {
+    // Output frames on an input frame (every 6th ground-truth frame for 3:2) come out exactly.
+    EXPECT_LT(cubic.rows[r].metrics.known.position_max_cm, 1e-6) << r;
+    EXPECT_LT(cubic.rows[r].metrics.l2p, interp.rows[r].metrics.l2p) << r;
+    EXPECT_GT(interp.rows[r].metrics.l2p, 0.0) << r;
+  }
+  const std::string table = format_table(cubic, false);
+  EXPECT_NE(table.find("| 3:2 | 2 |"), std::string::npos) << table;
+  EXPECT_NE(table.find("| 4:5 | 1 |"), std::string::npos) << table;
+}
+
+TEST(ProtocolTest, ParsesResampleRatios) {
+  EXPECT_EQ(parse_resample_ratio("5:4").in_step, 5);
+  EXPECT_EQ(parse_resample_ratio("5:4").out_step, 4);
+  EXPECT_EQ(parse_resample_ratio("2").out_step, 1);
+  EXPECT_EQ(parse_resample_ratio("4:5").label(), "4:5");
+  for (const char* bad : {"", ":", "5:", ":4", "0:1", "3:3", "1", "2.5", "a:b", "5:4:3", "-2", "2000"})
+    EXPECT_THROW(parse_resample_ratio(bad), InputError) << bad;
 }
 
 }  // namespace
