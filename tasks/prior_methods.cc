@@ -58,7 +58,7 @@ bool upsample_by_solving(const Motion& in, double fps, int frames, const TaskCon
 // Input rates in any other ratio to the model's (24 -> 30, 30 -> 60, 30 ->
 // 24, 12 -> 30, ...) have no model frames to solve at. Measured at whole ratios
 // r = model fps / input fps with the path forced (training split, 100 windows,
-// L2P; docs/BENCHMARKS.md, "Session 13: resampling at any ratio"), the
+// L2P; docs/BENCHMARKS.md, "Session 13"), the
 // encode / decode with the residual loses to the spline up to r = 6 (r = 2: 0.193
 // against 0.071; 4: 0.502 against 0.335; 6: 0.899 against 0.813), ties at 7
 // (0.987 / 0.976) and wins at 8 (1.226 / 1.348). So the spline serves inputs up
