@@ -401,6 +401,13 @@ bool pair_needs_grad(const PairSpec& p, bool need_x, bool need_y) {
 // The batch size of x [Bx, ...] and y [By, ...] where Bx and By are equal or one of them is 1.
 int64_t batch_of(const at::Tensor& x, const at::Tensor& y) { return x.size(0) == 1 ? y.size(0) : x.size(0); }
 
+// Item b of a [batch, size] buffer in double; a batch of 1 is broadcast.
+template <typename T>
+std::vector<double> item_in_double(const T* data, int64_t batch, int64_t b, int64_t size) {
+  const T* item = data + (batch == 1 ? 0 : b) * size;
+  return std::vector<double>(item, item + size);
+}
+
 class SoftDtwSequenceFunction : public torch::autograd::Function<SoftDtwSequenceFunction> {
  public:
   // x [Bx, m, d], y [By, n, d] validated and contiguous, Bx and By equal or 1;
@@ -429,10 +436,8 @@ class SoftDtwSequenceFunction : public torch::autograd::Function<SoftDtwSequence
       const scalar_t* xb = x.data_ptr<scalar_t>();
       const scalar_t* yb = y.data_ptr<scalar_t>();
       for_each_item(B, plan, [&](int64_t b) {
-        const std::vector<double> xd(xb + (x.size(0) == 1 ? 0 : b) * m * d,
-                                     xb + (x.size(0) == 1 ? 0 : b) * m * d + m * d);
-        const std::vector<double> yd(yb + (y.size(0) == 1 ? 0 : b) * n * d,
-                                     yb + (y.size(0) == 1 ? 0 : b) * n * d + n * d);
+        const std::vector<double> xd = item_in_double(xb, x.size(0), b, m * d);
+        const std::vector<double> yd = item_in_double(yb, y.size(0), b, n * d);
         double total = 0.0;
         for (size_t k = 0; k < pairs.size(); ++k) {
           const PairSpec& p = pairs[k];
@@ -492,10 +497,8 @@ class SoftDtwSequenceFunction : public torch::autograd::Function<SoftDtwSequence
       const scalar_t* xb = x.data_ptr<scalar_t>();
       const scalar_t* yb = y.data_ptr<scalar_t>();
       for_each_item(B, plan, [&](int64_t b) {
-        const std::vector<double> xd(xb + (x.size(0) == 1 ? 0 : b) * m * d,
-                                     xb + (x.size(0) == 1 ? 0 : b) * m * d + m * d);
-        const std::vector<double> yd(yb + (y.size(0) == 1 ? 0 : b) * n * d,
-                                     yb + (y.size(0) == 1 ? 0 : b) * n * d + n * d);
+        const std::vector<double> xd = item_in_double(xb, x.size(0), b, m * d);
+        const std::vector<double> yd = item_in_double(yb, y.size(0), b, n * d);
         std::vector<double> scratch_x(need_x ? 0 : m * d), scratch_y(need_y ? 0 : n * d);
         double* gxb = need_x ? gx.data() + b * m * d : scratch_x.data();
         double* gyb = need_y ? gy.data() + b * n * d : scratch_y.data();

@@ -52,7 +52,7 @@ import json
 import os
 import threading
 import warnings
-from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple, TypeVar, Union
+from typing import Any, Callable, Dict, List, NamedTuple, Optional, Sequence, Tuple, Type, TypeVar, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -580,6 +580,9 @@ def default_method(*, model: Optional["Model"] = None) -> str:
 # ------------------------------------------------------------------ handles
 
 
+_H = TypeVar("_H", bound="_Handle")
+
+
 class _Handle:
     _destroy: Any = None
     _handle: Any
@@ -613,6 +616,13 @@ class _Handle:
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
+
+    @classmethod
+    def _wrap(cls: Type[_H], handle: Any) -> _H:
+        # An object around a handle the C API made, without the public constructor.
+        self = cls.__new__(cls)
+        _Handle.__init__(self, handle)
+        return self
 
     def _live(self) -> Any:
         if not self._handle:
@@ -706,12 +716,6 @@ class Model(_Skeletal):
         handle = ctypes.POINTER(_c.MfModel)()
         _check(_c.mf_model_load(None if path is None else os.fspath(path).encode(), ctypes.byref(handle)))
         super().__init__(handle)
-
-    @classmethod
-    def _wrap(cls, handle: Any) -> "Model":
-        self = cls.__new__(cls)
-        _Handle.__init__(self, handle)
-        return self
 
     @classmethod
     def from_bytes(cls, data: bytes) -> "Model":
@@ -867,12 +871,6 @@ class Motion(_Skeletal):
 
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         raise TypeError("use Motion.from_arrays, Motion.load_bvh or Motion.from_bvh_text")
-
-    @classmethod
-    def _wrap(cls, handle: Any) -> "Motion":
-        self = cls.__new__(cls)
-        _Handle.__init__(self, handle)
-        return self
 
     @classmethod
     @_keywords_after("joint_names", "parents", "offsets", "model", "like")
@@ -1493,9 +1491,7 @@ class Constraints(_Handle):
         """
         out = ctypes.POINTER(_c.MfConstraints)()
         _check(_c.mf_constraints_load_json(os.fsencode(path), ctypes.byref(out)))
-        c = cls.__new__(cls)
-        _Handle.__init__(c, out)
-        return c
+        return cls._wrap(out)
 
     def add_keys(self, frames: Sequence[int]) -> "Constraints":
         """Adds whole-pose keys.
@@ -2028,25 +2024,15 @@ class Encoding(_Handle):
     def __init__(self, *args: Any, **kwargs: Any) -> None:
         raise TypeError("use motionfield.encode(motion, model=model)")
 
-    @classmethod
-    def _wrap(cls, handle: Any) -> "Encoding":
-        self = cls.__new__(cls)
-        _Handle.__init__(self, handle)
-        return self
-
     @property
     def window_count(self) -> int:
         """Number of windows."""
-        v = ctypes.c_int32(0)
-        _check(_c.mf_encoding_get_window_count(self._live(), ctypes.byref(v)))
-        return v.value
+        return self._i32(_c.mf_encoding_get_window_count)
 
     @property
     def duration(self) -> float:
         """Seconds from the first to the last frame of the encoded motion."""
-        v = ctypes.c_double(0)
-        _check(_c.mf_encoding_get_duration(self._live(), ctypes.byref(v)))
-        return v.value
+        return self._f64(_c.mf_encoding_get_duration)
 
     @property
     def window_times(self) -> npt.NDArray[np.float64]:
