@@ -102,16 +102,46 @@ void contact_goals(const GlobalPose& pose, int ankle, const std::vector<char>& o
 
 // Moves the chain's end toward `goal` with `weight` at every frame not `fixed`:
 // its ground position (x, z) only, or its height too.
+// Where hold() moves the ankle at a frame: `weight` of the way from `now` to
+// `goal` (on the ground plane only unless `height`).
+Eigen::Vector3d hold_target(const Eigen::Vector3d& now, const Eigen::Vector3d& goal, double weight, bool height) {
+  Eigen::Vector3d target = now + weight * (goal - now);
+  if (!height) target.y() = now.y();
+  return target;
+}
+
 void hold(const Leg& leg, const std::vector<Eigen::Vector3d>& goal, const std::vector<double>& weight,
           const std::vector<char>& fixed, bool height, Motion* out, GlobalPose* pose) {
   for (int f = 0; f < out->num_frames(); ++f) {
     if (weight[f] <= 0.0 || fixed[f]) continue;
-    const Eigen::Vector3d now = pose->position(f, leg.ankle);
-    Eigen::Vector3d target = now;
-    target.x() += weight[f] * (goal[f].x() - now.x());
-    if (height) target.y() += weight[f] * (goal[f].y() - now.y());
-    target.z() += weight[f] * (goal[f].z() - now.z());
-    two_bone_ik(out, pose, f, leg.hip, leg.knee, leg.ankle, target);
+    two_bone_ik(out, pose, f, leg.hip, leg.knee, leg.ankle,
+                hold_target(pose->position(f, leg.ankle), goal[f], weight[f], height));
+  }
+}
+
+// A pin's target can lie beyond the leg's reach from the hip (the solve left
+// the hip a little too far from the planted point, the leg straight); the IK
+// would stop short and the foot slide. On frames where the root is free, the
+// root moves toward the target by the shortfall, so that the IK reaches it
+// (hold() with height). The shortfall is zero where the target is in reach, so
+// the root path stays continuous.
+void bring_in_reach(const MotionConstraints& c, const Leg& leg, const std::vector<Eigen::Vector3d>& goal,
+                    const std::vector<double>& weight, const std::vector<char>& fixed, Motion* out,
+                    GlobalPose* pose) {
+  const int J = out->num_joints();
+  for (int f = 0; f < out->num_frames(); ++f) {
+    if (weight[f] <= 0.0 || fixed[f] || c.fixes_root_position(f)) continue;
+    const Eigen::Vector3d hip = pose->position(f, leg.hip);
+    // two_bone_ik() clamps a target to 1e-4 inside the reach: aim 2e-4 inside.
+    const double reach = (pose->position(f, leg.knee) - hip).norm() +
+                         (pose->position(f, leg.ankle) - pose->position(f, leg.knee)).norm() - 2e-4;
+    const Eigen::Vector3d to_goal =
+        hold_target(pose->position(f, leg.ankle), goal[f], weight[f], /*height=*/true) - hip;
+    const double shortfall = to_goal.norm() - reach;
+    if (!(shortfall > 0)) continue;
+    const Eigen::Vector3d delta = shortfall * to_goal.normalized();
+    out->root_positions[f] += delta;
+    for (int j = 0; j < J; ++j) pose->positions[static_cast<size_t>(f) * J + j] += delta;
   }
 }
 
@@ -227,6 +257,7 @@ std::vector<std::string> pin_contacts(const MotionConstraints& c, int ramp, Moti
     std::vector<double> weight;
     contact_goals(pose, leg.ankle, on, known, ramp, &goal, &weight);
     warn_conflicts(what, pose, leg.ankle, p, fixed, known, &warnings);
+    bring_in_reach(c, leg, goal, weight, fixed, out, &pose);
     hold(leg, goal, weight, fixed, /*height=*/true, out, &pose);
   }
   return warnings;

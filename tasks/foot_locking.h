@@ -47,7 +47,9 @@ void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector
                Motion* out);
 
 /// Holds every contact pin of `c` in `out` (see the top of this file), with a
-/// ramp of `ramp` frames on each side. Returns a warning for each pin that
+/// ramp of `ramp` frames on each side. Where the pinned point is beyond the
+/// leg's reach from the hip, the root moves toward it by the shortfall, on
+/// frames whose root position no key fixes. Returns a warning for each pin that
 /// cannot hold exactly: a joint without a two-bone chain, keys inside the pin
 /// that place the joint at different points (the pin then moves between them),
 /// keys or targets that constrain part of its chain inside the pin.

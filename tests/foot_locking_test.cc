@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "prior/model/representation.h"
@@ -109,6 +110,48 @@ TEST(FootLocking, ToesOutOfContactAndKeyedFramesAreLeftAlone) {
   lock_feet(leg_rig(m.skeleton), MotionConstraints::full_pose({10}), contacts(0.0f, 1.0f), kFootLockRamp, &out);
   for (int j = 0; j < m.num_joints(); ++j) EXPECT_EQ(out.rotation(10, j).coeffs(), m.rotation(10, j).coeffs());
   EXPECT_LT(horizontal_spread(out, kToe, 0, 9), 0.002);
+}
+
+// A contact pin on a nearly straight leg whose hips walk 3 cm a frame, with a
+// full-pose key at frame 12 inside it: the pinned point (where the key puts
+// the foot) is out of the leg's reach on the contact's other frames, so the IK
+// alone would stop short and the foot slide. The root moves toward it by the
+// shortfall on the frames it is free, and keeps its value on the keyed frame.
+TEST(FootLocking, AContactPinOutOfReachMovesTheFreeRootByTheShortfall) {
+  Motion m = Motion::identity(leg_with_toe(), kFrames, 30.0);
+  for (int f = 0; f < kFrames; ++f) m.root_positions[f] = Eigen::Vector3d(0, 0.85, 0.03 * f);
+  MotionConstraints c = MotionConstraints::full_pose({12});
+  c.contacts.push_back(ContactPin{kFoot, 4, 15});
+  Motion out = m;
+  const std::vector<std::string> warnings = pin_contacts(c, kDefaultContactRamp, &out);
+  EXPECT_TRUE(warnings.empty()) << warnings.front();
+  const GlobalPose pose = forward_kinematics(out);
+  for (int f = 4; f <= 15; ++f) {
+    if (f == 12) continue;  // the key keeps the leg and the root there
+    EXPECT_LT((pose.position(f, kFoot) - pose.position(4, kFoot)).norm(), 1e-3) << "frame " << f;
+  }
+  EXPECT_EQ(out.root_positions[12], m.root_positions[12]);
+  for (int j = 0; j < m.num_joints(); ++j) EXPECT_EQ(out.rotation(12, j).coeffs(), m.rotation(12, j).coeffs());
+  double moved = 0.0, jump = 0.0;
+  for (int f = 0; f < kFrames; ++f) {
+    moved = std::max(moved, (out.root_positions[f] - m.root_positions[f]).norm());
+    if (f > 0) jump = std::max(jump, (out.root_positions[f] - out.root_positions[f - 1]).norm());
+  }
+  EXPECT_GT(moved, 0.02);  // frame 4 is 3.3 cm out of reach: sqrt(0.84^2 + 0.24^2) - 0.84
+  EXPECT_LT(moved, 0.04);
+  EXPECT_LT(jump, 0.04);  // a root path of 3 cm a frame stays continuous
+  // Without the root's help the same pin slides (the test's premise).
+  Motion ik_only = m;
+  MotionConstraints all_keyed = c;
+  for (int f = 0; f < kFrames; ++f) {
+    PoseKey root_only;
+    root_only.frame = f;
+    root_only.rotations = false;
+    if (f != 12) all_keyed.keys.push_back(root_only);
+  }
+  pin_contacts(all_keyed, kDefaultContactRamp, &ik_only);
+  const GlobalPose stuck = forward_kinematics(ik_only);
+  EXPECT_GT((stuck.position(15, kFoot) - stuck.position(5, kFoot)).norm(), 5e-3);
 }
 
 }  // namespace
