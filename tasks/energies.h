@@ -121,9 +121,9 @@ enum class Penalty { Squared, Absolute };
 
 /// Weights of the energy terms (see the top of this file for each term's
 /// definition and unit). Defaults were chosen by measurement (docs/BENCHMARKS.md,
-/// "Latent solvers").
+/// "Latent solvers"; the rotation weight in "Session 14").
 struct EnergyWeights {
-  double rotation = 1.0;
+  double rotation = 5.0;
   double position = 10.0;
   double root_orientation = 1.0;
   double root_translation = 10.0;

@@ -18,7 +18,7 @@
 // Defaults (docs/BENCHMARKS.md, "Latent solvers", has the measurements):
 // L-BFGS: 30 keys-only iterations then at most 20 full ones (a single stage of
 // 60 with long gaps or end-effector targets; window_caps()),
-// function tolerance 1e-3; weights rotation 1,
+// function tolerance 1e-3; weights rotation 5,
 // position 10, root orientation 1, root translation 10 (the GMP path), no
 // prior, skating or smoothness term (they bought nothing measurable with the
 // pilot prior); squared penalties; foot locking with a 3-frame ramp.
