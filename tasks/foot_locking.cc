@@ -4,6 +4,8 @@
 #include <cctype>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "tasks/two_bone_ik.h"
 
@@ -237,28 +239,41 @@ std::vector<std::string> pin_contacts(const MotionConstraints& c, int ramp, Moti
   std::vector<std::string> warnings;
   const Skeleton& skel = out->skeleton;
   const int N = out->num_frames();
+  struct Pinned {
+    Leg leg;
+    std::vector<char> fixed;
+    std::vector<Eigen::Vector3d> goal;
+    std::vector<double> weight;
+  };
+  std::vector<Pinned> pinned;
+  // Every root move comes before every hold: a root move carries the whole
+  // body, so after a hold it would shift the feet already pinned.
+  GlobalPose pose = forward_kinematics(*out);
   for (const ContactPin& p : c.contacts) {
     const std::string what = "contact of joint '" + skel.names[p.joint] + "' on frames " + std::to_string(p.first) +
                              ".." + std::to_string(p.last);
-    Leg leg;
-    leg.ankle = p.joint;
-    leg.knee = skel.parents[p.joint];
-    leg.hip = leg.knee > 0 ? skel.parents[leg.knee] : -1;
-    if (leg.hip <= 0) {
+    Pinned pin;
+    pin.leg.ankle = p.joint;
+    pin.leg.knee = skel.parents[p.joint];
+    pin.leg.hip = pin.leg.knee > 0 ? skel.parents[pin.leg.knee] : -1;
+    if (pin.leg.hip <= 0) {
       warnings.push_back(what + " is not held: the joint needs two bones above it below the root");
       continue;
     }
-    std::vector<char> fixed, known;
-    protected_frames(c, skel, leg, N, &fixed, &known);
-    GlobalPose pose = forward_kinematics(*out);
+    std::vector<char> known;
+    protected_frames(c, skel, pin.leg, N, &pin.fixed, &known);
     std::vector<char> on(N, 0);
     std::fill(on.begin() + p.first, on.begin() + p.last + 1, 1);
-    std::vector<Eigen::Vector3d> goal;
-    std::vector<double> weight;
-    contact_goals(pose, leg.ankle, on, known, ramp, &goal, &weight);
-    warn_conflicts(what, pose, leg.ankle, p, fixed, known, &warnings);
-    bring_in_reach(c, leg, goal, weight, fixed, out, &pose);
-    hold(leg, goal, weight, fixed, /*height=*/true, out, &pose);
+    contact_goals(pose, pin.leg.ankle, on, known, ramp, &pin.goal, &pin.weight);
+    warn_conflicts(what, pose, pin.leg.ankle, p, pin.fixed, known, &warnings);
+    bring_in_reach(c, pin.leg, pin.goal, pin.weight, pin.fixed, out, &pose);
+    pinned.push_back(std::move(pin));
+  }
+  // A later pin's root move can take an earlier pin's target out of reach again.
+  for (const Pinned& pin : pinned) bring_in_reach(c, pin.leg, pin.goal, pin.weight, pin.fixed, out, &pose);
+  for (const Pinned& pin : pinned) {
+    pose = forward_kinematics(*out);
+    hold(pin.leg, pin.goal, pin.weight, pin.fixed, /*height=*/true, out, &pose);
   }
   return warnings;
 }

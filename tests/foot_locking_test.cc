@@ -154,5 +154,34 @@ TEST(FootLocking, AContactPinOutOfReachMovesTheFreeRootByTheShortfall) {
   EXPECT_GT((stuck.position(15, kFoot) - stuck.position(5, kFoot)).norm(), 5e-3);
 }
 
+// Two legs whose contacts overlap on frames 8..11 while the hips walk 3 cm a
+// frame: both pinned points are out of reach on some of those frames. Each
+// root move carries the whole body, so both happen before either foot is
+// held; otherwise the right leg's move would shift the left foot, already held.
+TEST(FootLocking, TwoContactPinsOutOfReachOnTheSameFramesBothHold) {
+  Skeleton s;
+  s.names = {"Hips", "UpperLeg_L", "LowerLeg_L", "Foot_L", "UpperLeg_R", "LowerLeg_R", "Foot_R"};
+  s.parents = {-1, 0, 1, 2, 0, 4, 5};
+  s.offsets = {{0, 0, 0}, {0.1, -0.05, 0}, {0, -0.42, 0.02}, {0, -0.42, -0.02},
+               {-0.1, -0.05, 0}, {0, -0.42, 0.02}, {0, -0.42, -0.02}};
+  Motion m = Motion::identity(s, kFrames, 30.0);
+  for (int f = 0; f < kFrames; ++f) m.root_positions[f] = Eigen::Vector3d(0, 0.85, 0.03 * f);
+  MotionConstraints c;
+  c.contacts.push_back(ContactPin{3, 0, 11});
+  c.contacts.push_back(ContactPin{6, 8, 19});
+  Motion out = m;
+  const std::vector<std::string> warnings = pin_contacts(c, kDefaultContactRamp, &out);
+  EXPECT_TRUE(warnings.empty()) << warnings.front();
+  const GlobalPose pose = forward_kinematics(out);
+  for (const ContactPin& p : c.contacts) {
+    for (int f = p.first + 1; f <= p.last; ++f)
+      EXPECT_LT((pose.position(f, p.joint) - pose.position(p.first, p.joint)).norm(), 1e-3)
+          << s.names[p.joint] << " frame " << f;
+  }
+  double moved = 0.0;
+  for (int f = 0; f < kFrames; ++f) moved = std::max(moved, (out.root_positions[f] - m.root_positions[f]).norm());
+  EXPECT_GT(moved, 0.01);  // the premise: the root had to move
+}
+
 }  // namespace
 }  // namespace mf
