@@ -264,6 +264,83 @@ TEST(Retarget, AnatomyJsonRoundTrip) {
   EXPECT_THROW(RigAnatomy::from_json("nope", sample().skeleton, "x.json"), InputError);
 }
 
+// The sample walk with the left knee turned about one fixed axis only, as the
+// training data's knees do (a hinge).
+Motion hinge_knee_walk(int* knee, Eigen::Vector3d* hinge) {
+  Motion m = sample();
+  *knee = m.skeleton.find("LowerLeg_L");
+  *hinge = Eigen::Vector3d(0.2, 1.0, -0.1).normalized();
+  for (int f = 0; f < m.num_frames(); ++f)
+    m.rotation(f, *knee) = Eigen::Quaterniond(Eigen::AngleAxisd(0.3 + 0.5 * std::sin(0.2 * f), *hinge));
+  return m;
+}
+
+TEST(Retarget, LockedAxesOfAHingeAreMeasuredAndRemoved) {
+  int knee = -1;
+  Eigen::Vector3d hinge;
+  const Motion m = hinge_knee_walk(&knee, &hinge);
+  RigAnatomy a = estimate_anatomy(m, find_rig_parts(m.skeleton));
+  measure_locked_axes(m, 0.6, &a);
+  ASSERT_EQ(a.locked_axes.size(), static_cast<size_t>(m.num_joints()));
+  ASSERT_EQ(a.locked_axes[knee].size(), 2u);
+  for (const Eigen::Vector3d& axis : a.locked_axes[knee]) EXPECT_LT(std::abs(axis.dot(hinge)), 1e-6);
+  int free = 0;  // a joint the walk turns every way
+  while (free < m.num_joints() && !a.locked_axes[free].empty()) ++free;
+  ASSERT_LT(free, m.num_joints());
+
+  // A rotation off the hinge comes back onto it; one on it is unchanged.
+  const Eigen::Quaterniond on(Eigen::AngleAxisd(0.7, hinge));
+  const Eigen::Quaterniond off = on * Eigen::Quaterniond(Eigen::AngleAxisd(0.05, a.locked_axes[knee][0]));
+  EXPECT_GT(geodesic_angle(off, on), 0.04);
+  EXPECT_LT(geodesic_angle(without_locked_rotation(a, knee, off), on), 0.002);
+  EXPECT_LT(geodesic_angle(without_locked_rotation(a, knee, on), on), 1e-9);
+  EXPECT_EQ(without_locked_rotation(a, free, off).coeffs(), off.coeffs());
+
+  const RigAnatomy back = RigAnatomy::from_json(a.to_json(m.skeleton), m.skeleton, "x.json");
+  ASSERT_EQ(back.locked_axes[knee].size(), 2u);
+  for (int k = 0; k < 2; ++k) EXPECT_LT((back.locked_axes[knee][k] - a.locked_axes[knee][k]).norm(), 1e-12);
+  for (int j = 0; j < m.num_joints(); ++j) EXPECT_EQ(back.locked_axes[j].size(), a.locked_axes[j].size());
+  std::string bad = a.to_json(m.skeleton);
+  bad.replace(bad.find("\"locked_axes\""), 13, "\"locked_axes\": [[0, 0, 0]], \"x\"");
+  EXPECT_THROW(RigAnatomy::from_json(bad, m.skeleton, "x.json"), InputError);
+}
+
+// A user's anatomy measured on a few frames is a little off (here the thigh's
+// frame turned 2 degrees about the bone): without the model's locked axes the
+// knee would leave its hinge on the model's side. With them it stays on it,
+// and the joints below keep their world orientation.
+TEST(Retarget, MotionOntoTheModelKeepsTheModelsHinges) {
+  int knee = -1;
+  Eigen::Vector3d hinge;
+  const Motion m = hinge_knee_walk(&knee, &hinge);
+  RigAnatomy model = estimate_anatomy(m, find_rig_parts(m.skeleton));
+  measure_locked_axes(m, 0.6, &model);
+  for (int j = 0; j < m.num_joints(); ++j)
+    if (j != knee) model.locked_axes[j].clear();  // the hand-made walk holds other joints still too
+  const bench::VariantMotion vm = bench::make_variant(m, model, bench::rig_variant("mixamo"));
+  const RigMap map = map_rig(vm.motion.skeleton, m.skeleton);
+  RigAnatomy user = estimate_anatomy(vm.motion, map.user_parts);
+  const int user_thigh = vm.motion.skeleton.find("mixamorig:LeftUpLeg");
+  ASSERT_GE(user_thigh, 0);
+  user.frames[user_thigh] = user.frames[user_thigh] * Eigen::Quaterniond(Eigen::AngleAxisd(2.0 * M_PI / 180, Eigen::Vector3d::UnitX()));
+  RigAnatomy unlocked = model;
+  unlocked.locked_axes.clear();
+  const Motion kept = Retargeter(vm.motion.skeleton, m.skeleton, map, user, model).to_model(vm.motion);
+  const Motion loose = Retargeter(vm.motion.skeleton, m.skeleton, map, user, unlocked).to_model(vm.motion);
+  double off_hinge = 0, loose_off_hinge = 0;
+  for (int f = 0; f < m.num_frames(); ++f) {
+    off_hinge = std::max(off_hinge, geodesic_angle(kept.rotation(f, knee), without_locked_rotation(model, knee, kept.rotation(f, knee))));
+    loose_off_hinge = std::max(loose_off_hinge, geodesic_angle(loose.rotation(f, knee), without_locked_rotation(model, knee, loose.rotation(f, knee))));
+  }
+  EXPECT_LT(off_hinge, 1e-9);
+  EXPECT_GT(loose_off_hinge, 0.5 * M_PI / 180);  // the premise: the error leaves the hinge
+  const GlobalPose gk = forward_kinematics(kept), gl = forward_kinematics(loose);
+  for (const char* name : {"Foot_L", "Toes_L"}) {
+    const int j = m.skeleton.find(name);
+    for (int f = 0; f < m.num_frames(); ++f) EXPECT_LT(geodesic_angle(gk.rotation(f, j), gl.rotation(f, j)), 1e-6) << name;
+  }
+}
+
 // A context whose prior is a tiny untrained model on the sample's rig: the
 // adapter needs its skeleton, frame rate and the rig anatomy, not its weights.
 TaskContext sample_rig_context() {

@@ -245,6 +245,7 @@ struct RigArgs {
   mf::DatasetOptions data;
   std::string out;
   int stride = 2;
+  double locked_sd = 0.6;
 };
 
 void add_rig_options(CLI::App& cmd, RigArgs& a) {
@@ -255,6 +256,10 @@ void add_rig_options(CLI::App& cmd, RigArgs& a) {
                                           "archive)");
   cmd.add_option("--cache-dir", a.data.cache_dir, "extraction and parse cache (default: <project>/.cache)");
   cmd.add_option("--stride", a.stride, "every N-th frame of the training split")->check(mf::cli::at_least(1));
+  cmd.add_option("--locked-sd", a.locked_sd,
+                 "a joint's rotation axis counts as locked when its standard deviation over the frames is below this "
+                 "many degrees (default 0.6: the knees' and toes' hinges, one axis of the shoulders)")
+      ->check(CLI::Range(0.0, 10.0));
 }
 
 // motionfield-train rig: the rig anatomy of the training split, as JSON.
@@ -267,12 +272,16 @@ int measure_rig_main(const RigArgs& a) {
       all.root_positions.push_back(c.motion.root_positions[f]);
     }
   }
-  const mf::RigAnatomy anatomy = mf::estimate_anatomy(all, mf::find_rig_parts(data.skeleton));
+  mf::RigAnatomy anatomy = mf::estimate_anatomy(all, mf::find_rig_parts(data.skeleton));
+  mf::measure_locked_axes(all, a.locked_sd, &anatomy);
   std::ofstream file(a.out);
   file << anatomy.to_json(data.skeleton) << "\n";
   if (!file) throw std::runtime_error("cannot write " + a.out);
   std::printf("measured the rig anatomy on %d frames of %zu training clips: %s\n", all.num_frames(),
               data.train.size(), a.out.c_str());
+  for (int j = 0; j < data.skeleton.num_joints(); ++j)
+    if (!anatomy.locked_axes[j].empty())
+      std::printf("  %s: %zu locked axis(es)\n", data.skeleton.names[j].c_str(), anatomy.locked_axes[j].size());
   return 0;
 }
 

@@ -1,5 +1,7 @@
 #include "prior/rig/retarget.h"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -221,7 +223,52 @@ Vector3d root_placing_hips(const Motion& out, int f, int hips, const Vector3d& t
   return root + (target - pos);
 }
 
+// Rotation vector (axis times angle, the shortest way) of q, and back.
+Vector3d log_map(Quaterniond q) {
+  if (q.w() < 0) q.coeffs() = -q.coeffs();
+  const Eigen::AngleAxisd aa(q.normalized());
+  return aa.angle() * aa.axis();
+}
+
+Quaterniond exp_map(const Vector3d& r) {
+  const double angle = r.norm();
+  return angle < 1e-12 ? Quaterniond::Identity() : Quaterniond(Eigen::AngleAxisd(angle, r / angle));
+}
+
 }  // namespace
+
+void measure_locked_axes(const Motion& motion, double max_sd_degrees, RigAnatomy* anatomy) {
+  const int J = motion.num_joints(), F = motion.num_frames();
+  if (static_cast<int>(anatomy->mean_local.size()) != J)
+    throw InputError("measure_locked_axes: the anatomy's mean rotations do not match the motion's joints");
+  const double limit = max_sd_degrees * M_PI / 180.0;
+  anatomy->locked_axes.assign(J, {});
+  if (F < 2) return;
+  for (int j = 0; j < J; ++j) {
+    const Quaterniond inv_mean = anatomy->mean_local[j].conjugate();
+    Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+    Vector3d sum = Vector3d::Zero();
+    for (int f = 0; f < F; ++f) {
+      const Vector3d r = log_map(inv_mean * motion.rotation(f, j));
+      sum += r;
+      second += r * r.transpose();
+    }
+    const Vector3d mean = sum / F;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(second / F - mean * mean.transpose());
+    std::vector<Vector3d> locked;
+    for (int k = 0; k < 3; ++k)
+      if (std::sqrt(std::max(0.0, eig.eigenvalues()[k])) < limit) locked.push_back(eig.eigenvectors().col(k));
+    if (locked.size() < 3) anatomy->locked_axes[j] = std::move(locked);
+  }
+}
+
+Quaterniond without_locked_rotation(const RigAnatomy& anatomy, int joint, const Quaterniond& local) {
+  if (joint >= static_cast<int>(anatomy.locked_axes.size()) || anatomy.locked_axes[joint].empty()) return local;
+  const Quaterniond& mean = anatomy.mean_local[joint];
+  Vector3d r = log_map(mean.conjugate() * local);
+  for (const Vector3d& a : anatomy.locked_axes[joint]) r -= r.dot(a) * a;
+  return (mean * exp_map(r)).normalized();
+}
 
 double leg_length(const Skeleton& s, const RigParts& p) {
   const std::vector<Vector3d> rest = rest_positions(s);
@@ -278,9 +325,15 @@ std::string RigAnatomy::to_json(const Skeleton& s) const {
   j["version"] = 1;
   j["leg_length"] = leg_length;
   nlohmann::ordered_json joints = nlohmann::ordered_json::object();
-  for (int i = 0; i < s.num_joints(); ++i)
+  for (int i = 0; i < s.num_joints(); ++i) {
     joints[s.names[i]] = {{"frame", quat_json(frames[i])}, {"toe_frame", quat_json(toe_frames[i])},
                           {"mean_local", quat_json(mean_local[i])}};
+    if (i < static_cast<int>(locked_axes.size()) && !locked_axes[i].empty()) {
+      nlohmann::ordered_json axes = nlohmann::ordered_json::array();
+      for (const Vector3d& a : locked_axes[i]) axes.push_back({a.x(), a.y(), a.z()});
+      joints[s.names[i]]["locked_axes"] = axes;
+    }
+  }
   j["joints"] = joints;
   return j.dump(1);
 }
@@ -306,6 +359,20 @@ RigAnatomy RigAnatomy::from_json(const std::string& text, const Skeleton& s, con
     a.frames.push_back(json_quat(e["frame"], source + ": " + name + ".frame"));
     a.toe_frames.push_back(json_quat(e["toe_frame"], source + ": " + name + ".toe_frame"));
     a.mean_local.push_back(json_quat(e["mean_local"], source + ": " + name + ".mean_local"));
+    std::vector<Vector3d> axes;
+    if (e.contains("locked_axes")) {
+      const nlohmann::json& l = e["locked_axes"];
+      const std::string what = source + ": " + name + ".locked_axes";
+      if (!l.is_array() || l.size() > 2) throw InputError(what + " must be an array of at most 2 directions");
+      for (const nlohmann::json& v : l) {
+        if (!v.is_array() || v.size() != 3 || !v[0].is_number() || !v[1].is_number() || !v[2].is_number())
+          throw InputError(what + ": each direction must be an array of 3 numbers");
+        const Vector3d d(v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
+        if (!d.allFinite() || d.norm() < 1e-6) throw InputError(what + ": a direction is not a finite nonzero vector");
+        axes.push_back(d.normalized());
+      }
+    }
+    a.locked_axes.push_back(std::move(axes));
   }
   return a;
 }
@@ -421,6 +488,9 @@ Motion Retargeter::transfer(const Motion& src, bool to_model, const Motion* refe
         local = reference ? reference->rotation(f, j) : AD.mean_local[j];
       }
       local.normalize();
+      // The model never saw its locked axes turn (a knee off its hinge): keep
+      // the motion off them; the children keep their world targets.
+      if (to_model && has_target[j]) local = without_locked_rotation(AD, j, local);
       out.rotation(f, j) = local;
       world[j] = p < 0 ? local : (world[p] * local).normalized();
     }

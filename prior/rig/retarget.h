@@ -39,6 +39,13 @@ struct RigAnatomy {
   std::vector<Eigen::Quaterniond> mean_local;
   /// Thigh to ankle, averaged over both legs, metres.
   double leg_length = 0.0;
+  /// Per joint (or empty: none measured): unit directions of the rotation
+  /// vector of mean_local^-1 * local (the joint's local frame) along which the
+  /// rig's motion does not turn that joint: two for a hinge such as the
+  /// training data's knees and toes, one for a joint with two degrees of
+  /// freedom. From measure_locked_axes() on a large motion set, never from a
+  /// user's few frames; motion retargeted onto this rig is kept off them.
+  std::vector<std::vector<Eigen::Vector3d>> locked_axes;
 
   /// JSON with per-joint quaternions (w, x, y, z) keyed by joint name.
   std::string to_json(const Skeleton& skeleton) const;
@@ -51,6 +58,18 @@ struct RigAnatomy {
 /// (all frames when empty; no other frame is read). `parts` from
 /// find_rig_parts() or RigMap. Throws InputError if a required part is missing.
 RigAnatomy estimate_anatomy(const Motion& motion, const RigParts& parts, const std::vector<int>& frames = {});
+
+/// Fills anatomy->locked_axes from `motion` (mean_local must be set, e.g. by
+/// estimate_anatomy on the same motion): per joint, the principal directions
+/// of its local rotations about mean_local whose standard deviation is below
+/// `max_sd_degrees`. Joints that hardly move at all (every direction below it,
+/// e.g. a container root) get none.
+void measure_locked_axes(const Motion& motion, double max_sd_degrees, RigAnatomy* anatomy);
+
+/// `local` (a local rotation of `joint` on the rig of `anatomy`) with its
+/// rotation about the joint's locked axes removed: the nearest rotation the
+/// rig's own motion makes. `local` itself when the joint has none.
+Eigen::Quaterniond without_locked_rotation(const RigAnatomy& anatomy, int joint, const Eigen::Quaterniond& local);
 
 /// Leg length (thigh to ankle, mean of both legs) of a skeleton's rest offsets,
 /// in the skeleton's units; 0 when the legs are not found.
