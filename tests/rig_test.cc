@@ -275,12 +275,18 @@ Motion hinge_knee_walk(int* knee, Eigen::Vector3d* hinge) {
   return m;
 }
 
+// The anatomy of `m` with its locked axes, as `motionfield-train rig` measures it.
+RigAnatomy anatomy_with_locked_axes(const Motion& m) {
+  RigAnatomy a = estimate_anatomy(m, find_rig_parts(m.skeleton));
+  measure_locked_axes(m, 0.6, &a);
+  return a;
+}
+
 TEST(Retarget, LockedAxesOfAHingeAreMeasuredAndRemoved) {
   int knee = -1;
   Eigen::Vector3d hinge;
   const Motion m = hinge_knee_walk(&knee, &hinge);
-  RigAnatomy a = estimate_anatomy(m, find_rig_parts(m.skeleton));
-  measure_locked_axes(m, 0.6, &a);
+  RigAnatomy a = anatomy_with_locked_axes(m);
   ASSERT_EQ(a.locked_axes.size(), static_cast<size_t>(m.num_joints()));
   ASSERT_EQ(a.locked_axes[knee].size(), 2u);
   for (const Eigen::Vector3d& axis : a.locked_axes[knee]) EXPECT_LT(std::abs(axis.dot(hinge)), 1e-6);
@@ -313,8 +319,7 @@ TEST(Retarget, MotionOntoTheModelKeepsTheModelsHinges) {
   int knee = -1;
   Eigen::Vector3d hinge;
   const Motion m = hinge_knee_walk(&knee, &hinge);
-  RigAnatomy model = estimate_anatomy(m, find_rig_parts(m.skeleton));
-  measure_locked_axes(m, 0.6, &model);
+  RigAnatomy model = anatomy_with_locked_axes(m);
   for (int j = 0; j < m.num_joints(); ++j)
     if (j != knee) model.locked_axes[j].clear();  // the hand-made walk holds other joints still too
   const bench::VariantMotion vm = bench::make_variant(m, model, bench::rig_variant("mixamo"));
