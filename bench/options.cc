@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "prior/inbetween/inbetweener.h"
+#include "prior/rig/mirror.h"
 #include "prior/util/command_line.h"
 #include "tasks/inbetweener_files.h"
 
@@ -46,13 +47,23 @@ Dataset load_data(const DataSource& data, bool verbose) {
 }
 
 const std::vector<Clip>& SplitChoice::clips(const Dataset& data) const {
-  return split == "train" ? data.train : data.validation;
+  if (split == "train") return data.train;
+  if (split != "validation-mirror") return data.validation;
+  if (mirrored_.empty()) {
+    // The twists of the mirror are chosen from the training split's statistics, as in training.
+    std::vector<const Motion*> motions;
+    for (const Clip& c : data.train) motions.push_back(&c.motion);
+    const MirrorMap map = mirror_map(data.skeleton, mean_local_rotations(motions));
+    for (const Clip& c : data.validation) mirrored_.push_back({c.name + "#mirror", mirror_motion(c.motion, map)});
+  }
+  return mirrored_;
 }
 
 void add_split_options(CLI::App& app, SplitChoice& choice) {
   app.add_option("--split", choice.split,
-                 "validation or train: the clips the tables are measured on (tune on train)")
-      ->check(CLI::IsMember({"validation", "train"}));
+                 "validation, train or validation-mirror (the validation clips' left/right mirrors): the clips "
+                 "the tables are measured on (tune on train)")
+      ->check(CLI::IsMember({"validation", "train", "validation-mirror"}));
   app.add_option("--max-windows", choice.max_windows, "at most N windows per table row, spread evenly (0: all)")
       ->check(mf::cli::at_least(0));
 }

@@ -38,14 +38,19 @@ void add_data_options(CLI::App& app, DataSource& data);
 /// Loads `data` through the data pipeline (prior/data/dataset.h).
 Dataset load_data(const DataSource& data, bool verbose);
 
-/// --split validation|train, --max-windows N: the clips the tables are
-/// measured on (tune on train, report on validation) and how many windows
-/// per table row at most (0 = all).
+/// --split validation|train|validation-mirror, --max-windows N: the clips the
+/// tables are measured on (tune on train, report on validation;
+/// validation-mirror: every validation clip's left/right mirror, motion of
+/// another distribution than the training split's) and how many windows per
+/// table row at most (0 = all).
 struct SplitChoice {
   std::string split = "validation";
   int max_windows = 0;
   /// The chosen split of `data`.
   const std::vector<Clip>& clips(const Dataset& data) const;
+
+ private:
+  mutable std::vector<Clip> mirrored_;
 };
 void add_split_options(CLI::App& app, SplitChoice& choice);
 

@@ -9,7 +9,10 @@
 
 #include "prior/model/nemf.h"
 #include "prior/model/representation.h"
+#include "bench/options.h"
 #include "prior/motion/errors.h"
+#include "prior/motion/motion_bvh.h"
+#include "prior/rig/mirror.h"
 #include "tests/test_util.h"
 
 namespace mf::bench {
@@ -276,6 +279,42 @@ TEST(ProtocolTest, ParsesResampleRatios) {
   EXPECT_EQ(parse_resample_ratio("4:5").label(), "4:5");
   for (const char* bad : {"", ":", "5:", ":4", "0:1", "3:3", "1", "2.5", "a:b", "5:4:3", "-2", "2000"})
     EXPECT_THROW(parse_resample_ratio(bad), InputError) << bad;
+}
+
+// --split validation-mirror measures on the validation clips' mirrors (the
+// twists chosen from the training split): same clips and lengths, every joint
+// where its counterpart's reflection was; the other splits are the data's own.
+TEST(ProtocolTest, MirroredValidationSplitReflectsTheValidationClips) {
+  const Motion walk = read_motion(std::string(MF_SOURCE_DIR) + "/samples/walk_keyframes.bvh");
+  Dataset data;
+  data.skeleton = walk.skeleton;
+  data.train.push_back(make_clip("train.bvh", walk));
+  data.validation.push_back(make_clip("a.bvh", walk.slice(0, 40)));
+  data.validation.push_back(make_clip("b.bvh", walk.slice(20, 61)));
+  SplitChoice choice;
+  EXPECT_EQ(&choice.clips(data), &data.validation);
+  choice.split = "train";
+  EXPECT_EQ(&choice.clips(data), &data.train);
+  choice.split = "validation-mirror";
+  const std::vector<Clip>& mirrored = choice.clips(data);
+  ASSERT_EQ(mirrored.size(), 2u);
+  EXPECT_EQ(mirrored[1].name, "b.bvh#mirror");
+  const MirrorMap map = mirror_map(walk.skeleton, mean_local_rotations({&walk}));
+  const Eigen::Matrix3d M = Eigen::Vector3d(-1, 1, 1).asDiagonal();
+  for (size_t c = 0; c < 2; ++c) {
+    const Motion& original = data.validation[c].motion;
+    ASSERT_EQ(mirrored[c].motion.num_frames(), original.num_frames());
+    const GlobalPose a = forward_kinematics(original), b = forward_kinematics(mirrored[c].motion);
+    double worst = 0.0, moved = 0.0;
+    for (int f = 0; f < original.num_frames(); ++f)
+      for (int j = 0; j < original.num_joints(); ++j) {
+        worst = std::max(worst, (b.position(f, j) - M * a.position(f, map.counterpart[j])).norm());
+        moved = std::max(moved, (b.position(f, j) - a.position(f, j)).norm());
+      }
+    EXPECT_LT(worst, 1e-9);
+    EXPECT_GT(moved, 0.05);  // not the clip itself
+  }
+  EXPECT_EQ(&choice.clips(data), &mirrored);  // built once
 }
 
 }  // namespace
