@@ -48,6 +48,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "training/data_parallel.h"
 
@@ -85,6 +86,7 @@ struct InbetweenTrainingOptions {
   std::string init_from;
   int max_train_clips = 0;          ///< 0 = all
   bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
+  std::vector<double> speeds;       ///< add every training clip played at these speeds (time warp)
   bool verbose = true;
   /// Data-parallel training (training/data_parallel.h): `batch` samples per
   /// process and step, a global batch of world_size * batch.

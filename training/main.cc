@@ -82,6 +82,10 @@ void add_run_options(CLI::App& cmd, Options& o, RunArgs& run) {
   cmd.add_option("--max-train-clips", o.max_train_clips, "use at most N training clips (0 = all)");
   cmd.add_flag("--mirror", o.mirror,
                "also train on every training clip's left/right mirror (doubles the data; give it again on --resume)");
+  cmd.add_option("--speeds", o.speeds,
+                 "also train on every training clip played at these speeds, e.g. 0.8,1.25 (time warp, each in "
+                 "[0.5, 2]; give them again on --resume)")
+      ->delimiter(',');
   cmd.add_flag("--resume", o.resume, "continue from DIR/last.* if present");
   cmd.add_option("--init", o.init_from,
                  "start a new run from this model's weights and statistics (same sizes and skeleton), not random ones");

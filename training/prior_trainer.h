@@ -22,6 +22,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "prior/model/nemf.h"
 #include "training/data_parallel.h"
@@ -53,6 +54,7 @@ struct PriorTrainingOptions {
   std::string init_from;
   int max_train_clips = 0;          ///< 0 = all (small values for smoke tests)
   bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
+  std::vector<double> speeds;       ///< add every training clip played at these speeds (time warp)
   int max_steps = 0;                ///< 0 = unlimited (for tests)
   bool verbose = true;
   /// Data-parallel training (training/data_parallel.h): `batch` windows per

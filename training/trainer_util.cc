@@ -11,13 +11,25 @@
 #include <fstream>
 
 #include "prior/motion/errors.h"
+#include "prior/motion/interpolation.h"
 #include "prior/motion/rotations.h"
 #include "prior/rig/mirror.h"
 
 namespace mf::training {
 
+Motion played_at_speed(const Motion& motion, double speed) {
+  if (!(std::isfinite(speed) && speed > 0)) throw InputError("a playback speed must be finite and positive");
+  Motion faster = motion;
+  faster.fps = motion.fps * speed;  // resampled back to the motion's rate: frame i lands at position i * speed
+  const int frames = static_cast<int>(std::floor((motion.num_frames() - 1) / speed + 1e-9)) + 1;
+  return resample_cubic(faster, motion.fps, frames);
+}
+
 Dataset load_training_data(const std::string& source, const std::string& cache_dir, int max_train_clips, double fps,
-                           bool mirror, bool verbose) {
+                           bool mirror, const std::vector<double>& speeds, bool verbose) {
+  for (double s : speeds)
+    if (!(s >= 0.5 && s <= 2.0) || std::abs(s - 1.0) < 1e-6)
+      throw InputError("train: --speeds takes playback speeds in [0.5, 2] other than 1, got " + std::to_string(s));
   DatasetOptions dopt;
   dopt.source = source;
   dopt.cache_dir = cache_dir;
@@ -55,6 +67,17 @@ Dataset load_training_data(const std::string& source, const std::string& cache_d
                    "within %.1f deg of the originals', the most at %s)\n",
                    n, map.max_asymmetry * 100.0, worst, data.skeleton.names[at].c_str());
     }
+  }
+  if (!speeds.empty()) {
+    const size_t n = data.train.size();
+    data.train.reserve(n * (1 + speeds.size()));
+    for (double s : speeds)
+      for (size_t i = 0; i < n; ++i) {
+        char name[32];
+        std::snprintf(name, sizeof name, "@%gx", s);
+        data.train.push_back({data.train[i].name + name, played_at_speed(data.train[i].motion, s)});
+      }
+    if (verbose) std::fprintf(stderr, "train: %zu clips played at other speeds added\n", n * speeds.size());
   }
   return data;
 }

@@ -6,6 +6,7 @@
 #include <ATen/core/Tensor.h>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "prior/data/dataset.h"
 #include "prior/model/representation.h"
@@ -20,10 +21,19 @@ namespace mf::training {
 /// `max_train_clips` training clips (0 = all), checks that every training
 /// clip is at `fps` (when fps > 0) and, with `mirror`, appends each training
 /// clip's left/right mirror (named "<clip>#mirror"; InputError when the rig
-/// cannot be mirrored). The validation split is never mirrored. Throws
-/// InputError when there is no training clip.
+/// cannot be mirrored), then for each of `speeds` every training clip (and
+/// mirror) played that many times as fast at the same frame rate (time-warp
+/// augmentation; Catmull-Rom resampling, prior/motion/interpolation.h; named
+/// "<clip>@<speed>x"; InputError for a speed outside [0.5, 2] or of 1). The
+/// validation split is never augmented. Throws InputError when there is no
+/// training clip.
 Dataset load_training_data(const std::string& data, const std::string& cache_dir, int max_train_clips, double fps,
-                           bool mirror, bool verbose);
+                           bool mirror, const std::vector<double>& speeds, bool verbose);
+
+/// `motion` played `speed` times as fast at its own frame rate (frame i of the
+/// result is the motion at frame position i * speed; Catmull-Rom between
+/// frames); the result covers the whole motion.
+Motion played_at_speed(const Motion& motion, double speed);
 
 /// The rig measured from the training clips (as the prior's trainer does).
 RigInfo measure_training_rig(const Dataset& data);
