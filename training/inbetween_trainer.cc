@@ -420,7 +420,7 @@ InbetweenRun::InbetweenRun(const InbetweenTrainingOptions& o)
       t0_(Clock::now()),
       files_(o.out_dir),
       dp_(o.distributed),
-      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, 0.0, o.mirror, o.speeds,
+      data_(training::load_training_data(o.data, o.cache_dir, o.max_train_clips, 0.0, o.augmentation,
                                          o.verbose && dp_.writes())),
       resume_from_(dp_.resume_files(files_, o.resume, &resuming_)),
       model_(load_or_make_model(o, data_, resume_from_, resuming_)),

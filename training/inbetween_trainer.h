@@ -50,6 +50,7 @@
 #include <string>
 #include <vector>
 
+#include "training/augmentation.h"
 #include "training/data_parallel.h"
 
 namespace mf {
@@ -85,8 +86,9 @@ struct InbetweenTrainingOptions {
   /// skeleton must be the data's. Ignored when resuming.
   std::string init_from;
   int max_train_clips = 0;          ///< 0 = all
-  bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
-  std::vector<double> speeds;       ///< add every training clip played at these speeds (time warp)
+  /// Clips added to the training split (training/augmentation.h); give the
+  /// same again on --resume.
+  training::Augmentation augmentation;
   bool verbose = true;
   /// Data-parallel training (training/data_parallel.h): `batch` samples per
   /// process and step, a global batch of world_size * batch.

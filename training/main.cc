@@ -80,9 +80,13 @@ void add_run_options(CLI::App& cmd, Options& o, RunArgs& run) {
   cmd.add_option("--seed", o.seed, "random seed");
   cmd.add_option("--threads", o.threads, "torch intra-op threads");
   cmd.add_option("--max-train-clips", o.max_train_clips, "use at most N training clips (0 = all)");
-  cmd.add_flag("--mirror", o.mirror,
+  cmd.add_flag("--mirror", o.augmentation.mirror,
                "also train on every training clip's left/right mirror (doubles the data; give it again on --resume)");
-  cmd.add_option("--speeds", o.speeds,
+  cmd.add_option("--frame-noise", o.augmentation.frame_noise_degrees,
+                 "also train on every clip (and mirror) with each joint's frame turned by a constant random "
+                 "rotation of at most DEG degrees (a retarget's anatomy errors, other bodies; doubles the data; "
+                 "give it again on --resume)");
+  cmd.add_option("--speeds", o.augmentation.speeds,
                  "also train on every training clip played at these speeds, e.g. 0.8,1.25 (time warp, each in "
                  "[0.5, 2]; give them again on --resume)")
       ->delimiter(',');

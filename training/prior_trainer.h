@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "prior/model/nemf.h"
+#include "training/augmentation.h"
 #include "training/data_parallel.h"
 
 namespace mf {
@@ -53,8 +54,9 @@ struct PriorTrainingOptions {
   /// statistics are kept. Ignored when resuming.
   std::string init_from;
   int max_train_clips = 0;          ///< 0 = all (small values for smoke tests)
-  bool mirror = false;              ///< add every training clip's left/right mirror (prior/rig/mirror.h)
-  std::vector<double> speeds;       ///< add every training clip played at these speeds (time warp)
+  /// Clips added to the training split (training/augmentation.h); give the
+  /// same again on --resume.
+  training::Augmentation augmentation;
   int max_steps = 0;                ///< 0 = unlimited (for tests)
   bool verbose = true;
   /// Data-parallel training (training/data_parallel.h): `batch` windows per

@@ -11,25 +11,11 @@
 #include <fstream>
 
 #include "prior/motion/errors.h"
-#include "prior/motion/interpolation.h"
-#include "prior/motion/rotations.h"
-#include "prior/rig/mirror.h"
 
 namespace mf::training {
 
-Motion played_at_speed(const Motion& motion, double speed) {
-  if (!(std::isfinite(speed) && speed > 0)) throw InputError("a playback speed must be finite and positive");
-  Motion faster = motion;
-  faster.fps = motion.fps * speed;  // resampled back to the motion's rate: frame i lands at position i * speed
-  const int frames = static_cast<int>(std::floor((motion.num_frames() - 1) / speed + 1e-9)) + 1;
-  return resample_cubic(faster, motion.fps, frames);
-}
-
 Dataset load_training_data(const std::string& source, const std::string& cache_dir, int max_train_clips, double fps,
-                           bool mirror, const std::vector<double>& speeds, bool verbose) {
-  for (double s : speeds)
-    if (!(s >= 0.5 && s <= 2.0) || std::abs(s - 1.0) < 1e-6)
-      throw InputError("train: --speeds takes playback speeds in [0.5, 2] other than 1, got " + std::to_string(s));
+                           const Augmentation& augmentation, bool verbose) {
   DatasetOptions dopt;
   dopt.source = source;
   dopt.cache_dir = cache_dir;
@@ -43,42 +29,7 @@ Dataset load_training_data(const std::string& source, const std::string& cache_d
                        std::to_string(fps) + " fps");
     }
   }
-  if (mirror) {
-    data.train.reserve(2 * data.train.size());  // the pointers below stay valid while the mirrors are added
-    std::vector<const Motion*> motions;
-    for (const Clip& c : data.train) motions.push_back(&c.motion);
-    const MirrorMap map = mirror_map(data.skeleton, mean_local_rotations(motions));
-    const size_t n = data.train.size();
-    for (size_t i = 0; i < n; ++i)
-      data.train.push_back({data.train[i].name + "#mirror", mirror_motion(data.train[i].motion, map)});
-    if (verbose) {
-      // The twists are chosen to keep the mean local rotations; how close they stay says whether they were found.
-      std::vector<const Motion*> mirrored;
-      for (size_t i = n; i < data.train.size(); ++i) mirrored.push_back(&data.train[i].motion);
-      const std::vector<Eigen::Quaterniond> a = mean_local_rotations(motions), b = mean_local_rotations(mirrored);
-      double worst = 0.0;
-      size_t at = 0;
-      for (size_t j = 1; j < a.size(); ++j) {
-        const double d = geodesic_angle(a[j], b[j]) * 180.0 / M_PI;
-        if (d > worst) worst = d, at = j;
-      }
-      std::fprintf(stderr,
-                   "train: %zu mirrored clips added (rest offsets mirror within %.2f cm; mean local rotations "
-                   "within %.1f deg of the originals', the most at %s)\n",
-                   n, map.max_asymmetry * 100.0, worst, data.skeleton.names[at].c_str());
-    }
-  }
-  if (!speeds.empty()) {
-    const size_t n = data.train.size();
-    data.train.reserve(n * (1 + speeds.size()));
-    for (double s : speeds)
-      for (size_t i = 0; i < n; ++i) {
-        char name[32];
-        std::snprintf(name, sizeof name, "@%gx", s);
-        data.train.push_back({data.train[i].name + name, played_at_speed(data.train[i].motion, s)});
-      }
-    if (verbose) std::fprintf(stderr, "train: %zu clips played at other speeds added\n", n * speeds.size());
-  }
+  augment_training_split(data, augmentation, verbose);
   return data;
 }
 

@@ -10,6 +10,7 @@
 
 #include "prior/data/dataset.h"
 #include "prior/model/representation.h"
+#include "training/augmentation.h"
 
 namespace torch::optim {
 class Optimizer;
@@ -19,21 +20,12 @@ namespace mf::training {
 
 /// Loads `data` (folder or archive) through the cache, keeps at most
 /// `max_train_clips` training clips (0 = all), checks that every training
-/// clip is at `fps` (when fps > 0) and, with `mirror`, appends each training
-/// clip's left/right mirror (named "<clip>#mirror"; InputError when the rig
-/// cannot be mirrored), then for each of `speeds` every training clip (and
-/// mirror) played that many times as fast at the same frame rate (time-warp
-/// augmentation; Catmull-Rom resampling, prior/motion/interpolation.h; named
-/// "<clip>@<speed>x"; InputError for a speed outside [0.5, 2] or of 1). The
-/// validation split is never augmented. Throws InputError when there is no
-/// training clip.
+/// clip is at `fps` (when fps > 0), then adds `augmentation`'s clips to the
+/// training split (augmentation.h; the validation split is never augmented).
+/// Throws InputError when there is no training clip and for the errors of
+/// augment_training_split.
 Dataset load_training_data(const std::string& data, const std::string& cache_dir, int max_train_clips, double fps,
-                           bool mirror, const std::vector<double>& speeds, bool verbose);
-
-/// `motion` played `speed` times as fast at its own frame rate (frame i of the
-/// result is the motion at frame position i * speed; Catmull-Rom between
-/// frames); the result covers the whole motion.
-Motion played_at_speed(const Motion& motion, double speed);
+                           const Augmentation& augmentation, bool verbose);
 
 /// The rig measured from the training clips (as the prior's trainer does).
 RigInfo measure_training_rig(const Dataset& data);
