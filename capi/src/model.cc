@@ -69,13 +69,13 @@ std::unique_ptr<mf_model> load_bytes(const uint8_t* data, size_t size, const std
 }
 
 // The bytes of a file; MF_ERROR_IO when it cannot be read.
-std::vector<uint8_t> read_file(const std::string& file) { return read_file_bytes(file); }  // FileError: MF_ERROR_IO
+FileBytes read_file(const std::string& file) { return read_file_bytes(file); }  // FileError: MF_ERROR_IO
 
 // The in-betweener file `file` for the prior of `model`: MF_ERROR_IO when
 // unreadable, MF_ERROR_MODEL when it is not an in-betweener or not on the
 // prior's skeleton.
 std::shared_ptr<const InbetweenModel> load_inbetweener_file(const std::string& file, const mf_model& model) {
-  const std::vector<uint8_t> bytes = read_file(file);
+  const FileBytes bytes = read_file(file);
   try {
     return frozen_inbetweener(deserialize_inbetweener(bytes.data(), bytes.size(), file), file, "", model.model.get());
   } catch (const InputError& e) {
@@ -125,7 +125,7 @@ int mf_model_load(const char* path, mf_model** out) {
         throw ApiError(MF_ERROR_IO,
                        "no default model: set MF_MODEL or install models/motionfield-prior.mfm (see README)");
     }
-    const std::vector<uint8_t> bytes = mf::capi::read_file(file);
+    const mf::FileBytes bytes = mf::capi::read_file(file);
     std::unique_ptr<mf_model> handle = mf::capi::load_bytes(bytes.data(), bytes.size(), file);
     mf::load_inbetweeners_next_to(file, handle.get());
     mf::capi::load_anatomy(handle.get(), file);

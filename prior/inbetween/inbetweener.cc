@@ -308,7 +308,7 @@ void save_inbetweener(const InbetweenModel& model, const std::string& path) {
 }
 
 std::unique_ptr<InbetweenModel> load_inbetweener(const std::string& path) {
-  std::vector<uint8_t> bytes = read_file_bytes(path);
+  const FileBytes bytes = read_file_bytes(path);
   return deserialize_inbetweener(bytes.data(), bytes.size(), path);
 }
 

@@ -148,18 +148,20 @@ RigInfo read_rig(ByteReader& p, const std::string& source) {
   return rig;
 }
 
-// The named tensors as write_tensor() writes them; finite values only.
-std::map<std::string, at::Tensor> read_tensors(ByteReader& p) {
-  std::map<std::string, at::Tensor> tensors;
+// The named tensors as write_tensor() writes them, as views of the bytes;
+// finite values only.
+std::map<std::string, StoredTensor> read_tensors(ByteReader& p) {
+  std::map<std::string, StoredTensor> tensors;
   uint32_t count = p.u32();
   if (count > 100000) p.fail("too many tensors");
   for (uint32_t i = 0; i < count; ++i) {
     std::string name = p.str(1024);
     uint32_t rank = p.u32();
     if (rank > 8) p.fail("tensor '" + name + "' has rank " + std::to_string(rank));
-    std::vector<int64_t> dims(rank);
+    StoredTensor t;
+    t.shape.resize(rank);
     uint64_t numel = 1;
-    for (auto& d : dims) {
+    for (auto& d : t.shape) {
       d = p.pod<int64_t>();
       if (d < 0 || d > (int64_t(1) << 32)) p.fail("tensor '" + name + "' has a bad dimension");
       // Dimensions of 2^32 wrap the product to 0, which need_items() accepts
@@ -168,10 +170,13 @@ std::map<std::string, at::Tensor> read_tensors(ByteReader& p) {
         p.fail("tensor '" + name + "' has too many elements");
     }
     p.need_items(numel, sizeof(float));
-    at::Tensor t = at::empty(dims, at::kFloat);
-    p.bytes(t.data_ptr<float>(), numel * sizeof(float));
-    if (!at::isfinite(t).all().item<bool>()) p.fail("tensor '" + name + "' holds non-finite values");
-    tensors[name] = t;
+    t.data = p.skip(numel * sizeof(float));
+    for (uint64_t k = 0; k < numel; ++k) {
+      float v;
+      std::memcpy(&v, t.data + k * sizeof(float), sizeof v);
+      if (!std::isfinite(v)) p.fail("tensor '" + name + "' holds non-finite values");
+    }
+    tensors[name] = std::move(t);
   }
   return tensors;
 }
@@ -194,21 +199,35 @@ ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::
   return c;
 }
 
-void take_model_tensor(std::map<std::string, at::Tensor>& tensors, const std::string& name, at::Tensor& target,
+int64_t StoredTensor::numel() const {
+  int64_t n = 1;
+  for (int64_t d : shape) n *= d;
+  return n;
+}
+
+void take_model_tensor(std::map<std::string, StoredTensor>& tensors, const std::string& name, at::Tensor& target,
                        const std::string& source) {
   auto it = tensors.find(name);
   if (it == tensors.end()) throw InputError(source + ": model file lacks tensor '" + name + "'");
-  if (target.defined() && !target.sizes().equals(it->second.sizes())) {
-    throw InputError(source + ": tensor '" + name + "' has shape " + shape_string(it->second.sizes()) +
-                     ", expected " + shape_string(target.sizes()));
+  const StoredTensor& stored = it->second;
+  if (target.defined() && !target.sizes().equals(stored.shape)) {
+    throw InputError(source + ": tensor '" + name + "' has shape " + shape_string(stored.shape) + ", expected " +
+                     shape_string(target.sizes()));
   }
+  const size_t bytes = static_cast<size_t>(stored.numel()) * sizeof(float);
   at::NoGradGuard guard;
-  if (target.defined()) target.copy_(it->second);
-  else target = it->second;
+  if (target.defined() && target.is_contiguous() && target.scalar_type() == at::kFloat && target.device().is_cpu()) {
+    if (bytes != 0) std::memcpy(target.data_ptr<float>(), stored.data, bytes);
+  } else {
+    at::Tensor copy = at::empty(stored.shape, at::kFloat);
+    if (bytes != 0) std::memcpy(copy.data_ptr<float>(), stored.data, bytes);
+    if (target.defined()) target.copy_(copy);
+    else target = copy;
+  }
   tensors.erase(it);
 }
 
-void check_no_extra_tensors(const std::map<std::string, at::Tensor>& tensors, const std::string& source) {
+void check_no_extra_tensors(const std::map<std::string, StoredTensor>& tensors, const std::string& source) {
   if (!tensors.empty()) {
     throw InputError(source + ": model file has unexpected tensor '" + tensors.begin()->first +
                      "' (trained with another architecture?)");
@@ -245,7 +264,7 @@ NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& 
 void save_nemf(const NemfModel& model, const std::string& path) { write_file_atomically(path, serialize_nemf(model)); }
 
 NemfModel load_nemf(const std::string& path) {
-  std::vector<uint8_t> bytes = read_file_bytes(path);
+  const FileBytes bytes = read_file_bytes(path);
   return deserialize_nemf(bytes.data(), bytes.size(), path);
 }
 

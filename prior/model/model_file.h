@@ -32,13 +32,22 @@ namespace mf {
 constexpr uint32_t kModelFormatVersion = 1;
 constexpr char kNemfKind[] = "nemf";
 
+/// A tensor as a model file stores it: its shape and its float32 values,
+/// which stay in the file's bytes (no copy; not necessarily aligned), so
+/// they are valid only while the bytes given to parse_model_file live.
+struct StoredTensor {
+  std::vector<int64_t> shape;
+  const uint8_t* data = nullptr;
+  int64_t numel() const;
+};
+
 /// The generic container, shared by every model kind (the NeMF prior here,
 /// the in-betweeners in prior/inbetween/inbetweener.cc).
 struct ModelFileContents {
   std::string kind;
   std::map<std::string, double> hyperparameters;
   RigInfo rig;                                   ///< skeleton validated
-  std::map<std::string, at::Tensor> tensors;     ///< float32, finite
+  std::map<std::string, StoredTensor> tensors;   ///< finite values; views of the parsed bytes
 };
 
 /// The bytes of a model file of `kind` (layout above); tensors are written in
@@ -51,13 +60,14 @@ std::vector<uint8_t> serialize_model_file(const std::string& kind, const std::ma
 /// any other throws "wrong kind of model". `source` names the file in errors.
 ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::string& source,
                                    const std::vector<std::string>& expected_kinds);
-/// Copies tensor `name` of `tensors` into `target` (same shape required) and
-/// removes it from the map; throws InputError when missing or misshapen.
-void take_model_tensor(std::map<std::string, at::Tensor>& tensors, const std::string& name, at::Tensor& target,
+/// Copies tensor `name` of `tensors` into `target` (same shape required; a
+/// new tensor when `target` is undefined) and removes it from the map;
+/// throws InputError when missing or misshapen.
+void take_model_tensor(std::map<std::string, StoredTensor>& tensors, const std::string& name, at::Tensor& target,
                        const std::string& source);
 /// Throws InputError naming the first tensor left in `tensors` (one the
 /// architecture does not have), if any.
-void check_no_extra_tensors(const std::map<std::string, at::Tensor>& tensors, const std::string& source);
+void check_no_extra_tensors(const std::map<std::string, StoredTensor>& tensors, const std::string& source);
 
 std::vector<uint8_t> serialize_nemf(const NemfModel& model);
 NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& source);

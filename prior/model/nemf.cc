@@ -40,7 +40,9 @@ struct SkeletonConvImpl : torch::nn::Module {
     mask_ = register_buffer("mask", mask);
     at::Tensor degree = adjacency.sum(1).repeat_interleave(cout, 0).view({-1, 1, 1});
     at::Tensor bound = at::rsqrt(degree * (cin * kernel));
-    weight_ = register_parameter("weight", (at::rand({J * cout, J * cin, kernel}) * 2 - 1) * bound * mask);
+    // In place: the same values as (rand * 2 - 1) * bound * mask without four
+    // weight-sized temporaries (fresh memory is slow to touch; see FileBytes).
+    weight_ = register_parameter("weight", at::rand({J * cout, J * cin, kernel}).mul_(2).sub_(1).mul_(bound).mul_(mask));
     bias_ = register_parameter("bias", at::zeros({J * cout}));
   }
   at::Tensor forward(const at::Tensor& x) {

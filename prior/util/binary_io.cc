@@ -1,18 +1,24 @@
 #include "prior/util/binary_io.h"
 
 #include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
 #include <cstring>
+#include <utility>
 
 namespace mf {
 
 namespace {
 
 std::string mib(size_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
+
+std::string too_large(const std::string& path, const std::string& what, size_t max_bytes) {
+  return "cannot read " + what + " " + path + ": larger than the limit of " + mib(max_bytes) + " for a " + what;
+}
 
 // Writes all of `data` to `fd`; 0 or the errno of the failure.
 int write_all(int fd, const char* data, size_t size) {
@@ -29,18 +35,25 @@ int write_all(int fd, const char* data, size_t size) {
   return 0;
 }
 
+// Opens `path` for reading after the checks of read_file_limited (a
+// directory, a device or a regular file over `max_bytes` is refused);
+// `st` receives the open file's status.
+int open_checked(const std::string& path, const std::string& what, size_t max_bytes, struct stat* st) {
+  if (::stat(path.c_str(), st) != 0) throw FileError("cannot open " + what + " " + path + ": " + std::strerror(errno));
+  const std::string cannot = "cannot read " + what + " " + path + ": ";
+  if (S_ISDIR(st->st_mode)) throw FileError(cannot + "it is a directory");
+  if (S_ISCHR(st->st_mode) || S_ISBLK(st->st_mode)) throw FileError(cannot + "it is a device, not a file");
+  if (S_ISREG(st->st_mode) && static_cast<uint64_t>(st->st_size) > max_bytes) throw FileError(too_large(path, what, max_bytes));
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) throw FileError("cannot open " + what + " " + path + ": " + std::strerror(errno));
+  return fd;
+}
+
 }  // namespace
 
 std::string read_file_limited(const std::string& path, const std::string& what, size_t max_bytes) {
   struct stat st;
-  if (::stat(path.c_str(), &st) != 0) throw FileError("cannot open " + what + " " + path + ": " + std::strerror(errno));
-  const std::string cannot = "cannot read " + what + " " + path + ": ";
-  if (S_ISDIR(st.st_mode)) throw FileError(cannot + "it is a directory");
-  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) throw FileError(cannot + "it is a device, not a file");
-  const std::string too_large = cannot + "larger than the limit of " + mib(max_bytes) + " for a " + what;
-  if (S_ISREG(st.st_mode) && static_cast<uint64_t>(st.st_size) > max_bytes) throw FileError(too_large);
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw FileError("cannot open " + what + " " + path + ": " + std::strerror(errno));
+  const int fd = open_checked(path, what, max_bytes, &st);
   std::string text;
   if (S_ISREG(st.st_mode)) text.reserve(static_cast<size_t>(st.st_size));
   char buffer[1 << 16];
@@ -50,12 +63,12 @@ std::string read_file_limited(const std::string& path, const std::string& what, 
       if (errno == EINTR) continue;
       const int error = errno;
       ::close(fd);
-      throw FileError(cannot + std::strerror(error));
+      throw FileError("cannot read " + what + " " + path + ": " + std::strerror(error));
     }
     if (n == 0) break;
     if (text.size() + static_cast<size_t>(n) > max_bytes) {
       ::close(fd);
-      throw FileError(too_large);
+      throw FileError(too_large(path, what, max_bytes));
     }
     text.append(buffer, static_cast<size_t>(n));
   }
@@ -63,9 +76,50 @@ std::string read_file_limited(const std::string& path, const std::string& what, 
   return text;
 }
 
-std::vector<uint8_t> read_file_bytes(const std::string& path) {
-  const std::string text = read_file_limited(path, "model file", kMaxModelFileBytes);
-  return std::vector<uint8_t>(text.begin(), text.end());
+FileBytes::~FileBytes() {
+  if (map_) ::munmap(map_, map_size_);
+}
+
+FileBytes::FileBytes(FileBytes&& other) noexcept
+    : map_(std::exchange(other.map_, nullptr)), map_size_(std::exchange(other.map_size_, 0)), text_(std::move(other.text_)) {}
+
+FileBytes& FileBytes::operator=(FileBytes&& other) noexcept {
+  if (this != &other) {
+    if (map_) ::munmap(map_, map_size_);
+    map_ = std::exchange(other.map_, nullptr);
+    map_size_ = std::exchange(other.map_size_, 0);
+    text_ = std::move(other.text_);
+  }
+  return *this;
+}
+
+const uint8_t* FileBytes::data() const {
+  return map_ ? static_cast<const uint8_t*>(map_) : reinterpret_cast<const uint8_t*>(text_.data());
+}
+
+size_t FileBytes::size() const { return map_ ? map_size_ : text_.size(); }
+
+FileBytes read_file_bytes(const std::string& path) {
+  const std::string what = "model file";
+  FileBytes out;
+  struct stat st;
+  const int fd = open_checked(path, what, kMaxModelFileBytes, &st);
+  // The open file's own status: the path may have been replaced since stat().
+  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && st.st_size > 0 &&
+      static_cast<uint64_t>(st.st_size) <= kMaxModelFileBytes) {
+    const size_t size = static_cast<size_t>(st.st_size);
+    // MAP_POPULATE maps the whole file up front (one call instead of a fault per page).
+    void* map = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    if (map != MAP_FAILED) {
+      ::close(fd);
+      out.map_ = map;
+      out.map_size_ = size;
+      return out;
+    }
+  }
+  ::close(fd);
+  out.text_ = read_file_limited(path, what, kMaxModelFileBytes);
+  return out;
 }
 
 void write_file_atomically(const std::string& path, const void* data, size_t size) {

@@ -66,6 +66,13 @@ class ByteReader {
     pos_ += n;
     return s;
   }
+  /// The next `n` bytes, in place (no copy); the reader moves past them.
+  const uint8_t* skip(size_t n) {
+    need(n);
+    const uint8_t* at = data_ + pos_;
+    pos_ += n;
+    return at;
+  }
   /// Checks that `count` items of `item_size` bytes can still be read.
   void need_items(uint64_t count, size_t item_size) {
     if (item_size != 0 && count > (size_ - pos_) / item_size) fail("truncated (count " + std::to_string(count) + ")");
@@ -118,8 +125,36 @@ constexpr size_t kMaxRigMapFileBytes = 1 * kMiB;   ///< rig map files
 /// larger than `max_bytes`. Regular files, pipes and FIFOs are read.
 std::string read_file_limited(const std::string& path, const std::string& what, size_t max_bytes);
 
-/// Reads a whole model-sized file (read_file_limited, kMaxModelFileBytes).
-std::vector<uint8_t> read_file_bytes(const std::string& path);
+/// The read-only bytes of a whole file (read_file_bytes). A regular file is
+/// mapped into memory, not copied: the first touch of fresh memory costs a
+/// page fault per 4 KiB, and on virtual machines these dominated loading a
+/// model (a 22 MB copy took 150-300 ms; docs/BENCHMARKS.md, "Start-up").
+/// Pipes and files that cannot be mapped are read into memory instead.
+/// A mapped file must not be truncated while the object lives (the process
+/// would get SIGBUS); motionfield itself only ever replaces files by rename,
+/// which leaves a mapped file intact.
+class FileBytes {
+ public:
+  FileBytes() = default;
+  ~FileBytes();
+  FileBytes(FileBytes&& other) noexcept;
+  FileBytes& operator=(FileBytes&& other) noexcept;
+  FileBytes(const FileBytes&) = delete;
+  FileBytes& operator=(const FileBytes&) = delete;
+
+  const uint8_t* data() const;
+  size_t size() const;
+
+ private:
+  friend FileBytes read_file_bytes(const std::string& path);
+  void* map_ = nullptr;  ///< the mapping, or null when the bytes are in text_
+  size_t map_size_ = 0;
+  std::string text_;
+};
+
+/// Reads a whole model-sized file (the checks and errors of
+/// read_file_limited, kMaxModelFileBytes).
+FileBytes read_file_bytes(const std::string& path);
 
 /// Writes `size` bytes to `path`. A regular file (or a new one) is replaced
 /// through a temporary file in its directory and a rename, so a failure never

@@ -139,6 +139,60 @@ TEST(CApiFaults, AnEndlessFifoIsCutAtTheLimit) {
   writer.join();
 }
 
+// The local latents of one random motion under `model`.
+std::vector<float> local_latents(const mf_model* model) {
+  const MotionPtr input = random_capi_motion(40, 30.0, 5);
+  mf_encoding* raw = nullptr;
+  EXPECT_EQ(mf_encode(model, input.get(), nullptr, &raw), MF_OK) << describe(1);
+  const EncodingPtr code(raw);
+  size_t n = 0;
+  EXPECT_EQ(mf_encoding_get_local_latents(raw, nullptr, 0, &n), MF_OK);
+  std::vector<float> z(n);
+  EXPECT_EQ(mf_encoding_get_local_latents(raw, z.data(), z.size(), &n), MF_OK);
+  return z;
+}
+
+// Item 2: a model file is mapped, not copied, when it is a regular file
+// (FileBytes); through a FIFO it is read instead, and both give the same
+// network as the bytes given from memory.
+TEST(CApiFaults, AModelLoadsTheSameFromAFileAFifoAndMemory) {
+  ScratchDir d;
+  const std::string fifo = d.path + "/model.mfm";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::vector<uint8_t>& bytes = tiny_model_bytes();
+  std::thread writer([&] {
+    const int fd = ::open(fifo.c_str(), O_WRONLY);
+    if (fd < 0) return;
+    for (size_t done = 0; done < bytes.size();) {
+      const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+      if (n <= 0) break;
+      done += static_cast<size_t>(n);
+    }
+    ::close(fd);
+  });
+  mf_model* piped = nullptr;
+  EXPECT_EQ(mf_model_load(fifo.c_str(), &piped), MF_OK) << describe(1);
+  writer.join();
+  const ModelPtr from_fifo(piped);
+  mf_model* in_memory = nullptr;
+  ASSERT_EQ(mf_model_load_from_memory(bytes.data(), bytes.size(), &in_memory), MF_OK) << describe(1);
+  const ModelPtr from_memory(in_memory);
+  const ModelPtr from_file = load_tiny_model();
+  ASSERT_TRUE(from_fifo && from_file);
+  const std::vector<float> expected = local_latents(from_memory.get());
+  ASSERT_FALSE(expected.empty());
+  EXPECT_EQ(local_latents(from_file.get()), expected);
+  EXPECT_EQ(local_latents(from_fifo.get()), expected);
+
+  // A truncated copy is refused with the reason, mapped or not.
+  const std::string cut = d.path + "/cut.mfm";
+  std::ofstream(cut, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), bytes.size() / 2);
+  mf_model* broken = nullptr;
+  EXPECT_EQ(mf_model_load(cut.c_str(), &broken), MF_ERROR_MODEL);
+  EXPECT_NE(std::string(mf_last_error_message()).find("truncated"), std::string::npos) << mf_last_error_message();
+  EXPECT_EQ(broken, nullptr);
+}
+
 // Item 3: bytes of the input reach messages escaped.
 TEST(CApiFaults, ControlBytesOfTheInputAreEscapedInMessages) {
   const std::string bvh = "HIERARCHY\nROOT a\x1b[2J\x1b]0;pwned\x07\n{\n OFFSET 0 0 zero\x1b[31m\n}\n";

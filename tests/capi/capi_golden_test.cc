@@ -43,8 +43,10 @@ struct GoldenCase {
 // The networks alone: measured differences up to 5e-6 element by element.
 constexpr double kNetworkTolerance = 1e-4;
 // Outputs of the prior's solver, whose iterations amplify rounding: measured
-// differences up to 1.5e-3 in the sketches (2.7e-2 element by element).
-constexpr double kSolverTolerance = 5e-3;
+// differences up to 5.2e-3 in the sketches across BLAS kernel sets (the
+// session-20 prior; 2.7e-2 element by element with the one before), while
+// replacing the prior by another fine-tune moves them by 8.6e-3 to 1.7e-2.
+constexpr double kSolverTolerance = 7.5e-3;
 
 const std::string kSample = "samples/walk_keyframes.bvh";
 const std::string kRig = "models/motionfield-rig.json";
@@ -75,7 +77,7 @@ std::string hex64(uint64_t v) {
 std::string fingerprint(const GoldenCase& c) {
   std::string out;
   for (const std::string& f : c.files) {
-    const std::vector<uint8_t> bytes = read_file_bytes(source_path(f));
+    const FileBytes bytes = read_file_bytes(source_path(f));
     if (!out.empty()) out += ",";
     out += f + "=" + std::to_string(bytes.size()) + ":" + hex64(fnv1a64_bytes(bytes.data(), bytes.size()));
   }
