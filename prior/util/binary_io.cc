@@ -49,11 +49,9 @@ int open_checked(const std::string& path, const std::string& what, size_t max_by
   return fd;
 }
 
-}  // namespace
-
-std::string read_file_limited(const std::string& path, const std::string& what, size_t max_bytes) {
-  struct stat st;
-  const int fd = open_checked(path, what, max_bytes, &st);
+// Reads `fd` (opened by open_checked, with status `st`) to its end and closes it.
+std::string read_open_file(int fd, const struct stat& st, const std::string& path, const std::string& what,
+                           size_t max_bytes) {
   std::string text;
   if (S_ISREG(st.st_mode)) text.reserve(static_cast<size_t>(st.st_size));
   char buffer[1 << 16];
@@ -74,6 +72,14 @@ std::string read_file_limited(const std::string& path, const std::string& what, 
   }
   ::close(fd);
   return text;
+}
+
+}  // namespace
+
+std::string read_file_limited(const std::string& path, const std::string& what, size_t max_bytes) {
+  struct stat st;
+  const int fd = open_checked(path, what, max_bytes, &st);
+  return read_open_file(fd, st, path, what, max_bytes);
 }
 
 FileBytes::~FileBytes() {
@@ -117,8 +123,9 @@ FileBytes read_file_bytes(const std::string& path) {
       return out;
     }
   }
-  ::close(fd);
-  out.text_ = read_file_limited(path, what, kMaxModelFileBytes);
+  // Not mapped (a pipe, a FIFO): read from the same descriptor, since a FIFO's
+  // writer must never see its reader close before the end.
+  out.text_ = read_open_file(fd, st, path, what, kMaxModelFileBytes);
   return out;
 }
 
