@@ -2,8 +2,10 @@
 // test paths: a straight line (0 -> 4 m), circles of radius 0.5 m and 1.5 m
 // (one full turn) and a sinusoid (4 m forward, amplitude 0.5 m, wavelength 2 m).
 // Each path is a polyline walked at the reference clip's mean ground speed
-// (polyline_frame_count / resample_polyline), so its frame count depends on the
-// clip. Prints a markdown table (docs/BENCHMARKS.md, "Re-navigation") and writes
+// times --pace (default 1; polyline_frame_count / resample_polyline), so its
+// frame count depends on the clip; the output's style and skating are compared
+// with the reference played at the path's pace (played_at_speed) over as many
+// frames. Prints a markdown table (docs/BENCHMARKS.md, "Re-navigation") and writes
 // a few results as BVH files, their path CSVs and SVG top views.
 //
 //   renav-bench [--model FILE] [--source PATH] [--cache-dir DIR] [--threads N] [--clips N] [--paths straight,circle0.5,circle1.5,sine]
@@ -53,6 +55,7 @@
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/motion/interpolation.h"
 #include "prior/motion/motion_bvh.h"
 #include "tasks/renav.h"
 #include "tasks/soft_dtw.h"
@@ -73,6 +76,7 @@ struct Args {
   mf::bench::DataSource data;
   int threads = 1;
   int clips = 6;
+  double pace = 1.0;
   std::vector<std::string> paths{"straight", "circle0.5", "circle1.5", "sine"};
   std::vector<std::string> methods{"turned", "nemf", "nemf-adam"};
   std::map<std::string, double> numbers;
@@ -90,6 +94,10 @@ void add_options(CLI::App& app, Args& a) {
   mf::bench::add_threads_option(app, a.threads);
   app.add_option("--clips", a.clips, "reference clips (validation clips walking or running)")
       ->check(mf::cli::at_least(1));
+  app.add_option("--pace", a.pace,
+                 "walk each path at this multiple of the reference's mean ground speed (style and skating are "
+                 "compared with the reference played at that pace)")
+      ->check(CLI::Range(0.25, 4.0));
   mf::bench::add_list_option(app, "--paths", a.paths, "straight, circle<R> (radius R in metres), sine");
   mf::bench::add_list_option(app, "--methods", a.methods, "turned (the baseline), nemf, nemf-adam")
       ->check(CLI::IsMember({"turned", "nemf", "nemf-adam"}));
@@ -110,7 +118,8 @@ void add_options(CLI::App& app, Args& a) {
                                  {"w-heading", "weight of the soft-DTW divergence of the heading"},
                                  {"w-skate", "weight of foot skating"},
                                  {"w-continuity", "weight of the continuity with the previous window"},
-                                 {"lock-ramp", "foot locking ramp in frames (negative: no foot locking)"}},
+                                 {"lock-ramp", "foot locking ramp in frames (negative: no foot locking)"},
+                                 {"match-pace", "1: play the reference at the path's pace (the default), 0: as it is"}},
                                 "Solver settings (default: tasks/renav.h)");
 }
 
@@ -138,6 +147,7 @@ mf::RenavOptions options_for(const Args& a, const std::string& method) {
   take("w-continuity", &o.weights.continuity);
   take("overlap", &o.overlap);
   take("lock-ramp", &o.foot_lock_ramp);
+  take("match-pace", &o.match_pace);
   if (!n.empty()) throw mf::InputError("unknown option --" + n.begin()->first);
   o.inits = a.inits;
   return o;
@@ -380,7 +390,7 @@ int run(Args& args, const std::string& command) {
        ")\n- torch threads: " + std::to_string(at::get_num_threads()) + "\n- reference clips: " +
        std::to_string(refs.size()) + " validation clips (");
   for (size_t i = 0; i < ref_names.size(); ++i) emit((i ? ", " : "") + ref_names[i]);
-  emit(")\n");
+  emit(")\n- path speed: " + fixed(args.pace, 2) + " x the reference's mean ground speed\n");
   for (const std::string& m : args.methods) {
     if (m == "turned") continue;
     const mf::RenavOptions o = options_for(args, m);
@@ -389,7 +399,7 @@ int run(Args& args, const std::string& command) {
          (o.max_iterations ? std::to_string(o.max_iterations) : std::string("default")) + ", ftol " +
          fixed(o.function_tolerance, 6) + "; weights path " + fixed(w.path, 2) + ", joints " + fixed(w.joints, 2) +
          ", heading " + fixed(w.heading, 2) + ", foot skating " + fixed(w.foot_skating, 2) + ", continuity " +
-         fixed(w.continuity, 2) + "\n");
+         fixed(w.continuity, 2) + "; match pace " + (o.match_pace ? "yes" : "no") + "\n");
   }
   if (args.profile > 0 && !refs.empty()) emit("\n" + profile(model, refs[0], args.profile));
   emit("\n| path | method | clips | frames | path error (cm) | foot skating (cm) | skating, reference (cm) | "
@@ -407,7 +417,7 @@ int run(Args& args, const std::string& command) {
       double frames_sum = 0;
       for (size_t c = 0; c < refs.size(); ++c) {
         const mf::Motion& ref = refs[c];
-        const int N = mf::polyline_frame_count(poly, mf::mean_ground_speed(ref), fps);
+        const int N = mf::polyline_frame_count(poly, args.pace * mf::mean_ground_speed(ref), fps);
         const std::vector<Eigen::Vector2d> path = mf::resample_polyline(poly, N);
         targets[c] = path;
         frames_sum += N;
@@ -439,7 +449,8 @@ int run(Args& args, const std::string& command) {
           err += std::hypot(out.root_positions[f].x() - path[f].x(), out.root_positions[f].z() - path[f].y());
         sum.path_cm += err / N * 100.0;
         sum.skate_cm += skating_cm(out, feet, standing);
-        const mf::Motion ref_same = ref.slice(0, std::min(N, ref.num_frames()));
+        const mf::Motion paced = args.pace == 1.0 ? ref : mf::played_at_speed(ref, args.pace);
+        const mf::Motion ref_same = paced.slice(0, std::min(N, paced.num_frames()));
         sum.ref_skate_cm += skating_cm(ref_same, feet, standing);
         double dj = 0, dh = 0;
         {

@@ -12,6 +12,7 @@
 
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/motion/interpolation.h"
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations.h"
 #include "prior/motion/rotations_torch.h"
@@ -356,6 +357,21 @@ Motion reference_at_model_rate(const Motion& reference, double fm) {
   return ref_m;
 }
 
+}  // namespace
+
+double reference_pace(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double path_fps) {
+  const int N = static_cast<int>(path.size());
+  const double speed = mean_ground_speed(reference);
+  if (N < 2 || !(path_fps > 0) || !std::isfinite(speed) || speed < 0.05) return 1.0;
+  double length = 0.0;
+  for (int i = 1; i < N; ++i) length += (path[i] - path[i - 1]).norm();
+  const double ratio = length / ((N - 1) / path_fps) / speed;
+  if (!std::isfinite(ratio) || std::abs(ratio - 1.0) <= 0.05) return 1.0;
+  return std::clamp(ratio, kMinPace, kMaxPace);
+}
+
+namespace {
+
 // The path (points at `path_fps`) at the model's rate `fm`: linear in time,
 // the last point at or past the path's end time.
 std::vector<Eigen::Vector2d> path_at_model_rate(const std::vector<Eigen::Vector2d>& path, double path_fps, double fm) {
@@ -459,8 +475,10 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
   check_renav_input(model, reference, path, path_fps, options);
   const double fm = model.config().fps;
   const int W = model.config().window;
-  // Everything at the model's rate.
-  const Motion ref_m = reference_at_model_rate(reference, fm);
+  // Everything at the model's rate, the reference at the path's pace.
+  RenavReport rep;
+  if (options.match_pace) rep.pace = reference_pace(reference, path, path_fps);
+  const Motion ref_m = reference_at_model_rate(rep.pace == 1.0 ? reference : played_at_speed(reference, rep.pace), fm);
   const std::vector<Eigen::Vector2d> path_m = path_at_model_rate(path, path_fps, fm);
   const int M = static_cast<int>(path_m.size());
   const int overlap = options.overlap > 0 ? std::min(options.overlap, W / 2) : std::max(1, W / 4);
@@ -469,7 +487,6 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
   const int cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.solver);
   const std::vector<std::string> inits = options.inits.empty() ? init_names() : options.inits;
 
-  RenavReport rep;
   Motion out = Motion::identity(reference.skeleton, M, fm);
   const int F = model.rig().num_feet();
   std::vector<float> contacts(static_cast<size_t>(M) * F, 0.0f);
@@ -486,6 +503,8 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
     RenavWindowSummary sum;
     sum.begin = span.begin;
     sum.length = span.length;
+    sum.reference_from = span.ref_begin * rep.pace / fm;
+    sum.reference_to = (span.ref_begin + span.ref_length - 1) * rep.pace / fm;
     const FlatLatentEnergy energy(window_energy(model, window, options.weights), model.config().zl,
                                   model.config().zg);
     const at::Tensor x0 = initial_codes(model, window, energy, inits, ctx.seed, k, &sum);

@@ -67,6 +67,13 @@
 // The GMP's root path starts at that origin, so the output starts exactly at
 // the path's first point.
 //
+// Pace (RenavOptions::match_pace): a path walked faster or slower than the
+// reference is followed with the reference played at the path's pace (time
+// scaled by the ratio of their mean ground speeds, reference_pace(); at most
+// 2x either way):
+// the joints' soft-DTW aligns in time but still asks for as many steps as the
+// reference takes, which holds the motion back on a faster path.
+//
 // Initialisation (per window), NeMF's and ours, the lowest energy kept:
 // z_l is the encoder's mean on the reference segment; z_g is, in turn, the
 // encoder's mean on the reference segment turned to follow the target path
@@ -202,10 +209,29 @@ struct RenavOptions : LatentOptimizerSettings {
   /// motion predictor's contacts of the decoded windows, cross-faded as the
   /// poses are), with a ramp of this many frames; negative: off.
   int foot_lock_ramp = kFootLockRamp;
+  /// Pace: when the path is walked faster or slower than the reference (by
+  /// more than 5 %), the reference is first played faster or slower
+  /// (played_at_speed() by reference_pace(), at most 2x either way)
+  /// so that the style terms do not pull the motion back to the reference's
+  /// own pace and off a faster or slower path. false: the reference as it is.
+  bool match_pace = true;
 
   /// Empty when valid, else what is wrong.
   std::string validate() const;
 };
+
+/// The playback speeds match_pace may apply to a reference.
+constexpr double kMinPace = 0.5, kMaxPace = 2.0;
+
+/// The speed factor match_pace applies: the path's mean ground speed (points
+/// at `path_fps`) over the reference's (mean_ground_speed()), clamped to
+/// [kMinPace, kMaxPace]; 1 when within 5 % of 1, when the reference barely
+/// moves (under 0.05 m/s: a clip in place has no pace to match) or the path
+/// has one point. (Matching the distance the reference covers over the
+/// compared frames instead also re-timed references whose start is slower or
+/// faster than their mean, at no gain in path error: docs/BENCHMARKS.md,
+/// "Session 21".)
+double reference_pace(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double path_fps);
 
 /// The options of the methods "nemf" (L-BFGS) and "nemf-adam".
 RenavOptions default_renav_options(RenavSolver solver = RenavSolver::Lbfgs);
@@ -213,6 +239,9 @@ RenavOptions default_renav_options(RenavSolver solver = RenavSolver::Lbfgs);
 /// What one window's solve did.
 struct RenavWindowSummary {
   int begin = 0, length = 0;           ///< output frames (model fps)
+  /// The span of the reference this window was compared with, in seconds of
+  /// the reference as given (before match_pace played it faster or slower).
+  double reference_from = 0.0, reference_to = 0.0;
   std::string init;                    ///< the initial z_g kept
   std::vector<std::pair<std::string, double>> init_energies;  ///< each candidate's energy
   int iterations = 0;
@@ -229,6 +258,7 @@ struct RenavReport {
   int iterations = 0;                  ///< summed over windows
   double path_error_mean_cm = 0.0;     ///< output root vs target path, horizontal, over output frames
   double path_error_max_cm = 0.0;
+  double pace = 1.0;                   ///< the reference's playback speed (RenavOptions::match_pace)
   double wall_ms = 0.0;
 };
 

@@ -127,6 +127,34 @@ TEST(RenavPath, GroundSpeedAndTangents) {
   EXPECT_DOUBLE_EQ(still[1], 0.2);
 }
 
+TEST(RenavPath, ReferencePaceIsTheSpeedRatioWithinLimits) {
+  // A reference walking v m/s along +Z for 61 frames at 30 fps.
+  auto walk = [](double v) {
+    Motion m = Motion::identity(test::small_skeleton(), 61, 30.0);
+    for (int f = 0; f < 61; ++f) m.root_positions[f] = Eigen::Vector3d(0.0, 0.9, v * f / 30.0);
+    return m;
+  };
+  std::vector<Eigen::Vector2d> p;
+  for (int f = 0; f <= 30; ++f) p.emplace_back(0.03 * f, -0.04 * f);  // 1.5 m in 1 s
+  EXPECT_NEAR(reference_pace(walk(1.0), p, 30.0), 1.5, 1e-9);
+  EXPECT_NEAR(reference_pace(walk(2.0), p, 30.0), 0.75, 1e-9);
+  EXPECT_NEAR(reference_pace(walk(1.0), p, 60.0), 2.0, 1e-9);  // the same points twice as fast: 3 m/s, clamped
+  EXPECT_EQ(reference_pace(walk(1.46), p, 30.0), 1.0);          // within 5 %: played as it is
+  EXPECT_EQ(reference_pace(walk(1.54), p, 30.0), 1.0);
+  EXPECT_EQ(reference_pace(walk(0.3), p, 30.0), kMaxPace);      // 5x faster: at most 2x
+  EXPECT_EQ(reference_pace(walk(30.0), p, 30.0), kMinPace);
+  EXPECT_EQ(reference_pace(walk(0.01), p, 30.0), 1.0);          // a clip in place has no pace to match
+  EXPECT_EQ(reference_pace(walk(1.0), {{0, 0}}, 30.0), 1.0);
+  // The mean speeds decide, not where the reference is fast or slow: one that
+  // stands for its first 15 frames, then walks 2 m/s, averages the path's 1.5.
+  Motion pause = walk(0.0);
+  for (int f = 15; f < 61; ++f) pause.root_positions[f].z() = 2.0 * (f - 15) / 30.0;
+  EXPECT_EQ(reference_pace(pause, p, 30.0), 1.0);
+  std::vector<Eigen::Vector2d> slow_far;
+  for (int f = 0; f <= 300; ++f) slow_far.emplace_back(0.0, 0.05 * f);  // 15 m in 10 s
+  EXPECT_NEAR(reference_pace(walk(1.0), slow_far, 30.0), 1.5, 1e-9);
+}
+
 // ---------------------------------------------------------------- the energy
 
 TEST(RenavEnergyTest, LowerForAMotionThatFollowsThePath) {
@@ -254,6 +282,29 @@ TEST(Renavigate, DecreasesTheEnergyAndHasThePathsLength) {
   EXPECT_NEAR(out.root_positions[0].x(), path[0].x(), 1e-6);
   EXPECT_NEAR(out.root_positions[0].z(), path[0].y(), 1e-6);
   EXPECT_GT(report.path_error_mean_cm, 0.0);
+  EXPECT_EQ(report.pace, reference_pace(ref, path, 30.0));
+}
+
+TEST(Renavigate, PlaysTheReferenceAtThePathsPace) {
+  auto model = tiny_model();
+  Motion ref = test::random_motion(model->rig().skeleton, 40, 30.0, 11);
+  for (int f = 0; f < 40; ++f) ref.root_positions[f] = Eigen::Vector3d(0.0, 0.9, 0.02 * f);  // 0.6 m/s
+  const auto path = line_path(20, 0.04);  // 1.2 m/s
+  RenavOptions o = quick(RenavSolver::Lbfgs, 5);
+  RenavReport paced, as_is;
+  const Motion a = renavigate(*model, ref, path, 30.0, o, {}, &paced);
+  o.match_pace = false;
+  const Motion b = renavigate(*model, ref, path, 30.0, o, {}, &as_is);
+  EXPECT_NEAR(paced.pace, 2.0, 1e-9);
+  EXPECT_EQ(as_is.pace, 1.0);
+  EXPECT_EQ(a.num_frames(), 20);
+  EXPECT_EQ(b.num_frames(), 20);
+  // The 20-frame window is compared with the whole reference played twice as
+  // fast (frames 0-38 of 0-39), not with its first 20 frames.
+  ASSERT_EQ(paced.windows.size(), 1u);
+  EXPECT_DOUBLE_EQ(paced.windows[0].reference_from, 0.0);
+  EXPECT_NEAR(paced.windows[0].reference_to, 38.0 / 30.0, 1e-9);
+  EXPECT_NEAR(as_is.windows[0].reference_to, 19.0 / 30.0, 1e-9);
 }
 
 TEST(Renavigate, AdamAndOtherFrameRates) {

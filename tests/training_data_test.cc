@@ -7,6 +7,7 @@
 #include <string>
 
 #include "prior/motion/errors.h"
+#include "prior/motion/interpolation.h"
 #include "prior/motion/motion_bvh.h"
 #include "prior/motion/rotations.h"
 #include "tests/test_util.h"
@@ -21,7 +22,7 @@ namespace {
 // rate, and it covers the whole clip; half speed doubles the frames.
 TEST(TrainingData, PlayedAtSpeedSamplesTheClipAtScaledTimes) {
   const Motion m = test::random_motion(test::small_skeleton(), 41, 30.0, 7);
-  const Motion fast = training::played_at_speed(m, 1.25);
+  const Motion fast = played_at_speed(m, 1.25);
   EXPECT_EQ(fast.num_frames(), 33);  // positions 0, 1.25, ..., 40
   EXPECT_DOUBLE_EQ(fast.fps, 30.0);
   for (int i = 0; i < fast.num_frames(); i += 4) {  // i = 4k lands on frame 5k
@@ -32,10 +33,10 @@ TEST(TrainingData, PlayedAtSpeedSamplesTheClipAtScaledTimes) {
   // Between frames: near the two neighbours' blend (a smooth clip's spline stays close to it).
   Motion smooth = m;
   for (int f = 0; f < m.num_frames(); ++f) smooth.root_positions[f] = Eigen::Vector3d(0.1 * f, 1.0, 0.02 * f * f);
-  const Motion fast_smooth = training::played_at_speed(smooth, 1.25);
+  const Motion fast_smooth = played_at_speed(smooth, 1.25);
   EXPECT_NEAR(fast_smooth.root_positions[1].x(), 0.125, 1e-9);
   EXPECT_NEAR(fast_smooth.root_positions[1].z(), 0.02 * 1.25 * 1.25, 1e-3);
-  EXPECT_EQ(training::played_at_speed(m, 0.5).num_frames(), 81);
+  EXPECT_EQ(played_at_speed(m, 0.5).num_frames(), 81);
 }
 
 TEST(TrainingData, AugmentationAddsToTheTrainingSplitOnly) {
@@ -56,7 +57,7 @@ TEST(TrainingData, AugmentationAddsToTheTrainingSplitOnly) {
   EXPECT_EQ(more.train[n].name, plain.train[0].name + "#mirror");
   EXPECT_EQ(more.train[2 * n].name, plain.train[0].name + "@0.8x");
   EXPECT_EQ(more.train[5 * n].name, plain.train[0].name + "#mirror@1.25x");
-  EXPECT_EQ(more.train[2 * n].motion.num_frames(), training::played_at_speed(plain.train[0].motion, 0.8).num_frames());
+  EXPECT_EQ(more.train[2 * n].motion.num_frames(), played_at_speed(plain.train[0].motion, 0.8).num_frames());
   a.frame_noise_degrees = 5.0;
   const Dataset noisy = training::load_training_data(dir, dir + "/cache", 0, 0.0, a, false);
   ASSERT_EQ(noisy.train.size(), 12 * n);  // originals, mirrors, their noisy copies, then all at each speed

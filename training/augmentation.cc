@@ -87,13 +87,6 @@ void augment_training_split(Dataset& data, const Augmentation& a, bool verbose) 
   }
 }
 
-Motion played_at_speed(const Motion& motion, double speed) {
-  if (!(std::isfinite(speed) && speed > 0)) throw InputError("a playback speed must be finite and positive");
-  Motion faster = motion;
-  faster.fps = motion.fps * speed;  // resampled back to the motion's rate: frame i lands at position i * speed
-  const int frames = static_cast<int>(std::floor((motion.num_frames() - 1) / speed + 1e-9)) + 1;
-  return resample_cubic(faster, motion.fps, frames);
-}
 
 Motion with_frame_noise(const Motion& motion, double max_degrees, uint64_t seed) {
   std::mt19937_64 rng(seed);

@@ -20,7 +20,7 @@ struct Augmentation {
   /// the anatomy errors of a retarget from another rig, other performers'
   /// bodies. 0 = none.
   double frame_noise_degrees = 0.0;
-  std::vector<double> speeds;   ///< each clip played at these speeds (played_at_speed), "<clip>@<speed>x"
+  std::vector<double> speeds;   ///< each clip played at these speeds (played_at_speed(), prior/motion/interpolation.h), "<clip>@<speed>x"
 };
 
 /// Appends the augmented clips to data.train (see Augmentation). Throws
@@ -28,11 +28,6 @@ struct Augmentation {
 /// [0, 45] degrees, or (with mirror) a rig that cannot be mirrored. With
 /// `verbose`, says on stderr what it added.
 void augment_training_split(Dataset& data, const Augmentation& a, bool verbose);
-
-/// `motion` played `speed` times as fast at its own frame rate (frame i of the
-/// result is the motion at frame position i * speed; Catmull-Rom between
-/// frames); the result covers the whole motion.
-Motion played_at_speed(const Motion& motion, double speed);
 
 /// `motion` with every non-root joint's frame turned by a constant rotation
 /// E_j (random axis, angle uniform in [0, max_degrees], drawn from `seed`):

@@ -194,7 +194,11 @@ void define_renav(CLI::App& app, HelpFormatter& help, Arguments& a) {
                               "are skipped. At least two points, all finite, at least 1 mm long.");
   add_task_files(cmd, a.job, "reference BVH");
   CLI::Option* path =
-      cmd->add_option("--path", a.path, "one point per output frame: the output has as many frames")->type_name("PATH");
+      cmd->add_option("--path", a.path,
+                      "one point per output frame: the output has as many frames; a\n"
+                      "path walked faster or slower than the reference plays the\n"
+                      "reference at the path's pace (at most 2x)")
+          ->type_name("PATH");
   CLI::Option* polyline = cmd->add_option("--polyline", a.polyline,
                                           "the vertices of a polyline, walked at constant speed: the\n"
                                           "reference's mean ground speed, or --frames N frames")

@@ -562,7 +562,10 @@ MF_API int mf_decode_times(const mf_encoding *encoding, const double *times, siz
  * frames (0: as many as walking it at the reference's mean ground speed
  * takes; MF_ERROR_INVALID_ARGUMENT if the reference barely moves). Paths
  * longer than the model's window are solved in overlapping windows that agree
- * where they overlap. The output has the reference's skeleton and BVH layout,
+ * where they overlap. A path walked faster or slower than the reference (by
+ * more than 5 %, mean ground speeds) is followed with the reference played at
+ * the path's pace, at most 2x faster or slower: its steps come quicker or
+ * slower, its poses stay the reference's. The output has the reference's skeleton and BVH layout,
  * starts exactly at the path's first point, and has as many frames as the
  * (resampled) path at mf_renav_options.fps. On another rig than the model's,
  * the path stays in the reference's metres and joints the model lacks hold

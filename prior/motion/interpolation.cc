@@ -172,4 +172,12 @@ Motion resample_zero_velocity(const Motion& input, double new_fps, int frames) {
   return out;
 }
 
+Motion played_at_speed(const Motion& motion, double speed) {
+  if (!(std::isfinite(speed) && speed > 0)) throw InputError("a playback speed must be finite and positive");
+  Motion faster = motion;
+  faster.fps = motion.fps * speed;  // resampled back to the motion's rate: frame i lands at position i * speed
+  const int frames = static_cast<int>(std::floor((motion.num_frames() - 1) / speed + 1e-9)) + 1;
+  return resample_cubic(faster, motion.fps, frames);
+}
+
 }  // namespace mf

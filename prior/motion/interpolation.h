@@ -58,6 +58,12 @@ Motion resample_interpolate(const Motion& input, double new_fps, int frames);
 /// into one hemisphere, the result normalised).
 Motion resample_cubic(const Motion& input, double new_fps, int frames);
 
+/// `motion` played `speed` times as fast at its own frame rate (frame i of the
+/// result is the motion at frame position i * speed; resample_cubic() between
+/// frames); the result covers the whole motion. Throws InputError unless speed
+/// is finite and positive.
+Motion played_at_speed(const Motion& motion, double speed);
+
 /// Resampling by holding the most recent input frame (zero velocity): output
 /// frame i copies input frame floor(s), s as above.
 Motion resample_zero_velocity(const Motion& input, double new_fps, int frames);

@@ -380,12 +380,13 @@ TEST(CApiRig, RenavigatesAReferenceOnAnotherRig) {
   for (float v : root) ASSERT_TRUE(std::isfinite(v));
   EXPECT_NEAR(root[0], 0.0f, 1e-4f);  // starts at the path's first point
   EXPECT_NEAR(root[2], 0.0f, 1e-4f);
-  // and travels along +x. The path (1.2 m/s) is faster than the sample's own walk, and the
-  // solver trades the path for the reference's style: the session-15 prior ends 0.6 m short
-  // of the path's end on this rig (x = 0.92 m), the session-20 prior 1.1 m (x = 0.49 m).
-  // renav-bench walks its paths at the reference's speed; paths at other speeds are measured
-  // in docs/BENCHMARKS.md, "Session 20".
-  EXPECT_GT(root[3 * 39], 0.4f) << "the root ends at x = " << root[3 * 39] << " m, z = " << root[3 * 39 + 2]
+  // and travels along +x. The path (1.22 m/s, 90 degrees off the sample's own +z) is 5.3 %
+  // slower than the sample (1.29 m/s on this rig), so the reference is played at 0.947x
+  // (mf::reference_pace). Without that the solver traded the path for the reference's
+  // style: the session-20 prior ended at x = 0.49 m (the session-15 prior 0.92 m); with it,
+  // 1.37 m. The bound asks for more than half the path. renav-bench measures path following
+  // at other paces on longer references (docs/BENCHMARKS.md, "Session 21").
+  EXPECT_GT(root[3 * 39], 0.8f) << "the root ends at x = " << root[3 * 39] << " m, z = " << root[3 * 39 + 2]
                                 << " m; the path ends at x = 1.56 m, z = 0.39 m";
 }
 
