@@ -1907,6 +1907,8 @@ def renav(reference: Motion, path: npt.ArrayLike, *, model: Optional[Model] = No
         The style reference, on any humanoid rig.
     path : array_like
         [points, 2] ground (x, z) positions, metres (see load_path_csv()).
+        A path walked faster or slower than the reference plays the reference
+        at the path's pace (at most 2x either way).
     polyline : bool, optional
         False: one point per output frame at `fps`. True: the points are the
         vertices of a polyline walked at constant speed in `frames` frames.
