@@ -478,7 +478,12 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
   // Everything at the model's rate, the reference at the path's pace.
   RenavReport rep;
   if (options.match_pace) rep.pace = reference_pace(reference, path, path_fps);
-  const Motion ref_m = reference_at_model_rate(rep.pace == 1.0 ? reference : played_at_speed(reference, rep.pace), fm);
+  Motion played = rep.pace == 1.0 ? reference : played_at_speed(reference, rep.pace);
+  if (std::floor((played.num_frames() - 1) * fm / played.fps + 1e-6) < 1.0) {
+    played = reference;  // too short to play faster: under two frames at the model's rate
+    rep.pace = 1.0;
+  }
+  const Motion ref_m = reference_at_model_rate(played, fm);
   const std::vector<Eigen::Vector2d> path_m = path_at_model_rate(path, path_fps, fm);
   const int M = static_cast<int>(path_m.size());
   const int overlap = options.overlap > 0 ? std::min(options.overlap, W / 2) : std::max(1, W / 4);

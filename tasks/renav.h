@@ -70,9 +70,10 @@
 // Pace (RenavOptions::match_pace): a path walked faster or slower than the
 // reference is followed with the reference played at the path's pace (time
 // scaled by the ratio of their mean ground speeds, reference_pace(); at most
-// 2x either way):
-// the joints' soft-DTW aligns in time but still asks for as many steps as the
-// reference takes, which holds the motion back on a faster path.
+// 2x either way; a reference that would be left with fewer than two frames
+// at the model's rate keeps its own). Why: the joints' soft-DTW aligns in
+// time but still asks for as many steps as the reference takes, which holds
+// the motion back on a faster path and pushes it past the end of a slower one.
 //
 // Initialisation (per window), NeMF's and ours, the lowest energy kept:
 // z_l is the encoder's mean on the reference segment; z_g is, in turn, the

@@ -305,6 +305,12 @@ TEST(Renavigate, PlaysTheReferenceAtThePathsPace) {
   EXPECT_DOUBLE_EQ(paced.windows[0].reference_from, 0.0);
   EXPECT_NEAR(paced.windows[0].reference_to, 38.0 / 30.0, 1e-9);
   EXPECT_NEAR(as_is.windows[0].reference_to, 19.0 / 30.0, 1e-9);
+  // Two frames cannot be played twice as fast: such a reference keeps its pace.
+  RenavReport two;
+  o.match_pace = true;
+  const Motion c = renavigate(*model, ref.slice(0, 2), path, 30.0, o, {}, &two);
+  EXPECT_EQ(c.num_frames(), 20);
+  EXPECT_EQ(two.pace, 1.0);
 }
 
 TEST(Renavigate, AdamAndOtherFrameRates) {
