@@ -218,7 +218,7 @@ TEST(CApiFaults, PrintableTextEscapesAndIsIdempotent) {
   EXPECT_EQ(printable("\xc2\x9b" "31m"), "\\u009b31m");        // C1 CSI as UTF-8
   EXPECT_EQ(printable("\xe2\x80\xae" "gpj.bvh"), "\\u202egpj.bvh");  // right-to-left override
   EXPECT_EQ(printable("\xff\xc3"), "\\xff\\xc3");              // invalid UTF-8
-  for (const std::string s : {std::string("a\x1b[0m\xff"), std::string(10000, '\x01'), std::string(9000, 'x')})
+  for (const std::string& s : {std::string("a\x1b[0m\xff"), std::string(10000, '\x01'), std::string(9000, 'x')})
     EXPECT_EQ(printable(printable(s)), printable(s));
 }
 
