@@ -34,7 +34,7 @@ double median_ms(F&& f, int reps) {
 int run(int threads) {
   mf::set_compute_threads(threads);
   Eigen::setNbThreads(threads);
-  std::printf("threads: %d; BLAS: %s\n\n| m x k x n | torch mm (ms) | torch GFLOP/s | Eigen (ms) | Eigen GFLOP/s |\n|---|---|---|---|---|\n", threads, mf::blas_library().c_str());
+  std::printf("threads: %d; BLAS: %s\n\n| m x k x n | torch mm (ms) | torch GFLOP/s | Eigen (ms) | Eigen GFLOP/s |\n|---|---|---|---|---|\n", threads, mf::describe_blas().c_str());
   const int shapes[][3] = {{2048, 782, 512}, {2048, 512, 512}, {128, 526, 256}, {4096, 1024, 1024}};
   for (auto& s : shapes) {
     int m = s[0], k = s[1], n = s[2];

@@ -567,7 +567,7 @@ int run(Args& args, const std::string& command) {
   };
   emit("## solver-bench\n\n- command: `" + command + "`\n- model: " + args.model + " (" + model.config().describe() +
        ")\n- split: " + args.split.split + " (" + std::to_string(clips.size()) + " clips)\n- torch threads: " +
-       std::to_string(at::get_num_threads()) + "\n- BLAS: " + mf::blas_library() + "\n");
+       std::to_string(at::get_num_threads()) + "\n- BLAS: " + mf::describe_blas() + "\n");
   for (const mf::InbetweenerKind& kind : mf::inbetweener_kinds()) {
     const mf::InbetweenModel* t = args.transformers.inbetweener(kind.name);
     emit("- " + kind.name + " transformer: " + (t ? t->describe() : std::string("not loaded")) + "\n");

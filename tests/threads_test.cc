@@ -4,6 +4,9 @@
 #include <dlfcn.h>
 #include <gtest/gtest.h>
 
+#include <strings.h>
+
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -16,7 +19,9 @@ TEST(Threads, SetComputeThreadsSizesLibtorchAndKeepsOpenBlasSerial) {
   for (int n : {1, 2}) {
     set_compute_threads(n);
     EXPECT_EQ(at::get_num_threads(), n);
-    if (openblas) EXPECT_EQ(openblas(), 1);
+    if (openblas) {
+      EXPECT_EQ(openblas(), 1);
+    }
   }
   set_compute_threads(0);  // clamped, never an invalid pool size
   EXPECT_EQ(at::get_num_threads(), 1);
@@ -33,6 +38,22 @@ TEST(Threads, MatrixProductsUseTheSelectedBlas) {
   const auto selected = std::filesystem::canonical("/usr/lib/x86_64-linux-gnu/libblas.so.3", ec);
   if (ec) GTEST_SKIP() << "no /usr/lib/x86_64-linux-gnu/libblas.so.3 on this machine";
   EXPECT_EQ(blas, selected.string());
+}
+
+// OpenBLAS picks its kernels when it is loaded, from the CPU or from
+// OPENBLAS_CORETYPE; openblas_core() names the ones it runs (benchmark headers
+// print it, docs/BLAS.md).
+TEST(Threads, NamesTheOpenBlasKernels) {
+  const std::string core = openblas_core();
+  if (blas_library().find("openblas") == std::string::npos) {
+    EXPECT_EQ(core, "") << blas_library();
+    GTEST_SKIP() << "the BLAS is not OpenBLAS: " << blas_library();
+  }
+  ASSERT_NE(core, "");
+  EXPECT_NE(describe_blas().find("(OpenBLAS kernels: " + core + ")"), std::string::npos) << describe_blas();
+  if (const char* chosen = std::getenv("OPENBLAS_CORETYPE")) {
+    EXPECT_EQ(strcasecmp(core.c_str(), chosen), 0) << "OPENBLAS_CORETYPE=" << chosen << ", kernels " << core;
+  }
 }
 
 }  // namespace

@@ -43,4 +43,16 @@ std::string blas_library() {
   return ec ? std::string(info.dli_fname) : real.string();
 }
 
+std::string openblas_core() {
+  using CoreName = char* (*)();
+  auto name = reinterpret_cast<CoreName>(find_symbol("openblas_get_corename", "libopenblas.so.0"));
+  const char* s = name ? name() : nullptr;
+  return s ? s : "";
+}
+
+std::string describe_blas() {
+  const std::string core = openblas_core();
+  return blas_library() + (core.empty() ? "" : " (OpenBLAS kernels: " + core + ")");
+}
+
 }  // namespace mf

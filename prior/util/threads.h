@@ -21,4 +21,12 @@ void set_compute_threads(int n);
 /// For benchmark headers and the BLAS test.
 std::string blas_library();
 
+/// OpenBLAS's name of the kernels it runs in this process
+/// (openblas_get_corename(): "SkylakeX", "Haswell", "Zen", ...; chosen when it
+/// was loaded; docs/BLAS.md), or "" when the BLAS is not OpenBLAS.
+std::string openblas_core();
+
+/// blas_library() and, for OpenBLAS, its kernels: the BLAS line of benchmark headers.
+std::string describe_blas();
+
 }  // namespace mf
