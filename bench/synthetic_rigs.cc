@@ -141,6 +141,9 @@ std::vector<RigVariant> standard_rig_variants() {
   s.name = "smpl", s.convention = "smpl", s.rest = "tpose", s.length_unit = 1.0, s.fingers = true;
   s.extra_spine = true, s.fps = 60;
   v.push_back(s);
+  RigVariant rough = m;
+  rough.name = "mixamo-rough", rough.rest_jitter_degrees = 5.0;
+  v.push_back(rough);
   return v;
 }
 
@@ -160,6 +163,12 @@ VariantMotion make_variant(const Motion& motion, const RigAnatomy& anatomy, cons
   std::vector<Quaterniond> Q(J, Quaterniond::Identity());
   if (v.rest == "tpose" || v.rest == "apose") {
     Q = reference_pose(s, find_rig_parts(s), anatomy, v.rest == "apose" ? 45.0 : 0.0);
+    std::mt19937_64 rng(11);
+    std::normal_distribution<double> n(0.0, 1.0);
+    for (int j = 0; j < J && v.rest_jitter_degrees > 0; ++j) {
+      const Vector3d axis = Vector3d(n(rng), n(rng), n(rng)).normalized();
+      Q[j] = Quaterniond(Eigen::AngleAxisd(v.rest_jitter_degrees * M_PI / 180.0, axis)) * Q[j];
+    }
   } else if (v.rest == "random") {
     std::mt19937_64 rng(7);
     for (int j = 0; j < J; ++j) Q[j] = random_rotation(rng);

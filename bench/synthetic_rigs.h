@@ -22,6 +22,9 @@ struct RigVariant {
   std::string name;            ///< "mixamo", "cmu", ...
   std::string convention;      ///< naming convention: "mixamo", "mixamo-bare", "cmu", "lafan1", "unreal", "rigify", "smpl", "native"
   std::string rest = "native"; ///< "native", "tpose", "apose" or "random" (local frames rotated at random)
+  /// T or A pose: each joint's rest frame turned this many degrees about a
+  /// random axis (a pose a person built, not reference_pose()'s exactly).
+  double rest_jitter_degrees = 0.0;
   double scale = 1.0;          ///< every bone and the root path
   double length_unit = 0.01;   ///< metres per unit of the BVH file
   bool fingers = false;        ///< two animated finger chains under each hand
@@ -38,7 +41,8 @@ struct RigVariant {
 /// third spine joint, T-pose rest), "cmu" (A-pose, inches, ZYX, 120 fps),
 /// "lafan1" (random local frames, centimetres, YXZ), "unreal" (container root,
 /// twist bones, 1.3x bones), "rigify" (.L/.R names, metres, 24 fps, 0.7x bones,
-/// zero-length helpers), "smpl" (SMPL names, metres, finger joints).
+/// zero-length helpers), "smpl" (SMPL names, metres, finger joints),
+/// "mixamo-rough" (Mixamo's, its T-pose's joints each turned 5 degrees).
 std::vector<RigVariant> standard_rig_variants();
 /// One of standard_rig_variants() by name; throws InputError listing them.
 RigVariant rig_variant(const std::string& name);

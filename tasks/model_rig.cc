@@ -208,6 +208,7 @@ Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, 
   check_model_rig(input.skeleton, ctx);
   RigMap map = model_rig_map(input.skeleton, ctx);
   RigAnatomy user = estimate_anatomy(input, map.user_parts, known);
+  take_rest_pose_frames(input.skeleton, map.user_parts, &user);
   return Retargeter(input.skeleton, model, std::move(map), std::move(user), *ctx.model_anatomy);
 }
 

@@ -255,6 +255,47 @@ TEST(Retarget, VariantsRetargetToTheOriginal) {
   }
 }
 
+// A rig whose rest pose is a T or A pose gives every part's frame from that
+// pose: a few frames then give the anatomy the whole motion gives,
+// where the cues of the motion alone do not. Random local frames and the
+// sample's own rest (every bone along local X) are not recognised.
+TEST(Retarget, RestPoseFramesOfTAndAPoseRigsAreTheWholeMotionsAnatomy) {
+  int recognised = 0;
+  for (const bench::RigVariant& v0 : bench::standard_rig_variants()) {
+    bench::RigVariant v = v0;
+    v.fps = 0;
+    SCOPED_TRACE(v.name);
+    const bench::VariantMotion vm = bench::make_variant(sample(), sample_anatomy(), v);
+    const RigMap map = map_rig(vm.motion.skeleton, sample().skeleton);
+    const RigAnatomy whole = estimate_anatomy(vm.motion, map.user_parts);
+    const std::vector<int> few = {0, 1, 2};
+    RigAnatomy a = estimate_anatomy(vm.motion, map.user_parts, few);
+    const RigAnatomy motion_only = a;
+    const bool taken = take_rest_pose_frames(vm.motion.skeleton, map.user_parts, &a);
+    EXPECT_EQ(taken, v.rest == "tpose" || v.rest == "apose");
+    if (!taken) continue;
+    ++recognised;
+    const RigParts& p = map.user_parts;
+    double worst = 0, worst_motion_only = 0;
+    for (int j : {p.hips, p.chest, p.head, p.arms[0].upper, p.arms[0].fore, p.arms[1].hand, p.arms[1].shoulder,
+                  p.legs[0].thigh, p.legs[1].shin}) {
+      worst = std::max(worst, geodesic_angle(a.frames[j], whole.frames[j]) * 180 / M_PI);
+      worst_motion_only = std::max(worst_motion_only, geodesic_angle(motion_only.frames[j], whole.frames[j]) * 180 / M_PI);
+    }
+    if (v.rest_jitter_degrees > 0) {  // a rough pose: off by about its jitter, not more
+      EXPECT_LT(worst, 2 * v.rest_jitter_degrees) << "degrees";
+      continue;
+    }
+    EXPECT_LT(worst, 0.01) << "degrees";
+    EXPECT_GT(worst_motion_only, 1.0) << "the premise: three frames of motion alone are off";
+    for (int s = 0; s < 2; ++s)
+      EXPECT_LT(geodesic_angle(a.toe_frames[p.legs[s].foot], whole.toe_frames[p.legs[s].foot]) * 180 / M_PI, 0.01);
+  }
+  EXPECT_GE(recognised, 4);
+  RigAnatomy native = sample_anatomy();
+  EXPECT_FALSE(take_rest_pose_frames(sample().skeleton, find_rig_parts(sample().skeleton), &native));
+}
+
 TEST(Retarget, AnatomyJsonRoundTrip) {
   const std::string text = sample_anatomy().to_json(sample().skeleton);
   const RigAnatomy a = RigAnatomy::from_json(text, sample().skeleton, "x.json");

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "prior/motion/errors.h"
@@ -84,6 +85,13 @@ void add_between_rules(const Skeleton& s, const RigParts& p, std::vector<Rule>* 
   }
 }
 
+// Rest-pose position of every joint (identity rotations, root at the origin).
+std::vector<Vector3d> rest_positions(const Skeleton& s) {
+  std::vector<Vector3d> p(s.num_joints(), Vector3d::Zero());
+  for (int j = 1; j < s.num_joints(); ++j) p[j] = p[s.parents[j]] + s.offsets[j];
+  return p;
+}
+
 struct Pose {
   const GlobalPose& g;
   int f;
@@ -133,6 +141,65 @@ Quaterniond frame_from(Vector3d first, Vector3d second) {
   return Quaterniond(m).normalized();
 }
 
+// The body's directions in a rest pose recognised as a T or A pose.
+struct RestBody {
+  std::vector<Vector3d> p;  // rest positions
+  Vector3d up, left, forward;
+};
+
+bool near(const Vector3d& a, const Vector3d& b, double max_degrees) {
+  return a.dot(b) >= std::cos(max_degrees * M_PI / 180.0);
+}
+
+std::optional<RestBody> recognise_rest_pose(const Skeleton& s, const RigParts& parts) {
+  if (!parts.missing().empty()) return std::nullopt;
+  RestBody b;
+  b.p = rest_positions(s);
+  const auto dir = [&](int from, int to) { return unit(b.p[to] - b.p[from]); };
+  // Rest poses stand along an axis of the file: that axis is up (the line from
+  // the hips to the head leans with the spine's curve).
+  const Vector3d torso = dir(parts.hips, parts.head);
+  Eigen::Index k;
+  torso.cwiseAbs().maxCoeff(&k);
+  b.up = Vector3d::Zero();
+  b.up[k] = torso[k] < 0 ? -1.0 : 1.0;
+  const Vector3d across = dir(parts.legs[1].thigh, parts.legs[0].thigh);
+  if (!near(torso, b.up, 30) || across.isZero() || std::abs(across.dot(b.up)) > 0.25) return std::nullopt;
+  b.left = unit(across - across.dot(b.up) * b.up);
+  b.forward = b.left.cross(b.up);
+  if (!near(dir(parts.hips, parts.chest), b.up, 30) || !near(dir(parts.chest, parts.head), b.up, 30)) return std::nullopt;
+  for (int side = 0; side < 2; ++side) {
+    const LegParts& l = parts.legs[side];
+    if (!near(dir(l.thigh, l.foot), -b.up, 25)) return std::nullopt;
+    if (l.toe >= 0 && dir(l.foot, l.toe).dot(b.forward) < 0.3) return std::nullopt;
+    const ArmParts& a = parts.arms[side];
+    const Vector3d upper = dir(a.upper, a.fore), fore = dir(a.fore, a.hand);
+    const Vector3d out = side == 0 ? b.left : Vector3d(-b.left);
+    // Straight arms out to the side, between 60 degrees below horizontal and 20 above.
+    if (!near(upper, fore, 30) || !near(upper, out, 65) || std::abs(upper.dot(b.forward)) > 0.5 ||
+        upper.dot(b.up) < -std::sin(60 * M_PI / 180) || upper.dot(b.up) > std::sin(20 * M_PI / 180))
+      return std::nullopt;
+  }
+  return b;
+}
+
+// The anatomical frame (in world = local axes at rest) of a joint with rule
+// `r` in a recognised rest pose: the conventions of reference_pose().
+Quaterniond rest_frame(const Rule& r, const RestBody& b) {
+  switch (r.second) {
+    case Second::HipLateral:
+    case Second::TorsoLateral:
+    case Second::ArmLateral: return frame_from(b.up, b.left);
+    case Second::Up: return frame_from(b.p[r.to] - b.p[r.from], b.up);
+    case Second::Knee: return frame_from(b.p[r.to] - b.p[r.from], b.left);
+    case Second::Elbow: {
+      const Vector3d first = unit(b.p[r.to] - b.p[r.from]);
+      return frame_from(first, first.cross(b.forward));
+    }
+  }
+  return Quaterniond::Identity();
+}
+
 std::vector<Quaterniond> estimate_frames(const Motion& motion, const GlobalPose& g, const RigParts& parts,
                                          const std::vector<int>& frames, bool along_toes) {
   const int J = motion.num_joints();
@@ -153,13 +220,6 @@ std::vector<Quaterniond> estimate_frames(const Motion& motion, const GlobalPose&
   for (int j = 0; j < J; ++j)
     if (rules[j].from >= 0) out[j] = frame_from(first[j], second[j]);
   return out;
-}
-
-// Rest-pose position of every joint (identity rotations, root at the origin).
-std::vector<Vector3d> rest_positions(const Skeleton& s) {
-  std::vector<Vector3d> p(s.num_joints(), Vector3d::Zero());
-  for (int j = 1; j < s.num_joints(); ++j) p[j] = p[s.parents[j]] + s.offsets[j];
-  return p;
 }
 
 Quaterniond json_quat(const nlohmann::json& v, const std::string& what) {
@@ -280,6 +340,24 @@ double leg_length(const Skeleton& s, const RigParts& p) {
     ++n;
   }
   return n ? sum / n : 0.0;
+}
+
+bool take_rest_pose_frames(const Skeleton& s, const RigParts& parts, RigAnatomy* anatomy) {
+  const int J = s.num_joints();
+  if (static_cast<int>(anatomy->frames.size()) != J || static_cast<int>(anatomy->toe_frames.size()) != J)
+    throw InputError("take_rest_pose_frames: the anatomy does not match the skeleton's joints");
+  const std::optional<RestBody> body = recognise_rest_pose(s, parts);
+  if (!body) return false;
+  for (bool toes : {false, true}) {
+    std::vector<Rule> rules = part_rules(parts, J, toes);
+    add_between_rules(s, parts, &rules);
+    for (int j = 0; j < J; ++j) {
+      const Rule& r = rules[j];
+      if (r.from < 0) continue;
+      (toes ? anatomy->toe_frames : anatomy->frames)[j] = rest_frame(r, *body);
+    }
+  }
+  return true;
 }
 
 RigAnatomy estimate_anatomy(const Motion& motion, const RigParts& parts, const std::vector<int>& frames_in) {

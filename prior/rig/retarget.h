@@ -59,6 +59,18 @@ struct RigAnatomy {
 /// find_rig_parts() or RigMap. Throws InputError if a required part is missing.
 RigAnatomy estimate_anatomy(const Motion& motion, const RigParts& parts, const std::vector<int>& frames = {});
 
+/// When `skeleton`'s rest pose (every local rotation identity) is a T or A
+/// pose (standing along an axis of the file, legs down, straight arms out to
+/// the sides at most 60 degrees below horizontal), replaces the anatomical
+/// frames (`frames`, `toe_frames`) of `anatomy` by that pose's, in the
+/// conventions of reference_pose(): torso and head along the axis, the knees'
+/// hinges along the line between the thighs, the elbows' vertical to the arm
+/// and the facing direction, first axes along the bones. Returns true then;
+/// false (nothing changed) for any other rest. The rest pose is one pose the
+/// rig's author chose, where a few frames of motion mix the clip's poses into
+/// the frames (docs/RIGS.md).
+bool take_rest_pose_frames(const Skeleton& skeleton, const RigParts& parts, RigAnatomy* anatomy);
+
 /// Fills anatomy->locked_axes from `motion` (mean_local must be set, e.g. by
 /// estimate_anatomy on the same motion): per joint, the principal directions
 /// of its local rotations about mean_local whose standard deviation is below
