@@ -142,6 +142,11 @@ void print_rig(const std::string& in, const JsonValue& d, const std::string& mod
   for (const JsonValue& j : d.find("unmapped_user_joints")->as_array())
     left += (left.empty() ? "" : ", ") + j.as_string();
   std::printf("user joints left out: %s\n", left.empty() ? "none" : printable(left).c_str());
+  const std::string anatomy = d.find("anatomy")->as_string();
+  if (anatomy == "rest pose")
+    std::printf("joint frames: read from the rest pose (a T or A pose)\n");
+  else if (anatomy == "known frames")
+    std::printf("joint frames: measured on each input's known frames (the rest pose is not a T or A pose)\n");
   if (!d.find("retargeting")->as_bool())
     std::printf(
         "note: the model has no rig anatomy (motionfield-rig.json next to it): "

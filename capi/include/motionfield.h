@@ -626,12 +626,16 @@ MF_API int mf_length_unit_scale(const char *unit, double *out);
  *     "how": {"model joint": "name" | "shape" | "map file", ...},
  *     "unmapped_user_joints": ["user joint", ...],
  *     "model_joints": ["model joint", ...],            (every model joint)
- *     "retargeting": true}
+ *     "retargeting": true,
+ *     "anatomy": "rest pose" | "known frames" | "model rig"}
  *  "unit" is the unit's name ("custom" for a length_scale that is none of
  *  mf_length_unit_scale's), "unit_detected" false when it was given or could
  *  not be detected (no humanoid legs found: centimetres), "joints" the
  *  motion's joint count, "retargeting" whether the model has the rig anatomy
- *  that tasks on another rig need. `rig_map_json` (NULL or "" = automatic) as
+ *  that tasks on another rig need, "anatomy" where the user's anatomical
+ *  joint frames come from: the rig's rest pose when it is a T or A pose,
+ *  otherwise the known frames of each task's input ("model rig": the
+ *  model's own skeleton, not retargeted; docs/RIGS.md). `rig_map_json` (NULL or "" = automatic) as
  *  mf_task_options.rig_map. MF_ERROR_MODEL without a model;
  *  MF_ERROR_INVALID_ARGUMENT with the rig map's message when the skeleton
  *  cannot be mapped or the map is malformed. */

@@ -4,6 +4,7 @@
 #include "capi/src/capi_internal.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/rig/retarget.h"
 #include "prior/rig/rig_map.h"
 
 namespace mf::capi {
@@ -35,6 +36,9 @@ std::string describe_rig(const mf_model& model, const mf_motion& motion, const s
     if (!used[static_cast<size_t>(u)]) out["unmapped_user_joints"].push_back(user.names[static_cast<size_t>(u)]);
   out["model_joints"] = rig.names;
   out["retargeting"] = model.model_anatomy != nullptr;
+  out["anatomy"] = user.same_as(rig)                                 ? "model rig"
+                   : rest_pose_is_t_or_a(user, map.user_parts) ? "rest pose"
+                                                                     : "known frames";
   return out.dump();
 }
 

@@ -342,6 +342,8 @@ double leg_length(const Skeleton& s, const RigParts& p) {
   return n ? sum / n : 0.0;
 }
 
+bool rest_pose_is_t_or_a(const Skeleton& s, const RigParts& parts) { return recognise_rest_pose(s, parts).has_value(); }
+
 bool take_rest_pose_frames(const Skeleton& s, const RigParts& parts, RigAnatomy* anatomy) {
   const int J = s.num_joints();
   if (static_cast<int>(anatomy->frames.size()) != J || static_cast<int>(anatomy->toe_frames.size()) != J)

@@ -70,6 +70,8 @@ RigAnatomy estimate_anatomy(const Motion& motion, const RigParts& parts, const s
 /// rig's author chose, where a few frames of motion mix the clip's poses into
 /// the frames (docs/RIGS.md).
 bool take_rest_pose_frames(const Skeleton& skeleton, const RigParts& parts, RigAnatomy* anatomy);
+/// Whether take_rest_pose_frames reads `skeleton`'s rest pose (a T or A pose).
+bool rest_pose_is_t_or_a(const Skeleton& skeleton, const RigParts& parts);
 
 /// Fills anatomy->locked_axes from `motion` (mean_local must be set, e.g. by
 /// estimate_anatomy on the same motion): per joint, the principal directions

@@ -1960,7 +1960,9 @@ def describe_rig(motion: Motion, *, model: Optional[Model] = None, rig_map: Opti
     dict
         {"unit", "length_scale", "unit_detected", "joints", "map": {user joint:
         model joint}, "how": {model joint: "name" | "shape" | "map file"},
-        "unmapped_user_joints", "model_joints", "retargeting"}.
+        "unmapped_user_joints", "model_joints", "retargeting", "anatomy": "rest
+        pose" | "known frames" | "model rig"} (where the user's joint frames
+        come from: docs/RIGS.md).
 
     Raises
     ------

@@ -402,6 +402,7 @@ class OtherRigTest(unittest.TestCase):
         self.assertEqual(d["unmapped_user_joints"], [])
         self.assertEqual(d["model_joints"], self.model.joint_names)
         self.assertTrue(d["retargeting"])
+        self.assertEqual(d["anatomy"], "known frames")  # the sample's rest is no T or A pose
         given = mf.describe_rig(self.user, model=self.model, rig_map={"mixamorig:Spine2": "Chest"})
         self.assertEqual(given["how"]["Chest"], "map file")
         with self.assertRaisesRegex(mf.InvalidArgumentError, "rig map: not valid JSON"):

@@ -2,6 +2,7 @@
 // rig maps (automatic, as JSON text or a file, and their errors), and the
 // learned methods and re-navigation served on a rig that is not the model's,
 // with the bundled default model (skipped when it is absent).
+#include <functional>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <unistd.h>
@@ -99,6 +100,50 @@ MotionPtr mixamo_metres() {
   return motion_from_text(bvh_text(cm.get(), 1.0));
 }
 
+// A Mixamo-named rig whose rest pose (every rotation zero) is a T-pose facing
+// +Z, centimetres, two frames of that pose.
+MotionPtr tpose_rig() {
+  struct Joint {
+    std::string name;
+    int parent;
+    double x, y, z;
+  };
+  std::vector<Joint> joints = {{"Hips", -1, 0, 95, 0}, {"Spine", 0, 0, 10, 0}, {"Spine2", 1, 0, 25, 0},
+                               {"Neck", 2, 0, 20, 0},  {"Head", 3, 0, 10, 0}};
+  for (int side = 0; side < 2; ++side) {
+    const std::string S = side == 0 ? "Left" : "Right";
+    const double x = side == 0 ? 1 : -1;
+    const int base = static_cast<int>(joints.size());
+    joints.push_back({S + "Shoulder", 2, x * 5, 15, 0});
+    joints.push_back({S + "Arm", base, x * 12, 0, 0});
+    joints.push_back({S + "ForeArm", base + 1, x * 28, 0, 0});
+    joints.push_back({S + "Hand", base + 2, x * 25, 0, 0});
+    joints.push_back({S + "UpLeg", 0, x * 9, -5, 0});
+    joints.push_back({S + "Leg", base + 4, 0, -42, 0});
+    joints.push_back({S + "Foot", base + 5, 0, -40, 0});
+    joints.push_back({S + "ToeBase", base + 6, 0, -6, 12});
+  }
+  std::string text = "HIERARCHY\n";
+  std::function<void(int, int)> write = [&](int j, int depth) {
+    const std::string pad(static_cast<size_t>(depth) * 2, ' ');
+    const Joint& J = joints[static_cast<size_t>(j)];
+    text += pad + (J.parent < 0 ? "ROOT " : "JOINT ") + "mixamorig:" + J.name + "\n" + pad + "{\n";
+    text += pad + "  OFFSET " + std::to_string(J.x) + " " + std::to_string(J.y) + " " + std::to_string(J.z) + "\n";
+    text += pad + (J.parent < 0 ? "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+                                : "  CHANNELS 3 Zrotation Xrotation Yrotation\n");
+    bool leaf = true;
+    for (size_t c = 0; c < joints.size(); ++c)
+      if (joints[c].parent == j) write(static_cast<int>(c), depth + 1), leaf = false;
+    if (leaf) text += pad + "  End Site\n" + pad + "  {\n" + pad + "    OFFSET 0 5 0\n" + pad + "  }\n";
+    text += pad + "}\n";
+  };
+  write(0, 0);
+  std::string frame = "0 95 0";
+  for (size_t j = 0; j < joints.size(); ++j) frame += " 0 0 0";
+  text += "MOTION\nFrames: 2\nFrame Time: 0.0333333\n" + frame + "\n" + frame + "\n";
+  return motion_from_text(text);
+}
+
 std::string default_model_file() { return std::string(MF_SOURCE_DIR) + "/models/motionfield-prior.mfm"; }
 
 // The bundled model, loaded once (null when it is absent).
@@ -184,6 +229,10 @@ TEST(CApiRig, DescribeShowsTheUnitAndTheMap) {
   EXPECT_TRUE(d["unmapped_user_joints"].empty());
   EXPECT_EQ(d["model_joints"].size(), 21u);
   EXPECT_EQ(d["retargeting"], true);
+  // The sample's rest (every bone along its local X) is no T or A pose.
+  EXPECT_EQ(d["anatomy"], "known frames");
+  const MotionPtr tpose = tpose_rig();
+  EXPECT_EQ(describe_rig(default_model(), tpose.get())["anatomy"], "rest pose");
   // A map's entries say so.
   const nlohmann::json m = describe_rig(default_model(), user.get(), R"({"mixamorig:Spine2": "Chest"})");
   EXPECT_EQ(m["how"]["Chest"], "map file");
