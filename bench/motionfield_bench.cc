@@ -84,7 +84,7 @@ void add_options(CLI::App& app, Args& args) {
   mf::bench::add_data_options(app, args.data);
   mf::bench::add_split_options(app, args.split);
   app.add_option("--rig", args.rig,
-                 "gap and sparse tables on a synthetic rig (mixamo, cmu, lafan1, unreal, rigify, smpl; "
+                 "gap and sparse tables on a synthetic rig (mixamo, cmu, lafan1, unreal, rigify, smpl, mixamo-rough; "
                  "bench/synthetic_rigs.h): each window rewritten onto it, solved there, brought back; needs "
                  "motionfield-rig.json next to the model")
       ->each([](const std::string& name) {

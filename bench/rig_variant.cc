@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
                "rig-variant"};
   mf::cli::use_tool_defaults(app);
   app.add_option("--in", a.in, "the input BVH, on the training data's rig")->required();
-  app.add_option("--rig", a.rig, "mixamo, cmu, lafan1, unreal, rigify or smpl")->required();
+  app.add_option("--rig", a.rig, "mixamo, cmu, lafan1, unreal, rigify, smpl or mixamo-rough")->required();
   app.add_option("--out", a.out, "the output BVH")->required();
   app.add_option("--anatomy", a.anatomy, "the rig anatomy of the input's rig (default: motionfield-rig.json next to "
                                          "the default model)");
