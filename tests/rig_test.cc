@@ -296,6 +296,29 @@ TEST(Retarget, RestPoseFramesOfTAndAPoseRigsAreTheWholeMotionsAnatomy) {
   EXPECT_FALSE(take_rest_pose_frames(sample().skeleton, find_rig_parts(sample().skeleton), &native));
 }
 
+// The rest pose is read whichever axis it stands along and wherever it faces:
+// the whole rig turned turns every frame read from it with it. An arm raised
+// out of the pose is not read.
+TEST(Retarget, RestPoseFramesTurnWithTheRig) {
+  const bench::VariantMotion vm = bench::make_variant(sample(), sample_anatomy(), bench::rig_variant("mixamo"));
+  const RigMap map = map_rig(vm.motion.skeleton, sample().skeleton);
+  RigAnatomy upright = estimate_anatomy(vm.motion, map.user_parts);
+  ASSERT_TRUE(take_rest_pose_frames(vm.motion.skeleton, map.user_parts, &upright));
+  // Z up and facing +X.
+  const Eigen::Quaterniond turn = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ())) *
+                                  Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()));
+  Skeleton turned = vm.motion.skeleton;
+  for (Eigen::Vector3d& o : turned.offsets) o = turn * o;
+  RigAnatomy a = upright;
+  ASSERT_TRUE(take_rest_pose_frames(turned, map.user_parts, &a));
+  for (const auto& [part, j] : map.user_parts.list())
+    EXPECT_LT(geodesic_angle(a.frames[j], turn * upright.frames[j]) * 180 / M_PI, 1e-6) << part;
+  Skeleton raised = vm.motion.skeleton;
+  const int fore = map.user_parts.arms[0].fore;
+  raised.offsets[fore] = Eigen::AngleAxisd(M_PI / 3, Eigen::Vector3d::UnitZ()) * raised.offsets[fore];
+  EXPECT_FALSE(take_rest_pose_frames(raised, map.user_parts, &a));
+}
+
 TEST(Retarget, AnatomyJsonRoundTrip) {
   const std::string text = sample_anatomy().to_json(sample().skeleton);
   const RigAnatomy a = RigAnatomy::from_json(text, sample().skeleton, "x.json");
