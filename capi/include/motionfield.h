@@ -167,8 +167,10 @@ MF_API int mf_printable_text(const char *text, size_t length, char *out, size_t 
 /* ================================================================ threads */
 
 /** Sets the number of intra-op threads of the numeric work in this process
- *  (1..1024). Until it is called, the library uses libtorch's default. Results
- *  may differ in the last bits between thread counts. */
+ *  (1..1024). Until it is called, the library uses libtorch's default number.
+ *  Either way the BLAS library's own thread pool is kept at one thread, since
+ *  libtorch calls it from inside its own threads. Results may differ in the
+ *  last bits between thread counts. */
 MF_API int mf_set_num_threads(int32_t num_threads);
 /** The current number of intra-op threads. */
 MF_API int mf_get_num_threads(int32_t *out);

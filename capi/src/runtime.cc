@@ -2,6 +2,7 @@
 #include <ATen/Parallel.h>
 
 #include <cstdio>
+#include <mutex>
 #include <new>
 
 #include "capi/src/capi_internal.h"
@@ -179,6 +180,11 @@ void skeleton_offsets(const Skeleton& s, float* out, size_t capacity, size_t* ne
 void apply_num_threads() {
   const int n = g_num_threads.load();
   if (n > 0 && at::get_num_threads() != n) mf::set_compute_threads(n);
+  // Without mf_set_num_threads, libtorch's default stays, but OpenBLAS's pool
+  // must not run under it either: left at one thread per core it made a
+  // caller who never chose a thread count 10x slower.
+  static std::once_flag blas_once;
+  if (n == 0) std::call_once(blas_once, mf::keep_blas_single_threaded);
 }
 
 }  // namespace mf::capi

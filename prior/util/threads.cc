@@ -25,8 +25,11 @@ void* find_symbol(const char* name, const char* library) {
 }  // namespace
 
 void set_compute_threads(int n) {
-  n = std::max(1, n);
-  at::set_num_threads(n);
+  at::set_num_threads(std::max(1, n));
+  keep_blas_single_threaded();
+}
+
+void keep_blas_single_threaded() {
   // OpenBLAS's own pool stays at 1: libtorch calls BLAS from inside its
   // intra-op threads, and a second pool under them thrashes (a 40-iteration
   // sparse solve: 2.3-2.5 s with both pools at 2, 0.87 s with OpenBLAS at 1).

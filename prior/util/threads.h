@@ -15,6 +15,10 @@ namespace mf {
 /// n >= 1.
 void set_compute_threads(int n);
 
+/// Only the second half: OpenBLAS's pool at 1 thread, libtorch's untouched. For
+/// a library whose caller never chose a thread count.
+void keep_blas_single_threaded();
+
 /// The file (links resolved) of the library whose sgemm_ serves libtorch's
 /// float matrix products in this process, e.g.
 /// "/usr/lib/x86_64-linux-gnu/openblas-pthread/libblas.so.3", or "unknown".

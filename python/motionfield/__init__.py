@@ -343,7 +343,7 @@ def set_num_threads(n: int) -> None:
     Parameters
     ----------
     n : int
-        Number of threads, 1..1024 (the CLI's default is 2).
+        Number of threads, 1..1024 (the CLI's default is 1).
 
     Returns
     -------

@@ -1,5 +1,6 @@
 // The C API's behaviour on good input: versions, methods, models, motions
 // (arrays and BVH), tasks, progress and cancel, threads, encode and decode.
+#include <dlfcn.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -60,6 +61,20 @@ TEST(CApi, StatusNamesAndTheMessageIsNeverNull) {
   EXPECT_EQ(mf_method_count(&n), MF_OK);
   EXPECT_EQ(mf_last_error_message(), message);
   std::thread([] { EXPECT_STREQ(mf_last_error_message(), ""); }).join();
+}
+
+// Until mf_set_num_threads is called libtorch keeps its default, but OpenBLAS's
+// own pool (one thread per core unless told otherwise) must not run under it:
+// nested, the two pools made a default caller's in-between about 10x slower.
+// CTest runs each test in a process of its own, so this sees the fresh state.
+TEST(CApi, WithoutAThreadCountBlasStaysSerial) {
+  using GetThreads = int (*)();
+  auto openblas = reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+  if (!openblas) GTEST_SKIP() << "the BLAS is not OpenBLAS";
+  int32_t n = 0;
+  ASSERT_EQ(mf_get_num_threads(&n), MF_OK);  // library work without a chosen count
+  EXPECT_GE(n, 1);
+  EXPECT_EQ(openblas(), 1);
 }
 
 TEST(CApi, ThreadCount) {
