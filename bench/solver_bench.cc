@@ -9,7 +9,7 @@
 //   solver-bench --model FILE [--split validation|train] [--threads N] [--max-windows N]
 //                [--source PATH] [--cache-dir DIR]
 //                [--tasks gap,sparse,caps,effector,partial,long,none] [--methods interp,nemf,nemf-adam]
-//                [--lengths 5,15] [--spacings 5,10] [--caps 5,10,20,40] [--speed N] [--out FILE]
+//                [--lengths 5,15] [--spacings 5,10] [--caps 5,10,20,40] [--speed N] [--op-profile] [--out FILE]
 //                [--iterations N] [--ftol X] [--ptol X] [--rank N] [--eigen-scaling 0|1]
 //                [--keyed-iterations N] [--adam-iterations N] [--adam-tol X] [--lock-ramp N] [--effector-falloff N] [--overwrite 0|1]
 //                [--penalty squared|absolute] [--init NAME] [--twostage FILE] [--citl FILE]
@@ -27,7 +27,9 @@
 // --speed N adds the speed table: N sparse windows (a key every 15th frame),
 // each solved by every solver method; wall time, iterations, evaluations and
 // the floor (one decoder forward + backward over 128 frames, times the
-// iterations) per solve.
+// iterations) per solve. --op-profile adds, after each gap or sparse table and
+// after the speed table, the operators run per energy evaluation and the time in
+// them (bench/op_profile.h; with --threads 1).
 //
 // Transformers (tasks/transformer_methods.h): --twostage/--citl FILE, else
 // motionfield-twostage.mfm / motionfield-citl.mfm next to --model when they
@@ -38,6 +40,7 @@
 // "context-encoder", "detail-encoder", "citl-encoder".
 #include <ATen/ATen.h>
 #include <ATen/Parallel.h>
+#include <time.h>
 
 #include <algorithm>
 #include <cmath>
@@ -47,11 +50,13 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/op_profile.h"
 #include "bench/options.h"
 #include "bench/text.h"
 #include "bench/protocol.h"
@@ -75,6 +80,14 @@ using mf::bench::ms_since;
 
 using Clock = std::chrono::steady_clock;
 
+// CPU time of every thread of the process: less disturbed than wall time by
+// other jobs on the machine.
+double process_cpu_ms() {
+  timespec ts;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec / 1e6;
+}
+
 struct Args {
   std::string model;
   mf::bench::SplitChoice split;
@@ -86,6 +99,7 @@ struct Args {
   std::vector<int> spacings{5, 10, 15, 20, 30};
   std::vector<int> caps{5, 10, 20, 40};  // task "caps": L-BFGS iteration caps
   int speed = 0;
+  bool op_profile = false;
   std::string out;
   std::map<std::string, double> numbers;  // solver overrides
   std::string penalty;
@@ -121,6 +135,9 @@ void add_options(CLI::App& app, Args& a) {
   mf::bench::add_list_option(app, "--caps", a.caps, "L-BFGS iteration caps of the caps task");
   app.add_option("--speed", a.speed, "add the speed table over N sparse windows (0: none)")
       ->check(mf::cli::at_least(0));
+  app.add_flag("--op-profile", a.op_profile,
+               "count the operators of each gap and sparse row and of each method's --speed solves (bench/op_profile.h; "
+               "slows them; use --threads 1)");
   app.add_option("--out", a.out, "also write the markdown to FILE");
   app.add_option("--penalty", a.penalty, "squared or absolute (default: the solver's, squared)")
       ->check(CLI::IsMember({"squared", "absolute"}));
@@ -550,6 +567,18 @@ Row sparse_row(const Runner& runner, const std::string& method, const std::vecto
   return row;
 }
 
+// --op-profile: one operator profile per gap or sparse row.
+std::unique_ptr<mf::bench::OpProfile> row_profile(const Args& args) {
+  return args.op_profile ? std::make_unique<mf::bench::OpProfile>() : nullptr;
+}
+
+std::string profile_table(const mf::bench::OpProfile& profile, const std::string& method, const std::string& what,
+                          const Row& row) {
+  return "#### Operators of `" + method + "`, " + what + " (" + fixed(row.evaluations, 0) +
+         " evaluations; the profile's callback slows every operator)\n\n" + profile.table(row.evaluations, "evaluation") +
+         "\n";
+}
+
 int run(Args& args, const std::string& command) {
   mf::set_compute_threads(args.threads);
 
@@ -585,17 +614,23 @@ int run(Args& args, const std::string& command) {
     for (const std::string& method : args.methods) {
       std::vector<Row> rows;
       if (task == "gap") {
+        std::string profiles;
         for (int T : args.lengths) {
+          const auto profile = row_profile(args);
           rows.push_back(gap_row(runner, method, clips, stats, forward, T));
+          if (profile) profiles += profile_table(*profile, method, "gap T = " + std::to_string(T), rows.back());
           std::cerr << "gap " << T << " " << method << " done\n";
         }
-        emit(table("#### Gap filling, `" + method + "`", "T", rows) + "\n");
+        emit(table("#### Gap filling, `" + method + "`", "T", rows) + "\n" + profiles);
       } else if (task == "sparse") {
+        std::string profiles;
         for (int k : args.spacings) {
+          const auto profile = row_profile(args);
           rows.push_back(sparse_row(runner, method, clips, stats, forward, k));
+          if (profile) profiles += profile_table(*profile, method, "keys every " + std::to_string(k), rows.back());
           std::cerr << "sparse " << k << " " << method << " done\n";
         }
-        emit(table("#### Sparse keyframes (128 frames), `" + method + "`", "k", rows) + "\n");
+        emit(table("#### Sparse keyframes (128 frames), `" + method + "`", "k", rows) + "\n" + profiles);
       } else if (task == "caps") {
         if (method == "interp" || is_transformer_method(method) || method == "nemf-adam") continue;
         for (const bool gap : {true, false}) {
@@ -636,25 +671,30 @@ int run(Args& args, const std::string& command) {
     s << "#### Speed: sparse keyframes every 15 frames, 128-frame windows, " << windows.size() << " windows, "
       << at::get_num_threads() << " torch thread(s)\n\n"
       << "Decoder forward + backward over 128 frames: " << fixed(step, 2) << " ms (median of 20).\n\n"
-      << "| method | ms / solve (mean) | ms / solve (median) | iterations | evaluations | floor: decoder f+b x "
-         "iterations (ms) | L2P |\n|---|---:|---:|---:|---:|---:|---:|\n";
+      << "| method | ms / solve (mean) | ms / solve (median) | process CPU ms / solve (mean) | iterations | "
+         "evaluations | floor: decoder f+b x iterations (ms) | L2P |\n|---|---:|---:|---:|---:|---:|---:|---:|\n";
     std::map<std::string, double> mean_ms;
+    std::ostringstream profiles;
     for (const std::string& method : args.methods) {
       if (method == "interp") continue;
       std::vector<double> ms;
-      double iters = 0, evals = 0;
+      double iters = 0, evals = 0, cpu = 0;
       mf::bench::MetricAccumulator acc(stats);
       std::vector<int> evaluated;
       for (int f = 0; f < 128; ++f) {
         if (!std::binary_search(keys.begin(), keys.end(), f)) evaluated.push_back(f);
       }
+      std::unique_ptr<mf::bench::OpProfile> profile;
+      if (args.op_profile) profile = std::make_unique<mf::bench::OpProfile>();
       for (const mf::Window& w : windows) {
         const mf::Motion truth = mf::bench::canonicalise(clips[w.clip].motion.slice(w.start, w.start + 128), 0, forward);
         const mf::Motion input = mf::bench::hide_unknown_frames(truth, keys);
         mf::CompletionReport report;
         const auto t0 = Clock::now();
+        const double c0 = process_cpu_ms();
         mf::Motion out = complete(model, args, method, input, mf::MotionConstraints::full_pose(keys), &report);
         ms.push_back(ms_since(t0));
+        cpu += process_cpu_ms() - c0;
         iters += report.iterations;
         for (const auto& r : report.windows) evals += r.evaluations;
         acc.add(truth, out, evaluated, keys);
@@ -666,9 +706,15 @@ int run(Args& args, const std::string& command) {
       std::sort(sorted.begin(), sorted.end());
       mean_ms[method] = sum / n;
       s << "| " << method << " | " << fixed(sum / n, 0) << " | " << fixed(sorted.empty() ? 0 : sorted[sorted.size() / 2], 0)
-        << " | " << fixed(iters / n, 1) << " | " << fixed(evals / n, 1) << " | " << fixed(step * iters / n, 0) << " | "
+        << " | " << fixed(cpu / n, 0) << " | " << fixed(iters / n, 1) << " | " << fixed(evals / n, 1) << " | " << fixed(step * iters / n, 0) << " | "
         << fixed(acc.summary().l2p, 3) << " |\n";
+      if (profile) {
+        profiles << "\n#### Operators of `" << method << "` (" << fixed(evals / n, 1)
+                 << " evaluations per solve; the profile's callback slows every operator)\n\n"
+                 << profile->table(evals, "evaluation");
+      }
     }
+    s << profiles.str();
     if (mean_ms.count("nemf") && mean_ms.count("nemf-adam") && mean_ms["nemf"] > 0) {
       s << "\nSpeed-up of `nemf` over `nemf-adam`: " << fixed(mean_ms["nemf-adam"] / mean_ms["nemf"], 1) << "x\n";
     }
