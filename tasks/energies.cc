@@ -457,8 +457,7 @@ EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem
   EnergyTerms out;
   // Decode the whole window when a dense term needs it (the key frames then
   // gathered from it), else only the key frames. One FK pass of the dense
-  // decode serves the GMP's input, the key positions and the output terms:
-  // the tree-level FK is many small ops, a large share of an evaluation.
+  // decode serves the GMP's input, the key positions and the output terms.
   const at::Tensor offsets = offsets_tensor(rig.skeleton).to(opt);
   at::Tensor dense_rot, dense_pos, key_rot, key_pos;
   if (a.dense) {

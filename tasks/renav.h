@@ -114,7 +114,9 @@ class NemfModel;
 // ---------------------------------------------------------------- the energy
 
 struct RenavWeights {
-  double path = 1.0;
+  /// 2 since session 25: at 1 a path turned from the reference's own direction
+  /// could be traded for a slower walk (docs/BENCHMARKS.md, "Re-navigation").
+  double path = 2.0;
   double joints = 0.5;
   double heading = 1.0;
   double foot_skating = 0.0;

@@ -196,6 +196,37 @@ TEST(KinematicsTorch, GradientsMatchFiniteDifferences) {
   EXPECT_LT(offsets.grad()[0].abs().max().item<double>(), 1e-15);
 }
 
+TEST(KinematicsTorch, GradientsWhenOnlyPositionsAreUsedAndTheRootIsShared) {
+  // The rotations output unused (its gradient undefined in the backward) and one
+  // root path shared by two windows (its gradient summed over them): checked
+  // against central differences in double precision.
+  const Skeleton skel = test::small_skeleton();
+  const int B = 2, T = 3, J = skel.num_joints();
+  torch::manual_seed(5);
+  at::Tensor d6 = torch::randn({B, T, J, 6}, torch::kDouble).requires_grad_(true);
+  at::Tensor root = torch::randn({T, 3}, torch::kDouble).requires_grad_(true);
+  const at::Tensor offsets = offsets_tensor(skel).to(torch::kDouble);
+  const at::Tensor weights = torch::randn({B, T, J, 3}, torch::kDouble);
+  auto loss = [&](const at::Tensor& x6, const at::Tensor& r) {
+    return (forward_kinematics(skel.parents, offsets, torch_rot::sixd_to_matrix(x6), r).positions * weights).sum();
+  };
+  loss(d6, root).backward();
+  const double h = 1e-6;
+  for (const at::Tensor& param : {d6, root}) {
+    const at::Tensor grad = param.grad().reshape({-1});
+    for (int64_t i = 0; i < param.numel(); i += 7) {  // every 7th entry keeps the test fast
+      at::Tensor plus = param.detach().clone(), minus = param.detach().clone();
+      plus.view({-1})[i] += h;
+      minus.view({-1})[i] -= h;
+      const bool is_d6 = param.is_same(d6);
+      const double fd = ((is_d6 ? loss(plus, root.detach()) : loss(d6.detach(), plus)).item<double>() -
+                         (is_d6 ? loss(minus, root.detach()) : loss(d6.detach(), minus)).item<double>()) /
+                        (2 * h);
+      EXPECT_NEAR(grad[i].item<double>(), fd, 1e-6 * std::max(1.0, std::abs(fd))) << (is_d6 ? "6D " : "root ") << i;
+    }
+  }
+}
+
 TEST(KinematicsTorch, OffsetsTensor) {
   const Skeleton skel = test::small_skeleton();
   at::Tensor o = offsets_tensor(skel);

@@ -1,7 +1,10 @@
 #include "prior/motion/kinematics_torch.h"
 
 #include <ATen/ATen.h>
+#include <ATen/Dispatch.h>
 #include <ATen/ExpandUtils.h>
+#include <ATen/Parallel.h>
+#include <torch/csrc/autograd/custom_function.h>
 
 #include <algorithm>
 #include <string>
@@ -18,6 +21,118 @@ std::string shape_string(const at::Tensor& t) {
   for (int64_t i = 0; i < t.dim(); ++i) s += (i ? ", " : "") + std::to_string(t.size(i));
   return s + "]";
 }
+
+// The kinematic chain as one autograd node with a hand-written backward over
+// plain arrays. FK runs in every energy evaluation of the latent solvers, where
+// a batched formulation (a few tensor operations per tree level) cost about
+// 2 ms per forward + backward over 128 frames, nearly all of it per-operation
+// framework overhead; the arithmetic is ~100 flops per joint and frame
+// (bench/fk_cost.cc compares it with a joint-by-joint autograd reference).
+//   R_0 = L_0, p_0 = root;  R_j = R_par L_j, p_j = p_par + R_par o_j.
+// Backward, children before parents (parents[j] < j):
+//   gp_par += gp_j;  gR_par += gp_j o_j^T + gR_j L_j^T;
+//   go_j = R_par^T gp_j (summed over frames);  gL_j = R_par^T gR_j;  gL_0 = gR_0;  g_root = gp_0.
+template <typename T>
+void fk_forward(const T* L, const T* root, const T* o, const int* parents, int64_t J, int64_t n0, int64_t n1, T* P,
+                T* R) {
+  for (int64_t n = n0; n < n1; ++n) {
+    const T* l = L + n * J * 9;
+    T* r = R + n * J * 9;
+    T* p = P + n * J * 3;
+    std::copy(l, l + 9, r);
+    std::copy(root + n * 3, root + n * 3 + 3, p);
+    for (int64_t j = 1; j < J; ++j) {
+      const T* a = r + parents[j] * 9;
+      const T* b = l + j * 9;
+      const T* oj = o + j * 3;
+      const T* pp = p + parents[j] * 3;
+      T* c = r + j * 9;
+      for (int i = 0; i < 3; ++i) {
+        for (int k = 0; k < 3; ++k) c[i * 3 + k] = a[i * 3] * b[k] + a[i * 3 + 1] * b[3 + k] + a[i * 3 + 2] * b[6 + k];
+        p[j * 3 + i] = pp[i] + a[i * 3] * oj[0] + a[i * 3 + 1] * oj[1] + a[i * 3 + 2] * oj[2];
+      }
+    }
+  }
+}
+
+template <typename T>
+void fk_backward(const T* L, const T* o, const T* R, const T* gP, const T* gR, const int* parents, int64_t J,
+                 int64_t n0, int64_t n1, T* gL, T* gRoot, T* gO, std::vector<T>& gp, std::vector<T>& gr) {
+  for (int64_t n = n0; n < n1; ++n) {
+    const T* l = L + n * J * 9;
+    const T* r = R + n * J * 9;
+    std::copy(gP + n * J * 3, gP + (n + 1) * J * 3, gp.begin());
+    std::copy(gR + n * J * 9, gR + (n + 1) * J * 9, gr.begin());
+    T* gl = gL + n * J * 9;
+    T* go = gO + n * J * 3;
+    std::fill(go, go + 3, T(0));
+    for (int64_t j = J - 1; j >= 1; --j) {
+      const int64_t q = parents[j];
+      const T* a = r + q * 9;   // R_par
+      const T* b = l + j * 9;   // L_j
+      const T* oj = o + j * 3;
+      const T* gpj = &gp[j * 3];
+      const T* grj = &gr[j * 9];
+      T* grq = &gr[q * 9];
+      for (int i = 0; i < 3; ++i) {
+        gp[q * 3 + i] += gpj[i];
+        go[j * 3 + i] = a[i] * gpj[0] + a[3 + i] * gpj[1] + a[6 + i] * gpj[2];
+        for (int k = 0; k < 3; ++k) {
+          grq[i * 3 + k] += gpj[i] * oj[k] + grj[i * 3] * b[k * 3] + grj[i * 3 + 1] * b[k * 3 + 1] +
+                            grj[i * 3 + 2] * b[k * 3 + 2];
+          gl[j * 9 + i * 3 + k] = a[i] * grj[k] + a[3 + i] * grj[3 + k] + a[6 + i] * grj[6 + k];
+        }
+      }
+    }
+    std::copy(gr.begin(), gr.begin() + 9, gl);
+    std::copy(gp.begin(), gp.begin() + 3, gRoot + n * 3);
+  }
+}
+
+// Frames per parallel task: a humanoid's FK costs about a microsecond per frame.
+constexpr int64_t kGrain = 64;
+
+class FkFunction : public torch::autograd::Function<FkFunction> {
+ public:
+  // local [N, J, 3, 3], root [N, 3], offsets [J, 3]: contiguous, one float type.
+  static torch::autograd::variable_list forward(torch::autograd::AutogradContext* ctx, const at::Tensor& local,
+                                                const at::Tensor& root, const at::Tensor& offsets,
+                                                const std::vector<int>& parents) {
+    const int64_t N = local.size(0), J = local.size(1);
+    at::Tensor P = at::empty({N, J, 3}, local.options()), R = at::empty({N, J, 3, 3}, local.options());
+    AT_DISPATCH_FLOATING_TYPES(local.scalar_type(), "forward_kinematics", [&] {
+      const scalar_t *l = local.data_ptr<scalar_t>(), *rt = root.data_ptr<scalar_t>(), *o = offsets.data_ptr<scalar_t>();
+      scalar_t *p = P.data_ptr<scalar_t>(), *r = R.data_ptr<scalar_t>();
+      at::parallel_for(0, N, kGrain, [&](int64_t n0, int64_t n1) { fk_forward(l, rt, o, parents.data(), J, n0, n1, p, r); });
+    });
+    ctx->save_for_backward({local, offsets, R});
+    ctx->saved_data["parents"] = c10::List<int64_t>(std::vector<int64_t>(parents.begin(), parents.end()));
+    return {P, R};
+  }
+
+  static torch::autograd::variable_list backward(torch::autograd::AutogradContext* ctx,
+                                                 torch::autograd::variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const at::Tensor &local = saved[0], &offsets = saved[1], &R = saved[2];
+    const c10::List<int64_t> list = ctx->saved_data["parents"].toIntList();
+    const std::vector<int> parents(list.begin(), list.end());
+    const int64_t N = local.size(0), J = local.size(1);
+    const at::Tensor gP = grads[0].defined() ? grads[0].contiguous() : at::zeros({N, J, 3}, local.options());
+    const at::Tensor gR = grads[1].defined() ? grads[1].contiguous() : at::zeros({N, J, 3, 3}, local.options());
+    at::Tensor gL = at::empty_like(local), gRoot = at::empty({N, 3}, local.options());
+    at::Tensor gO = at::empty({N, J, 3}, local.options());  // per frame, summed below (deterministic)
+    AT_DISPATCH_FLOATING_TYPES(local.scalar_type(), "forward_kinematics_backward", [&] {
+      const scalar_t *l = local.data_ptr<scalar_t>(), *o = offsets.data_ptr<scalar_t>(), *r = R.data_ptr<scalar_t>();
+      const scalar_t *gp = gP.data_ptr<scalar_t>(), *gr = gR.data_ptr<scalar_t>();
+      scalar_t *gl = gL.data_ptr<scalar_t>(), *groot = gRoot.data_ptr<scalar_t>(), *go = gO.data_ptr<scalar_t>();
+      at::parallel_for(0, N, kGrain, [&](int64_t n0, int64_t n1) {
+        std::vector<scalar_t> acc_p(static_cast<size_t>(J) * 3), acc_r(static_cast<size_t>(J) * 9);
+        fk_backward(l, o, r, gp, gr, parents.data(), J, n0, n1, gl, groot, go, acc_p, acc_r);
+      });
+    });
+    return {gL, gRoot, gO.sum(0), at::Tensor()};
+  }
+};
 
 }  // namespace
 
@@ -51,53 +166,23 @@ FkTensors forward_kinematics(const std::vector<int>& parents, const at::Tensor& 
                      " and root_positions " + shape_string(root_positions) + " do not broadcast");
   }
 
-  // matmul does not promote dtypes: bring everything to the common one.
+  // Computed in double for double inputs and in float otherwise.
   const at::ScalarType dtype =
       at::promote_types(at::promote_types(local_rotations.scalar_type(), root_positions.scalar_type()),
                         offsets.scalar_type());
-  const at::TensorOptions opts = local_rotations.options().dtype(dtype);
+  const at::ScalarType work = dtype == at::kDouble ? at::kDouble : at::kFloat;
+  const at::TensorOptions opts = local_rotations.options().dtype(work);
   std::vector<int64_t> rot_shape = batch, pos_shape = batch;
   rot_shape.insert(rot_shape.end(), {J, 3, 3});
   pos_shape.push_back(3);
-  const at::Tensor local = local_rotations.to(opts).expand(rot_shape);
-  const at::Tensor root = root_positions.to(opts).expand(pos_shape);
-  const at::Tensor offs = offsets.to(opts);
-
-  // Joints are processed a tree level at a time (every parent lies on the level
-  // before its children), so a humanoid's ~22 joints take ~8 batched steps
-  // instead of 22: FK runs in every energy evaluation of the latent solvers,
-  // and its per-op overhead, not its arithmetic, is what costs; at::matmul's
-  // backward is also cheaper than that of torch_rot::matmul3's broadcast
-  // product (bench/fk_cost.cc: forward + backward over 128 frames about half the
-  // time of the joint-by-joint loop). No in-place writes into tensors that
-  // autograd needs.
-  std::vector<int> level(static_cast<size_t>(J), 0);
-  int depth = 0;
-  for (int64_t j = 1; j < J; ++j) depth = std::max(depth, level[j] = level[static_cast<size_t>(parents[j])] + 1);
-  std::vector<std::vector<int64_t>> members(static_cast<size_t>(depth) + 1);
-  std::vector<int64_t> slot(static_cast<size_t>(J));  // index of a joint within its level
-  for (int64_t j = 0; j < J; ++j) {
-    slot[j] = static_cast<int64_t>(members[level[j]].size());
-    members[level[j]].push_back(j);
-  }
-  const auto index = [](const std::vector<int64_t>& v) { return at::tensor(v, at::kLong); };
-  std::vector<at::Tensor> level_rot{local.narrow(-3, 0, 1)}, level_pos{root.unsqueeze(-2)};
-  std::vector<int64_t> order{0};
-  for (int d = 1; d <= depth; ++d) {
-    const std::vector<int64_t>& joints = members[static_cast<size_t>(d)];
-    std::vector<int64_t> parent_slots;
-    for (int64_t j : joints) parent_slots.push_back(slot[static_cast<size_t>(parents[j])]);
-    const at::Tensor ps = index(parent_slots), js = index(joints);
-    const at::Tensor parent_rot = level_rot.back().index_select(-3, ps);
-    level_rot.push_back(at::matmul(parent_rot, local.index_select(-3, js)));
-    level_pos.push_back(level_pos.back().index_select(-2, ps) +
-                        at::matmul(parent_rot, offs.index_select(0, js).unsqueeze(-1)).squeeze(-1));
-    order.insert(order.end(), joints.begin(), joints.end());
-  }
-  std::vector<int64_t> inverse(static_cast<size_t>(J));
-  for (int64_t i = 0; i < J; ++i) inverse[static_cast<size_t>(order[i])] = i;
-  const at::Tensor back = index(inverse);
-  return {at::cat(level_pos, -2).index_select(-2, back), at::cat(level_rot, -3).index_select(-3, back)};
+  const at::Tensor local = local_rotations.to(opts).expand(rot_shape).reshape({-1, J, 3, 3}).contiguous();
+  const at::Tensor root = root_positions.to(opts).expand(pos_shape).reshape({-1, 3}).contiguous();
+  const at::Tensor offs = offsets.to(opts).contiguous();
+  const torch::autograd::variable_list out = FkFunction::apply(local, root, offs, parents);
+  std::vector<int64_t> out_pos = batch, out_rot = batch;
+  out_pos.insert(out_pos.end(), {J, 3});
+  out_rot.insert(out_rot.end(), {J, 3, 3});
+  return {out[0].view(out_pos).to(dtype), out[1].view(out_rot).to(dtype)};
 }
 
 at::Tensor offsets_tensor(const Skeleton& skeleton) {
