@@ -281,6 +281,32 @@ TEST(RotationsTorch, GeodesicGradientsFiniteAtIdentityAnd180) {
   }
 }
 
+TEST(RotationsTorch, SixdGradientMatchesFiniteDifferences) {
+  // Every entry of the matrix weighted, on non-orthonormal inputs of several scales
+  // (double precision), and a zero 6D vector: finite values and gradients.
+  torch::manual_seed(11);
+  at::Tensor d6 = (torch::randn({5, 6}, torch::kDouble) * torch::tensor({0.1, 1.0, 3.0, 1.0, 20.0}, torch::kDouble)
+                                                              .unsqueeze(-1))
+                      .requires_grad_(true);
+  const at::Tensor w = torch::randn({5, 3, 3}, torch::kDouble);
+  auto f = [&](const at::Tensor& x) { return (sixd_to_matrix(x) * w).sum(); };
+  f(d6).backward();
+  const at::Tensor grad = d6.grad().reshape({-1});
+  const double h = 1e-6;
+  for (int64_t i = 0; i < d6.numel(); ++i) {
+    at::Tensor xp = d6.detach().clone(), xm = d6.detach().clone();
+    xp.view({-1})[i] += h;
+    xm.view({-1})[i] -= h;
+    const double fd = (f(xp).item<double>() - f(xm).item<double>()) / (2 * h);
+    EXPECT_NEAR(grad[i].item<double>(), fd, 1e-6 * std::max(1.0, std::abs(fd))) << "entry " << i;
+  }
+  at::Tensor zero = torch::zeros({1, 6}, torch::kFloat).requires_grad_(true);
+  at::Tensor m = sixd_to_matrix(zero);
+  m.sum().backward();
+  EXPECT_TRUE(torch::isfinite(m).all().item<bool>());
+  EXPECT_TRUE(torch::isfinite(zero.grad()).all().item<bool>());
+}
+
 TEST(RotationsTorch, GeodesicGradientMatchesFiniteDifferences) {
   // Away from the singular points the gradient is the ordinary derivative.
   at::Tensor d6 = torch::tensor({0.9, 0.3, -0.2, -0.1, 0.8, 0.4}, torch::kDouble).requires_grad_(true);

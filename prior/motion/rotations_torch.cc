@@ -1,6 +1,11 @@
 #include "prior/motion/rotations_torch.h"
 
 #include <ATen/ATen.h>
+#include <ATen/Dispatch.h>
+#include <ATen/Parallel.h>
+#include <torch/csrc/autograd/custom_function.h>
+
+#include <cmath>
 
 #include <string>
 #include <vector>
@@ -56,6 +61,107 @@ at::Tensor sqrt_positive(const at::Tensor& x) {
   at::Tensor positive = x > 0;
   return at::where(positive, at::sqrt(at::where(positive, x, at::ones_like(x))), at::zeros_like(x));
 }
+
+
+// Gram-Schmidt of the 6D representation as one autograd node with a
+// hand-written backward: as tensor operations it was ~25 operators forward and
+// as many backward nodes in every decode (per-operation overhead, not
+// arithmetic, is what a latent solver's evaluation pays; see FK). Same clamp as
+// normalize_last. Per 6-vector (a1, a2):
+//   b1 = a1 r1, r1 = 1/|a1|;  u = a2 - (b1.a2) b1;  b2 = u r2, r2 = 1/|u|;  b3 = b1 x b2.
+// Backward: g1 += b2 x g3, g2 += g3 x b1;  gu = r2 (g2 - (g2.b2) b2);
+//   ga2 = gu - (gu.b1) b1;  g1 += -(b1.a2) gu - (gu.b1) a2;  ga1 = r1 (g1 - (g1.b1) b1)
+// (a clamped norm passes g r unprojected, as clamp_min's zero gradient does).
+constexpr double kNormFloor = 1e-24;
+
+template <typename T>
+struct SixdFrame {
+  T a1[3], a2[3], b1[3], b2[3], b3[3], u[3], r1, r2, d;
+  bool clamp1, clamp2;
+  explicit SixdFrame(const T* x) {
+    for (int i = 0; i < 3; ++i) a1[i] = x[i], a2[i] = x[3 + i];
+    const T n1 = a1[0] * a1[0] + a1[1] * a1[1] + a1[2] * a1[2];
+    clamp1 = n1 < T(kNormFloor);
+    r1 = T(1) / std::sqrt(clamp1 ? T(kNormFloor) : n1);
+    for (int i = 0; i < 3; ++i) b1[i] = a1[i] * r1;
+    d = b1[0] * a2[0] + b1[1] * a2[1] + b1[2] * a2[2];
+    for (int i = 0; i < 3; ++i) u[i] = a2[i] - d * b1[i];
+    const T n2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    clamp2 = n2 < T(kNormFloor);
+    r2 = T(1) / std::sqrt(clamp2 ? T(kNormFloor) : n2);
+    for (int i = 0; i < 3; ++i) b2[i] = u[i] * r2;
+    b3[0] = b1[1] * b2[2] - b1[2] * b2[1];
+    b3[1] = b1[2] * b2[0] - b1[0] * b2[2];
+    b3[2] = b1[0] * b2[1] - b1[1] * b2[0];
+  }
+};
+
+template <typename T>
+T dot3(const T* a, const T* b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+template <typename T>
+void cross_add(const T* a, const T* b, T* out) {
+  out[0] += a[1] * b[2] - a[2] * b[1];
+  out[1] += a[2] * b[0] - a[0] * b[2];
+  out[2] += a[0] * b[1] - a[1] * b[0];
+}
+
+class SixdFunction : public torch::autograd::Function<SixdFunction> {
+ public:
+  // d6 [N, 6] contiguous float or double -> [N, 3, 3] (columns b1, b2, b3).
+  static torch::autograd::variable_list forward(torch::autograd::AutogradContext* ctx, const at::Tensor& d6) {
+    const int64_t N = d6.size(0);
+    at::Tensor m = at::empty({N, 3, 3}, d6.options());
+    AT_DISPATCH_FLOATING_TYPES(d6.scalar_type(), "sixd_to_matrix", [&] {
+      const scalar_t* x = d6.data_ptr<scalar_t>();
+      scalar_t* out = m.data_ptr<scalar_t>();
+      at::parallel_for(0, N, 1024, [&](int64_t n0, int64_t n1) {
+        for (int64_t n = n0; n < n1; ++n) {
+          const SixdFrame<scalar_t> f(x + n * 6);
+          scalar_t* o = out + n * 9;
+          for (int i = 0; i < 3; ++i) o[i * 3] = f.b1[i], o[i * 3 + 1] = f.b2[i], o[i * 3 + 2] = f.b3[i];
+        }
+      });
+    });
+    ctx->save_for_backward({d6});
+    return {m};
+  }
+
+  static torch::autograd::variable_list backward(torch::autograd::AutogradContext* ctx,
+                                                 torch::autograd::variable_list grads) {
+    const at::Tensor d6 = ctx->get_saved_variables()[0];
+    const at::Tensor g = grads[0].contiguous();
+    const int64_t N = d6.size(0);
+    at::Tensor gd = at::empty_like(d6);
+    AT_DISPATCH_FLOATING_TYPES(d6.scalar_type(), "sixd_to_matrix_backward", [&] {
+      const scalar_t *x = d6.data_ptr<scalar_t>(), *gm = g.data_ptr<scalar_t>();
+      scalar_t* out = gd.data_ptr<scalar_t>();
+      at::parallel_for(0, N, 1024, [&](int64_t n0, int64_t n1) {
+        for (int64_t n = n0; n < n1; ++n) {
+          const SixdFrame<scalar_t> f(x + n * 6);
+          const scalar_t* G = gm + n * 9;
+          scalar_t g1[3], g2[3], g3[3], gu[3];
+          for (int i = 0; i < 3; ++i) g1[i] = G[i * 3], g2[i] = G[i * 3 + 1], g3[i] = G[i * 3 + 2];
+          cross_add(f.b2, g3, g1);
+          cross_add(g3, f.b1, g2);
+          const scalar_t p2 = f.clamp2 ? scalar_t(0) : dot3(g2, f.b2);
+          for (int i = 0; i < 3; ++i) gu[i] = f.r2 * (g2[i] - p2 * f.b2[i]);
+          const scalar_t ub = dot3(gu, f.b1);
+          scalar_t* o = out + n * 6;
+          for (int i = 0; i < 3; ++i) {
+            o[3 + i] = gu[i] - ub * f.b1[i];
+            g1[i] += -f.d * gu[i] - ub * f.a2[i];
+          }
+          const scalar_t p1 = f.clamp1 ? scalar_t(0) : dot3(g1, f.b1);
+          for (int i = 0; i < 3; ++i) o[i] = f.r1 * (g1[i] - p1 * f.b1[i]);
+        }
+      });
+    });
+    return {gd};
+  }
+};
 
 }  // namespace
 
@@ -142,11 +248,12 @@ at::Tensor matrix_to_sixd(const at::Tensor& m) {
 
 at::Tensor sixd_to_matrix(const at::Tensor& d6) {
   require_last(d6, 6, "sixd_to_matrix", "d6");
-  at::Tensor a1 = d6.narrow(-1, 0, 3), a2 = d6.narrow(-1, 3, 3);
-  at::Tensor b1 = normalize_last(a1);
-  at::Tensor b2 = normalize_last(a2 - (b1 * a2).sum(-1, /*keepdim=*/true) * b1);
-  at::Tensor b3 = cross3(b1, b2);
-  return at::stack({b1, b2, b3}, -1);  // columns
+  if (!at::isFloatingType(d6.scalar_type()))
+    throw InputError("sixd_to_matrix: d6 must be a floating-point tensor, got " + std::string(c10::toString(d6.scalar_type())));
+  const at::ScalarType work = d6.scalar_type() == at::kDouble ? at::kDouble : at::kFloat;
+  std::vector<int64_t> shape(d6.sizes().begin(), d6.sizes().end() - 1);
+  shape.insert(shape.end(), {3, 3});
+  return SixdFunction::apply(d6.to(work).reshape({-1, 6}).contiguous())[0].view(shape).to(d6.scalar_type());
 }
 
 at::Tensor quat_slerp(const at::Tensor& q0, const at::Tensor& q1, const at::Tensor& t) {
