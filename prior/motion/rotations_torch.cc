@@ -6,7 +6,6 @@
 #include <torch/csrc/autograd/custom_function.h>
 
 #include <cmath>
-
 #include <string>
 #include <vector>
 
@@ -61,7 +60,6 @@ at::Tensor sqrt_positive(const at::Tensor& x) {
   at::Tensor positive = x > 0;
   return at::where(positive, at::sqrt(at::where(positive, x, at::ones_like(x))), at::zeros_like(x));
 }
-
 
 // Gram-Schmidt of the 6D representation as one autograd node with a
 // hand-written backward: as tensor operations it was ~25 operators forward and
