@@ -81,6 +81,40 @@ TEST(PriorModel, GmpInputsFromPositionsAtTheOriginMatch) {
   EXPECT_GT(a.abs().max().item<float>(), 0.1f);
 }
 
+// The heading node: R_y(yaw) of the root's forward axis on the ground, in value
+// and (finite differences on every entry, any matrices) in gradient.
+TEST(PriorModel, HeadingRotationValueAndGradient) {
+  at::manual_seed(3);
+  const Eigen::Vector3d forward = Eigen::Vector3d(0.3, -0.2, 0.9).normalized();
+  at::Tensor root = at::randn({2, 3, 3, 3}, at::kDouble).requires_grad_(true);
+  at::Tensor h = heading_rotation(root, forward);
+  ASSERT_EQ(h.sizes(), (at::IntArrayRef{2, 3, 3, 3}));
+  at::Tensor fwd = at::tensor({forward.x(), forward.y(), forward.z()}, at::kDouble);
+  at::Tensor f = at::matmul(root.detach(), fwd);  // [2, 3, 3]
+  at::Tensor n = (f.select(-1, 0).square() + f.select(-1, 2).square() + 1e-12).sqrt();
+  EXPECT_LT((h.select(-1, 2).select(-1, 0) - f.select(-1, 0) / n).abs().max().item<double>(), 1e-12);  // sin
+  EXPECT_LT((h.select(-1, 0).select(-1, 0) - f.select(-1, 2) / n).abs().max().item<double>(), 1e-12);  // cos
+  EXPECT_TRUE(at::equal(h.select(-2, 1).detach(), at::tensor({0.0, 1.0, 0.0}, at::kDouble).expand({2, 3, 3})));
+  const at::Tensor w = at::randn({2, 3, 3, 3}, at::kDouble);
+  auto loss = [&](const at::Tensor& r) { return (heading_rotation(r, forward) * w).sum(); };
+  loss(root).backward();
+  const at::Tensor grad = root.grad().reshape({-1});
+  const double step = 1e-6;
+  for (int64_t i = 0; i < root.numel(); ++i) {
+    at::Tensor xp = root.detach().clone(), xm = root.detach().clone();
+    xp.view({-1})[i] += step;
+    xm.view({-1})[i] -= step;
+    const double fd = (loss(xp) - loss(xm)).item<double>() / (2 * step);
+    EXPECT_NEAR(grad[i].item<double>(), fd, 1e-6 * std::max(1.0, std::abs(fd))) << "entry " << i;
+  }
+  // Strided float input (a joint of a window), float out; a vertical forward gives a finite identity-like heading.
+  at::Tensor win = at::randn({1, 4, 5, 3, 3});
+  EXPECT_EQ(heading_rotation(win.select(-3, 0), forward).scalar_type(), at::kFloat);
+  at::Tensor up = heading_rotation(at::eye(3).unsqueeze(0), Eigen::Vector3d::UnitY());
+  EXPECT_TRUE(at::isfinite(up).all().item<bool>());
+  EXPECT_THROW(heading_rotation(at::eye(3, at::kLong), forward), InputError);
+}
+
 TEST(PriorModel, EncodeDecodeShapesShortWindowsAndContinuousTime) {
   at::manual_seed(0);
   RigInfo rig = tiny_rig();

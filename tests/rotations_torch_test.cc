@@ -324,6 +324,58 @@ TEST(RotationsTorch, GeodesicGradientMatchesFiniteDifferences) {
   }
 }
 
+TEST(RotationsTorch, GeodesicNodeGradientMatchesFiniteDifferencesOnAnyMatrices) {
+  // The node's backward is the derivative of its own forward, atan2(|skew|, (trace - 1) / 2)
+  // of m0^T m1, for any matrices (here not rotations), in both arguments.
+  torch::manual_seed(5);
+  at::Tensor m0 = torch::randn({4, 3, 3}, torch::kDouble).requires_grad_(true);
+  at::Tensor m1 = torch::randn({4, 3, 3}, torch::kDouble).requires_grad_(true);
+  const at::Tensor w = torch::randn({4}, torch::kDouble);
+  auto f = [&](const at::Tensor& a, const at::Tensor& b) { return (geodesic_angle(a, b) * w).sum(); };
+  f(m0, m1).backward();
+  const double h = 1e-6;
+  for (int which = 0; which < 2; ++which) {
+    const at::Tensor x = which == 0 ? m0 : m1;
+    const at::Tensor grad = x.grad().reshape({-1});
+    for (int64_t i = 0; i < x.numel(); ++i) {
+      at::Tensor xp = x.detach().clone(), xm = x.detach().clone();
+      xp.view({-1})[i] += h;
+      xm.view({-1})[i] -= h;
+      const double fd = which == 0 ? (f(xp, m1.detach()) - f(xm, m1.detach())).item<double>() / (2 * h)
+                                   : (f(m0.detach(), xp) - f(m0.detach(), xm)).item<double>() / (2 * h);
+      EXPECT_NEAR(grad[i].item<double>(), fd, 1e-6 * std::max(1.0, std::abs(fd))) << "m" << which << " entry " << i;
+    }
+  }
+}
+
+TEST(RotationsTorch, GeodesicMatchesTheQuaternionRouteOnRotations) {
+  // On rotations the node equals 2 atan2(|xyz|, |w|) of matrix_to_quat(m0^T m1), in value
+  // and in the gradient with respect to 6D inputs (the directions a decode can move).
+  torch::manual_seed(9);
+  at::Tensor d6 = torch::randn({64, 6}, torch::kDouble).requires_grad_(true);
+  const at::Tensor target = quat_to_matrix(stack_quats(random_quats(64, 21), at::kDouble));
+  auto quat_route = [&](const at::Tensor& m0, const at::Tensor& m1) {
+    at::Tensor q = matrix_to_quat(matmul3(m0.transpose(-1, -2), m1));
+    return 2 * at::atan2(q.narrow(-1, 1, 3).norm(2, -1), q.select(-1, 0).abs());
+  };
+  at::Tensor node = geodesic_angle(sixd_to_matrix(d6), target);
+  node.square().sum().backward();
+  const at::Tensor node_grad = d6.grad().clone();
+  d6.grad().zero_();
+  at::Tensor reference = quat_route(sixd_to_matrix(d6), target);
+  reference.square().sum().backward();
+  EXPECT_LT(max_abs_diff(node, reference), 1e-9);
+  EXPECT_LT(max_abs_diff(node_grad, d6.grad()), 1e-8);
+  // Broadcasting: one target against a batch, float in and out.
+  at::Tensor batch = quat_to_matrix(stack_quats(random_quats(5, 22)));
+  at::Tensor one = quat_to_matrix(stack_quats(random_quats(1, 23))).squeeze(0);
+  at::Tensor out = geodesic_angle(batch, one);
+  EXPECT_EQ(out.sizes(), (at::IntArrayRef{5}));
+  EXPECT_EQ(out.scalar_type(), torch::kFloat);
+  EXPECT_LT(max_abs_diff(out, quat_route(batch, one.expand({5, 3, 3}))), 1e-5);
+  EXPECT_THROW(geodesic_angle(torch::eye(3, torch::kLong), torch::eye(3)), InputError);
+}
+
 TEST(RotationsTorch, MatrixToQuatGradientsFiniteAt180) {
   at::Tensor m = torch::diag(torch::tensor({-1.0, -1.0, 1.0}, torch::kDouble)).requires_grad_(true);
   matrix_to_quat(m).sum().backward();

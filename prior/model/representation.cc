@@ -1,6 +1,9 @@
 #include "prior/model/representation.h"
 
 #include <ATen/ATen.h>
+#include <ATen/Dispatch.h>
+#include <ATen/Parallel.h>
+#include <torch/csrc/autograd/custom_function.h>
 
 #include <algorithm>
 #include <cctype>
@@ -56,6 +59,78 @@ at::Tensor time_derivative(const at::Tensor& x, double fps) {
   shape[1] = T;
   return (next - prev) * fps / span.view(shape);
 }
+
+// The heading R_y(yaw) of each root rotation as one autograd node (as tensor
+// operations it was ~17 operators forward and as many backward, paid twice in
+// every evaluation of a dense energy: the GMP's inputs and the root path).
+// f = R forward, n = sqrt(fx^2 + fz^2 + eps), (s, c) = (fx, fz) / n,
+// H = [[c, 0, s], [0, 1, 0], [-s, 0, c]]. Backward: g_s = G02 - G20,
+// g_c = G00 + G22; g_fx = (g_s (fz^2 + eps) - g_c fx fz) / n^3,
+// g_fz = (g_c (fx^2 + eps) - g_s fx fz) / n^3; dL/dR row 0 = g_fx forward^T,
+// row 2 = g_fz forward^T, row 1 = 0.
+constexpr double kHeadingEps = 1e-12;
+
+class HeadingFunction : public torch::autograd::Function<HeadingFunction> {
+ public:
+  // root [N, 3, 3] contiguous float or double -> [N, 3, 3].
+  static torch::autograd::variable_list forward(torch::autograd::AutogradContext* ctx, const at::Tensor& root,
+                                                const Eigen::Vector3d& forward) {
+    const int64_t N = root.size(0);
+    at::Tensor out = at::empty({N, 3, 3}, root.options());
+    AT_DISPATCH_FLOATING_TYPES(root.scalar_type(), "heading_rotation", [&] {
+      const scalar_t* R = root.data_ptr<scalar_t>();
+      scalar_t* H = out.data_ptr<scalar_t>();
+      const scalar_t w[3] = {scalar_t(forward.x()), scalar_t(forward.y()), scalar_t(forward.z())};
+      at::parallel_for(0, N, 2048, [&](int64_t n0, int64_t n1) {
+        for (int64_t n = n0; n < n1; ++n) {
+          const scalar_t* r = R + n * 9;
+          const scalar_t fx = r[0] * w[0] + r[1] * w[1] + r[2] * w[2];
+          const scalar_t fz = r[6] * w[0] + r[7] * w[1] + r[8] * w[2];
+          const scalar_t inv = scalar_t(1) / std::sqrt(fx * fx + fz * fz + scalar_t(kHeadingEps));
+          const scalar_t s = fx * inv, c = fz * inv;
+          scalar_t* h = H + n * 9;
+          h[0] = c, h[1] = 0, h[2] = s;
+          h[3] = 0, h[4] = 1, h[5] = 0;
+          h[6] = -s, h[7] = 0, h[8] = c;
+        }
+      });
+    });
+    ctx->save_for_backward({root});
+    ctx->saved_data["forward"] = std::vector<double>{forward.x(), forward.y(), forward.z()};
+    return {out};
+  }
+
+  static torch::autograd::variable_list backward(torch::autograd::AutogradContext* ctx,
+                                                 torch::autograd::variable_list grads) {
+    const at::Tensor root = ctx->get_saved_variables()[0];
+    const std::vector<double> forward = ctx->saved_data["forward"].toDoubleVector();
+    const at::Tensor g = grads[0].contiguous();
+    const int64_t N = root.size(0);
+    at::Tensor groot = at::empty_like(root);
+    AT_DISPATCH_FLOATING_TYPES(root.scalar_type(), "heading_rotation_backward", [&] {
+      const scalar_t *R = root.data_ptr<scalar_t>(), *G = g.data_ptr<scalar_t>();
+      scalar_t* out = groot.data_ptr<scalar_t>();
+      const scalar_t w[3] = {scalar_t(forward[0]), scalar_t(forward[1]), scalar_t(forward[2])};
+      const scalar_t eps = scalar_t(kHeadingEps);
+      at::parallel_for(0, N, 2048, [&](int64_t n0, int64_t n1) {
+        for (int64_t n = n0; n < n1; ++n) {
+          const scalar_t* r = R + n * 9;
+          const scalar_t* gh = G + n * 9;
+          const scalar_t fx = r[0] * w[0] + r[1] * w[1] + r[2] * w[2];
+          const scalar_t fz = r[6] * w[0] + r[7] * w[1] + r[8] * w[2];
+          const scalar_t n2 = fx * fx + fz * fz + eps;
+          const scalar_t inv3 = scalar_t(1) / (n2 * std::sqrt(n2));
+          const scalar_t gs = gh[2] - gh[6], gc = gh[0] + gh[8];
+          const scalar_t gfx = (gs * (fz * fz + eps) - gc * fx * fz) * inv3;
+          const scalar_t gfz = (gc * (fx * fx + eps) - gs * fx * fz) * inv3;
+          scalar_t* o = out + n * 9;
+          for (int k = 0; k < 3; ++k) o[k] = gfx * w[k], o[3 + k] = 0, o[6 + k] = gfz * w[k];
+        }
+      });
+    });
+    return {groot, at::Tensor()};
+  }
+};
 
 // FK of the local motion with the heading removed from the root and the root at the origin.
 FkTensors heading_free_fk(const at::Tensor& local_rotations, const RigInfo& rig) {
@@ -195,13 +270,14 @@ void write_window(const at::Tensor& local_rotations, const at::Tensor& root_posi
 at::Tensor ground_xz(const at::Tensor& points) { return at::stack({points.select(-1, 0), points.select(-1, 2)}, -1); }
 
 at::Tensor heading_rotation(const at::Tensor& root_rotations, const Eigen::Vector3d& root_forward) {
-  at::Tensor fwd = at::tensor({root_forward.x(), root_forward.y(), root_forward.z()}, root_rotations.options());
-  at::Tensor f = torch_rot::matvec3(root_rotations, fwd);
-  at::Tensor fx = f.select(-1, 0), fz = f.select(-1, 2);
-  at::Tensor n = at::sqrt(fx * fx + fz * fz + 1e-12);
-  at::Tensor s = fx / n, c = fz / n;
-  at::Tensor zero = at::zeros_like(s), one = at::ones_like(s);
-  return at::stack({c, zero, s, zero, one, zero, -s, zero, c}, -1).unflatten(-1, {3, 3});
+  if (!root_rotations.defined() || root_rotations.dim() < 2 || root_rotations.size(-1) != 3 ||
+      root_rotations.size(-2) != 3 || !at::isFloatingType(root_rotations.scalar_type()))
+    throw InputError("heading_rotation: expected floating-point root rotations [..., 3, 3]");
+  const at::ScalarType work = root_rotations.scalar_type() == at::kDouble ? at::kDouble : at::kFloat;
+  std::vector<int64_t> shape(root_rotations.sizes().begin(), root_rotations.sizes().end());
+  return HeadingFunction::apply(root_rotations.to(work).reshape({-1, 3, 3}).contiguous(), root_forward)[0]
+      .view(shape)
+      .to(root_rotations.scalar_type());
 }
 
 at::Tensor trajectory_features(const at::Tensor& root_rotations, const at::Tensor& root_positions,

@@ -75,7 +75,9 @@ void write_window(const at::Tensor& local_rotations, const at::Tensor& root_posi
 /// The ground-plane coordinates (x, z) of points [..., 3] -> [..., 2].
 at::Tensor ground_xz(const at::Tensor& points);
 
-/// Heading rotations H(t) [..., 3, 3] from root rotations [..., 3, 3].
+/// Heading rotations H(t) [..., 3, 3] from root rotations [..., 3, 3]: the
+/// rotation about +Y that turns +Z to the root's forward axis projected on the
+/// ground (one autograd node; floating-point input, else InputError).
 at::Tensor heading_rotation(const at::Tensor& root_rotations, const Eigen::Vector3d& root_forward);
 
 /// The ground trajectory of a motion, [..., 4] per frame: the root's ground

@@ -38,11 +38,13 @@ at::Tensor sixd_to_matrix(const at::Tensor& d6);                       // [...,6
 /// (pass times as [..., 1]). Falls back to normalised linear interpolation when
 /// |q0.q1| > 0.9995, like slerp() in rotations.h.
 at::Tensor quat_slerp(const at::Tensor& q0, const at::Tensor& q1, const at::Tensor& t);
-/// Geodesic angle (radians) between rotation matrices, [...,3,3] x2 -> [...].
-/// Computed as 2 atan2(|xyz|, |w|) of the relative rotation m0^T m1, which keeps
-/// float precision for small angles. Gradients are finite everywhere; at the two
-/// points where the angle is not smooth, identical inputs (gradient zero) and
-/// exactly 180 degrees, they are a subgradient.
+/// Geodesic angle (radians) between rotation matrices, [...,3,3] x2 -> [...]
+/// (the two broadcast; floating-point inputs, else InputError). Computed as
+/// atan2(|skew part|, (trace - 1) / 2) of the relative rotation m0^T m1 (equal to
+/// 2 atan2(|xyz|, |w|) of its quaternion), which keeps float precision for small
+/// angles, in one autograd node. Gradients are finite everywhere; at the two
+/// points where the angle is not smooth, identical inputs and exactly 180
+/// degrees, they are a subgradient (zero).
 at::Tensor geodesic_angle(const at::Tensor& m0, const at::Tensor& m1);
 /// Makes quaternion signs continuous along dimension `dim` (each q flipped to
 /// agree with its predecessor; the first keeps its sign). `dim` may be negative
