@@ -115,6 +115,31 @@ TEST(PriorModel, HeadingRotationValueAndGradient) {
   EXPECT_THROW(heading_rotation(at::eye(3, at::kLong), forward), InputError);
 }
 
+// One window's decode (the latent projections as matrix-vector products) equals
+// the same latents decoded in a batch (matrix products), values and gradients.
+TEST(PriorModel, SingleWindowDecodeMatchesBatchedDecode) {
+  at::manual_seed(4);
+  RigInfo rig = tiny_rig();
+  NemfModel model(tiny_nemf_config(), rig);
+  const NemfConfig& c = model.config();
+  at::Tensor z_l = at::randn({3, c.zl}).requires_grad_(true), z_g = at::randn({3, c.zg}).requires_grad_(true);
+  at::Tensor frames = at::arange(0.0, 20.0, 0.5);
+  at::Tensor batched = model.decode(frames, z_l, z_g);
+  const at::Tensor w = at::randn(batched.select(0, 1).sizes());  // a rotation's squared entries sum to 3
+  (batched.select(0, 1) * w).sum().backward();
+  for (int b = 0; b < 3; ++b) {
+    at::Tensor zl1 = z_l.detach().narrow(0, b, 1).clone().requires_grad_(true);
+    at::Tensor zg1 = z_g.detach().narrow(0, b, 1).clone().requires_grad_(true);
+    at::Tensor one = model.decode(frames, zl1, zg1);
+    EXPECT_LT((one.select(0, 0) - batched.select(0, b).detach()).abs().max().item<float>(), 1e-5) << b;
+    if (b != 1) continue;
+    (one.select(0, 0) * w).sum().backward();
+    EXPECT_LT((zl1.grad() - z_l.grad().narrow(0, 1, 1)).abs().max().item<float>(), 1e-4);
+    EXPECT_LT((zg1.grad() - z_g.grad().narrow(0, 1, 1)).abs().max().item<float>(), 1e-4);
+    EXPECT_GT(zl1.grad().abs().max().item<float>(), 1e-3f);
+  }
+}
+
 TEST(PriorModel, EncodeDecodeShapesShortWindowsAndContinuousTime) {
   at::manual_seed(0);
   RigInfo rig = tiny_rig();

@@ -124,9 +124,9 @@ struct DecoderImpl : torch::nn::Module {
   at::Tensor forward(const at::Tensor& pe, const at::Tensor& z_l, const at::Tensor& z_g) {
     at::Tensor h;
     for (int l = 0; l < config_.decoder_layers; ++l) {
-      at::Tensor a = pe_[l]->forward(pe) + zl_[l]->forward(z_l).unsqueeze(1);
+      at::Tensor a = pe_[l]->forward(pe) + latent_part(zl_[l], z_l);
       if (hidden_[l]) a = a + hidden_[l]->forward(h);
-      if (zg_[l]) a = a + zg_[l]->forward(z_g).unsqueeze(1);
+      if (zg_[l]) a = a + latent_part(zg_[l], z_g);
       h = at::relu(norms_[l]->forward(a));
     }
     at::Tensor out = head_->forward(h);
@@ -134,6 +134,14 @@ struct DecoderImpl : torch::nn::Module {
     // Centred on the identity rotation so the initial output is well conditioned.
     at::Tensor identity = at::tensor({1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f}, out.options());
     return out + identity;
+  }
+  // A latent's projection [B, n] -> [B, 1, W] (bias-free). One window (B = 1,
+  // every latent solve) takes a matrix-vector product: as a [1, n] x [n, W]
+  // matrix product BLAS repacks the whole weight matrix on every call, which
+  // cost about as much as the product itself (perf, 30-frame gaps).
+  static at::Tensor latent_part(torch::nn::Linear& linear, const at::Tensor& z) {
+    if (z.size(0) == 1) return at::mv(linear->weight, z.select(0, 0)).view({1, 1, -1});
+    return linear->forward(z).unsqueeze(1);
   }
   NemfConfig config_;
   int joints_;
