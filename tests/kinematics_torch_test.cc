@@ -171,27 +171,13 @@ TEST(KinematicsTorch, GradientsMatchFiniteDifferences) {
     return (fk.positions * weights).sum() + (fk.rotations * rot_weights).sum();
   };
   loss(d6, root, offsets).backward();
-  const double h = 1e-6;
-  auto check = [&](const at::Tensor& param, const char* name) {
-    at::Tensor flat_grad = param.grad().reshape({-1});
-    ASSERT_TRUE(torch::isfinite(flat_grad).all().item<bool>()) << name;
-    const int64_t n = param.numel();
-    for (int64_t i = 0; i < n; ++i) {
-      at::Tensor plus = param.detach().clone(), minus = param.detach().clone();
-      plus.view({-1})[i] += h;
-      minus.view({-1})[i] -= h;
-      at::Tensor x6p = d6.detach(), rp = root.detach(), op = offsets.detach();
-      at::Tensor x6m = x6p, rm = rp, om = op;
-      if (param.is_same(d6)) { x6p = plus; x6m = minus; }
-      if (param.is_same(root)) { rp = plus; rm = minus; }
-      if (param.is_same(offsets)) { op = plus; om = minus; }
-      const double fd = (loss(x6p, rp, op).item<double>() - loss(x6m, rm, om).item<double>()) / (2 * h);
-      EXPECT_NEAR(flat_grad[i].item<double>(), fd, 1e-6 * std::max(1.0, std::abs(fd))) << name << " entry " << i;
-    }
-  };
-  check(d6, "6D rotations");
-  check(root, "root positions");
-  check(offsets, "offsets");
+  const at::Tensor x6 = d6.detach(), r = root.detach(), o = offsets.detach();
+  test::expect_gradient_matches_finite_differences([&](const at::Tensor& x) { return loss(x, r, o); }, d6,
+                                                   "6D rotations");
+  test::expect_gradient_matches_finite_differences([&](const at::Tensor& x) { return loss(x6, x, o); }, root,
+                                                   "root positions");
+  test::expect_gradient_matches_finite_differences([&](const at::Tensor& x) { return loss(x6, r, x); }, offsets,
+                                                   "offsets");
   // The root's offset row does not influence anything.
   EXPECT_LT(offsets.grad()[0].abs().max().item<double>(), 1e-15);
 }
@@ -211,20 +197,11 @@ TEST(KinematicsTorch, GradientsWhenOnlyPositionsAreUsedAndTheRootIsShared) {
     return (forward_kinematics(skel.parents, offsets, torch_rot::sixd_to_matrix(x6), r).positions * weights).sum();
   };
   loss(d6, root).backward();
-  const double h = 1e-6;
-  for (const at::Tensor& param : {d6, root}) {
-    const at::Tensor grad = param.grad().reshape({-1});
-    for (int64_t i = 0; i < param.numel(); i += 7) {  // every 7th entry keeps the test fast
-      at::Tensor plus = param.detach().clone(), minus = param.detach().clone();
-      plus.view({-1})[i] += h;
-      minus.view({-1})[i] -= h;
-      const bool is_d6 = param.is_same(d6);
-      const double fd = ((is_d6 ? loss(plus, root.detach()) : loss(d6.detach(), plus)).item<double>() -
-                         (is_d6 ? loss(minus, root.detach()) : loss(d6.detach(), minus)).item<double>()) /
-                        (2 * h);
-      EXPECT_NEAR(grad[i].item<double>(), fd, 1e-6 * std::max(1.0, std::abs(fd))) << (is_d6 ? "6D " : "root ") << i;
-    }
-  }
+  // Every 7th entry keeps the test fast.
+  test::expect_gradient_matches_finite_differences([&](const at::Tensor& x) { return loss(x, root.detach()); }, d6,
+                                                   "6D", 1e-6, 1e-6, 7);
+  test::expect_gradient_matches_finite_differences([&](const at::Tensor& x) { return loss(d6.detach(), x); }, root,
+                                                   "root", 1e-6, 1e-6, 7);
 }
 
 TEST(KinematicsTorch, OffsetsTensor) {

@@ -98,15 +98,7 @@ TEST(PriorModel, HeadingRotationValueAndGradient) {
   const at::Tensor w = at::randn({2, 3, 3, 3}, at::kDouble);
   auto loss = [&](const at::Tensor& r) { return (heading_rotation(r, forward) * w).sum(); };
   loss(root).backward();
-  const at::Tensor grad = root.grad().reshape({-1});
-  const double step = 1e-6;
-  for (int64_t i = 0; i < root.numel(); ++i) {
-    at::Tensor xp = root.detach().clone(), xm = root.detach().clone();
-    xp.view({-1})[i] += step;
-    xm.view({-1})[i] -= step;
-    const double fd = (loss(xp) - loss(xm)).item<double>() / (2 * step);
-    EXPECT_NEAR(grad[i].item<double>(), fd, 1e-6 * std::max(1.0, std::abs(fd))) << "entry " << i;
-  }
+  test::expect_gradient_matches_finite_differences(loss, root, "root rotations");
   // Strided float input (a joint of a window), float out; a vertical forward gives a finite identity-like heading.
   at::Tensor win = at::randn({1, 4, 5, 3, 3});
   EXPECT_EQ(heading_rotation(win.select(-3, 0), forward).scalar_type(), at::kFloat);

@@ -12,6 +12,7 @@
 
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "tests/test_util.h"
 
 namespace mf {
 namespace {
@@ -291,15 +292,7 @@ TEST(RotationsTorch, SixdGradientMatchesFiniteDifferences) {
   const at::Tensor w = torch::randn({5, 3, 3}, torch::kDouble);
   auto f = [&](const at::Tensor& x) { return (sixd_to_matrix(x) * w).sum(); };
   f(d6).backward();
-  const at::Tensor grad = d6.grad().reshape({-1});
-  const double h = 1e-6;
-  for (int64_t i = 0; i < d6.numel(); ++i) {
-    at::Tensor xp = d6.detach().clone(), xm = d6.detach().clone();
-    xp.view({-1})[i] += h;
-    xm.view({-1})[i] -= h;
-    const double fd = (f(xp).item<double>() - f(xm).item<double>()) / (2 * h);
-    EXPECT_NEAR(grad[i].item<double>(), fd, 1e-6 * std::max(1.0, std::abs(fd))) << "entry " << i;
-  }
+  test::expect_gradient_matches_finite_differences(f, d6, "6D");
   at::Tensor zero = torch::zeros({1, 6}, torch::kFloat).requires_grad_(true);
   at::Tensor m = sixd_to_matrix(zero);
   m.sum().backward();
@@ -313,15 +306,7 @@ TEST(RotationsTorch, GeodesicGradientMatchesFiniteDifferences) {
   at::Tensor target = matrix_tensor(axis_angle(2.0, {0.3, 1, -0.5}).toRotationMatrix(), torch::kDouble);
   auto f = [&](const at::Tensor& x) { return geodesic_angle(sixd_to_matrix(x), target); };
   f(d6).backward();
-  at::Tensor grad = d6.grad().clone();
-  const double h = 1e-6;
-  for (int i = 0; i < 6; ++i) {
-    at::Tensor xp = d6.detach().clone(), xm = d6.detach().clone();
-    xp[i] += h;
-    xm[i] -= h;
-    const double fd = (f(xp).item<double>() - f(xm).item<double>()) / (2 * h);
-    EXPECT_NEAR(grad[i].item<double>(), fd, 1e-6) << "component " << i;
-  }
+  test::expect_gradient_matches_finite_differences(f, d6, "6D");
 }
 
 TEST(RotationsTorch, GeodesicNodeGradientMatchesFiniteDifferencesOnAnyMatrices) {
@@ -333,19 +318,8 @@ TEST(RotationsTorch, GeodesicNodeGradientMatchesFiniteDifferencesOnAnyMatrices) 
   const at::Tensor w = torch::randn({4}, torch::kDouble);
   auto f = [&](const at::Tensor& a, const at::Tensor& b) { return (geodesic_angle(a, b) * w).sum(); };
   f(m0, m1).backward();
-  const double h = 1e-6;
-  for (int which = 0; which < 2; ++which) {
-    const at::Tensor x = which == 0 ? m0 : m1;
-    const at::Tensor grad = x.grad().reshape({-1});
-    for (int64_t i = 0; i < x.numel(); ++i) {
-      at::Tensor xp = x.detach().clone(), xm = x.detach().clone();
-      xp.view({-1})[i] += h;
-      xm.view({-1})[i] -= h;
-      const double fd = which == 0 ? (f(xp, m1.detach()) - f(xm, m1.detach())).item<double>() / (2 * h)
-                                   : (f(m0.detach(), xp) - f(m0.detach(), xm)).item<double>() / (2 * h);
-      EXPECT_NEAR(grad[i].item<double>(), fd, 1e-6 * std::max(1.0, std::abs(fd))) << "m" << which << " entry " << i;
-    }
-  }
+  test::expect_gradient_matches_finite_differences([&](const at::Tensor& x) { return f(x, m1.detach()); }, m0, "m0");
+  test::expect_gradient_matches_finite_differences([&](const at::Tensor& x) { return f(m0.detach(), x); }, m1, "m1");
 }
 
 TEST(RotationsTorch, GeodesicMatchesTheQuaternionRouteOnRotations) {
