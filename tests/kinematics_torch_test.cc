@@ -13,6 +13,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/motion.h"
 #include "prior/motion/rotations_torch.h"
+#include "tests/gradient_check.h"
 #include "tests/test_util.h"
 
 namespace mf {

@@ -15,6 +15,7 @@
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/motion_bvh.h"
 #include "prior/motion/rotations_torch.h"
+#include "tests/gradient_check.h"
 #include "tests/test_util.h"
 #include "training/prior_trainer.h"
 

@@ -12,6 +12,7 @@
 
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "tests/gradient_check.h"
 #include "tests/test_util.h"
 
 namespace mf {

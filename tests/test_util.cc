@@ -1,9 +1,7 @@
 #include "tests/test_util.h"
 
 #include <ATen/ATen.h>
-#include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -78,21 +76,6 @@ std::unique_ptr<InbetweenModel> tiny_transformer(const std::string& kind, const 
   std::map<std::string, double> hp = {{"width", 16}, {"layers", 1}, {"heads", 2}, {"ffn", 32}, {"window", 32}};
   if (kind == kCitlKind) hp["time_dim"] = 4;
   return make_inbetweener(kind, hp, rig);
-}
-
-void expect_gradient_matches_finite_differences(const std::function<at::Tensor(const at::Tensor&)>& loss,
-                                                const at::Tensor& param, const std::string& what, double h, double tol,
-                                                int64_t stride) {
-  ASSERT_TRUE(param.grad().defined()) << what << ": no gradient";
-  const at::Tensor grad = param.grad().reshape({-1});
-  ASSERT_TRUE(at::isfinite(grad).all().item<bool>()) << what;
-  for (int64_t i = 0; i < param.numel(); i += stride) {
-    at::Tensor plus = param.detach().clone(), minus = param.detach().clone();
-    plus.view({-1})[i] += h;
-    minus.view({-1})[i] -= h;
-    const double fd = (loss(plus).item<double>() - loss(minus).item<double>()) / (2 * h);
-    EXPECT_NEAR(grad[i].item<double>(), fd, tol * std::max(1.0, std::abs(fd))) << what << " entry " << i;
-  }
 }
 
 std::string scratch_dir(const std::string& name) {

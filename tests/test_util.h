@@ -2,7 +2,6 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <string>
 
@@ -29,14 +28,6 @@ NemfModel tiny_prior(uint64_t seed = 0, const NemfConfig& config = tiny_nemf_con
 /// A tiny random transformer in-betweener of `kind` (kTwoStageKind or
 /// kCitlKind; width 16, one layer, window 32), drawn after at::manual_seed(seed).
 std::unique_ptr<InbetweenModel> tiny_transformer(const std::string& kind, const RigInfo& rig, uint64_t seed = 0);
-
-/// Checks `param.grad()` (left by a backward of `loss(param)`) against central
-/// differences of `loss` with every `stride`-th entry of `param` moved by +-h,
-/// within tol * max(1, |difference quotient|). `loss` receives the moved copy
-/// (no gradient) and returns a scalar; failures name `what` and the entry.
-void expect_gradient_matches_finite_differences(const std::function<at::Tensor(const at::Tensor&)>& loss,
-                                                const at::Tensor& param, const std::string& what, double h = 1e-6,
-                                                double tol = 1e-6, int64_t stride = 1);
 
 /// A fresh empty directory under the build tree's test scratch area.
 std::string scratch_dir(const std::string& name);
