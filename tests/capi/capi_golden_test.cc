@@ -43,10 +43,11 @@ struct GoldenCase {
 // The networks alone: measured differences up to 5e-6 element by element.
 constexpr double kNetworkTolerance = 1e-4;
 // Outputs of the prior's solver, whose iterations amplify rounding: measured
-// differences up to 5.2e-3 in the sketches across BLAS kernel sets (the
-// session-20 prior; 2.7e-2 element by element with the one before), while
-// replacing the prior by another fine-tune moves them by 8.6e-3 to 1.7e-2.
-constexpr double kSolverTolerance = 7.5e-3;
+// differences up to 8.0e-3 in the sketches across BLAS kernel sets (session 27's
+// two-stage start; 2.7e-2 element by element with the session-18 prior), while
+// replacing the prior or the two-stage model by another fine-tune moves the
+// largest entry of each case by 1.3e-2 to 1.8e-2.
+constexpr double kSolverTolerance = 1e-2;
 
 const std::string kSample = "samples/walk_keyframes.bvh";
 const std::string kRig = "models/motionfield-rig.json";
