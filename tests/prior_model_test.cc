@@ -168,6 +168,40 @@ TEST(PriorModel, GradientsReachTheLatentThroughAFrozenNetwork) {
   for (auto& p : model.parameters()) EXPECT_FALSE(p.grad().defined());
 }
 
+TEST(PriorModel, FrozenEncoderMatchesUnfrozenAndHonoursLaterWeightEdits) {
+  // Freezing snapshots the skeleton convolutions' masked weights; the encode
+  // must not change, and an in-place edit of a weight afterwards must reach it.
+  at::manual_seed(0);
+  RigInfo rig = tiny_rig();
+  NemfModel model(tiny_nemf_config(), rig);
+  Motion m = test::random_motion(rig.skeleton, 32, 30.0, 2);
+  WindowTensors w = window_tensors(m, 0, 32, rig, 0);
+  const at::Tensor mask = at::ones({1, 32});
+  auto encode = [&] {
+    at::NoGradGuard no_grad;
+    return model.encode(w.local_rotations, mask).mu_l;
+  };
+  const at::Tensor unfrozen = encode();
+  model.set_requires_grad(false);
+  EXPECT_TRUE(at::equal(encode(), unfrozen));
+
+  at::Tensor weight;
+  for (auto& [name, p] : model.named_parameters()) {
+    if (name == "local_encoder.conv0.weight") weight = p;
+  }
+  ASSERT_TRUE(weight.defined());
+  {
+    at::NoGradGuard no_grad;
+    weight.mul_(1.5);
+  }
+  const at::Tensor edited_frozen = encode();
+  EXPECT_FALSE(at::allclose(edited_frozen, unfrozen));
+  model.set_requires_grad(true);
+  EXPECT_TRUE(at::equal(edited_frozen, encode()));
+  model.set_requires_grad(false);  // a new snapshot of the edited weights
+  EXPECT_TRUE(at::equal(edited_frozen, encode()));
+}
+
 class ModelFile : public ::testing::Test {
  protected:
   void SetUp() override {

@@ -258,6 +258,9 @@ NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& 
   take("stats.gmp_out_std", s.gmp_out_std);
   for (auto& [name, param] : model.named_parameters()) take(name, param);
   check_no_extra_tensors(c.tensors, source);
+  // Solvers differentiate through the network, never into it: without this every
+  // forward op on a weight records an autograd node and saves its inputs.
+  model.set_requires_grad(false);
   return model;
 }
 

@@ -70,6 +70,8 @@ void take_model_tensor(std::map<std::string, StoredTensor>& tensors, const std::
 void check_no_extra_tensors(const std::map<std::string, StoredTensor>& tensors, const std::string& source);
 
 std::vector<uint8_t> serialize_nemf(const NemfModel& model);
+/// The prior stored by serialize_nemf(), frozen (set_requires_grad(false)): the
+/// trainer unfreezes it to continue training.
 NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& source);
 
 void save_nemf(const NemfModel& model, const std::string& path);

@@ -45,11 +45,23 @@ struct SkeletonConvImpl : torch::nn::Module {
     weight_ = register_parameter("weight", at::rand({J * cout, J * cin, kernel}).mul_(2).sub_(1).mul_(bound).mul_(mask));
     bias_ = register_parameter("bias", at::zeros({J * cout}));
   }
+  // Frozen, the masked weights are computed once here instead of on every
+  // forward (a weight-sized product, most of an encode). Forward uses them only
+  // while the weights are unchanged since (their version counter), so a later
+  // in-place edit is never served stale, and it never writes: frozen models are
+  // shared between threads.
+  void set_frozen(bool frozen) {
+    at::NoGradGuard no_grad;
+    masked_ = frozen ? weight_ * mask_ : at::Tensor();
+    masked_version_ = weight_._version();
+  }
   at::Tensor forward(const at::Tensor& x) {
-    return at::conv1d(x, weight_ * mask_, bias_, {stride_}, {padding_});
+    const bool snapshot = masked_.defined() && !weight_.requires_grad() && weight_._version() == masked_version_;
+    return at::conv1d(x, snapshot ? masked_ : weight_ * mask_, bias_, {stride_}, {padding_});
   }
   int stride_, padding_;
-  at::Tensor weight_, bias_, mask_;
+  at::Tensor weight_, bias_, mask_, masked_;
+  int64_t masked_version_ = 0;
 };
 TORCH_MODULE(SkeletonConv);
 
@@ -66,6 +78,9 @@ struct LocalEncoderImpl : torch::nn::Module {
     }
     mix_ = register_module("mix", torch::nn::Conv1d(torch::nn::Conv1dOptions(joints_ * cin, 256, 1)));
     head_ = register_module("head", torch::nn::Linear(256 * (c.window / 16), 2 * c.zl));
+  }
+  void set_frozen(bool frozen) {
+    for (auto& conv : convs_) conv->set_frozen(frozen);
   }
   at::Tensor forward(at::Tensor x) {  // [B, J * 16, window] -> [B, 2 * zl]
     for (size_t i = 0; i < convs_.size(); ++i) x = lrelu(norms_[i]->forward(convs_[i]->forward(x)));
@@ -404,6 +419,7 @@ void NemfModel::train(bool on) { impl_->net->train(on); }
 
 void NemfModel::set_requires_grad(bool on) {
   for (auto& p : parameters()) p.set_requires_grad(on);
+  impl_->net->local->set_frozen(!on);
 }
 
 }  // namespace mf

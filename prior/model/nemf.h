@@ -125,7 +125,9 @@ class NemfModel {
   int64_t num_parameters() const;
   /// Training mode (affects nothing stochastic today; kept for symmetry).
   void train(bool on);
-  /// Freezes (false) or unfreezes every parameter for autograd.
+  /// Freezes (false) or unfreezes every parameter for autograd. Freezing also
+  /// precomputes what depends on the weights alone (the skeleton convolutions'
+  /// masked weights); weights edited in place afterwards are still honoured.
   void set_requires_grad(bool on);
 
  private:
