@@ -45,22 +45,25 @@ struct SkeletonConvImpl : torch::nn::Module {
     weight_ = register_parameter("weight", at::rand({J * cout, J * cin, kernel}).mul_(2).sub_(1).mul_(bound).mul_(mask));
     bias_ = register_parameter("bias", at::zeros({J * cout}));
   }
-  // Frozen, the masked weights are computed once here instead of on every
-  // forward (a weight-sized product, most of an encode). Forward uses them only
+  // Frozen, the weights are masked once, in place (a no-op on trained weights,
+  // whose masked entries never leave zero; it adds no memory), and forward skips
+  // the weight-sized product that was most of an encode. Forward skips it only
   // while the weights are unchanged since (their version counter), so a later
-  // in-place edit is never served stale, and it never writes: frozen models are
-  // shared between threads.
+  // in-place edit is still masked, and it never writes: frozen models are shared
+  // between threads.
   void set_frozen(bool frozen) {
     at::NoGradGuard no_grad;
-    masked_ = frozen ? weight_ * mask_ : at::Tensor();
+    frozen_ = frozen;
+    if (frozen) weight_.mul_(mask_);
     masked_version_ = weight_._version();
   }
   at::Tensor forward(const at::Tensor& x) {
-    const bool snapshot = masked_.defined() && !weight_.requires_grad() && weight_._version() == masked_version_;
-    return at::conv1d(x, snapshot ? masked_ : weight_ * mask_, bias_, {stride_}, {padding_});
+    const bool masked = frozen_ && !weight_.requires_grad() && weight_._version() == masked_version_;
+    return at::conv1d(x, masked ? weight_ : weight_ * mask_, bias_, {stride_}, {padding_});
   }
   int stride_, padding_;
-  at::Tensor weight_, bias_, mask_, masked_;
+  at::Tensor weight_, bias_, mask_;
+  bool frozen_ = false;
   int64_t masked_version_ = 0;
 };
 TORCH_MODULE(SkeletonConv);

@@ -126,8 +126,9 @@ class NemfModel {
   /// Training mode (affects nothing stochastic today; kept for symmetry).
   void train(bool on);
   /// Freezes (false) or unfreezes every parameter for autograd. Freezing also
-  /// precomputes what depends on the weights alone (the skeleton convolutions'
-  /// masked weights); weights edited in place afterwards are still honoured.
+  /// applies the skeleton convolutions' masks to their weights once, in place
+  /// (outputs unchanged), so that inference skips them; weights edited in place
+  /// afterwards are masked per call again.
   void set_requires_grad(bool on);
 
  private:
