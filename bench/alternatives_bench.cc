@@ -186,8 +186,7 @@ int run(Args& args, const std::string& command) {
   if (args.model.empty()) throw mf::InputError("no default model: pass --model FILE");
   mf::set_compute_threads(args.threads);
   mf::TaskContext ctx;
-  auto model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));
-  model->set_requires_grad(false);
+  auto model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));  // frozen
   ctx.model = model;
   ctx.seed = args.seed;
   mf::bench::load_transformers(args.transformers, args.model, &ctx, false);

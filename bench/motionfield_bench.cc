@@ -156,8 +156,7 @@ int run(Args& args, const std::string& command) {
   std::shared_ptr<mf::NemfModel> model;
   if (!args.model.empty()) {
     std::cerr << "loading model " << args.model << "\n";
-    model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));
-    model->set_requires_grad(false);
+    model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));  // frozen
     ctx.model = model;
     mf::bench::load_transformers(args.transformers, args.model, &ctx, true);
     ctx.model_anatomy = mf::load_rig_anatomy_next_to(args.model, model->rig().skeleton);

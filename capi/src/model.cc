@@ -53,8 +53,7 @@ std::string default_path() {
   return mf::default_model_path();
 }
 
-std::unique_ptr<mf_model> make_model(NemfModel model) {
-  model.set_requires_grad(false);
+std::unique_ptr<mf_model> make_model(NemfModel model) {  // frozen by deserialize_nemf()
   auto handle = std::make_unique<mf_model>();
   handle->model = std::make_shared<const NemfModel>(std::move(model));
   return handle;
