@@ -14,8 +14,6 @@
 namespace mf {
 namespace {
 
-constexpr double kMaxResampledFrames = 10'000'000;
-
 std::string method_list() {
   std::string s;
   for (const std::string& m : available_methods()) s += (s.empty() ? "" : ", ") + m;

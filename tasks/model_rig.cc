@@ -24,7 +24,15 @@ namespace {
 int model_rate_frames(int frames, double fps, double model_fps) {
   const double exact = (frames - 1) * model_fps / fps;
   const double r = std::round(exact);
-  return static_cast<int>(std::abs(exact - r) <= 1e-5 * std::max(1.0, r) ? r : std::ceil(exact)) + 1;
+  const double count = (std::abs(exact - r) <= 1e-5 * std::max(1.0, r) ? r : std::ceil(exact)) + 1;
+  // Not `count > max`: an overflowing ratio gives inf or NaN, which must not reach the cast.
+  if (!(count <= kMaxResampledFrames)) {
+    std::ostringstream msg;
+    msg << frames << " frames at " << fps << " fps span more than " << static_cast<long long>(kMaxResampledFrames)
+        << " frames at the model's " << model_fps << " fps";
+    throw InputError(msg.str());
+  }
+  return static_cast<int>(count);
 }
 
 // Known frames at the model's rate: model frames whose time lies within a run

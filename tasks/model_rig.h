@@ -21,6 +21,11 @@
 
 namespace mf {
 
+/// The most frames any change of frame rate may produce: resampling a motion
+/// (resampled_frame_count(), tasks/jobs.h) and a motion's span at the model's
+/// rate when a method solves there. More is refused with an InputError.
+inline constexpr double kMaxResampledFrames = 10'000'000;
+
 /// File name of the prior's rig anatomy, next to the prior's model file.
 inline constexpr char kRigAnatomyFileName[] = "motionfield-rig.json";
 

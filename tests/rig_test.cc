@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "bench/synthetic_rigs.h"
 #include "prior/motion/errors.h"
@@ -501,6 +502,40 @@ TEST(ModelRig, NativeRigAtOtherRatesIsResampledAroundTheModel) {
   std::vector<int> frames;
   for (int f = 0; f < at60.num_frames(); ++f) frames.push_back(f);
   EXPECT_LT(mean_angle_deg(out, at60, all, frames), 1.0);
+}
+
+// A frame rate so low that the motion's span at the model's rate would exceed
+// kMaxResampledFrames (or overflow a double) is refused before any solve.
+TEST(ModelRig, RatesSpanningTooManyModelFramesAreClearErrors) {
+  const TaskContext ctx = sample_rig_context();
+  for (double fps : {1e-6, 1e-300, std::numeric_limits<double>::denorm_min()}) {
+    SCOPED_TRACE(fps);
+    Motion slow = sample();
+    slow.fps = fps;
+    bool called = false;
+    try {
+      complete_on_model_rig(slow, {0, 30, slow.num_frames() - 1}, ctx, [&](const Motion& m, const std::vector<int>&) {
+        called = true;
+        return m;
+      });
+      FAIL() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("frames at the model's 30 fps"), std::string::npos) << e.what();
+    }
+    MotionConstraints keys;
+    keys.keys.resize(2);  // whole poses (every joint, the root position) at the ends
+    keys.keys[1].frame = slow.num_frames() - 1;
+    std::vector<std::string> warnings;
+    EXPECT_THROW(complete_constrained_on_model_rig(
+                     slow, keys, ctx,
+                     [&](const Motion& m, const MotionConstraints&) {
+                       called = true;
+                       return m;
+                     },
+                     &warnings),
+                 InputError);
+    EXPECT_FALSE(called);
+  }
 }
 
 TEST(ModelRig, UnmappableRigAndMissingAnatomyAreClearErrors) {
