@@ -322,6 +322,40 @@ TEST(PriorTraining, AFewStepsRunCheckpointAndResume) {
   EXPECT_TRUE(at::equal(m.stats().feature_mean, tuned.stats().feature_mean));
   EXPECT_TRUE(at::equal(m.stats().gmp_out_std, tuned.stats().gmp_out_std));
 
+  // --gmp-only: a new GMP of other sizes on --init's frozen VAE and statistics.
+  PriorTrainingOptions g = f;
+  g.out_dir = dir + "/gmp-only";
+  g.gmp_only = true;
+  g.config.gmp_width = 12;
+  g.config.gmp_blocks = 2;
+  g.lr = g.lr_final = 1e-2;
+  train_prior(g);
+  NemfModel regrown = load_nemf(g.out_dir + "/last.mfm");
+  EXPECT_EQ(regrown.config().gmp_width, 12);
+  EXPECT_EQ(regrown.config().gmp_blocks, 2);
+  std::vector<at::Tensor> vae_a = m.vae_parameters(), vae_b = regrown.vae_parameters();
+  ASSERT_EQ(vae_a.size(), vae_b.size());
+  for (size_t i = 0; i < vae_a.size(); ++i) EXPECT_TRUE(at::equal(vae_a[i], vae_b[i])) << "VAE parameter " << i;
+  EXPECT_TRUE(at::equal(m.stats().gmp_in_mean, regrown.stats().gmp_in_mean));
+  EXPECT_EQ(regrown.gmp_parameters()[0].size(0), 12);
+  // It is trained: the GMP's weights move off their initial values over a second run.
+  PriorTrainingOptions g2 = g;
+  g2.resume = true;
+  g2.max_epochs = 2;
+  train_prior(g2);
+  std::vector<at::Tensor> before = regrown.gmp_parameters(), after = load_nemf(g.out_dir + "/last.mfm").gmp_parameters();
+  bool moved = false;
+  for (size_t i = 0; i < before.size(); ++i) moved = moved || !at::equal(before[i], after[i]);
+  EXPECT_TRUE(moved);
+  // Other VAE sizes, or no model to start from, are refused.
+  PriorTrainingOptions bad_vae = g;
+  bad_vae.out_dir = dir + "/gmp-only-bad";
+  bad_vae.config.zl = 16;
+  EXPECT_THROW(train_prior(bad_vae), InputError);
+  bad_vae.config.zl = g.config.zl;
+  bad_vae.init_from.clear();
+  EXPECT_THROW(train_prior(bad_vae), InputError);
+
   // Other sizes, or data on another skeleton, are refused before training.
   PriorTrainingOptions other_size = f;
   other_size.out_dir = dir + "/other-size";

@@ -114,6 +114,9 @@ void add_prior_options(CLI::App& cmd, mf::PriorTrainingOptions& o, RunArgs& run)
   cmd.add_option("--gmp-width", c.gmp_width, "global motion predictor width")->group(sizes);
   cmd.add_option("--gmp-kernel", c.gmp_kernel, "global motion predictor kernel")->group(sizes);
   cmd.add_option("--gmp-blocks", c.gmp_blocks, "global motion predictor blocks")->group(sizes);
+  cmd.add_flag("--gmp-only", o.gmp_only,
+               "train only a new global motion predictor of the --gmp-* sizes on the --init model's frozen VAE "
+               "(the best checkpoint: lowest validation translation error; give it again on --resume)");
   cmd.add_option("--window", c.window, "frames per window")->group(sizes);
   cmd.add_option("--stride", o.stride, "frames between training windows");
   cmd.add_option("--frames-per-window", o.frames_per_window, "decoded frames per window and step");

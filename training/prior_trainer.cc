@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 
@@ -135,17 +136,12 @@ struct Losses {
   }
 };
 
-// frames_per_window > 0: the decoder is evaluated on that many random valid
-// frames of each window and z is sampled; 0: every frame, z = mu (validation).
-// The random numbers are drawn for the whole global batch of `global` windows
-// (0 = this batch) and the rows [offset, offset + B) used, so that each
-// process of a data-parallel run draws what one process on the global batch
-// would (training/data_parallel.h).
-Losses compute_losses(const NemfModel& model, const Batch& b, int frames_per_window, int64_t offset = 0,
-                      int64_t global = 0) {
+// The VAE's losses (rotations, root orientation, positions, KL) into *L.
+void compute_vae_losses(const NemfModel& model, const Batch& b, int frames_per_window, int64_t offset,
+                        int64_t global, Losses* out) {
   const RigInfo& rig = model.rig();
   const int64_t B = b.rot.size(0), W = b.rot.size(1), J = rig.num_joints();
-  Losses L;
+  Losses& L = *out;
   at::Tensor root6d = torch_rot::matrix_to_sixd(b.rot.select(2, 0));
   NemfLatent z = model.encode_features(b.features, root6d, b.mask);
   at::Tensor zl = z.mu_l, zg = z.mu_g;
@@ -179,6 +175,21 @@ Losses compute_losses(const NemfModel& model, const Batch& b, int frames_per_win
   };
   L.kl = kl(z.mu_l, z.logvar_l) + kl(z.mu_g, z.logvar_g);
 
+}
+
+// frames_per_window > 0: the decoder is evaluated on that many random valid
+// frames of each window and z is sampled; 0: every frame, z = mu (validation).
+// The random numbers are drawn for the whole global batch of `global` windows
+// (0 = this batch) and the rows [offset, offset + B) used, so that each
+// process of a data-parallel run draws what one process on the global batch
+// would (training/data_parallel.h).
+// With vae = false only the GMP's losses are computed (the VAE's are zero).
+Losses compute_losses(const NemfModel& model, const Batch& b, int frames_per_window, int64_t offset = 0,
+                      int64_t global = 0, bool vae = true) {
+  const RigInfo& rig = model.rig();
+  Losses L;
+  if (vae) compute_vae_losses(model, b, frames_per_window, offset, global, &L);
+  else L.rot = L.root = L.pos = L.kl = at::zeros({});
   GmpOutput g = model.predict_global_from_inputs(b.gmp_in);
   L.vel = masked_mean((g.velocity - b.vel).abs(), b.mask);
   L.height = masked_mean((g.height - b.height).abs(), b.mask);
@@ -231,6 +242,39 @@ void check_options(const PriorTrainingOptions& o) {
   }
   std::string problem = o.config.validate();
   if (!problem.empty()) throw InputError("train: " + problem);
+  if (o.gmp_only && o.init_from.empty() && !o.resume) {
+    throw InputError("train: --gmp-only trains a new GMP on a trained prior's VAE: give it with --init");
+  }
+}
+
+bool is_gmp_key(const std::string& key) { return key.rfind("gmp_", 0) == 0; }
+bool is_gmp_parameter(const std::string& name) { return name.rfind("gmp.", 0) == 0; }
+
+// A model of o.config with `init`'s VAE weights and statistics and a fresh GMP.
+NemfModel with_new_gmp(const PriorTrainingOptions& o, const NemfModel& init) {
+  auto without_gmp = [](const NemfConfig& c) {
+    auto map = c.to_map();
+    for (auto it = map.begin(); it != map.end();) it = is_gmp_key(it->first) ? map.erase(it) : std::next(it);
+    return map;
+  };
+  if (without_gmp(init.config()) != without_gmp(o.config)) {
+    throw InputError("train: --init " + o.init_from + " has other VAE sizes than the options (" +
+                     init.config().describe() + "; --gmp-only changes only the --gmp-* sizes)");
+  }
+  NemfModel model(o.config, init.rig());
+  at::NoGradGuard no_grad;
+  std::map<std::string, at::Tensor> source;
+  for (const auto& [name, value] : init.named_parameters()) source[name] = value;
+  for (const auto& [name, value] : model.named_parameters()) {
+    if (is_gmp_parameter(name)) continue;
+    auto it = source.find(name);
+    if (it == source.end() || !it->second.sizes().equals(value.sizes())) {
+      throw InputError("train: --init " + o.init_from + " has no parameter " + name + " of this model's shape");
+    }
+    value.copy_(it->second);
+  }
+  model.stats() = init.stats();
+  return model;
 }
 
 // A new model of o.config, the checkpoint's when resuming, or o.init_from's (same sizes).
@@ -240,6 +284,7 @@ NemfModel load_or_make_model(const PriorTrainingOptions& o, const Dataset& data,
   if (!resuming && o.init_from.empty()) return NemfModel(o.config, training::measure_training_rig(data));
   const std::string what = resuming ? "--resume" : "--init " + o.init_from;
   NemfModel model = load_nemf(resuming ? files.last_model : o.init_from);
+  if (o.gmp_only && !resuming) model = with_new_gmp(o, model);
   if (model.config().to_map() != o.config.to_map()) {
     throw InputError("train: " + what + " has other sizes than the options (" + model.config().describe() +
                      "; give the same sizes)");
@@ -275,7 +320,7 @@ struct EpochSums {
 // Validation per frame: rotation, root orientation (rad), position, translation (m) and the score.
 struct Validation {
   double rot = 0, root = 0, pos = 0, trans = 0;
-  double score() const { return rot + root + 10.0 * pos; }
+  double score(bool gmp_only) const { return gmp_only ? trans : rot + root + 10.0 * pos; }
 };
 
 // One training run: the set-up in the constructor, then train().
@@ -304,6 +349,7 @@ class PriorRun {
   const int W_;
   std::vector<ClipTensors> train_pre_, val_pre_;
   std::vector<Window> val_windows_;
+  std::vector<at::Tensor> trained_;  // every parameter, or with gmp_only the GMP's
   torch::optim::Adam optimizer_;
   training::TrainerState state_;
   double base_minutes_ = 0;
@@ -320,7 +366,8 @@ PriorRun::PriorRun(const PriorTrainingOptions& o)
       resume_from_(dp_.resume_files(files_, o.resume, &resuming_)),
       model_(load_or_make_model(o, data_, resume_from_, resuming_)),
       W_(model_.config().window),
-      optimizer_(model_.parameters(), torch::optim::AdamOptions(o.lr)) {
+      trained_(o.gmp_only ? model_.gmp_parameters() : model_.parameters()),
+      optimizer_(trained_, torch::optim::AdamOptions(o.lr)) {
   const auto p0 = Clock::now();
   train_pre_ = precompute(data_.train, model_.rig(), model_.config().fps);
   val_pre_ = precompute(data_.validation, model_.rig(), model_.config().fps);
@@ -328,6 +375,8 @@ PriorRun::PriorRun(const PriorTrainingOptions& o)
   // An --init model keeps its statistics: its weights were trained on them.
   if (!resuming_ && o.init_from.empty()) compute_stats(model_, data_.train, train_pre_);
   model_.set_requires_grad(true);
+  if (o.gmp_only)
+    for (at::Tensor& p : model_.vae_parameters()) p.requires_grad_(false);
   model_.train(true);
   if (resuming_) {
     torch::load(optimizer_, resume_from_.last_optim);
@@ -408,7 +457,7 @@ bool PriorRun::train_epoch(EpochSums* sums) {
 
 void PriorRun::train_step(const Batch& b, double beta, int64_t offset, int64_t global, EpochSums* sums) {
   const auto c1 = Clock::now();
-  Losses L = compute_losses(model_, b, o_.frames_per_window, offset, global);
+  Losses L = compute_losses(model_, b, o_.frames_per_window, offset, global, !o_.gmp_only);
   at::Tensor total = L.total(beta);
   const auto c2 = Clock::now();
   optimizer_.zero_grad();
@@ -417,9 +466,9 @@ void PriorRun::train_step(const Batch& b, double beta, int64_t offset, int64_t g
     std::fprintf(stderr, "forward %.3f s backward %.3f s\n", seconds_between(c1, c2), seconds_between(c2, Clock::now()));
   }
   const auto c3 = Clock::now();
-  dp_.average_gradients(model_.parameters(), static_cast<double>(b.rot.size(0)));  // weighted by windows
+  dp_.average_gradients(trained_, static_cast<double>(b.rot.size(0)));  // weighted by windows
   if (profile_ && dp_.distributed()) std::fprintf(stderr, "all-reduce %.3f s\n", seconds_between(c3, Clock::now()));
-  torch::nn::utils::clip_grad_norm_(model_.parameters(), 1.0);
+  torch::nn::utils::clip_grad_norm_(trained_, 1.0);
   optimizer_.step();
   ++state_.step;
   const at::Tensor parts[8] = {L.rot, L.root, L.pos, L.kl, L.vel, L.height, L.trans, L.contact};
@@ -458,7 +507,7 @@ void PriorRun::end_epoch(const EpochSums& local_sums, const Validation& v) {
   EpochSums sums = local_sums;
   const std::vector<double> summed = dp_.sum(std::vector<double>(sums.values, sums.values + 8));
   for (int k = 0; k < 8; ++k) sums.values[k] = summed[k] / dp_.world_size();
-  const double score = v.score();
+  const double score = v.score(o_.gmp_only);
   ++state_.epoch;
   state_.minutes = dp_.agree({minutes_now()})[0];
   const bool best = score < state_.best;

@@ -13,7 +13,7 @@
 // window (it is a field over time). The GMP is trained on ground-truth local
 // motion: L1(velocity) + L1(height) + L1(translation) + 0.5 * BCE(contacts).
 // Validation (encode the mean, decode every frame) after each epoch chooses
-// the best checkpoint. With options.distributed.world_size > 1 the processes
+// the best checkpoint (with gmp_only: the GMP's translation error). With options.distributed.world_size > 1 the processes
 // share each step's global batch (training/data_parallel.h); N processes with
 // batch B take the steps of one process with batch N * B (exactly so when the
 // windows of a step are all full length; a last global batch of fewer
@@ -53,6 +53,13 @@ struct PriorTrainingOptions {
   /// (Skeleton::same_as, as the in-betweener trainer checks); its rig and
   /// statistics are kept. Ignored when resuming.
   std::string init_from;
+  /// Train only a new global motion predictor of `config`'s GMP sizes on
+  /// --init's VAE: the VAE's weights and every statistic are --init's and stay
+  /// frozen, its other sizes must equal `config`'s, and the best checkpoint is
+  /// the one with the lowest validation translation error (the VAE's
+  /// validation figures are logged but constant). For a smaller, faster GMP
+  /// without retraining the VAE. Give it again on --resume.
+  bool gmp_only = false;
   int max_train_clips = 0;          ///< 0 = all (small values for smoke tests)
   /// Clips added to the training split (training/augmentation.h); give the
   /// same again on --resume.
