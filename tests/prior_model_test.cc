@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
@@ -347,6 +348,42 @@ TEST(PriorTraining, AFewStepsRunCheckpointAndResume) {
   bool moved = false;
   for (size_t i = 0; i < before.size(); ++i) moved = moved || !at::equal(before[i], after[i]);
   EXPECT_TRUE(moved);
+  // With the same GMP sizes --init's GMP is kept (here with a zero learning
+  // rate: unchanged), and its inputs can come from the VAE's reconstruction.
+  PriorTrainingOptions keep = g;
+  keep.out_dir = dir + "/gmp-keep";
+  keep.init_from = g.out_dir + "/last.mfm";
+  keep.lr = keep.lr_final = 0.0;
+  keep.gmp_reconstructed = 0.5;
+  keep.max_epochs = 1;
+  train_prior(keep);
+  std::vector<at::Tensor> kept = load_nemf(keep.out_dir + "/last.mfm").gmp_parameters();
+  ASSERT_EQ(kept.size(), after.size());
+  for (size_t i = 0; i < kept.size(); ++i) EXPECT_TRUE(at::equal(kept[i], after[i])) << "GMP parameter " << i;
+  // The same GMP on the same windows with captured inputs only has other losses.
+  PriorTrainingOptions captured = keep;
+  captured.out_dir = dir + "/gmp-captured";
+  captured.gmp_reconstructed = 0.0;
+  train_prior(captured);
+  auto gmp_losses = [](const std::string& log_path) {  // train_vel .. train_contact of the last epoch
+    std::ifstream log(log_path);
+    std::string line, last;
+    while (std::getline(log, line))
+      if (!line.empty()) last = line;
+    std::vector<std::string> fields;
+    std::stringstream in(last);
+    for (std::string f; std::getline(in, f, ',');) fields.push_back(f);
+    return fields.size() > 12 ? fields[9] + "," + fields[10] + "," + fields[11] + "," + fields[12] : last;
+  };
+  const std::string with_reconstruction = gmp_losses(keep.out_dir + "/log.csv");
+  EXPECT_NE(with_reconstruction, gmp_losses(captured.out_dir + "/log.csv")) << with_reconstruction;
+  PriorTrainingOptions bad_share = keep;
+  bad_share.gmp_reconstructed = 1.5;
+  EXPECT_THROW(train_prior(bad_share), InputError);
+  bad_share.gmp_reconstructed = 0.5;
+  bad_share.gmp_only = false;
+  EXPECT_THROW(train_prior(bad_share), InputError);
+
   // Other VAE sizes, or no model to start from, are refused.
   PriorTrainingOptions bad_vae = g;
   bad_vae.out_dir = dir + "/gmp-only-bad";

@@ -115,8 +115,12 @@ void add_prior_options(CLI::App& cmd, mf::PriorTrainingOptions& o, RunArgs& run)
   cmd.add_option("--gmp-kernel", c.gmp_kernel, "global motion predictor kernel")->group(sizes);
   cmd.add_option("--gmp-blocks", c.gmp_blocks, "global motion predictor blocks")->group(sizes);
   cmd.add_flag("--gmp-only", o.gmp_only,
-               "train only a new global motion predictor of the --gmp-* sizes on the --init model's frozen VAE "
-               "(the best checkpoint: lowest validation translation error; give it again on --resume)");
+               "train only the global motion predictor, of the --gmp-* sizes, on the --init model's frozen VAE "
+               "(its GMP is kept if the sizes are the same, else a fresh one; the best checkpoint: lowest "
+               "validation translation error; give it again on --resume)");
+  cmd.add_option("--gmp-reconstructed", o.gmp_reconstructed,
+                 "with --gmp-only: the share in [0, 1] of windows whose GMP inputs are the VAE's reconstruction "
+                 "instead of the captured motion (give it again on --resume)");
   cmd.add_option("--window", c.window, "frames per window")->group(sizes);
   cmd.add_option("--stride", o.stride, "frames between training windows");
   cmd.add_option("--frames-per-window", o.frames_per_window, "decoded frames per window and step");

@@ -177,20 +177,39 @@ void compute_vae_losses(const NemfModel& model, const Batch& b, int frames_per_w
 
 }
 
+// The GMP's inputs for a batch: the first round(reconstructed * B) windows'
+// from the VAE's reconstruction (encode the mean, decode every frame; the
+// padding past each window's length stays the captured motion's), the rest
+// from the captured motion.
+at::Tensor gmp_inputs_for(const NemfModel& model, const Batch& b, double reconstructed) {
+  const int64_t B = b.rot.size(0), W = b.rot.size(1);
+  const int64_t n = std::min<int64_t>(B, std::llround(reconstructed * static_cast<double>(B)));
+  if (n <= 0) return b.gmp_in;
+  at::NoGradGuard no_grad;
+  at::Tensor root6d = torch_rot::matrix_to_sixd(b.rot.narrow(0, 0, n).select(2, 0));
+  NemfLatent z = model.encode_features(b.features.narrow(0, 0, n), root6d, b.mask.narrow(0, 0, n));
+  at::Tensor decoded = model.decode(at::arange(W, at::kFloat), z.mu_l, z.mu_g);
+  at::Tensor captured = b.gmp_in.narrow(0, 0, n);
+  at::Tensor mixed = at::where(b.mask.narrow(0, 0, n).unsqueeze(-1) > 0, gmp_inputs(decoded, model.rig()), captured);
+  return n == B ? mixed : at::cat({mixed, b.gmp_in.narrow(0, n, B - n)}, 0);
+}
+
 // frames_per_window > 0: the decoder is evaluated on that many random valid
 // frames of each window and z is sampled; 0: every frame, z = mu (validation).
 // The random numbers are drawn for the whole global batch of `global` windows
 // (0 = this batch) and the rows [offset, offset + B) used, so that each
 // process of a data-parallel run draws what one process on the global batch
 // would (training/data_parallel.h).
-// With vae = false only the GMP's losses are computed (the VAE's are zero).
+// With vae = false only the GMP's losses are computed (the VAE's are zero);
+// `reconstructed`: the share of windows whose GMP inputs are the VAE's
+// reconstruction (gmp_inputs_for).
 Losses compute_losses(const NemfModel& model, const Batch& b, int frames_per_window, int64_t offset = 0,
-                      int64_t global = 0, bool vae = true) {
+                      int64_t global = 0, bool vae = true, double reconstructed = 0.0) {
   const RigInfo& rig = model.rig();
   Losses L;
   if (vae) compute_vae_losses(model, b, frames_per_window, offset, global, &L);
   else L.rot = L.root = L.pos = L.kl = at::zeros({});
-  GmpOutput g = model.predict_global_from_inputs(b.gmp_in);
+  GmpOutput g = model.predict_global_from_inputs(gmp_inputs_for(model, b, reconstructed));
   L.vel = masked_mean((g.velocity - b.vel).abs(), b.mask);
   L.height = masked_mean((g.height - b.height).abs(), b.mask);
   at::Tensor start = ground_xz(b.pos.select(1, 0));
@@ -243,14 +262,21 @@ void check_options(const PriorTrainingOptions& o) {
   std::string problem = o.config.validate();
   if (!problem.empty()) throw InputError("train: " + problem);
   if (o.gmp_only && o.init_from.empty() && !o.resume) {
-    throw InputError("train: --gmp-only trains a new GMP on a trained prior's VAE: give it with --init");
+    throw InputError("train: --gmp-only trains a GMP on a trained prior's VAE: give it with --init");
+  }
+  if (!(o.gmp_reconstructed >= 0.0 && o.gmp_reconstructed <= 1.0)) {
+    throw InputError("train: --gmp-reconstructed is a share of the windows, in [0, 1]");
+  }
+  if (o.gmp_reconstructed > 0.0 && !o.gmp_only) {
+    throw InputError("train: --gmp-reconstructed needs --gmp-only (a frozen VAE to reconstruct with)");
   }
 }
 
 bool is_gmp_key(const std::string& key) { return key.rfind("gmp_", 0) == 0; }
 bool is_gmp_parameter(const std::string& name) { return name.rfind("gmp.", 0) == 0; }
 
-// A model of o.config with `init`'s VAE weights and statistics and a fresh GMP.
+// A model of o.config with `init`'s VAE weights and statistics, and its GMP's
+// weights too when the GMP sizes are the same (else a fresh GMP).
 NemfModel with_new_gmp(const PriorTrainingOptions& o, const NemfModel& init) {
   auto without_gmp = [](const NemfConfig& c) {
     auto map = c.to_map();
@@ -265,8 +291,9 @@ NemfModel with_new_gmp(const PriorTrainingOptions& o, const NemfModel& init) {
   at::NoGradGuard no_grad;
   std::map<std::string, at::Tensor> source;
   for (const auto& [name, value] : init.named_parameters()) source[name] = value;
+  const bool same_gmp = init.config().to_map() == o.config.to_map();
   for (const auto& [name, value] : model.named_parameters()) {
-    if (is_gmp_parameter(name)) continue;
+    if (is_gmp_parameter(name) && !same_gmp) continue;
     auto it = source.find(name);
     if (it == source.end() || !it->second.sizes().equals(value.sizes())) {
       throw InputError("train: --init " + o.init_from + " has no parameter " + name + " of this model's shape");
@@ -457,7 +484,7 @@ bool PriorRun::train_epoch(EpochSums* sums) {
 
 void PriorRun::train_step(const Batch& b, double beta, int64_t offset, int64_t global, EpochSums* sums) {
   const auto c1 = Clock::now();
-  Losses L = compute_losses(model_, b, o_.frames_per_window, offset, global, !o_.gmp_only);
+  Losses L = compute_losses(model_, b, o_.frames_per_window, offset, global, !o_.gmp_only, o_.gmp_reconstructed);
   at::Tensor total = L.total(beta);
   const auto c2 = Clock::now();
   optimizer_.zero_grad();
@@ -486,7 +513,7 @@ Validation PriorRun::validate() {
     if (!dp_.owns(i / 64)) continue;
     Batch b = make_batch(data_.validation, val_pre_, val_windows_, i, std::min(val_windows_.size(), i + 64),
                          model_.rig(), W_);
-    Losses L = compute_losses(model_, b, 0);
+    Losses L = compute_losses(model_, b, 0, 0, 0, true, o_.gmp_reconstructed);
     const double n = item(b.mask.sum());
     v.rot += item(L.rot) * n;
     v.root += item(L.root) * n;

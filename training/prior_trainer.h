@@ -53,13 +53,20 @@ struct PriorTrainingOptions {
   /// (Skeleton::same_as, as the in-betweener trainer checks); its rig and
   /// statistics are kept. Ignored when resuming.
   std::string init_from;
-  /// Train only a new global motion predictor of `config`'s GMP sizes on
+  /// Train only the global motion predictor, of `config`'s GMP sizes, on
   /// --init's VAE: the VAE's weights and every statistic are --init's and stay
   /// frozen, its other sizes must equal `config`'s, and the best checkpoint is
   /// the one with the lowest validation translation error (the VAE's
-  /// validation figures are logged but constant). For a smaller, faster GMP
-  /// without retraining the VAE. Give it again on --resume.
+  /// validation figures are logged but constant). --init's GMP is kept when
+  /// its sizes are `config`'s, else a fresh one is trained. For a smaller,
+  /// faster GMP without retraining the VAE. Give it again on --resume.
   bool gmp_only = false;
+  /// With gmp_only: the share of each batch's windows (and of the validation
+  /// windows) whose GMP inputs come from the frozen VAE's reconstruction
+  /// (encode the mean, decode every frame) instead of the captured motion;
+  /// the targets stay the captured motion's. In a task the GMP reads decoded
+  /// motion, not captured motion. Give it again on --resume.
+  double gmp_reconstructed = 0.0;
   int max_train_clips = 0;          ///< 0 = all (small values for smoke tests)
   /// Clips added to the training split (training/augmentation.h); give the
   /// same again on --resume.
