@@ -275,8 +275,8 @@ void check_options(const PriorTrainingOptions& o) {
 bool is_gmp_key(const std::string& key) { return key.rfind("gmp_", 0) == 0; }
 bool is_gmp_parameter(const std::string& name) { return name.rfind("gmp.", 0) == 0; }
 
-// A model of o.config with `init`'s VAE weights and statistics, and its GMP's
-// weights too when the GMP sizes are the same (else a fresh GMP).
+// A model of o.config with `init`'s VAE weights and statistics and a fresh GMP
+// (called only when the GMP sizes differ from `init`'s).
 NemfModel with_new_gmp(const PriorTrainingOptions& o, const NemfModel& init) {
   auto without_gmp = [](const NemfConfig& c) {
     auto map = c.to_map();
@@ -291,9 +291,8 @@ NemfModel with_new_gmp(const PriorTrainingOptions& o, const NemfModel& init) {
   at::NoGradGuard no_grad;
   std::map<std::string, at::Tensor> source;
   for (const auto& [name, value] : init.named_parameters()) source[name] = value;
-  const bool same_gmp = init.config().to_map() == o.config.to_map();
   for (const auto& [name, value] : model.named_parameters()) {
-    if (is_gmp_parameter(name) && !same_gmp) continue;
+    if (is_gmp_parameter(name)) continue;
     auto it = source.find(name);
     if (it == source.end() || !it->second.sizes().equals(value.sizes())) {
       throw InputError("train: --init " + o.init_from + " has no parameter " + name + " of this model's shape");
@@ -311,7 +310,7 @@ NemfModel load_or_make_model(const PriorTrainingOptions& o, const Dataset& data,
   if (!resuming && o.init_from.empty()) return NemfModel(o.config, training::measure_training_rig(data));
   const std::string what = resuming ? "--resume" : "--init " + o.init_from;
   NemfModel model = load_nemf(resuming ? files.last_model : o.init_from);
-  if (o.gmp_only && !resuming) model = with_new_gmp(o, model);
+  if (o.gmp_only && !resuming && model.config().to_map() != o.config.to_map()) model = with_new_gmp(o, model);
   if (model.config().to_map() != o.config.to_map()) {
     throw InputError("train: " + what + " has other sizes than the options (" + model.config().describe() +
                      "; give the same sizes)");
