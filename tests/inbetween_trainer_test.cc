@@ -4,8 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "prior/inbetween/inbetweener.h"
 #include "prior/motion/errors.h"
@@ -27,26 +25,6 @@ std::string make_data(const std::string& name) {
     write_motion(dir + "/clip" + std::to_string(i) + ".bvh", m, default_bvh_layout(s));
   }
   return dir;
-}
-
-// Column `name` of log.csv, one value per epoch.
-std::vector<double> log_column(const std::string& path, const std::string& name) {
-  std::ifstream in(path);
-  std::string line, cell;
-  std::getline(in, line);
-  std::stringstream header(line);
-  int col = -1, k = 0;
-  while (std::getline(header, cell, ',')) {
-    if (cell == name) col = k;
-    ++k;
-  }
-  std::vector<double> out;
-  while (col >= 0 && std::getline(in, line)) {
-    std::stringstream row(line);
-    for (int i = 0; std::getline(row, cell, ','); ++i)
-      if (i == col) out.push_back(std::stod(cell));
-  }
-  return out;
 }
 
 InbetweenTrainingOptions tiny_options(const std::string& data, const std::string& kind) {
@@ -77,13 +55,13 @@ TEST(InbetweenTraining, LossDecreasesCheckpointAndResume) {
   for (const char* f : {"best.mfm", "last.mfm", "last.optim", "last.state", "log.csv"}) {
     EXPECT_TRUE(fs::exists(o.out_dir + "/" + f)) << f;
   }
-  std::vector<double> train = log_column(o.out_dir + "/log.csv", "train_loss");
+  std::vector<double> train = test::log_column(o.out_dir + "/log.csv", "train_loss");
   ASSERT_EQ(train.size(), 3u);
   EXPECT_LT(train[2], 0.95 * train[0]);
-  std::vector<double> val = log_column(o.out_dir + "/log.csv", "val_score");
+  std::vector<double> val = test::log_column(o.out_dir + "/log.csv", "val_score");
   EXPECT_LT(val[2], val[0]);
-  EXPECT_EQ(log_column(o.out_dir + "/log.csv", "train_linear").size(), 3u);
-  EXPECT_GT(log_column(o.out_dir + "/log.csv", "train_contact")[0], 0.0);
+  EXPECT_EQ(test::log_column(o.out_dir + "/log.csv", "train_linear").size(), 3u);
+  EXPECT_GT(test::log_column(o.out_dir + "/log.csv", "train_contact")[0], 0.0);
 
   auto best = load_inbetweener(r.best_path);
   EXPECT_EQ(best->kind(), "test-linear");
@@ -97,7 +75,7 @@ TEST(InbetweenTraining, LossDecreasesCheckpointAndResume) {
   EXPECT_EQ(r2.epochs, 5);
   EXPECT_EQ(r2.steps, 50);
   EXPECT_LE(r2.best_validation, r.best_validation);
-  EXPECT_EQ(log_column(o.out_dir + "/log.csv", "train_loss").size(), 5u);
+  EXPECT_EQ(test::log_column(o.out_dir + "/log.csv", "train_loss").size(), 5u);
   // Resuming with other hyperparameters or another kind is refused.
   o.hyperparameters = {{"window", 32}};
   EXPECT_THROW(train_inbetweener(o), InputError);
@@ -146,7 +124,7 @@ TEST(InbetweenTraining, RealKindsTrainAFewSteps) {
     auto m = load_inbetweener(r.best_path);
     EXPECT_EQ(m->kind(), kind);
     EXPECT_EQ(m->window(), 32);
-    EXPECT_EQ(log_column(o.out_dir + "/log.csv", "val_score").size(), 2u) << kind;
+    EXPECT_EQ(test::log_column(o.out_dir + "/log.csv", "val_score").size(), 2u) << kind;
   }
 }
 

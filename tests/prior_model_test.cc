@@ -7,7 +7,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
@@ -365,18 +364,16 @@ TEST(PriorTraining, AFewStepsRunCheckpointAndResume) {
   captured.out_dir = dir + "/gmp-captured";
   captured.gmp_reconstructed = 0.0;
   train_prior(captured);
-  auto gmp_losses = [](const std::string& log_path) {  // train_vel .. train_contact of the last epoch
-    std::ifstream log(log_path);
-    std::string line, last;
-    while (std::getline(log, line))
-      if (!line.empty()) last = line;
-    std::vector<std::string> fields;
-    std::stringstream in(last);
-    for (std::string f; std::getline(in, f, ',');) fields.push_back(f);
-    return fields.size() > 12 ? fields[9] + "," + fields[10] + "," + fields[11] + "," + fields[12] : last;
+  auto gmp_losses = [](const std::string& log_path) {  // the last epoch's
+    std::vector<double> out;
+    for (const char* column : {"train_vel", "train_height", "train_trans", "train_contact"}) {
+      const std::vector<double> values = test::log_column(log_path, column);
+      EXPECT_FALSE(values.empty()) << column;
+      out.push_back(values.empty() ? 0.0 : values.back());
+    }
+    return out;
   };
-  const std::string with_reconstruction = gmp_losses(keep.out_dir + "/log.csv");
-  EXPECT_NE(with_reconstruction, gmp_losses(captured.out_dir + "/log.csv")) << with_reconstruction;
+  EXPECT_NE(gmp_losses(keep.out_dir + "/log.csv"), gmp_losses(captured.out_dir + "/log.csv"));
   PriorTrainingOptions bad_share = keep;
   bad_share.gmp_reconstructed = 1.5;
   EXPECT_THROW(train_prior(bad_share), InputError);

@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <sstream>
+#include <fstream>
 #include <random>
 
 namespace mf::test {
@@ -84,6 +86,25 @@ std::string scratch_dir(const std::string& name) {
   fs::remove_all(p);
   fs::create_directories(p);
   return p.string();
+}
+
+std::vector<double> log_column(const std::string& path, const std::string& name) {
+  std::ifstream in(path);
+  std::string line, cell;
+  std::getline(in, line);
+  std::stringstream header(line);
+  int col = -1, k = 0;
+  while (std::getline(header, cell, ',')) {
+    if (cell == name) col = k;
+    ++k;
+  }
+  std::vector<double> out;
+  while (col >= 0 && std::getline(in, line)) {
+    std::stringstream row(line);
+    for (int i = 0; std::getline(row, cell, ','); ++i)
+      if (i == col) out.push_back(std::stod(cell));
+  }
+  return out;
 }
 
 }  // namespace mf::test

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "prior/inbetween/inbetweener.h"
 #include "prior/model/nemf.h"
@@ -31,5 +32,9 @@ std::unique_ptr<InbetweenModel> tiny_transformer(const std::string& kind, const 
 
 /// A fresh empty directory under the build tree's test scratch area.
 std::string scratch_dir(const std::string& name);
+
+/// Column `name` of a trainer's log.csv, one value per epoch (empty when the
+/// file or the column is missing).
+std::vector<double> log_column(const std::string& path, const std::string& name);
 
 }  // namespace mf::test
