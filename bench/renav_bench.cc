@@ -313,7 +313,7 @@ std::string profile(const mf::NemfModel& model, const mf::Motion& ref, int n) {
   s << "| decoder | " << fixed(median_ms(n, [&] { backward(model.decode(frames, z_l, z_g).sum()); }), 2) << " |\n";
   s << "| decoder + GMP + root integration | " << fixed(median_ms(n, [&] {
          at::Tensor r = model.decode(frames, z_l, z_g);
-         mf::GmpOutput g = model.predict_global(r);
+         mf::GmpOutput g = model.predict_global(r, mf::GmpUse::Steering);
          backward(model.root_positions(r, g, w.start_xz).sum());
        }), 2) << " |\n";
   s << "| decoder + heading-frame joints (FK) | " << fixed(median_ms(n, [&] {

@@ -265,7 +265,7 @@ RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindo
 RenavEnergy evaluate_renav_energy(const NemfModel& model, const RenavWindow& window, const RenavWeights& weights,
                                   const at::Tensor& z_l, const at::Tensor& z_g) {
   at::Tensor rot = model.decode(at::arange(window.length, at::kFloat), z_l, z_g);
-  GmpOutput gmp = model.predict_global(rot);
+  GmpOutput gmp = model.predict_global(rot, GmpUse::Steering);
   at::Tensor root = model.root_positions(rot, gmp, window.start_xz);
   at::Tensor contacts;
   if (weights.foot_skating > 0) contacts = at::sigmoid(gmp.contact_logits);
@@ -277,7 +277,7 @@ RenavDecoded decode_renav_window(const NemfModel& model, const RenavWindow& wind
   at::NoGradGuard no_grad;
   RenavDecoded d;
   d.local_rotations = model.decode(at::arange(window.length, at::kFloat), z_l, z_g);
-  GmpOutput gmp = model.predict_global(d.local_rotations);
+  GmpOutput gmp = model.predict_global(d.local_rotations, GmpUse::Steering);
   d.root_positions = model.root_positions(d.local_rotations, gmp, window.start_xz);
   d.contacts = at::sigmoid(gmp.contact_logits);
   return d;

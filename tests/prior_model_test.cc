@@ -258,6 +258,36 @@ TEST_F(ModelFile, ErrorsSayWhatIsWrong) {
   EXPECT_THROW(load_nemf(dir_ + "/missing.mfm"), InputError);
 }
 
+TEST_F(ModelFile, SteeringGmpIsStoredAndChosenByUse) {
+  NemfConfig c = tiny_nemf_config();
+  c.steering_gmp = 1;
+  at::manual_seed(1);
+  NemfModel a(c, tiny_rig());
+  ASSERT_TRUE(a.has_steering_gmp());
+  save_nemf(a, path_);
+  NemfModel b = load_nemf(path_);
+  ASSERT_TRUE(b.has_steering_gmp());
+  EXPECT_EQ(b.config().steering_gmp, 1);
+  at::Tensor z = at::randn({1, 8}), g = at::randn({1, 4}), t = at::arange(0, 32, at::kFloat);
+  const at::Tensor rot = b.decode(t, z, g);
+  auto velocity = [&](const NemfModel& m, GmpUse use) { return m.predict_global(rot, use).velocity; };
+  EXPECT_TRUE(at::allclose(velocity(a, GmpUse::Steering), velocity(b, GmpUse::Steering)));
+  EXPECT_TRUE(at::allclose(velocity(a, GmpUse::Default), velocity(b, GmpUse::Default)));
+  EXPECT_FALSE(at::allclose(velocity(b, GmpUse::Default), velocity(b, GmpUse::Steering)));  // two GMPs
+  // Neither the VAE's nor the default GMP's parameters include it.
+  NemfModel plain(tiny_nemf_config(), tiny_rig());
+  EXPECT_EQ(b.vae_parameters().size(), plain.vae_parameters().size());
+  EXPECT_EQ(b.gmp_parameters().size(), plain.gmp_parameters().size());
+  EXPECT_GT(b.parameters().size(), plain.parameters().size());
+  // Without one, Steering is the default GMP, and files do not carry the key.
+  EXPECT_FALSE(plain.has_steering_gmp());
+  EXPECT_TRUE(at::equal(velocity(plain, GmpUse::Steering), velocity(plain, GmpUse::Default)));
+  EXPECT_EQ(plain.config().to_map().count("steering_gmp"), 0u);
+  EXPECT_EQ(load_nemf(path_).config().to_map().at("steering_gmp"), 1.0);
+  c.steering_gmp = 2;
+  EXPECT_NE(c.validate(), "");
+}
+
 // Found by fuzz_model_file: hyperparameters outside int's range were cast
 // (undefined), and the GMP's width had no upper bound (2e9 asked for 200 GB).
 TEST(PriorModel, HyperparametersAreBoundedBeforeTheNetworkIsBuilt) {
@@ -374,6 +404,39 @@ TEST(PriorTraining, AFewStepsRunCheckpointAndResume) {
     return out;
   };
   EXPECT_NE(gmp_losses(keep.out_dir + "/log.csv"), gmp_losses(captured.out_dir + "/log.csv"));
+  // --steering-gmp: --init's GMP is kept, frozen, as the steering GMP and the
+  // default GMP is the one trained; the sizes must be --init's.
+  PriorTrainingOptions steer = keep;
+  steer.out_dir = dir + "/gmp-steer";
+  steer.config.steering_gmp = 1;
+  steer.lr = steer.lr_final = 1e-2;
+  train_prior(steer);
+  NemfModel steered = load_nemf(steer.out_dir + "/last.mfm");
+  ASSERT_TRUE(steered.has_steering_gmp());
+  std::map<std::string, at::Tensor> init_params, steered_params;
+  for (const auto& [name, value] : load_nemf(keep.init_from).named_parameters()) init_params[name] = value;
+  for (const auto& [name, value] : steered.named_parameters()) steered_params[name] = value;
+  bool default_moved = false;
+  int steering_count = 0;
+  for (const auto& [name, value] : init_params) {
+    if (name.rfind("gmp.", 0) != 0) continue;
+    EXPECT_TRUE(at::equal(steered_params.at("steering_" + name), value)) << name;
+    default_moved = default_moved || !at::equal(steered_params.at(name), value);
+    ++steering_count;
+  }
+  EXPECT_GT(steering_count, 0);
+  EXPECT_TRUE(default_moved);
+  PriorTrainingOptions steer_resume = steer;  // the checkpoint carries the steering GMP
+  steer_resume.resume = true;
+  steer_resume.max_epochs = 2;
+  EXPECT_NO_THROW(train_prior(steer_resume));
+  PriorTrainingOptions bad_steer = steer;
+  bad_steer.out_dir = dir + "/gmp-steer-bad";
+  bad_steer.config.gmp_width = 16;
+  EXPECT_THROW(train_prior(bad_steer), InputError);
+  bad_steer.config.gmp_width = steer.config.gmp_width;
+  bad_steer.gmp_only = false;
+  EXPECT_THROW(train_prior(bad_steer), InputError);
   PriorTrainingOptions bad_share = keep;
   bad_share.gmp_reconstructed = 1.5;
   EXPECT_THROW(train_prior(bad_share), InputError);

@@ -228,6 +228,37 @@ TEST(RenavEnergyTest, GradientsReachTheCodesOnly) {
   }
 }
 
+// Re-navigation reads the steering GMP where the model has one: editing the
+// default GMP changes nothing, editing the steering GMP changes the energy.
+TEST(RenavEnergyTest, UsesTheSteeringGmp) {
+  NemfConfig c = test::tiny_nemf_config();
+  c.steering_gmp = 1;
+  at::manual_seed(5);
+  NemfModel model(c, test::tiny_rig());
+  model.set_requires_grad(false);
+  const Motion ref = test::random_motion(model.rig().skeleton, 40, 30.0, 9);
+  const RenavWindow w = make_renav_window(model, ref, 0, 32, line_path(40, 0.04), 4, 32);
+  RenavWeights weights;
+  weights.foot_skating = 1.0;
+  at::manual_seed(3);
+  const at::Tensor z_l = at::randn({1, c.zl}), z_g = at::randn({1, c.zg});
+  auto energy = [&] { return evaluate_renav_energy(model, w, weights, z_l, z_g).total.item<double>(); };
+  auto root = [&] { return decode_renav_window(model, w, z_l, z_g).root_positions; };
+  const double e0 = energy();
+  const at::Tensor r0 = root();
+  at::NoGradGuard no_grad;
+  auto scale = [&](const std::string& prefix) {
+    for (auto& [name, value] : model.named_parameters())
+      if (name.rfind(prefix, 0) == 0) value.mul_(3.0);
+  };
+  scale("gmp.");
+  EXPECT_EQ(energy(), e0);
+  EXPECT_TRUE(at::equal(root(), r0));
+  scale("steering_gmp.");
+  EXPECT_NE(energy(), e0);
+  EXPECT_FALSE(at::allclose(root(), r0));
+}
+
 TEST(RenavEnergyTest, WindowStartsOnThePathWithTheReferencesFacing) {
   auto model = tiny_model();
   const RigInfo& rig = model->rig();

@@ -121,6 +121,10 @@ void add_prior_options(CLI::App& cmd, mf::PriorTrainingOptions& o, RunArgs& run)
   cmd.add_option("--gmp-reconstructed", o.gmp_reconstructed,
                  "with --gmp-only: the share in [0, 1] of windows whose GMP inputs are the VAE's reconstruction "
                  "instead of the captured motion (give it again on --resume)");
+  cmd.add_flag("--steering-gmp", c.steering_gmp,
+               "with --gmp-only: keep the --init model's GMP, frozen, as the steering GMP that re-navigation uses, "
+               "and train the default GMP (same sizes) that the other tasks use (give it again on --resume)")
+      ->group(sizes);
   cmd.add_option("--window", c.window, "frames per window")->group(sizes);
   cmd.add_option("--stride", o.stride, "frames between training windows");
   cmd.add_option("--frames-per-window", o.frames_per_window, "decoded frames per window and step");

@@ -270,13 +270,19 @@ void check_options(const PriorTrainingOptions& o) {
   if (o.gmp_reconstructed > 0.0 && !o.gmp_only) {
     throw InputError("train: --gmp-reconstructed needs --gmp-only (a frozen VAE to reconstruct with)");
   }
+  if (o.config.steering_gmp && !o.gmp_only) {
+    throw InputError("train: --steering-gmp needs --gmp-only (the steering GMP is --init's, kept frozen)");
+  }
 }
 
-bool is_gmp_key(const std::string& key) { return key.rfind("gmp_", 0) == 0; }
+bool is_gmp_key(const std::string& key) { return key.rfind("gmp_", 0) == 0 || key == "steering_gmp"; }
 bool is_gmp_parameter(const std::string& name) { return name.rfind("gmp.", 0) == 0; }
+bool is_steering_parameter(const std::string& name) { return name.rfind("steering_gmp.", 0) == 0; }
 
-// A model of o.config with `init`'s VAE weights and statistics and a fresh GMP
-// (called only when the GMP sizes differ from `init`'s).
+// A model of o.config with `init`'s VAE weights and statistics (called only
+// when o.config's GMP sizes or steering GMP differ from `init`'s). Its GMP is
+// `init`'s when the sizes are the same, else a fresh one; its steering GMP is
+// `init`'s steering GMP, or `init`'s GMP when `init` has none.
 NemfModel with_new_gmp(const PriorTrainingOptions& o, const NemfModel& init) {
   auto without_gmp = [](const NemfConfig& c) {
     auto map = c.to_map();
@@ -287,15 +293,24 @@ NemfModel with_new_gmp(const PriorTrainingOptions& o, const NemfModel& init) {
     throw InputError("train: --init " + o.init_from + " has other VAE sizes than the options (" +
                      init.config().describe() + "; --gmp-only changes only the --gmp-* sizes)");
   }
+  const NemfConfig& c = init.config();
+  const bool same_sizes =
+      c.gmp_width == o.config.gmp_width && c.gmp_kernel == o.config.gmp_kernel && c.gmp_blocks == o.config.gmp_blocks;
+  if (o.config.steering_gmp && !same_sizes) {
+    throw InputError("train: --steering-gmp keeps --init " + o.init_from +
+                     "'s GMP for steering, so the --gmp-* sizes must be its own (" + c.describe() + ")");
+  }
   NemfModel model(o.config, init.rig());
   at::NoGradGuard no_grad;
   std::map<std::string, at::Tensor> source;
   for (const auto& [name, value] : init.named_parameters()) source[name] = value;
   for (const auto& [name, value] : model.named_parameters()) {
-    if (is_gmp_parameter(name)) continue;
-    auto it = source.find(name);
+    if (is_gmp_parameter(name) && !same_sizes) continue;
+    const bool from_gmp = is_steering_parameter(name) && !init.has_steering_gmp();
+    const std::string from = from_gmp ? name.substr(std::string("steering_").size()) : name;
+    auto it = source.find(from);
     if (it == source.end() || !it->second.sizes().equals(value.sizes())) {
-      throw InputError("train: --init " + o.init_from + " has no parameter " + name + " of this model's shape");
+      throw InputError("train: --init " + o.init_from + " has no parameter " + from + " of this model's shape");
     }
     value.copy_(it->second);
   }

@@ -60,6 +60,9 @@ struct PriorTrainingOptions {
   /// validation figures are logged but constant). --init's GMP is kept when
   /// its sizes are `config`'s, else a fresh one is trained. For a smaller,
   /// faster GMP without retraining the VAE. Give it again on --resume.
+  /// With config.steering_gmp, --init's GMP (or its steering GMP if it has
+  /// one) is kept, frozen, as the model's steering GMP and the default GMP is
+  /// the one trained; the GMP sizes must then be --init's.
   bool gmp_only = false;
   /// With gmp_only: the share of each batch's windows (and of the validation
   /// windows) whose GMP inputs come from the frozen VAE's reconstruction

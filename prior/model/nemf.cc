@@ -197,11 +197,15 @@ struct NemfNetImpl : torch::nn::Module {
     global = register_module("global_encoder", GlobalEncoder(c));
     decoder = register_module("decoder", Decoder(c, rig.num_joints()));
     gmp = register_module("gmp", GlobalPredictor(c, rig.num_joints(), rig.num_feet()));
+    if (c.steering_gmp) {
+      steering_gmp = register_module("steering_gmp", GlobalPredictor(c, rig.num_joints(), rig.num_feet()));
+    }
   }
   LocalEncoder local{nullptr};
   GlobalEncoder global{nullptr};
   Decoder decoder{nullptr};
   GlobalPredictor gmp{nullptr};
+  GlobalPredictor steering_gmp{nullptr};
 };
 TORCH_MODULE(NemfNet);
 
@@ -225,6 +229,7 @@ std::string NemfConfig::validate() const {
   if (gmp_width < 4 || gmp_width > 4096 || gmp_kernel < 1 || gmp_kernel > 63 || gmp_kernel % 2 == 0 ||
       gmp_blocks < 0 || gmp_blocks > 64)
     e << "bad GMP sizes (width in [4, 4096], odd kernel in [1, 63], blocks in [0, 64]); ";
+  if (steering_gmp != 0 && steering_gmp != 1) e << "steering_gmp must be 0 or 1; ";
   return e.str();
 }
 
@@ -232,13 +237,14 @@ std::string NemfConfig::describe() const {
   std::ostringstream s;
   s << "decoder " << decoder_layers << "x" << decoder_width << ", z_l " << zl << ", z_g " << zg << " (last "
     << zg_layers << " layers), PE " << pe_frequencies << " octaves, encoder channels " << encoder_channels
-    << ", GMP " << gmp_blocks << " blocks x " << gmp_width << " (kernel " << gmp_kernel << "), window " << window
-    << " frames at " << fps << " fps";
+    << ", GMP " << gmp_blocks << " blocks x " << gmp_width << " (kernel " << gmp_kernel << ")"
+    << (steering_gmp ? " and a steering GMP of its sizes" : "") << ", window " << window << " frames at " << fps
+    << " fps";
   return s.str();
 }
 
 std::map<std::string, double> NemfConfig::to_map() const {
-  return {{"window", window},
+  std::map<std::string, double> m{{"window", window},
           {"fps", fps},
           {"pe_frequencies", pe_frequencies},
           {"decoder_width", decoder_width},
@@ -250,6 +256,9 @@ std::map<std::string, double> NemfConfig::to_map() const {
           {"gmp_width", gmp_width},
           {"gmp_kernel", gmp_kernel},
           {"gmp_blocks", gmp_blocks}};
+  // Written only when present, so that files without it stay as they were.
+  if (steering_gmp) m["steering_gmp"] = steering_gmp;
+  return m;
 }
 
 NemfConfig NemfConfig::from_map(const std::map<std::string, double>& v) {
@@ -279,6 +288,7 @@ NemfConfig NemfConfig::from_map(const std::map<std::string, double>& v) {
   get("gmp_width", c.gmp_width);
   get("gmp_kernel", c.gmp_kernel);
   get("gmp_blocks", c.gmp_blocks);
+  if (v.count("steering_gmp")) get("steering_gmp", c.steering_gmp);
   return c;
 }
 
@@ -373,15 +383,18 @@ at::Tensor NemfModel::decode(const at::Tensor& frames, const at::Tensor& z_l, co
   return torch_rot::sixd_to_matrix(d6);
 }
 
-GmpOutput NemfModel::predict_global(const at::Tensor& local_rotations) const {
-  return predict_global_from_inputs(gmp_inputs(local_rotations, impl_->rig));
+GmpOutput NemfModel::predict_global(const at::Tensor& local_rotations, GmpUse use) const {
+  return predict_global_from_inputs(gmp_inputs(local_rotations, impl_->rig), use);
 }
 
-GmpOutput NemfModel::predict_global_from_inputs(const at::Tensor& inputs) const {
+bool NemfModel::has_steering_gmp() const { return !impl_->net->steering_gmp.is_empty(); }
+
+GmpOutput NemfModel::predict_global_from_inputs(const at::Tensor& inputs, GmpUse use) const {
   const RigInfo& rig = impl_->rig;
   const NemfStats& s = impl_->stats;
+  GlobalPredictor& gmp = use == GmpUse::Steering && has_steering_gmp() ? impl_->net->steering_gmp : impl_->net->gmp;
   at::Tensor x = (inputs - s.gmp_in_mean) / s.gmp_in_std;
-  at::Tensor y = impl_->net->gmp->forward(x.transpose(1, 2)).transpose(1, 2);  // [B, T, 4 + F]
+  at::Tensor y = gmp->forward(x.transpose(1, 2)).transpose(1, 2);  // [B, T, 4 + F]
   at::Tensor out = y.narrow(-1, 0, 4) * s.gmp_out_std + s.gmp_out_mean;
   GmpOutput g;
   g.velocity = out.narrow(-1, 0, 3);
@@ -405,7 +418,8 @@ std::vector<at::Tensor> NemfModel::parameters() const { return impl_->net->param
 std::vector<at::Tensor> NemfModel::vae_parameters() const {
   std::vector<at::Tensor> out;
   for (const auto& item : impl_->net->named_parameters(true)) {
-    if (item.key().rfind("gmp.", 0) != 0) out.push_back(item.value());
+    const std::string& k = item.key();
+    if (k.rfind("gmp.", 0) != 0 && k.rfind("steering_gmp.", 0) != 0) out.push_back(item.value());
   }
   return out;
 }

@@ -50,6 +50,11 @@ struct NemfConfig {
   int gmp_width = 128;
   int gmp_kernel = 7;
   int gmp_blocks = 3;
+  /// 1: a second GMP of the same sizes, sharing the GMP statistics, for the
+  /// tasks that steer the root along a path (GmpUse::Steering). A GMP reading
+  /// the VAE's reconstructions in-betweens better; one trained on captured
+  /// motion follows a path better. Files without it load with 0.
+  int steering_gmp = 0;
 
   /// Empty when valid, else what is wrong.
   std::string validate() const;
@@ -79,6 +84,10 @@ struct GmpOutput {
   at::Tensor contact_logits;  ///< [B, T, F]
 };
 
+/// Which GMP a task asks for: the default one, or the steering GMP where the
+/// model has one (NemfConfig::steering_gmp; else the default).
+enum class GmpUse { Default, Steering };
+
 class NemfModel {
  public:
   NemfModel(const NemfConfig& config, const RigInfo& rig);
@@ -106,10 +115,13 @@ class NemfModel {
   at::Tensor decode(const at::Tensor& frames, const at::Tensor& z_l, const at::Tensor& z_g) const;
 
   /// The GMP on a dense sequence of frames at the model's fps, [B, T, J, 3, 3] -> outputs.
-  GmpOutput predict_global(const at::Tensor& local_rotations) const;
+  GmpOutput predict_global(const at::Tensor& local_rotations, GmpUse use = GmpUse::Default) const;
 
   /// The GMP from precomputed raw inputs [B, T, J * 3 + 6] (gmp_inputs()).
-  GmpOutput predict_global_from_inputs(const at::Tensor& inputs) const;
+  GmpOutput predict_global_from_inputs(const at::Tensor& inputs, GmpUse use = GmpUse::Default) const;
+
+  /// Whether GmpUse::Steering has a GMP of its own.
+  bool has_steering_gmp() const;
 
   /// Root positions [B, T, 3] in the canonical frame from the GMP's outputs,
   /// starting at the origin (or start_xz [B, 2]).
@@ -119,7 +131,8 @@ class NemfModel {
   /// Every parameter, by stable name ("local_encoder.conv0.weight", ...).
   std::vector<std::pair<std::string, at::Tensor>> named_parameters() const;
   std::vector<at::Tensor> parameters() const;
-  /// Parameters of the VAE (encoders and decoder) and of the GMP, for separate optimisers.
+  /// Parameters of the VAE (encoders and decoder) and of the default GMP, for
+  /// separate optimisers (the steering GMP is in neither).
   std::vector<at::Tensor> vae_parameters() const;
   std::vector<at::Tensor> gmp_parameters() const;
   int64_t num_parameters() const;
