@@ -245,17 +245,17 @@ std::string NemfConfig::describe() const {
 
 std::map<std::string, double> NemfConfig::to_map() const {
   std::map<std::string, double> m{{"window", window},
-          {"fps", fps},
-          {"pe_frequencies", pe_frequencies},
-          {"decoder_width", decoder_width},
-          {"decoder_layers", decoder_layers},
-          {"zl", zl},
-          {"zg", zg},
-          {"zg_layers", zg_layers},
-          {"encoder_channels", encoder_channels},
-          {"gmp_width", gmp_width},
-          {"gmp_kernel", gmp_kernel},
-          {"gmp_blocks", gmp_blocks}};
+                                  {"fps", fps},
+                                  {"pe_frequencies", pe_frequencies},
+                                  {"decoder_width", decoder_width},
+                                  {"decoder_layers", decoder_layers},
+                                  {"zl", zl},
+                                  {"zg", zg},
+                                  {"zg_layers", zg_layers},
+                                  {"encoder_channels", encoder_channels},
+                                  {"gmp_width", gmp_width},
+                                  {"gmp_kernel", gmp_kernel},
+                                  {"gmp_blocks", gmp_blocks}};
   // Written only when present, so that files without it stay as they were.
   if (steering_gmp) m["steering_gmp"] = steering_gmp;
   return m;
