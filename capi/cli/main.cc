@@ -11,6 +11,8 @@
 // stderr, prefixed with "motionfield: ", with control characters escaped
 // (cli.h printable).
 #include <CLI/CLI.hpp>
+#include <malloc.h>
+
 #include <cstdio>
 #include <string>
 
@@ -43,6 +45,10 @@ int report_parse_error(const CLI::App& app, const CLI::ParseError& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  // glibc's heap keeps 64 MB above its top, so that the solvers' iterations do
+  // not hand memory back to the system and fault it in again (the tools do the
+  // same: prior/util/command_line.h, pad_heap_top).
+  mallopt(M_TOP_PAD, 64 << 20);
   CLI::App app("", "motionfield");
   Arguments args;
   try {

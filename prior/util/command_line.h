@@ -9,6 +9,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <malloc.h>
 
 #include <cstdio>
 #include <exception>
@@ -36,12 +37,22 @@ inline CLI::Option* repeatable(CLI::Option* option) {
   return option->multi_option_policy(CLI::MultiOptionPolicy::TakeAll)->allow_extra_args(false);
 }
 
-/// Parses argc/argv into `app`, then returns `body()`, mapping every outcome to
-/// the exit codes above. `body` may throw mf::InputError (exit code 2) or any
-/// other std::exception (exit code 1).
+/// Lets glibc's heap keep 64 MB above its top when it grows and when it trims.
+/// Without it, malloc hands the freed top of the heap back to the system
+/// between the solver's iterations and takes it back, paying a page fault for
+/// each page touched again: 232k against 156k minor faults, and up to 30 %
+/// longer sparse solves, in whichever process lands in that state
+/// (docs/BENCHMARKS.md, "Session 31"). The CLI sets the same (capi/cli/main.cc);
+/// the library leaves its host's allocator alone.
+inline void pad_heap_top() { mallopt(M_TOP_PAD, 64 << 20); }
+
+/// Pads the heap (pad_heap_top), parses argc/argv into `app`, then returns
+/// `body()`, mapping every outcome to the exit codes above. `body` may throw
+/// mf::InputError (exit code 2) or any other std::exception (exit code 1).
 template <class Body>
 int run(CLI::App& app, int argc, char** argv, Body&& body) {
   const std::string tool = app.get_name();
+  pad_heap_top();
   try {
     try {
       app.parse(argc, argv);
