@@ -67,8 +67,14 @@ Eigen::Vector3d lock_point(const GlobalPose& pose, int ankle, const std::vector<
 }
 
 // Per frame, where the ankle is held (`goal`) and how much (`weight`): 1
-// inside each contact [s, e] of two or more frames, a linear ramp over `ramp`
-// frames on each side; where ramps of two contacts meet, the larger weight.
+// inside each contact [s, e] of two or more frames, on each side a ramp over
+// `ramp` frames whose weight grows with the square of the distance covered
+// ((k / (ramp + 1))^2 at the k-th frame); where ramps of two contacts meet,
+// the larger weight. A linear ramp moved a swinging foot a quarter of its
+// distance to the lock point on its first frame: 0.27 m at once for a foot
+// 34 cm from the contact's mean three frames before it (the Blender add-on's
+// test); the squared weights start small and still hold the foot near the
+// contact (docs/BENCHMARKS.md, "Session 32").
 void contact_goals(const GlobalPose& pose, int ankle, const std::vector<char>& on, const std::vector<char>& known,
                    int ramp, std::vector<Eigen::Vector3d>* goal, std::vector<double>* weight) {
   const int N = static_cast<int>(on.size());
@@ -90,8 +96,9 @@ void contact_goals(const GlobalPose& pose, int ankle, const std::vector<char>& o
       for (int f = s; f <= e; ++f) mean += pose.position(f, ankle);
       mean /= (e - s + 1);
       for (int f = std::max(0, s - ramp); f <= std::min(N - 1, e + ramp); ++f) {
-        const double w = f < s ? 1.0 - static_cast<double>(s - f) / (ramp + 1)
+        const double t = f < s ? 1.0 - static_cast<double>(s - f) / (ramp + 1)
                                : f > e ? 1.0 - static_cast<double>(f - e) / (ramp + 1) : 1.0;
+        const double w = t * t;
         if (w > (*weight)[f]) {
           (*weight)[f] = w;
           (*goal)[f] = lock_point(pose, ankle, inside, mean, std::clamp(f, s, e));

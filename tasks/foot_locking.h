@@ -7,7 +7,9 @@
 // held by two-bone IK on thigh and shin (tasks/two_bone_ik.h). It is held at
 // the ankle's positions at the known frames inside the contact, interpolated
 // between them (so that nothing jumps at a known frame), else at the
-// contact's mean position, with a linear ramp of `ramp` frames on each side.
+// contact's mean position, with a ramp of `ramp` frames on each side whose
+// weight grows as the square of the distance covered, so that a swinging
+// foot is not pulled toward the lock point at once.
 // Then each toe joint (its name contains "toe") below such an ankle is held
 // the same way, in (x, z), while the predictor says it is in contact and it is
 // low: with the heel planted (the ankle's lock weight) the foot turns about the
@@ -39,7 +41,7 @@ namespace mf {
 /// The ramp of contact pins the tasks use (frames on each side).
 inline constexpr int kDefaultContactRamp = 3;
 /// The ramp of foot locking after a solve or a transformer's pass.
-inline constexpr int kFootLockRamp = 3;
+inline constexpr int kFootLockRamp = 5;
 
 /// Locks the feet of `out` (see the top of this file). `contacts` holds the
 /// predictor's contact probabilities [frames, rig.num_feet()] row-major.

@@ -21,7 +21,7 @@
 // function tolerance 1e-3; weights rotation 5,
 // position 10, root orientation 1, root translation 10 (the GMP path), no
 // prior, skating or smoothness term (they bought nothing measurable with the
-// pilot prior); squared penalties; foot locking with a 3-frame ramp.
+// pilot prior); squared penalties; foot locking with a 5-frame ramp.
 //
 // complete_motion() is the task: it splits the input into windows of the
 // model's length, canonicalises each at its first key that fixes the root,

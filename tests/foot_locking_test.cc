@@ -1,7 +1,8 @@
 // Foot locking after a solve (tasks/foot_locking.h) on a one-legged rig with a
 // toe: a toe in contact is held whether its heel is planted (the foot turns
 // about the ankle) or lifted (the leg carries the foot, which keeps its
-// orientation), and frames a key protects are not touched.
+// orientation), frames a key protects are not touched, and the ramp into a
+// contact keeps the swing smooth.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
@@ -110,6 +111,32 @@ TEST(FootLocking, ToesOutOfContactAndKeyedFramesAreLeftAlone) {
   lock_feet(leg_rig(m.skeleton), MotionConstraints::full_pose({10}), contacts(0.0f, 1.0f), kFootLockRamp, &out);
   for (int j = 0; j < m.num_joints(); ++j) EXPECT_EQ(out.rotation(10, j).coeffs(), m.rotation(10, j).coeffs());
   EXPECT_LT(horizontal_spread(out, kToe, 0, 9), 0.002);
+}
+
+// A foot that swings 3 cm a frame until frame 10, then slides 1 cm a frame over
+// its contact (frames 10..19): the lock point, the contact's mean, is 4.5 cm
+// ahead of the foot's first contact frame and further ahead of its swing. The
+// ramp pulls the swinging foot toward it a little at first and more near the
+// contact, so no frame moves the foot much more than its own step (the linear
+// 3-frame ramp moved it 6.4 cm, over twice its step, on the ramp's first frame).
+TEST(FootLocking, TheRampIntoAContactKeepsTheSwingSmooth) {
+  Motion m = turning_foot(/*walk=*/false);
+  for (int f = 0; f < kFrames; ++f) {
+    m.rotation(f, kFoot) = m.rotation(0, kFoot);
+    m.root_positions[f].z() = f < 10 ? 0.03 * (f - 10) : 0.01 * (f - 10);
+  }
+  std::vector<float> c;
+  for (int f = 0; f < kFrames; ++f) c.insert(c.end(), {f < 10 ? 0.0f : 1.0f, 0.0f});
+  Motion out = m;
+  lock_feet(leg_rig(m.skeleton), MotionConstraints{}, c, kFootLockRamp, &out);
+  EXPECT_LT(horizontal_spread(out, kFoot, 10, kFrames - 1), 0.002);
+  const GlobalPose before = forward_kinematics(m), after = forward_kinematics(out);
+  for (int f = 1; f <= 10; ++f) {
+    const Eigen::Vector3d step = after.position(f, kFoot) - after.position(f - 1, kFoot);
+    EXPECT_LT(std::hypot(step.x(), step.z()), 1.6 * 0.03) << "frame " << f;
+  }
+  for (int f = 0; f < 10 - kFootLockRamp; ++f)  // before the ramp: untouched
+    EXPECT_LT((after.position(f, kFoot) - before.position(f, kFoot)).norm(), 1e-9) << "frame " << f;
 }
 
 // A contact pin on a nearly straight leg whose hips walk 3 cm a frame, with a
