@@ -74,9 +74,12 @@ Eigen::Vector3d lock_point(const GlobalPose& pose, int ankle, const std::vector<
 // distance to the lock point on its first frame: 0.27 m at once for a foot
 // 34 cm from the contact's mean three frames before it (the Blender add-on's
 // test); the squared weights start small and still hold the foot near the
-// contact (docs/BENCHMARKS.md, "Session 32").
+// contact (docs/BENCHMARKS.md, "Session 32"). A `fixed` frame (one the lock
+// must not touch) within a ramp shortens it to start there from zero, so the
+// first free frame next to a key is not moved most of the way at once.
 void contact_goals(const GlobalPose& pose, int ankle, const std::vector<char>& on, const std::vector<char>& known,
-                   int ramp, std::vector<Eigen::Vector3d>* goal, std::vector<double>* weight) {
+                   const std::vector<char>& fixed, int ramp, std::vector<Eigen::Vector3d>* goal,
+                   std::vector<double>* weight) {
   const int N = static_cast<int>(on.size());
   goal->assign(N, Eigen::Vector3d::Zero());
   weight->assign(N, 0.0);
@@ -95,9 +98,17 @@ void contact_goals(const GlobalPose& pose, int ankle, const std::vector<char>& o
       Eigen::Vector3d mean = Eigen::Vector3d::Zero();
       for (int f = s; f <= e; ++f) mean += pose.position(f, ankle);
       mean /= (e - s + 1);
-      for (int f = std::max(0, s - ramp); f <= std::min(N - 1, e + ramp); ++f) {
-        const double t = f < s ? 1.0 - static_cast<double>(s - f) / (ramp + 1)
-                               : f > e ? 1.0 - static_cast<double>(f - e) / (ramp + 1) : 1.0;
+      // The ramps run from weight 0 at `before` and `after` to 1 at s and e.
+      int before = s - ramp - 1, after = e + ramp + 1;
+      for (int f = std::max(0, s - ramp); f < s; ++f) {
+        if (fixed[f]) before = f;
+      }
+      for (int f = std::min(N - 1, e + ramp); f > e; --f) {
+        if (fixed[f]) after = f;
+      }
+      for (int f = std::max(0, before + 1); f <= std::min(N - 1, after - 1); ++f) {
+        const double t = f < s ? static_cast<double>(f - before) / (s - before)
+                               : f > e ? static_cast<double>(after - f) / (after - e) : 1.0;
         const double w = t * t;
         if (w > (*weight)[f]) {
           (*weight)[f] = w;
@@ -203,7 +214,7 @@ void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector
     protected_frames(c, skel, leg, N, &fixed, &known);
     GlobalPose pose = forward_kinematics(*out);
     std::vector<Eigen::Vector3d> goal;
-    contact_goals(pose, leg.ankle, in_contact(k, pose), known, ramp, &goal, &ankle_weight[leg.ankle]);
+    contact_goals(pose, leg.ankle, in_contact(k, pose), known, fixed, ramp, &goal, &ankle_weight[leg.ankle]);
     hold(leg, goal, ankle_weight[leg.ankle], fixed, /*height=*/false, out, &pose);
   }
   for (int k = 0; k < F; ++k) {
@@ -218,7 +229,7 @@ void lock_feet(const RigInfo& rig, const MotionConstraints& c, const std::vector
     GlobalPose pose = forward_kinematics(*out);
     std::vector<Eigen::Vector3d> goal;
     std::vector<double> weight;
-    contact_goals(pose, toe, in_contact(k, pose), known, ramp, &goal, &weight);
+    contact_goals(pose, toe, in_contact(k, pose), known, fixed, ramp, &goal, &weight);
     const std::vector<double>& planted = ankle_weight[leg.ankle];
     for (int f = 0; f < N; ++f) {
       if (weight[f] <= 0.0 || fixed[f]) continue;
@@ -271,7 +282,7 @@ std::vector<std::string> pin_contacts(const MotionConstraints& c, int ramp, Moti
     protected_frames(c, skel, pin.leg, N, &pin.fixed, &known);
     std::vector<char> on(N, 0);
     std::fill(on.begin() + p.first, on.begin() + p.last + 1, 1);
-    contact_goals(pose, pin.leg.ankle, on, known, ramp, &pin.goal, &pin.weight);
+    contact_goals(pose, pin.leg.ankle, on, known, pin.fixed, ramp, &pin.goal, &pin.weight);
     warn_conflicts(what, pose, pin.leg.ankle, p, pin.fixed, known, &warnings);
     bring_in_reach(c, pin.leg, pin.goal, pin.weight, pin.fixed, out, &pose);
     pinned.push_back(std::move(pin));

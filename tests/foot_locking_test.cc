@@ -119,16 +119,25 @@ TEST(FootLocking, ToesOutOfContactAndKeyedFramesAreLeftAlone) {
 // ramp pulls the swinging foot toward it a little at first and more near the
 // contact, so no frame moves the foot much more than its own step (the linear
 // 3-frame ramp moved it 6.4 cm, over twice its step, on the ramp's first frame).
-TEST(FootLocking, TheRampIntoAContactKeepsTheSwingSmooth) {
+Motion swing_into_contact() {
   Motion m = turning_foot(/*walk=*/false);
   for (int f = 0; f < kFrames; ++f) {
     m.rotation(f, kFoot) = m.rotation(0, kFoot);
     m.root_positions[f].z() = f < 10 ? 0.03 * (f - 10) : 0.01 * (f - 10);
   }
+  return m;
+}
+
+std::vector<float> foot_down_from_frame_10() {
   std::vector<float> c;
   for (int f = 0; f < kFrames; ++f) c.insert(c.end(), {f < 10 ? 0.0f : 1.0f, 0.0f});
+  return c;
+}
+
+TEST(FootLocking, TheRampIntoAContactKeepsTheSwingSmooth) {
+  const Motion m = swing_into_contact();
   Motion out = m;
-  lock_feet(leg_rig(m.skeleton), MotionConstraints{}, c, kFootLockRamp, &out);
+  lock_feet(leg_rig(m.skeleton), MotionConstraints{}, foot_down_from_frame_10(), kFootLockRamp, &out);
   EXPECT_LT(horizontal_spread(out, kFoot, 10, kFrames - 1), 0.002);
   const GlobalPose before = forward_kinematics(m), after = forward_kinematics(out);
   for (int f = 1; f <= 10; ++f) {
@@ -137,6 +146,21 @@ TEST(FootLocking, TheRampIntoAContactKeepsTheSwingSmooth) {
   }
   for (int f = 0; f < 10 - kFootLockRamp; ++f)  // before the ramp: untouched
     EXPECT_LT((after.position(f, kFoot) - before.position(f, kFoot)).norm(), 1e-9) << "frame " << f;
+}
+
+// The same swing with a full-pose key at frame 8, inside the ramp: the ramp
+// starts at the key, so frame 9, the one free frame between the key and the
+// contact, moves a quarter of the way to the lock point (7.5 cm away), not
+// the 69 % of a ramp that ignored the key.
+TEST(FootLocking, AKeyInsideARampStartsTheRampThere) {
+  const Motion m = swing_into_contact();
+  Motion out = m;
+  lock_feet(leg_rig(m.skeleton), MotionConstraints::full_pose({8}), foot_down_from_frame_10(), kFootLockRamp, &out);
+  const GlobalPose before = forward_kinematics(m), after = forward_kinematics(out);
+  for (int j = 0; j < m.num_joints(); ++j) EXPECT_EQ(out.rotation(8, j).coeffs(), m.rotation(8, j).coeffs());
+  const Eigen::Vector3d moved = after.position(9, kFoot) - before.position(9, kFoot);
+  EXPECT_NEAR(std::hypot(moved.x(), moved.z()), 0.25 * 0.075, 2e-3);
+  EXPECT_LT(horizontal_spread(out, kFoot, 10, kFrames - 1), 0.002);
 }
 
 // A contact pin on a nearly straight leg whose hips walk 3 cm a frame, with a
