@@ -9,7 +9,8 @@
 // between them (so that nothing jumps at a known frame), else at the
 // contact's mean position, with a ramp of `ramp` frames on each side whose
 // weight grows as the square of the distance covered, so that a swinging
-// foot is not pulled toward the lock point at once.
+// foot is not pulled toward the lock point at once (a key within a ramp
+// starts the ramp there).
 // Then each toe joint (its name contains "toe") below such an ankle is held
 // the same way, in (x, z), while the predictor says it is in contact and it is
 // low: with the heel planted (the ankle's lock weight) the foot turns about the
