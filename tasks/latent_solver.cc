@@ -13,6 +13,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "prior/util/threads.h"
 #include "tasks/effector_ik.h"
 #include "tasks/foot_locking.h"
 #include "tasks/latent_optimizer.h"
@@ -261,6 +262,9 @@ SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const Mo
   TaskContext window_ctx = ctx;  // reports carry the window
   window_ctx.window_count = static_cast<int>(plan.size());
   for (const WindowPlan& w : plan) {
+    // A short window's tensors are too small for a second thread to pay; its
+    // operators' parallel regions would only cost (docs/BENCHMARKS.md, "Session 33").
+    const ScopedComputeThreads threads(w.length < kNemfParallelFrames ? 1 : 0);
     window_ctx.window = static_cast<int>(&w - plan.data());
     const Motion src = window_source(input, out.motion, w);
     const WindowProblem problem = make_window_problem(rig, src, 0, w.length, w.constraints, w.anchor);

@@ -35,9 +35,9 @@
 // the calling thread (waking a second thread costs more than it saves, and
 // milliseconds when the other core is busy). No torch op with internal
 // threading runs on the hot path. Results are bitwise identical for every
-// thread count. Note: at::parallel_for is an inline template that runs serially
-// unless the calling file is compiled with OpenMP (-fopenmp); this project does
-// not compile with it, so today everything here runs on the calling thread.
+// thread count. at::parallel_for is an inline OpenMP loop: GCC builds compile
+// with -fopenmp (CMakeLists.txt) and run these loops in parallel; clang builds
+// (sanitizers, fuzzing) run them on the calling thread.
 //
 // Cost of the sequence functions: the squared Euclidean cost matrices and their
 // gradients are computed inside the C++ kernel in double (an Eigen product

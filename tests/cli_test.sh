@@ -303,6 +303,15 @@ if [ -n "$TINY" ]; then
     "$MF" --model "$TINY" --threads $t --verbose batch "$TMP/renav-par.jsonl" >/dev/null 2>"$TMP/err"
     grep -q "batch: $want jobs\? at once" "$TMP/err" && pass || fail "batch --threads $t runs $want jobs at once by default"
   done
+  # Without --threads: one intra-op thread per batch job, and a job per core;
+  # a single command takes 2 threads where there are 2 cores.
+  want=$cores; [ "$want" -gt 8 ] && want=8
+  "$MF" --model "$TINY" --verbose batch "$TMP/renav-par.jsonl" >/dev/null 2>"$TMP/err"
+  grep -q "motionfield: 1 intra-op threads" "$TMP/err" && grep -q "batch: $want jobs\? at once" "$TMP/err" && pass ||
+    fail "batch without --threads runs $want jobs of 1 thread at once"
+  want=1; [ "$cores" -ge 2 ] && want=2
+  "$MF" --model "$TINY" --verbose renav --in "$SMALL" --path "$TMP/path50.csv" --out "$TMP/renav-default.bvh" >/dev/null 2>"$TMP/err"
+  grep -q "motionfield: $want intra-op threads" "$TMP/err" && pass || fail "a single command without --threads runs on $want threads"
 else
   fail "no tiny model (mf_capi_tiny_model not built, MF_TEST_MODEL unset): the renav runs could not run"
 fi

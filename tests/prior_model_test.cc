@@ -2,6 +2,7 @@
 // latents through a frozen network, the model file and its error messages, and
 // a few steps of the training program.
 #include <ATen/ATen.h>
+#include <ATen/Parallel.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -166,6 +167,95 @@ TEST(PriorModel, GradientsReachTheLatentThroughAFrozenNetwork) {
   EXPECT_GT(zl.grad().abs().sum().item<float>(), 0.0f);
   EXPECT_GT(zg.grad().abs().sum().item<float>(), 0.0f);
   for (auto& p : model.parameters()) EXPECT_FALSE(p.grad().defined());
+}
+
+TEST(PriorModel, FrozenDecoderNodeMatchesTheModulePath) {
+  // A frozen model decodes one window through one hand-written autograd node;
+  // values and latent gradients must be the module path's (the unfrozen model).
+  at::manual_seed(5);
+  RigInfo rig = tiny_rig();
+  NemfModel model(tiny_nemf_config(), rig);
+  {
+    at::NoGradGuard no_grad;  // layer norms and head away from their initial values
+    for (auto& [name, p] : model.named_parameters()) {
+      if (name.rfind("decoder.", 0) == 0) p.add_(0.3 * at::randn_like(p));
+    }
+  }
+  const NemfConfig& c = model.config();
+  const at::Tensor z_l0 = at::randn({1, c.zl}), z_g0 = at::randn({1, c.zg});
+  const at::Tensor frames = at::arange(0.0, 31.0, 0.25);  // 124 rows: the node's two halves
+  at::Tensor w;
+  auto decode = [&](at::Tensor* g_zl, at::Tensor* g_zg) {
+    at::Tensor zl = z_l0.clone().requires_grad_(true), zg = z_g0.clone().requires_grad_(true);
+    at::Tensor rot = model.decode(frames, zl, zg);
+    if (!w.defined()) w = at::randn(rot.sizes());
+    (rot * w).sum().backward();
+    *g_zl = zl.grad();
+    *g_zg = zg.grad();
+    return rot.detach();
+  };
+  at::Tensor module_zl, module_zg;
+  const at::Tensor module = decode(&module_zl, &module_zg);
+  const float scale = module_zl.abs().max().item<float>();
+  ASSERT_GT(scale, 1e-2f);
+  model.set_requires_grad(false);
+  const int threads = at::get_num_threads();
+  for (int t : {1, 2}) {  // whole, then in two halves on two threads
+    SCOPED_TRACE(t);
+    at::set_num_threads(t);
+    at::Tensor node_zl, node_zg;
+    const at::Tensor node = decode(&node_zl, &node_zg);
+    EXPECT_LT((node - module).abs().max().item<float>(), 1e-5);
+    EXPECT_LT((node_zl - module_zl).abs().max().item<float>(), 1e-4 * scale);
+    EXPECT_LT((node_zg - module_zg).abs().max().item<float>(), 1e-4 * module_zg.abs().max().item<float>());
+    at::NoGradGuard no_grad;  // the same node without recording
+    EXPECT_LT((model.decode(frames, z_l0, z_g0) - module).abs().max().item<float>(), 1e-5);
+    EXPECT_LT((model.decode(frames.narrow(0, 0, 20), z_l0, z_g0) - module.narrow(1, 0, 20)).abs().max().item<float>(),
+              1e-5);  // always whole
+  }
+  at::set_num_threads(threads);
+}
+
+TEST(PriorModel, FrozenGmpNodeMatchesTheModulePath) {
+  // A frozen GMP runs one window through one hand-written autograd node (in
+  // two halves with halos from 64 frames up on two threads); outputs and input
+  // gradients must be the module path's at every length, on one thread or two.
+  at::manual_seed(6);
+  RigInfo rig = tiny_rig();
+  NemfConfig config = tiny_nemf_config();
+  config.gmp_blocks = 2;
+  config.gmp_kernel = 5;
+  NemfModel model(config, rig);
+  const int C = rig.num_joints() * 3 + 6;
+  for (int T : {3, 20, 64, 101}) {
+    SCOPED_TRACE(T);
+    const at::Tensor inputs = at::randn({1, T, C});
+    const at::Tensor w = at::randn({1, T, 4 + rig.num_feet()});
+    auto run = [&](at::Tensor* grad) {
+      at::Tensor x = inputs.clone().requires_grad_(true);
+      GmpOutput g = model.predict_global_from_inputs(x);
+      at::Tensor out = at::cat({g.velocity, g.height, g.contact_logits}, -1);
+      (out * w).sum().backward();
+      *grad = x.grad();
+      return out.detach();
+    };
+    model.set_requires_grad(true);
+    at::Tensor module_grad;
+    const at::Tensor module = run(&module_grad);
+    const float scale = module.abs().max().item<float>(), grad_scale = module_grad.abs().max().item<float>();
+    ASSERT_GT(grad_scale, 1e-3f);
+    model.set_requires_grad(false);
+    const int threads = at::get_num_threads();
+    for (int t : {1, 2}) {  // whole, then in halves from 64 frames on two threads
+      SCOPED_TRACE(t);
+      at::set_num_threads(t);
+      at::Tensor node_grad;
+      const at::Tensor node = run(&node_grad);
+      EXPECT_LT((node - module).abs().max().item<float>(), 1e-5 * scale + 1e-6);
+      EXPECT_LT((node_grad - module_grad).abs().max().item<float>(), 1e-5 * grad_scale);
+    }
+    at::set_num_threads(threads);
+  }
 }
 
 TEST(PriorModel, FrozenEncoderMatchesUnfrozenAndHonoursLaterWeightEdits) {

@@ -6,9 +6,13 @@
 
 #include <strings.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <mutex>
+#include <set>
 #include <string>
+#include <thread>
 
 namespace mf {
 namespace {
@@ -25,6 +29,44 @@ TEST(Threads, SetComputeThreadsSizesLibtorchAndKeepsOpenBlasSerial) {
   }
   set_compute_threads(0);  // clamped, never an invalid pool size
   EXPECT_EQ(at::get_num_threads(), 1);
+}
+
+// The thread ids an at::parallel_for over two chunks ran them on.
+std::set<std::thread::id> chunk_threads() {
+  std::mutex m;
+  std::set<std::thread::id> ids;
+  at::parallel_for(0, 2, 1, [&](int64_t, int64_t) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // both chunks in flight at once
+    std::lock_guard<std::mutex> lock(m);
+    ids.insert(std::this_thread::get_id());
+  });
+  return ids;
+}
+
+TEST(Threads, OurParallelLoopsRunInParallelAndTheScopeLimitsThem) {
+#if !defined(_OPENMP) && defined(__clang__)
+  GTEST_SKIP() << "built without OpenMP (clang): at::parallel_for runs serially here";
+#elif !defined(_OPENMP)
+  FAIL() << "a GCC build without -fopenmp: every at::parallel_for of ours runs on one thread";
+#else
+  // at::parallel_for is an inline OpenMP loop: a build that loses -fopenmp
+  // (CMakeLists.txt) runs every loop of ours on one thread.
+  set_compute_threads(2);
+  EXPECT_EQ(chunk_threads().size(), 2u);
+  {
+    ScopedComputeThreads one(1);
+    EXPECT_EQ(at::get_num_threads(), 1);
+    EXPECT_EQ(chunk_threads().size(), 1u);
+    int other = 0;  // another thread keeps its own count
+    std::thread([&] { other = at::get_num_threads(); }).join();
+    EXPECT_EQ(other, 2);
+    ScopedComputeThreads same(0);  // changes nothing
+    EXPECT_EQ(at::get_num_threads(), 1);
+  }
+  EXPECT_EQ(at::get_num_threads(), 2);
+  EXPECT_EQ(chunk_threads().size(), 2u);
+  set_compute_threads(1);
+#endif
 }
 
 // The matrix products go to the libblas.so.3 alternative, not to ATLAS's

@@ -106,7 +106,7 @@ void add_constraints(CLI::App* cmd, BatchJob& job) {
 void define_global_options(CLI::App& app, Settings& s, bool& version_flag) {
   app.option_defaults()->group("global options");
   app.set_help_flag("-h,--help", "this help; `motionfield <command> --help` for a command");
-  app.add_option("--threads", s.threads, "intra-op threads of each job's solver (default 1:\na single solve runs faster on one thread than on two)")
+  app.add_option("--threads", s.threads, "intra-op threads of each job's solver (default: 2 on\na machine of 2 or more cores, 1 for each of batch's jobs)")
       ->type_name("N")
       ->check(quiet(CLI::Range(1, 1024)));
   app.add_option("--model", s.model,

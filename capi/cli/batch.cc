@@ -97,10 +97,10 @@ void print_outcome(const Outcome& o, size_t line, const Settings& settings) {
   if (settings.json) std::fflush(stdout);
 }
 
-// --jobs, else one job per core's worth of --threads: a single solve is
-// fastest on one intra-op thread, so the cores are best used by jobs side by
-// side (docs/BENCHMARKS.md, "Session 12"). At most 8 by default: every job
-// holds its own solver's tensors.
+// --jobs, else one job per core's worth of --threads: jobs side by side use
+// the cores better than threads inside one job (docs/BENCHMARKS.md, "Session
+// 12"; a 128-frame solve is only 10-20 % faster on two threads, "Session 33").
+// At most 8 by default: every job holds its own solver's tensors.
 int batch_workers(const Settings& settings) {
   if (settings.jobs > 0) return settings.jobs;
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

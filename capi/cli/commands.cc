@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include "input_error.h"
@@ -177,8 +178,13 @@ int command_rig(const std::string& in, bool json, const Settings& settings) {
 
 }  // namespace
 
+int default_threads(bool batch) {
+  if (batch) return 1;
+  return std::thread::hardware_concurrency() >= 2 ? 2 : 1;
+}
+
 int run_command(const CLI::App& app, const Arguments& args) {
-  const Settings& settings = args.settings;
+  Settings settings = args.settings;
   if (args.version) return command_version(settings);
   units_scale(settings.units, "--units (--length-scale)");
   const std::vector<CLI::App*> chosen = app.get_subcommands();
@@ -186,10 +192,11 @@ int run_command(const CLI::App& app, const Arguments& args) {
     std::fputs(app.help().c_str(), stderr);
     throw InputError("no command given");
   }
+  const std::string command = chosen.front()->get_name();
+  if (settings.threads == 0) settings.threads = default_threads(command == "batch");
   set_num_threads(settings.threads);
   if (settings.verbose) std::fprintf(stderr, "motionfield: %d intra-op threads\n", settings.threads);
 
-  const std::string command = chosen.front()->get_name();
   if (command == "batch") return command_batch(args.file, settings);
   if (command == "rig") return command_rig(args.file, settings.json, settings);
   return command_task(task_job(command, args), settings);

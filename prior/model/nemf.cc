@@ -5,11 +5,14 @@
 #include <torch/nn/modules/linear.h>
 #include <torch/nn/modules/normalization.h>
 #include <torch/nn/init.h>
+#include <torch/csrc/autograd/custom_function.h>
 #include <ATen/ATen.h>
+#include <ATen/Parallel.h>
 
 #include <cmath>
 #include <limits>
 #include <type_traits>
+#include <utility>
 #include <sstream>
 
 #include "prior/motion/errors.h"
@@ -23,6 +26,28 @@ namespace {
 constexpr int kFeaturesPerJoint = 15;
 
 at::Tensor lrelu(const at::Tensor& x) { return at::leaky_relu(x, 0.2); }
+
+// The frozen networks' single-window nodes below split a dense window's frames
+// into two halves when there are threads to run them, from 64 frames up
+// (kNemfParallelFrames):
+// smaller matrix products lose more to BLAS's packing than a second core
+// gains, and on one thread the halves only cost (the GMP's halos). Results
+// therefore depend on the thread count, by rounding.
+int64_t num_chunks(int64_t frames) { return frames >= kNemfParallelFrames && at::get_num_threads() > 1 ? 2 : 1; }
+
+// Chunk k of `chunks` over `frames` frames: its first frame and frame count.
+std::pair<int64_t, int64_t> chunk_rows(int64_t frames, int64_t chunks, int64_t k) {
+  const int64_t begin = frames * k / chunks, end = frames * (k + 1) / chunks;
+  return {begin, end - begin};
+}
+
+// Whether every parameter of `m` is frozen.
+bool all_frozen(const torch::nn::Module& m) {
+  for (const auto& p : m.parameters()) {
+    if (p.requires_grad()) return false;
+  }
+  return true;
+}
 
 // Temporal convolution whose weights connect each joint only to itself, its
 // parent and its children (a skeleton-aware convolution with distance 1).
@@ -140,6 +165,7 @@ struct DecoderImpl : torch::nn::Module {
   }
   // pe [B or 1, S, 2F], z_l [B, zl], z_g [B, zg] -> 6D [B, S, J, 6]
   at::Tensor forward(const at::Tensor& pe, const at::Tensor& z_l, const at::Tensor& z_g) {
+    if (frozen_path_applies(pe, z_l, z_g)) return frozen_forward(pe, z_l, z_g);
     at::Tensor h;
     for (int l = 0; l < config_.decoder_layers; ++l) {
       at::Tensor a = pe_[l]->forward(pe) + latent_part(zl_[l], z_l);
@@ -161,6 +187,16 @@ struct DecoderImpl : torch::nn::Module {
     if (z.size(0) == 1) return at::mv(linear->weight, z.select(0, 0)).view({1, 1, -1});
     return linear->forward(z).unsqueeze(1);
   }
+  // One window with frozen weights and constant times (every latent solve):
+  // FrozenDecoderFunction, one autograd node.
+  bool frozen_path_applies(const at::Tensor& pe, const at::Tensor& z_l, const at::Tensor& z_g) const {
+    if (pe.size(0) != 1 || z_l.size(0) != 1 || z_g.size(0) != 1 || pe.requires_grad()) return false;
+    if (pe.scalar_type() != at::kFloat || z_l.scalar_type() != at::kFloat || z_g.scalar_type() != at::kFloat)
+      return false;
+    if (!pe.device().is_cpu() || !z_l.device().is_cpu() || !z_g.device().is_cpu()) return false;
+    return all_frozen(*this);
+  }
+  at::Tensor frozen_forward(const at::Tensor& pe, const at::Tensor& z_l, const at::Tensor& z_g);
   NemfConfig config_;
   int joints_;
   std::vector<torch::nn::Linear> pe_, zl_, hidden_, zg_;
@@ -168,6 +204,125 @@ struct DecoderImpl : torch::nn::Module {
   torch::nn::Linear head_{nullptr};
 };
 TORCH_MODULE(Decoder);
+
+// The decoder of one window with frozen weights as a single autograd node with
+// a hand-written backward (gradients of z_l and z_g only). A solve evaluates
+// the decoder 50-100 times; as separate operators each layer recorded about ten
+// autograd nodes, and their bookkeeping cost more than the arithmetic at the
+// few key frames of a keys-only evaluation. The arithmetic is the same
+// operators' (matrix products, ATen's layer norm), so values agree with the
+// module path to rounding.
+//
+// Rows are independent until the latent gradients sum over them, so a dense
+// window runs as two halves on two threads when there are two (num_chunks).
+class FrozenDecoderFunction : public torch::autograd::Function<FrozenDecoderFunction> {
+ public:
+  // pe [S, 2F], z_l [zl], z_g [zg] -> 6D [S, J * 6].
+  static torch::autograd::variable_list forward(torch::autograd::AutogradContext* ctx, const at::Tensor& pe,
+                                                const at::Tensor& z_l, const at::Tensor& z_g, DecoderImpl* d) {
+    const NemfConfig& c = d->config_;
+    const int L = c.decoder_layers;
+    const int64_t W = c.decoder_width, S = pe.size(0), chunks = num_chunks(S);
+    std::vector<at::Tensor> bias(L);  // what the latents (and the time features' bias) add to every row
+    for (int l = 0; l < L; ++l) {
+      bias[l] = at::addmv(d->pe_[l]->bias, d->zl_[l]->weight, z_l);
+      if (d->zg_[l]) bias[l].addmv_(d->zg_[l]->weight, z_g);
+    }
+    const at::Tensor identity =
+        at::tensor({1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f}, pe.options()).repeat({d->joints_});
+    const at::Tensor head_bias = d->head_->bias + identity;
+    // saved: z_l, z_g, the weights the backward needs (kWeights per layer, then
+    // the head's), then per chunk and layer a, mean, rstd and the layer's output.
+    // The graph holds the weights, not the module: it may outlive the model.
+    std::vector<at::Tensor> saved{z_l, z_g};
+    for (int l = 0; l < L; ++l) {
+      saved.push_back(d->zl_[l]->weight);
+      saved.push_back(d->hidden_[l] ? d->hidden_[l]->weight : at::Tensor());
+      saved.push_back(d->zg_[l] ? d->zg_[l]->weight : at::Tensor());
+      saved.push_back(d->norms_[l]->weight);
+      saved.push_back(d->norms_[l]->bias);
+    }
+    saved.push_back(d->head_->weight);
+    const size_t first = saved.size();
+    saved.resize(first + 4 * chunks * L);
+    std::vector<at::Tensor> out(chunks);
+    at::parallel_for(0, chunks, 1, [&](int64_t c0, int64_t c1) {
+      at::NoGradGuard no_grad;  // worker threads do not inherit the caller's mode
+      for (int64_t k = c0; k < c1; ++k) {
+        const auto [r0, rows] = chunk_rows(S, chunks, k);
+        const at::Tensor x = pe.narrow(0, r0, rows);
+        at::Tensor h;
+        for (int l = 0; l < L; ++l) {
+          at::Tensor a = at::addmm(bias[l], x, d->pe_[l]->weight.t());
+          if (d->hidden_[l]) a.addmm_(h, d->hidden_[l]->weight.t());
+          torch::nn::LayerNorm& norm = d->norms_[l];
+          auto ln = at::native_layer_norm(a, {W}, norm->weight, norm->bias, norm->options.eps());
+          h = at::relu(std::get<0>(ln));
+          const size_t i = first + 4 * (k * L + l);
+          saved[i] = a;
+          saved[i + 1] = std::get<1>(ln);  // mean
+          saved[i + 2] = std::get<2>(ln);  // rstd
+          saved[i + 3] = h;
+        }
+        out[k] = at::addmm(head_bias, h, d->head_->weight.t());
+      }
+    });
+    ctx->save_for_backward(saved);
+    ctx->saved_data["layers"] = static_cast<int64_t>(L);
+    return {chunks == 1 ? out[0] : at::cat(out)};
+  }
+
+  static torch::autograd::variable_list backward(torch::autograd::AutogradContext* ctx,
+                                                 torch::autograd::variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const int L = static_cast<int>(ctx->saved_data["layers"].toInt());
+    auto weight = [&](int l, int which) -> const at::Tensor& { return saved[2 + kWeights * l + which]; };
+    const at::Tensor& head = saved[2 + kWeights * L];
+    const size_t first = 3 + kWeights * L;
+    const int64_t chunks = (static_cast<int64_t>(saved.size()) - static_cast<int64_t>(first)) / (4 * L);
+    const int64_t W = head.size(1);
+    const at::Tensor& z_l = saved[0];
+    const at::Tensor& z_g = saved[1];
+    at::Tensor g_zl = at::zeros_like(z_l), g_zg = at::zeros_like(z_g);
+    if (!grads[0].defined()) return {at::Tensor(), g_zl, g_zg, at::Tensor()};
+    const at::Tensor g_out = grads[0].contiguous();
+    const int64_t S = g_out.size(0);
+    std::vector<at::Tensor> columns(chunks * L);  // per chunk and layer: d energy / d a, summed over rows
+    at::parallel_for(0, chunks, 1, [&](int64_t c0, int64_t c1) {
+      at::NoGradGuard no_grad;
+      for (int64_t k = c0; k < c1; ++k) {
+        const auto [r0, rows] = chunk_rows(S, chunks, k);
+        at::Tensor g = at::mm(g_out.narrow(0, r0, rows), head);  // d / d (last layer's output)
+        for (int l = L - 1; l >= 0; --l) {
+          const size_t i = first + 4 * (k * L + l);
+          const at::Tensor g_norm = at::threshold_backward(g, saved[i + 3], 0);
+          const at::Tensor g_a = std::get<0>(at::native_layer_norm_backward(
+              g_norm, saved[i], {W}, saved[i + 1], saved[i + 2], weight(l, 3), weight(l, 4), {true, false, false}));
+          columns[k * L + l] = g_a.sum(0);
+          if (l > 0) g = at::mm(g_a, weight(l, 1));
+        }
+      }
+    });
+    for (int l = 0; l < L; ++l) {
+      at::Tensor column = columns[l];
+      for (int64_t k = 1; k < chunks; ++k) column = column + columns[k * L + l];
+      g_zl.addmv_(weight(l, 0).t(), column);
+      if (weight(l, 2).defined()) g_zg.addmv_(weight(l, 2).t(), column);
+    }
+    return {at::Tensor(), g_zl, g_zg, at::Tensor()};
+  }
+
+ private:
+  // Saved weights per layer: z_l's, the hidden layer's, z_g's, the norm's weight and bias.
+  static constexpr int kWeights = 5;
+};
+
+at::Tensor DecoderImpl::frozen_forward(const at::Tensor& pe, const at::Tensor& z_l, const at::Tensor& z_g) {
+  const int64_t S = pe.size(1);
+  at::Tensor out = FrozenDecoderFunction::apply(pe.reshape({S, pe.size(2)}).contiguous(), z_l.reshape({config_.zl}),
+                                                z_g.reshape({config_.zg}), this)[0];
+  return out.view({1, S, joints_, 6});
+}
 
 struct GlobalPredictorImpl : torch::nn::Module {
   GlobalPredictorImpl(const NemfConfig& c, int joints, int feet) : pad_(c.gmp_kernel / 2) {
@@ -181,15 +336,134 @@ struct GlobalPredictorImpl : torch::nn::Module {
   }
   at::Tensor pad(const at::Tensor& x) const { return at::replication_pad1d(x, {pad_, pad_}); }
   at::Tensor forward(const at::Tensor& x) {  // [B, C, T] -> [B, 4 + F, T]
+    if (x.size(0) == 1 && x.scalar_type() == at::kFloat && x.device().is_cpu() && all_frozen(*this)) {
+      return frozen_forward(x);
+    }
     at::Tensor h = lrelu(input_->forward(pad(x)));
     for (auto& b : blocks_) h = h + lrelu(b->forward(pad(h)));
     return output_->forward(h);
   }
+  at::Tensor frozen_forward(const at::Tensor& x);  // FrozenGmpFunction
   int pad_;
   torch::nn::Conv1d input_{nullptr}, output_{nullptr};
   std::vector<torch::nn::Conv1d> blocks_;
 };
 TORCH_MODULE(GlobalPredictor);
+
+// The GMP of one window with frozen weights as a single autograd node with a
+// hand-written backward (the gradient of its input only), like the decoder's.
+// A dense window runs as two halves of its frames on two threads when there
+// are two: each half also computes the frames within the stack's receptive
+// field of it (a halo of pad x convolutions), replication-padding only at the
+// window's true ends, so each half's outputs are exactly the whole window's.
+class FrozenGmpFunction : public torch::autograd::Function<FrozenGmpFunction> {
+ public:
+  // One padded convolution's input range [first, first + length) of the window
+  // and the padding it gets on each side (only at the window's ends).
+  struct Span {
+    int64_t first, length, left, right;
+  };
+
+  // x [1, C, T] -> [1, 4 + F, T].
+  static torch::autograd::variable_list forward(torch::autograd::AutogradContext* ctx, const at::Tensor& x,
+                                                GlobalPredictorImpl* g) {
+    const int64_t T = x.size(2), chunks = num_chunks(T), R = g->pad_;
+    const int64_t layers = 1 + static_cast<int64_t>(g->blocks_.size());
+    // saved: x, the weights of the padded convolutions and of the output (the
+    // graph holds them, not the module), then per chunk and padded convolution
+    // its padded input and its pre-activation output.
+    std::vector<at::Tensor> saved{x, g->input_->weight};
+    for (auto& b : g->blocks_) saved.push_back(b->weight);
+    saved.push_back(g->output_->weight);
+    const size_t first = saved.size();
+    saved.resize(first + 2 * chunks * layers);
+    std::vector<at::Tensor> out(chunks);
+    at::parallel_for(0, chunks, 1, [&](int64_t c0, int64_t c1) {
+      at::NoGradGuard no_grad;  // worker threads do not inherit the caller's mode
+      for (int64_t k = c0; k < c1; ++k) {
+        const auto [r0, rows] = chunk_rows(T, chunks, k);
+        Span s = first_span(T, r0, rows, R, layers);
+        at::Tensor h = x.narrow(2, s.first, s.length);
+        for (int64_t l = 0; l < layers; ++l) {
+          const at::Tensor p = at::replication_pad1d(h, {s.left, s.right});
+          torch::nn::Conv1d& conv = l == 0 ? g->input_ : g->blocks_[l - 1];
+          const at::Tensor y = at::conv1d(p, conv->weight, conv->bias);
+          const Span next = next_span(T, s, R);
+          h = l == 0 ? lrelu(y) : h.narrow(2, next.first - s.first, next.length) + lrelu(y);
+          saved[first + 2 * (k * layers + l)] = p;
+          saved[first + 2 * (k * layers + l) + 1] = y;
+          s = next;
+        }
+        out[k] = at::conv1d(h.narrow(2, r0 - s.first, rows), g->output_->weight, g->output_->bias);
+      }
+    });
+    ctx->save_for_backward(saved);
+    ctx->saved_data["pad"] = R;
+    ctx->saved_data["layers"] = layers;
+    ctx->saved_data["chunks"] = chunks;
+    return {chunks == 1 ? out[0] : at::cat(out, 2)};
+  }
+
+  static torch::autograd::variable_list backward(torch::autograd::AutogradContext* ctx,
+                                                 torch::autograd::variable_list grads) {
+    const auto saved = ctx->get_saved_variables();
+    const int64_t R = ctx->saved_data["pad"].toInt(), layers = ctx->saved_data["layers"].toInt();
+    const size_t first = 2 + layers;
+    const at::Tensor& x = saved[0];
+    if (!grads[0].defined()) return {at::zeros_like(x), at::Tensor()};
+    const at::Tensor g_out = grads[0].contiguous();
+    const int64_t T = x.size(2), chunks = ctx->saved_data["chunks"].toInt();
+    std::vector<at::Tensor> g_x(chunks);  // over each chunk's first span
+    at::parallel_for(0, chunks, 1, [&](int64_t c0, int64_t c1) {
+      at::NoGradGuard no_grad;
+      for (int64_t k = c0; k < c1; ++k) {
+        const auto [r0, rows] = chunk_rows(T, chunks, k);
+        std::vector<Span> spans{first_span(T, r0, rows, R, layers)};
+        for (int64_t l = 0; l < layers; ++l) spans.push_back(next_span(T, spans.back(), R));
+        const Span& last = spans.back();
+        const at::Tensor w_out = saved[1 + layers].squeeze(-1);  // [4 + F, W]
+        at::Tensor g_h = at::zeros({1, w_out.size(1), last.length}, g_out.options());
+        g_h.narrow(2, r0 - last.first, rows).copy_(at::matmul(w_out.t(), g_out.narrow(2, r0, rows)));
+        for (int64_t l = layers - 1; l >= 0; --l) {
+          const Span &in = spans[l], &outs = spans[l + 1];
+          const at::Tensor &p = saved[first + 2 * (k * layers + l)], &y = saved[first + 2 * (k * layers + l) + 1];
+          const at::Tensor& weight = saved[1 + l];
+          const at::Tensor g_y = at::leaky_relu_backward(g_h, y, 0.2, false);
+          const at::Tensor g_p = std::get<0>(at::convolution_backward(
+              g_y, p, weight, c10::nullopt, {1}, {0}, {1}, false, {0}, 1, {true, false, false}));
+          at::Tensor g_in = at::replication_pad1d_backward(g_p, p.narrow(2, in.left, in.length), {in.left, in.right});
+          if (l > 0) g_in.narrow(2, outs.first - in.first, outs.length).add_(g_h);  // the residual path
+          g_h = g_in;
+        }
+        g_x[k] = g_h;
+      }
+    });
+    at::Tensor g_input = at::zeros_like(x);
+    for (int64_t k = 0; k < chunks; ++k) {
+      const auto [r0, rows] = chunk_rows(T, chunks, k);
+      const Span s = first_span(T, r0, rows, R, layers);
+      g_input.narrow(2, s.first, s.length).add_(g_x[k]);
+    }
+    return {g_input, at::Tensor()};
+  }
+
+ private:
+  // The input frames a chunk [r0, r0 + rows) needs: R x layers more on each
+  // side, within the window; padded by R where it reaches the window's ends.
+  static Span first_span(int64_t T, int64_t r0, int64_t rows, int64_t R, int64_t layers) {
+    const int64_t first = std::max<int64_t>(0, r0 - R * layers), end = std::min(T, r0 + rows + R * layers);
+    return {first, end - first, first == 0 ? R : 0, end == T ? R : 0};
+  }
+  // The output range of a padded convolution over span s, padded as the next one's input.
+  static Span next_span(int64_t T, const Span& s, int64_t R) {
+    const int64_t first = s.first + R - s.left, end = s.first + s.length - R + s.right;
+    return {first, end - first, first == 0 ? R : 0, end == T ? R : 0};
+  }
+};
+
+at::Tensor GlobalPredictorImpl::frozen_forward(const at::Tensor& x) {
+  return FrozenGmpFunction::apply(x.contiguous(), this)[0];
+}
 
 struct NemfNetImpl : torch::nn::Module {
   NemfNetImpl(const NemfConfig& c, const RigInfo& rig) {

@@ -84,6 +84,11 @@ struct GmpOutput {
   at::Tensor contact_logits;  ///< [B, T, F]
 };
 
+/// With frozen weights, one window of at least this many frames is decoded
+/// (and run through the GMP) in two halves on two threads when the calling
+/// thread has two or more; shorter windows gain nothing from a second thread.
+inline constexpr int kNemfParallelFrames = 64;
+
 /// Which GMP a task asks for: the default one, or the steering GMP where the
 /// model has one (NemfConfig::steering_gmp; else the default).
 enum class GmpUse { Default, Steering };

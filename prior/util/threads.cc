@@ -2,6 +2,9 @@
 
 #include <ATen/Parallel.h>
 #include <dlfcn.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <algorithm>
 #include <filesystem>
@@ -27,6 +30,24 @@ void* find_symbol(const char* name, const char* library) {
 void set_compute_threads(int n) {
   at::set_num_threads(std::max(1, n));
   keep_blas_single_threaded();
+}
+
+// libtorch's thread count is OpenMP's per-thread setting (at::get_num_threads
+// is omp_get_max_threads), so setting it here leaves other threads alone.
+ScopedComputeThreads::ScopedComputeThreads(int n) {
+#ifdef _OPENMP
+  const int current = at::get_num_threads();
+  if (n > 0 && n != current) {
+    saved_ = current;
+    omp_set_num_threads(n);
+  }
+#endif
+}
+
+ScopedComputeThreads::~ScopedComputeThreads() {
+#ifdef _OPENMP
+  if (saved_ > 0) omp_set_num_threads(saved_);
+#endif
 }
 
 void keep_blas_single_threaded() {

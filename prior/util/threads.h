@@ -15,6 +15,21 @@ namespace mf {
 /// n >= 1.
 void set_compute_threads(int n);
 
+/// Limits the calling thread's intra-op parallelism (libtorch's and our own
+/// at::parallel_for loops) to `n` threads until destroyed, then restores it;
+/// other threads keep theirs. n <= 0 changes nothing. In builds without OpenMP
+/// (clang: sanitizers, fuzzing) it changes nothing either.
+class ScopedComputeThreads {
+ public:
+  explicit ScopedComputeThreads(int n);
+  ~ScopedComputeThreads();
+  ScopedComputeThreads(const ScopedComputeThreads&) = delete;
+  ScopedComputeThreads& operator=(const ScopedComputeThreads&) = delete;
+
+ private:
+  int saved_ = 0;  // 0: nothing to restore
+};
+
 /// Only the second half: OpenBLAS's pool at 1 thread, libtorch's untouched. For
 /// a library whose caller never chose a thread count.
 void keep_blas_single_threaded();

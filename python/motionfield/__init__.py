@@ -343,7 +343,8 @@ def set_num_threads(n: int) -> None:
     Parameters
     ----------
     n : int
-        Number of threads, 1..1024 (the CLI's default is 1).
+        Number of threads, 1..1024 (the CLI uses 2 for a single command on two or more
+        cores, 1 for each batch job).
 
     Returns
     -------

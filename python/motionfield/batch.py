@@ -53,7 +53,7 @@ class InputError(Exception):
 class Settings:
     """The options of a batch run (the CLI's global options)."""
 
-    threads: int = 1           # --threads: intra-op threads (the CLI's default 1)
+    threads: int = 1           # --threads: intra-op threads (the CLI's default for batch jobs: 1)
     verbose: bool = False
     quiet: bool = False
     json: bool = False

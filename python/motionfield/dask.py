@@ -47,7 +47,7 @@ def _arguments(argv: Optional[Sequence[str]]) -> argparse.Namespace:
     where.add_argument("--scheduler", type=_non_empty, metavar="ADDRESS",
                        help="an existing Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--threads", type=int, default=1, metavar="N",
-                   help="intra-op threads of each worker process (default 1, as the CLI's --threads)")
+                   help="intra-op threads of each worker process (default 1, as for the CLI's batch jobs)")
     p.add_argument("--model", type=_non_empty, metavar="PATH",
                    help="the prior's model file (default: the default model)")
     p.add_argument("--twostage", action="append", default=[], type=_non_empty, metavar="PATH",
