@@ -41,6 +41,20 @@ std::pair<int64_t, int64_t> chunk_rows(int64_t frames, int64_t chunks, int64_t k
   return {begin, end - begin};
 }
 
+// Runs body(k, first frame, frame count) for each chunk of `frames` frames
+// (chunk_rows), on as many threads as there are chunks and threads, with grad
+// mode off (worker threads do not inherit the caller's).
+template <class Body>
+void for_each_chunk(int64_t frames, int64_t chunks, const Body& body) {
+  at::parallel_for(0, chunks, 1, [&](int64_t c0, int64_t c1) {
+    at::NoGradGuard no_grad;
+    for (int64_t k = c0; k < c1; ++k) {
+      const auto [r0, rows] = chunk_rows(frames, chunks, k);
+      body(k, r0, rows);
+    }
+  });
+}
+
 // Whether every parameter of `m` is frozen.
 bool all_frozen(const torch::nn::Module& m) {
   for (const auto& p : m.parameters()) {
@@ -246,26 +260,22 @@ class FrozenDecoderFunction : public torch::autograd::Function<FrozenDecoderFunc
     const size_t first = saved.size();
     saved.resize(first + 4 * chunks * L);
     std::vector<at::Tensor> out(chunks);
-    at::parallel_for(0, chunks, 1, [&](int64_t c0, int64_t c1) {
-      at::NoGradGuard no_grad;  // worker threads do not inherit the caller's mode
-      for (int64_t k = c0; k < c1; ++k) {
-        const auto [r0, rows] = chunk_rows(S, chunks, k);
-        const at::Tensor x = pe.narrow(0, r0, rows);
-        at::Tensor h;
-        for (int l = 0; l < L; ++l) {
-          at::Tensor a = at::addmm(bias[l], x, d->pe_[l]->weight.t());
-          if (d->hidden_[l]) a.addmm_(h, d->hidden_[l]->weight.t());
-          torch::nn::LayerNorm& norm = d->norms_[l];
-          auto ln = at::native_layer_norm(a, {W}, norm->weight, norm->bias, norm->options.eps());
-          h = at::relu(std::get<0>(ln));
-          const size_t i = first + 4 * (k * L + l);
-          saved[i] = a;
-          saved[i + 1] = std::get<1>(ln);  // mean
-          saved[i + 2] = std::get<2>(ln);  // rstd
-          saved[i + 3] = h;
-        }
-        out[k] = at::addmm(head_bias, h, d->head_->weight.t());
+    for_each_chunk(S, chunks, [&](int64_t k, int64_t r0, int64_t rows) {
+      const at::Tensor x = pe.narrow(0, r0, rows);
+      at::Tensor h;
+      for (int l = 0; l < L; ++l) {
+        at::Tensor a = at::addmm(bias[l], x, d->pe_[l]->weight.t());
+        if (d->hidden_[l]) a.addmm_(h, d->hidden_[l]->weight.t());
+        torch::nn::LayerNorm& norm = d->norms_[l];
+        auto ln = at::native_layer_norm(a, {W}, norm->weight, norm->bias, norm->options.eps());
+        h = at::relu(std::get<0>(ln));
+        const size_t i = first + 4 * (k * L + l);
+        saved[i] = a;
+        saved[i + 1] = std::get<1>(ln);  // mean
+        saved[i + 2] = std::get<2>(ln);  // rstd
+        saved[i + 3] = h;
       }
+      out[k] = at::addmm(head_bias, h, d->head_->weight.t());
     });
     ctx->save_for_backward(saved);
     ctx->saved_data["layers"] = static_cast<int64_t>(L);
@@ -288,19 +298,15 @@ class FrozenDecoderFunction : public torch::autograd::Function<FrozenDecoderFunc
     const at::Tensor g_out = grads[0].contiguous();
     const int64_t S = g_out.size(0);
     std::vector<at::Tensor> columns(chunks * L);  // per chunk and layer: d energy / d a, summed over rows
-    at::parallel_for(0, chunks, 1, [&](int64_t c0, int64_t c1) {
-      at::NoGradGuard no_grad;
-      for (int64_t k = c0; k < c1; ++k) {
-        const auto [r0, rows] = chunk_rows(S, chunks, k);
-        at::Tensor g = at::mm(g_out.narrow(0, r0, rows), head);  // d / d (last layer's output)
-        for (int l = L - 1; l >= 0; --l) {
-          const size_t i = first + 4 * (k * L + l);
-          const at::Tensor g_norm = at::threshold_backward(g, saved[i + 3], 0);
-          const at::Tensor g_a = std::get<0>(at::native_layer_norm_backward(
-              g_norm, saved[i], {W}, saved[i + 1], saved[i + 2], weight(l, 3), weight(l, 4), {true, false, false}));
-          columns[k * L + l] = g_a.sum(0);
-          if (l > 0) g = at::mm(g_a, weight(l, 1));
-        }
+    for_each_chunk(S, chunks, [&](int64_t k, int64_t r0, int64_t rows) {
+      at::Tensor g = at::mm(g_out.narrow(0, r0, rows), head);  // d / d (last layer's output)
+      for (int l = L - 1; l >= 0; --l) {
+        const size_t i = first + 4 * (k * L + l);
+        const at::Tensor g_norm = at::threshold_backward(g, saved[i + 3], 0);
+        const at::Tensor g_a = std::get<0>(at::native_layer_norm_backward(
+            g_norm, saved[i], {W}, saved[i + 1], saved[i + 2], weight(l, 3), weight(l, 4), {true, false, false}));
+        columns[k * L + l] = g_a.sum(0);
+        if (l > 0) g = at::mm(g_a, weight(l, 1));
       }
     });
     for (int l = 0; l < L; ++l) {
@@ -378,24 +384,20 @@ class FrozenGmpFunction : public torch::autograd::Function<FrozenGmpFunction> {
     const size_t first = saved.size();
     saved.resize(first + 2 * chunks * layers);
     std::vector<at::Tensor> out(chunks);
-    at::parallel_for(0, chunks, 1, [&](int64_t c0, int64_t c1) {
-      at::NoGradGuard no_grad;  // worker threads do not inherit the caller's mode
-      for (int64_t k = c0; k < c1; ++k) {
-        const auto [r0, rows] = chunk_rows(T, chunks, k);
-        Span s = first_span(T, r0, rows, R, layers);
-        at::Tensor h = x.narrow(2, s.first, s.length);
-        for (int64_t l = 0; l < layers; ++l) {
-          const at::Tensor p = at::replication_pad1d(h, {s.left, s.right});
-          torch::nn::Conv1d& conv = l == 0 ? g->input_ : g->blocks_[l - 1];
-          const at::Tensor y = at::conv1d(p, conv->weight, conv->bias);
-          const Span next = next_span(T, s, R);
-          h = l == 0 ? lrelu(y) : h.narrow(2, next.first - s.first, next.length) + lrelu(y);
-          saved[first + 2 * (k * layers + l)] = p;
-          saved[first + 2 * (k * layers + l) + 1] = y;
-          s = next;
-        }
-        out[k] = at::conv1d(h.narrow(2, r0 - s.first, rows), g->output_->weight, g->output_->bias);
+    for_each_chunk(T, chunks, [&](int64_t k, int64_t r0, int64_t rows) {
+      Span s = first_span(T, r0, rows, R, layers);
+      at::Tensor h = x.narrow(2, s.first, s.length);
+      for (int64_t l = 0; l < layers; ++l) {
+        const at::Tensor p = at::replication_pad1d(h, {s.left, s.right});
+        torch::nn::Conv1d& conv = l == 0 ? g->input_ : g->blocks_[l - 1];
+        const at::Tensor y = at::conv1d(p, conv->weight, conv->bias);
+        const Span next = next_span(T, s, R);
+        h = l == 0 ? lrelu(y) : h.narrow(2, next.first - s.first, next.length) + lrelu(y);
+        saved[first + 2 * (k * layers + l)] = p;
+        saved[first + 2 * (k * layers + l) + 1] = y;
+        s = next;
       }
+      out[k] = at::conv1d(h.narrow(2, r0 - s.first, rows), g->output_->weight, g->output_->bias);
     });
     ctx->save_for_backward(saved);
     ctx->saved_data["pad"] = R;
@@ -414,29 +416,25 @@ class FrozenGmpFunction : public torch::autograd::Function<FrozenGmpFunction> {
     const at::Tensor g_out = grads[0].contiguous();
     const int64_t T = x.size(2), chunks = ctx->saved_data["chunks"].toInt();
     std::vector<at::Tensor> g_x(chunks);  // over each chunk's first span
-    at::parallel_for(0, chunks, 1, [&](int64_t c0, int64_t c1) {
-      at::NoGradGuard no_grad;
-      for (int64_t k = c0; k < c1; ++k) {
-        const auto [r0, rows] = chunk_rows(T, chunks, k);
-        std::vector<Span> spans{first_span(T, r0, rows, R, layers)};
-        for (int64_t l = 0; l < layers; ++l) spans.push_back(next_span(T, spans.back(), R));
-        const Span& last = spans.back();
-        const at::Tensor w_out = saved[1 + layers].squeeze(-1);  // [4 + F, W]
-        at::Tensor g_h = at::zeros({1, w_out.size(1), last.length}, g_out.options());
-        g_h.narrow(2, r0 - last.first, rows).copy_(at::matmul(w_out.t(), g_out.narrow(2, r0, rows)));
-        for (int64_t l = layers - 1; l >= 0; --l) {
-          const Span &in = spans[l], &outs = spans[l + 1];
-          const at::Tensor &p = saved[first + 2 * (k * layers + l)], &y = saved[first + 2 * (k * layers + l) + 1];
-          const at::Tensor& weight = saved[1 + l];
-          const at::Tensor g_y = at::leaky_relu_backward(g_h, y, 0.2, false);
-          const at::Tensor g_p = std::get<0>(at::convolution_backward(
-              g_y, p, weight, c10::nullopt, {1}, {0}, {1}, false, {0}, 1, {true, false, false}));
-          at::Tensor g_in = at::replication_pad1d_backward(g_p, p.narrow(2, in.left, in.length), {in.left, in.right});
-          if (l > 0) g_in.narrow(2, outs.first - in.first, outs.length).add_(g_h);  // the residual path
-          g_h = g_in;
-        }
-        g_x[k] = g_h;
+    for_each_chunk(T, chunks, [&](int64_t k, int64_t r0, int64_t rows) {
+      std::vector<Span> spans{first_span(T, r0, rows, R, layers)};
+      for (int64_t l = 0; l < layers; ++l) spans.push_back(next_span(T, spans.back(), R));
+      const Span& last = spans.back();
+      const at::Tensor w_out = saved[1 + layers].squeeze(-1);  // [4 + F, W]
+      at::Tensor g_h = at::zeros({1, w_out.size(1), last.length}, g_out.options());
+      g_h.narrow(2, r0 - last.first, rows).copy_(at::matmul(w_out.t(), g_out.narrow(2, r0, rows)));
+      for (int64_t l = layers - 1; l >= 0; --l) {
+        const Span &in = spans[l], &outs = spans[l + 1];
+        const at::Tensor &p = saved[first + 2 * (k * layers + l)], &y = saved[first + 2 * (k * layers + l) + 1];
+        const at::Tensor& weight = saved[1 + l];
+        const at::Tensor g_y = at::leaky_relu_backward(g_h, y, 0.2, false);
+        const at::Tensor g_p = std::get<0>(at::convolution_backward(
+            g_y, p, weight, c10::nullopt, {1}, {0}, {1}, false, {0}, 1, {true, false, false}));
+        at::Tensor g_in = at::replication_pad1d_backward(g_p, p.narrow(2, in.left, in.length), {in.left, in.right});
+        if (l > 0) g_in.narrow(2, outs.first - in.first, outs.length).add_(g_h);  // the residual path
+        g_h = g_in;
       }
+      g_x[k] = g_h;
     });
     at::Tensor g_input = at::zeros_like(x);
     for (int64_t k = 0; k < chunks; ++k) {
