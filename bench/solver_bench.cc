@@ -25,9 +25,10 @@
 // spacing and method: how many iterations each start needs for a quality);
 // none runs only --speed.
 // --speed N adds the speed table: N sparse windows (a key every 15th frame),
-// each solved by every solver method; wall time, iterations, evaluations and
-// the floor (one decoder forward + backward over 128 frames, times the
-// iterations) per solve. --op-profile adds, after each gap or sparse table and
+// each solved by every solver method; wall time, iterations, evaluations, the
+// time in the optimiser (the rest is the initialiser, the decode and the
+// overwrite) and the floor (one decoder forward + backward over 128 frames,
+// times the iterations) per solve. --op-profile adds, after each gap or sparse table and
 // after the speed table, the operators run per energy evaluation and the time in
 // them (bench/op_profile.h; with --threads 1).
 //
@@ -672,13 +673,14 @@ int run(Args& args, const std::string& command) {
       << at::get_num_threads() << " torch thread(s)\n\n"
       << "Decoder forward + backward over 128 frames: " << fixed(step, 2) << " ms (median of 20).\n\n"
       << "| method | ms / solve (mean) | ms / solve (median) | process CPU ms / solve (mean) | iterations | "
-         "evaluations | floor: decoder f+b x iterations (ms) | L2P |\n|---|---:|---:|---:|---:|---:|---:|---:|\n";
+         "evaluations | of which in the optimiser (ms, mean) | floor: decoder f+b x iterations (ms) | L2P |\n"
+         "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
     std::map<std::string, double> mean_ms;
     std::ostringstream profiles;
     for (const std::string& method : args.methods) {
       if (method == "interp") continue;
       std::vector<double> ms;
-      double iters = 0, evals = 0, cpu = 0;
+      double iters = 0, evals = 0, cpu = 0, optimiser = 0;
       mf::bench::MetricAccumulator acc(stats);
       std::vector<int> evaluated;
       for (int f = 0; f < 128; ++f) {
@@ -696,7 +698,10 @@ int run(Args& args, const std::string& command) {
         ms.push_back(ms_since(t0));
         cpu += process_cpu_ms() - c0;
         iters += report.iterations;
-        for (const auto& r : report.windows) evals += r.evaluations;
+        for (const auto& r : report.windows) {
+          evals += r.evaluations;
+          optimiser += r.wall_ms;
+        }
         acc.add(truth, out, evaluated, keys);
       }
       const double n = std::max<size_t>(1, ms.size());
@@ -706,7 +711,7 @@ int run(Args& args, const std::string& command) {
       std::sort(sorted.begin(), sorted.end());
       mean_ms[method] = sum / n;
       s << "| " << method << " | " << fixed(sum / n, 0) << " | " << fixed(sorted.empty() ? 0 : sorted[sorted.size() / 2], 0)
-        << " | " << fixed(cpu / n, 0) << " | " << fixed(iters / n, 1) << " | " << fixed(evals / n, 1) << " | " << fixed(step * iters / n, 0) << " | "
+        << " | " << fixed(cpu / n, 0) << " | " << fixed(iters / n, 1) << " | " << fixed(evals / n, 1) << " | " << fixed(optimiser / n, 0) << " | " << fixed(step * iters / n, 0) << " | "
         << fixed(acc.summary().l2p, 3) << " |\n";
       if (profile) {
         profiles << "\n#### Operators of `" << method << "` (" << fixed(evals / n, 1)

@@ -13,7 +13,7 @@ constexpr int kExitBadInput = 2;
 
 /// The global options (motionfield --help).
 struct Settings {
-  int threads = 0;                    ///< --threads: intra-op threads of each job; 0: default_threads()
+  int threads = 1;                    ///< --threads: intra-op threads of each job (TaskThreads in capi/src/capi_internal.h: why 1)
   bool verbose = false;
   bool quiet = false;                 ///< --quiet: no progress bar, no warnings
   bool json = false;                  ///< --json: a JSON summary of each job on stdout
@@ -27,12 +27,6 @@ struct Settings {
   /// The transformer files to add to the model, --twostage first.
   std::vector<std::string> transformers() const;
 };
-
-/// The intra-op threads of a job when --threads is not given: 1 for each of
-/// batch's jobs (they run side by side, one per core), else 2 where there are
-/// two cores (a 128-frame window's solve is faster on two; shorter windows
-/// use one either way: docs/BENCHMARKS.md, "Session 33").
-int default_threads(bool batch);
 
 /// A failure as the user sees it: exit code 2 for bad input (InputError, and
 /// the C API's invalid-argument, I/O, model and unsupported statuses), else 1

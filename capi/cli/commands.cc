@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <fstream>
 #include <sstream>
-#include <thread>
 #include <vector>
 
 #include "input_error.h"
@@ -178,13 +177,8 @@ int command_rig(const std::string& in, bool json, const Settings& settings) {
 
 }  // namespace
 
-int default_threads(bool batch) {
-  if (batch) return 1;
-  return std::thread::hardware_concurrency() >= 2 ? 2 : 1;
-}
-
 int run_command(const CLI::App& app, const Arguments& args) {
-  Settings settings = args.settings;
+  const Settings& settings = args.settings;
   if (args.version) return command_version(settings);
   units_scale(settings.units, "--units (--length-scale)");
   const std::vector<CLI::App*> chosen = app.get_subcommands();
@@ -193,7 +187,6 @@ int run_command(const CLI::App& app, const Arguments& args) {
     throw InputError("no command given");
   }
   const std::string command = chosen.front()->get_name();
-  if (settings.threads == 0) settings.threads = default_threads(command == "batch");
   set_num_threads(settings.threads);
   if (settings.verbose) std::fprintf(stderr, "motionfield: %d intra-op threads\n", settings.threads);
 

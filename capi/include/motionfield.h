@@ -167,12 +167,18 @@ MF_API int mf_printable_text(const char *text, size_t length, char *out, size_t 
 /* ================================================================ threads */
 
 /** Sets the number of intra-op threads of the numeric work in this process
- *  (1..1024). Until it is called, the library uses libtorch's default number.
- *  Either way the BLAS library's own thread pool is kept at one thread, since
- *  libtorch calls it from inside its own threads. Results may differ in the
- *  last bits between thread counts. */
+ *  (1..1024; libtorch's setting, so other libtorch work in the process gets it
+ *  too). Until it is called, each task runs on one intra-op thread, its
+ *  calling thread, and libtorch's own setting is left alone. More than one
+ *  pays only on an otherwise idle machine: libtorch's OpenMP threads spin
+ *  while they wait for each other, and with another process busy on one of two
+ *  cores a 128-frame solve on two threads took 25-40x as long as on one
+ *  (docs/BENCHMARKS.md, "Session 34"). Either way the BLAS library's own
+ *  thread pool is kept at one thread, since libtorch calls it from inside its
+ *  own threads. Results may differ in the last bits between thread counts. */
 MF_API int mf_set_num_threads(int32_t num_threads);
-/** The current number of intra-op threads. */
+/** The number of intra-op threads a task started now on the calling thread
+ *  runs with: the count set by mf_set_num_threads(), else 1. */
 MF_API int mf_get_num_threads(int32_t *out);
 
 /* ================================================================ cancel, progress */

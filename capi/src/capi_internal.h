@@ -15,6 +15,7 @@
 #include "motionfield.h"
 #include "prior/motion/bvh.h"
 #include "prior/motion/motion.h"
+#include "prior/util/threads.h"
 #include "tasks/task_context.h"
 
 
@@ -182,7 +183,18 @@ mf_motion* derived_motion(Motion motion, const mf_motion& like);
 /// callback, cancel token and rig map (read from rig_map_path if given).
 TaskContext task_context(const mf_model* model, const mf_task_options& options);
 
-/// Applies the thread count of mf_set_num_threads() to the calling thread.
-void apply_num_threads();
+/// The intra-op threads of one task call, for its lifetime: the count of
+/// mf_set_num_threads() (process-wide, as libtorch's), else one thread for the
+/// calling thread only (the process's libtorch setting untouched). More than
+/// one is a choice the caller makes: libtorch's OpenMP threads spin while they
+/// wait, and on a machine where another process holds a core a solve on two
+/// threads took 25-40x as long as on one (docs/BENCHMARKS.md, "Session 34").
+class TaskThreads {
+ public:
+  TaskThreads();
+
+ private:
+  ScopedComputeThreads scope_;
+};
 
 }  // namespace mf::capi

@@ -103,7 +103,7 @@ int mf_encode(const mf_model* model, const mf_motion* input, const mf_codec_opti
                                                     std::to_string(model_joints));
     mf::CodecOptions co;
     co.hop = o.hop;
-    mf::capi::apply_num_threads();
+    const mf::capi::TaskThreads threads;
     auto handle = std::make_unique<mf_encoding>();
     handle->model = model->model;
     handle->code = mf::encode_motion(*model->model, input->motion, co);
@@ -189,7 +189,7 @@ int mf_decode(const mf_encoding* encoding, double fps, int32_t frame_count, cons
     if (frames == 0)
       frames = mf::resampled_frame_count(static_cast<int>(e.code.source_root_positions.size()), e.code.source_fps,
                                          fps, nullptr);
-    mf::capi::apply_num_threads();
+    const mf::capi::TaskThreads threads;
     *out = mf::capi::derived_motion(mf::decode_motion(*e.model, e.code, fps, frames, mf::capi::decode_options(o)),
                                     e.shell);
   });
@@ -209,7 +209,7 @@ int mf_decode_times(const mf_encoding* encoding, const double* times, size_t tim
     for (size_t i = 0; i < t.size(); ++i)
       if (!std::isfinite(t[i]))
         throw ApiError(MF_ERROR_INVALID_ARGUMENT, "times[" + std::to_string(i) + "] is not finite");
-    mf::capi::apply_num_threads();
+    const mf::capi::TaskThreads threads;
     *out = mf::capi::derived_motion(mf::decode_times(*e.model, e.code, t, fps, mf::capi::decode_options(o)), e.shell);
   });
 }

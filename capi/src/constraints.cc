@@ -190,7 +190,7 @@ int mf_solve(const mf_model* model, const mf_motion* input, const mf_constraints
     require(out, "out");
     const mf_task_options o = mf::capi::read_options(options, "mf_task_options");
     const mf::TaskContext ctx = mf::capi::task_context(model, o);
-    mf::capi::apply_num_threads();
+    const mf::capi::TaskThreads threads;
     const mf::MotionConstraints c = constraints->spec.resolve(input->motion.skeleton, input->length_scale);
     mf::ConstrainedResult r =
         mf::run_constrained(input->motion, c, o.method ? std::string(o.method) : std::string(), alternatives, ctx);

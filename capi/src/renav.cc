@@ -59,7 +59,7 @@ int mf_renav(const mf_model* model, const mf_motion* reference, const float* pat
           r.frame_count > 0 ? r.frame_count : mf::polyline_frame_count(path, mf::mean_ground_speed(ref), fps);
       path = mf::resample_polyline(path, frames);
     }
-    mf::capi::apply_num_threads();
+    const mf::capi::TaskThreads threads;
     mf::Motion result = mf::run_renav(ref, path, fps, method, ctx);
     *out = mf::capi::derived_motion(std::move(result), *reference);
   });

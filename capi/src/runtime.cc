@@ -177,15 +177,26 @@ void skeleton_offsets(const Skeleton& s, float* out, size_t capacity, size_t* ne
   write_buffer(offsets.data(), offsets.size(), out, capacity, needed);
 }
 
-void apply_num_threads() {
+namespace {
+
+// The count TaskThreads scopes the calling thread to: 0 (nothing to scope)
+// when the caller chose one, which is applied process-wide here, else 1.
+int task_scope_threads() {
   const int n = g_num_threads.load();
-  if (n > 0 && at::get_num_threads() != n) mf::set_compute_threads(n);
-  // Without mf_set_num_threads, libtorch's default stays, but OpenBLAS's pool
-  // must not run under it either: left at one thread per core it made a
-  // caller who never chose a thread count 10x slower.
+  if (n > 0) {
+    if (at::get_num_threads() != n) mf::set_compute_threads(n);
+    return 0;
+  }
+  // OpenBLAS's pool must not run under libtorch's threads either: left at one
+  // thread per core it made a caller who never chose a thread count 10x slower.
   static std::once_flag blas_once;
-  if (n == 0) std::call_once(blas_once, mf::keep_blas_single_threaded);
+  std::call_once(blas_once, mf::keep_blas_single_threaded);
+  return 1;
 }
+
+}  // namespace
+
+TaskThreads::TaskThreads() : scope_(task_scope_threads()) {}
 
 }  // namespace mf::capi
 
@@ -237,7 +248,7 @@ int mf_set_num_threads(int32_t num_threads) {
 int mf_get_num_threads(int32_t* out) {
   return guard([&] {
     require(out, "out");
-    mf::capi::apply_num_threads();
+    const mf::capi::TaskThreads threads;
     *out = static_cast<int32_t>(at::get_num_threads());
   });
 }

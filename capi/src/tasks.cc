@@ -75,7 +75,7 @@ int run_task(const mf_model* model, const mf_motion* input, const mf_task_option
     require(out, "out");
     const mf_task_options o = read_options(options, "mf_task_options");
     const TaskContext ctx = task_context(model, o);
-    apply_num_threads();
+    const TaskThreads threads;
     std::vector<std::string> warnings;
     Motion result = run(input->motion, o.method ? std::string(o.method) : std::string(), ctx, &warnings);
     std::unique_ptr<mf_motion> handle(derived_motion(std::move(result), *input));

@@ -343,8 +343,11 @@ def set_num_threads(n: int) -> None:
     Parameters
     ----------
     n : int
-        Number of threads, 1..1024 (the CLI uses 2 for a single command on two or more
-        cores, 1 for each batch job).
+        Number of threads, 1..1024. Until it is called, each task runs on one
+        thread (its calling thread), as the CLI's default. More than one pays only
+        on an otherwise idle machine: libtorch's OpenMP threads spin while they
+        wait, and with another process busy a solve on two threads of two cores
+        took 25-40x as long as on one.
 
     Returns
     -------
@@ -364,7 +367,8 @@ def get_num_threads() -> int:
     Returns
     -------
     int
-        The thread count set by set_num_threads(), else the library's default.
+        The threads a task started now on the calling thread runs with: the
+        count set by set_num_threads(), else 1.
 
     Raises
     ------

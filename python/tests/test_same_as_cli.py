@@ -20,7 +20,7 @@ import motionfield as mf
 HERE = os.path.dirname(os.path.abspath(__file__))
 SOURCE = os.environ.get("MF_SOURCE_DIR", os.path.normpath(os.path.join(HERE, "..", "..")))
 SAMPLE = os.path.join(SOURCE, "samples", "walk_keyframes.bvh")
-CLI_THREADS = 2  # the CLI's default --threads on a machine of two or more cores
+CLI_THREADS = 1  # the CLI's default --threads
 
 
 def motion_numbers(text):
