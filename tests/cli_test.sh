@@ -729,6 +729,7 @@ catalogue "--threads 100000" "--threads: Value 100000 not in range 1 to 1024" --
 catalogue "--length-scale nan" "--units (--length-scale) must be positive, not nan" --length-scale nan inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --method interp
 catalogue "--length-scale 0" "must be positive, not 0" --length-scale 0 inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --method interp
 catalogue "--alternatives -1" "--alternatives: Value -1 not in range 0 to 16" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --alternatives -1
+catalogue "--max-iterations -1" "--max-iterations: Value -1 not in range 0 to 100000" fill --in "$SAMPLE" --gap 10:20 --out "$TMP/bad.bvh" --max-iterations -1
 # Outputs: a directory, an existing file kept unchanged by a failing run.
 catalogue "--out naming a directory" "cannot write .*dir: it is a directory" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$CAT/dir" --method interp
 [ -d "$CAT/dir" ] && [ -z "$(ls -A "$CAT/dir")" ] && pass || fail "--out naming a directory changed the directory"

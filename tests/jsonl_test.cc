@@ -288,6 +288,14 @@ TEST(JsonlTest, BadJobsNameTheProblem) {
   EXPECT_TRUE(has(job_error(R"({"task": "resample", "in": "a", "out": "b", "fps": "60"})"), "\"fps\" must be a number"));
   EXPECT_TRUE(has(job_error(R"({"task": "resample", "in": "a", "out": "b", "fps": 60, "method": 1})"),
                   "\"method\" must be a string"));
+  EXPECT_TRUE(has(job_error(R"({"task": "resample", "in": "a", "out": "b", "fps": 60, "max_iterations": -1})"),
+                  "\"max_iterations\" must be between 0 and 100000, not -1"));
+  EXPECT_TRUE(has(job_error(R"({"task": "resample", "in": "a", "out": "b", "fps": 60, "max_iterations": 2.5})"),
+                  "\"max_iterations\" must be an integer, not 2.5"));
+  EXPECT_EQ(batch_job_from_json(parse_json(R"({"task": "renav", "in": "a", "out": "b", "path": "p.csv",
+                                               "max_iterations": 7})"))
+                .max_iterations,
+            7);
 }
 
 }  // namespace

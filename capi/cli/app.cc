@@ -81,6 +81,12 @@ void add_task_files(CLI::App* cmd, BatchJob& job, const std::string& in_help) {
 void add_method(CLI::App* cmd, BatchJob& job,
                 const std::string& help = "one of the methods below (default: the best available)") {
   cmd->add_option("--method", job.method, help)->type_name("M")->check(kNonEmpty);
+  cmd->add_option("--max-iterations", job.max_iterations,
+                  "iteration budget of the iterative methods per window (the\nlatent solvers' full-energy stage, "
+                  "prior resampling,\nre-navigation); 0, the default, is each method's own.\nFewer are faster and "
+                  "rougher (0..100000; docs/BENCHMARKS.md, Session 34)")
+      ->type_name("N")
+      ->check(quiet(CLI::Range(0, 100000)));
 }
 
 // --constraints, --alternatives and --report of inbetween and fill.
@@ -247,7 +253,8 @@ void define_batch(CLI::App& app, HelpFormatter& help, Arguments& a) {
       "the flags of `motionfield renav` mean. inbetween and fill take \"constraints\"\n"
       "(a file or an inline object), \"trajectory\" (a CSV file), \"alternatives\" and\n"
       "\"report\" as the flags --constraints, --trajectory, --alternatives and --report.\n"
-      "Every task takes \"rig_map\" (a file) and\n"
+      "Every task takes \"max_iterations\" as the flag --max-iterations, and\n"
+      "\"rig_map\" (a file) and\n"
       "\"units\" (a name, auto, or metres per unit), which replace --rig-map and\n"
       "--units for that job. Keys a job does not need (\"id\", frame counts, ...) are\n"
       "ignored; blank lines are skipped; relative paths are relative to the current\n"

@@ -122,6 +122,7 @@ Motion solve_task(const BatchJob& job, const Model& model, const Motion& input, 
 Solved solve(const BatchJob& job, const Settings& settings, const Model& model, const Motion& input,
              ProgressLine& progress) {
   TaskOptions options(job.method);
+  options.max_iterations = job.max_iterations;
   options.rig_map_path = job.rig_map.empty() ? settings.rig_map : job.rig_map;
   if (progress.enabled()) options.progress = [&progress](const mf_progress& p) { return progress.update(p); };
   if (job.constrained()) {

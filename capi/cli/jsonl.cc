@@ -394,6 +394,11 @@ BatchJob batch_job_from_json(const JsonValue& line) {
   job.in = string_value(required(line, "in", job.task), "in", false);
   job.out = string_value(required(line, "out", job.task), "out", false);
   if (const JsonValue* m = line.find("method")) job.method = string_value(*m, "method", false);
+  if (const JsonValue* n = line.find("max_iterations")) {
+    job.max_iterations = int_value(*n, "\"max_iterations\"");
+    if (job.max_iterations < 0 || job.max_iterations > 100000)
+      throw InputError("\"max_iterations\" must be between 0 and 100000, not " + n->dump());
+  }
   if (const JsonValue* r = line.find("rig_map")) job.rig_map = string_value(*r, "rig_map", false);
   if (const JsonValue* u = line.find("units")) {
     if (!u->is_number()) {

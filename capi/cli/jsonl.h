@@ -103,6 +103,7 @@ struct BatchJob {
   std::string task;    ///< "inbetween", "fill", "resample" or "renav"
   std::string in, out; ///< paths as given (relative to the current directory)
   std::string method;  ///< empty: the default method
+  int max_iterations = 0;  ///< iteration budget of iterative methods (mf_task_options); 0: each method's own
   std::string id;      ///< the job's "id" for messages (JSON text; strings unquoted), empty if none
   bool has_keyframes = false;
   std::vector<int> keyframes;  ///< inbetween: required; fill: optional and then authoritative
@@ -132,7 +133,8 @@ struct BatchJob {
 /// the key when the value is not an object, "task" is missing or unknown, or a
 /// key the task needs is missing or has the wrong type ("in" and "out" non-empty
 /// strings; "keyframes" an array of integers; "gap" an array of two integers;
-/// "fps" a number; "method", "path", "polyline" and "rig_map" strings;
+/// "fps" a number; "max_iterations" an integer in 0..100000; "method",
+/// "path", "polyline" and "rig_map" strings;
 /// "frames" an integer; "units" a string or a positive number; for inbetween
 /// and fill "constraints" a file name or an inline object, "trajectory" a file
 /// name, "alternatives" an

@@ -1723,7 +1723,7 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
           contacts: Sequence[Tuple[str, int, int]] = (), constraints: Union[Constraints, str, Dict[str, Any], None] = None,
           trajectory: Union[npt.ArrayLike, str, "os.PathLike[str]", None] = None, alternatives: int = 0, method: Optional[str] = None, model: Optional[Model] = None, seed: int = 0,
           progress: Optional[ProgressCallback] = None, cancel: Optional[CancelToken] = None,
-          rig_map: Optional[RigMap] = None) -> Solution:
+          rig_map: Optional[RigMap] = None, max_iterations: int = 0) -> Solution:
     """Completes a motion under any constraints, with alternative solutions.
 
     ``solve(motion, [0, 60], targets=[(30, "Hand_R", [20, 120, 40])])`` is
@@ -1796,7 +1796,7 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
         c.add_trajectory(trajectory[0], trajectory[1])
     elif trajectory is not None:
         c.add_trajectory(trajectory)
-    call = _TaskCall(method, seed, progress, cancel, rig_map)
+    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
     handle = call.run(_c.mf_solve, _task_model(model, method), motion._live(), c._live(), int(alternatives),
                       out_type=_c.MfSolution)
     try:

@@ -77,6 +77,7 @@ class BatchJob:
     in_path: str = ""
     out_path: str = ""
     method: str = ""
+    max_iterations: int = 0  # iteration budget of iterative methods; 0: each method's own
     id: str = ""
     has_keyframes: bool = False
     keyframes: List[int] = dataclasses.field(default_factory=list)
@@ -520,6 +521,10 @@ def batch_job_from_json(line: Any) -> BatchJob:
     job.out_path = _string_value(_required(line, "out", job.task), "out", False)
     if "method" in line:
         job.method = _string_value(line["method"], "method", False)
+    if "max_iterations" in line:
+        job.max_iterations = _int_value(line["max_iterations"], '"max_iterations"')
+        if not 0 <= job.max_iterations <= 100000:
+            raise InputError('"max_iterations" must be between 0 and 100000, not ' + dump(line["max_iterations"]))
     if "rig_map" in line:
         job.rig_map = _string_value(line["rig_map"], "rig_map", False)
     _read_units(line, job)
@@ -851,7 +856,8 @@ def _solve_constrained(job: BatchJob, options: Dict[str, Any], motion: mf.Motion
 def _solve(job: BatchJob, settings: Settings, model: Optional[mf.Model], motion: mf.Motion) -> Any:
     rig_map = job.rig_map or settings.rig_map
     options: Dict[str, Any] = dict(method=job.method or None, model=model,
-                                   rig_map=_FilePath(rig_map) if rig_map else None)
+                                   rig_map=_FilePath(rig_map) if rig_map else None,
+                                   max_iterations=job.max_iterations)
     if job.constrained:
         return _solve_constrained(job, options, motion)
     if job.task == "inbetween" or (job.task == "fill" and job.has_keyframes):

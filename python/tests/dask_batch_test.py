@@ -47,6 +47,8 @@ GOOD = [
      "report": "out/constrained-report.json"},                                       # docs/CONSTRAINTS.md
     {"task": "fill", "in": "walk.bvh", "out": "out/trajectory.bvh", "gap": [15, 45], "method": "nemf",
      "trajectory": "t.csv", "report": "out/trajectory-report.json"},                 # a trajectory CSV
+    {"task": "fill", "in": "walk.bvh", "out": "out/budget.bvh", "gap": [10, 40], "method": "nemf",
+     "max_iterations": 2},                                                           # an iteration budget
 ]
 REPORTS = ["constrained-report.json", "trajectory-report.json"]
 BAD_LINES = [
@@ -65,6 +67,7 @@ BAD_LINES = [
     '{"task": "inbetween", "in": "walk.bvh", "out": "z.bvh", "keyframes": [0, 60], "constraints": 3}',
     '{"task": "inbetween", "in": "walk.bvh", "out": "z.bvh", "keyframes": [0, 60], "alternatives": 17}',
     '{"task": "fill", "in": "walk.bvh", "out": "z.bvh", "gap": [15, 45], "trajectory": 3}',
+    '{"task": "fill", "in": "walk.bvh", "out": "z.bvh", "gap": [15, 45], "max_iterations": -1}',
 ]
 WORKER_FAILURES = [
     {"task": "fill", "in": "missing.bvh", "out": "out/missing.bvh", "gap": [1, 5]},
@@ -160,10 +163,11 @@ class DaskBatchTest(unittest.TestCase):
                          ["ok"] * len(GOOD) + ["error"] * (len(BAD_LINES) + len(WORKER_FAILURES)))
         self.assertEqual([s["line"] for s in summaries[:4]], [1, 2, 4, 5])  # line 3 is blank
         self.assertEqual(summaries[0]["method"], mf.default_method())
-        self.assertIn('motionfield: jobs.jsonl line 9 (id 7): error: "gap" must be an array of two integers',
-                      self.dask_run.stderr)
-        self.assertIn("jobs.jsonl line 25: error: cannot write nodir/x.bvh: directory nodir does not exist",
-                      self.dask_run.stderr)
+        first_bad = len(GOOD) + 2  # after the good jobs and the blank line
+        self.assertIn('motionfield: jobs.jsonl line %d (id 7): error: "gap" must be an array of two integers'
+                      % first_bad, self.dask_run.stderr)
+        self.assertIn("jobs.jsonl line %d: error: cannot write nodir/x.bvh: directory nodir does not exist"
+                      % (first_bad + len(BAD_LINES) + 1), self.dask_run.stderr)
         self.assertTrue(self.dask_run.stderr.endswith("motionfield: batch jobs.jsonl: %d jobs, %d ok, %d failed\n" % (
             len(summaries), len(GOOD), len(summaries) - len(GOOD))), self.dask_run.stderr)
 

@@ -97,6 +97,15 @@ class SameAsCliTest(unittest.TestCase):
         self.assert_same(python, cli_text)
         self.assertEqual(mf.resample(self.input, 60.0, method="prior").to_bvh_text(), python.to_bvh_text())
 
+    def test_an_iteration_budget_is_the_cli_flag(self):
+        keys = [0, 10, 20, 30]
+        cli_text, _ = self.run_cli("inbetween", "--keyframes", ",".join(map(str, keys)), "--max-iterations", "1")
+        python = mf.inbetween(self.input, keys, max_iterations=1)
+        self.assert_same(python, cli_text)
+        self.assertNotEqual(python.to_bvh_text(), mf.inbetween(self.input, keys).to_bvh_text())
+        solved = mf.solve(self.input, keys, max_iterations=1)  # the constrained path takes it too
+        self.assertEqual(solved.motions[0].to_bvh_text(), python.to_bvh_text())
+
 
 if __name__ == "__main__":
     unittest.main()
