@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -24,6 +25,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/inbetween/inbetweener.h"
+#include "bench/foreign_data.h"
 #include "bench/synthetic_rigs.h"
 #include "tasks/jobs.h"
 #include "tasks/model_rig.h"
@@ -64,10 +66,13 @@ struct Args {
   bool l2p_axes = false;
   bool print_stats = false;
   std::vector<int> gaps;    // gap lengths (default: the protocol's)
+  std::vector<int> spacings;  // keyframe spacings of the sparse task (default: the protocol's)
   std::vector<int> resample_factors;  // resampling: every k-th frame kept (default: the protocol's)
   std::vector<std::string> resample_ratios;  // resampling: a:b rows
   bool trajectory = false;  // gap filling with the ground-truth trajectory
   bool l2t = false;
+  std::string dataset = "bandai";  // or "foreign": real capture on other rigs (bench/foreign_data.h)
+  std::string foreign_source = mf::default_foreign_archive();
 };
 
 void add_options(CLI::App& app, Args& args) {
@@ -93,6 +98,8 @@ void add_options(CLI::App& app, Args& args) {
   app.add_option("--out", args.out, "also write the markdown to FILE");
   app.add_flag("--l2p-axes", args.l2p_axes, "add columns splitting L2P into horizontal (x, z) and vertical (y) parts");
   mf::bench::add_list_option(app, "--gaps", args.gaps, "gap lengths of the gap task (default: 5, 15, 30, 45, 90)");
+  mf::bench::add_list_option(app, "--spacings", args.spacings,
+                             "keyframe spacings of the sparse task (default: 5, 10, 15, 20, 30)");
   mf::bench::add_list_option(app, "--resample-factors", args.resample_factors,
                              "resampling: keep every k-th frame of a 65-frame window, bring it back to the full rate "
                              "(default: 2; 65 frames allow 2, 4, 8, 16, 32, 64)");
@@ -106,6 +113,12 @@ void add_options(CLI::App& app, Args& args) {
                "gap filling with the ground truth's trajectory of the gap (through the constrained path; methods "
                "without it are skipped)");
   app.add_flag("--l2t", args.l2t, "add the L2T column (trajectory error, bench/metrics.h)");
+  app.add_option("--dataset", args.dataset,
+                 "bandai: the training data's held-out clips (--source); foreign: real capture of other people on "
+                 "other rigs (--foreign-source, bench/foreign_data.h), each window solved on its own rig as the CLI "
+                 "gets it, scored on the model's rig, with tables per rig convention and content")
+      ->check(CLI::IsMember({"bandai", "foreign"}));
+  app.add_option("--foreign-source", args.foreign_source, "the foreign capture (folder or archive)");
   app.add_flag("--print-stats", args.print_stats,
                "add the table of training statistics (position mean / std, standing heights)");
 }
@@ -140,10 +153,125 @@ void resolve(Args& args) {
     throw mf::InputError("the tasks recon, fps, seams and sample need a model (--model PATH)");
   }
   if (args.rig == "native") args.rig.clear();
+  if (args.dataset == "foreign") {
+    if (args.model.empty()) throw mf::InputError("--dataset foreign needs the model (its rig anatomy maps the clips)");
+    if (!args.rig.empty() || args.trajectory)
+      throw mf::InputError("--dataset foreign takes neither --rig nor --trajectory");
+    if (!args.prior_tasks.empty() && args.tasks_given)
+      throw mf::InputError("--dataset foreign runs the gap, sparse and resample tasks only");
+    args.prior_tasks.clear();
+  }
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// One group of foreign validation clips: its name and clips, with the
+// retargeters that score them.
+struct ForeignGroup {
+  std::string name;
+  std::vector<mf::Clip> clips;
+  std::vector<std::shared_ptr<const mf::Retargeter>> to_model;
+};
+
+std::vector<ForeignGroup> foreign_groups(const std::vector<mf::bench::ForeignClip>& clips, const mf::TaskContext& ctx) {
+  std::vector<ForeignGroup> groups;
+  auto group = [&](const std::string& name) -> ForeignGroup& {
+    for (ForeignGroup& g : groups)
+      if (g.name == name) return g;
+    groups.push_back({name, {}, {}});
+    return groups.back();
+  };
+  for (const mf::bench::ForeignClip& c : clips) {
+    auto r = std::make_shared<const mf::Retargeter>(mf::model_retargeter(c.clip.motion, {}, ctx));
+    for (const std::string& name : {"rig " + c.convention, "content: " + c.content}) {
+      ForeignGroup& g = group(name);
+      g.clips.push_back(c.clip);
+      g.to_model.push_back(r);
+    }
+  }
+  return groups;
+}
+
+// The foreign capture's tables: per task row, L2P of each method and its
+// ratio to interpolation's, per group of clips (all, per rig convention, per
+// content).
+void run_foreign(const Args& args, const mf::TaskContext& ctx, const mf::bench::EvalStats& stats,
+                 mf::bench::ProtocolOptions options, const std::function<void(const std::string&)>& emit) {
+  const mf::bench::ForeignData data =
+      mf::bench::load_foreign_data(args.foreign_source, args.data.cache_dir, ctx.model->config().fps, true);
+  const std::vector<mf::bench::ForeignClip>& clips = args.split.split == "train" ? data.train : data.validation;
+  if (clips.empty()) throw mf::InputError("no foreign clip in the " + args.split.split + " split");
+  std::ostringstream head;
+  head << "### Foreign capture (" << args.split.split << " split: " << clips.size() << " clips)\n\n";
+  for (const mf::bench::ForeignClip& c : clips)
+    head << "- " << c.clip.name << ": " << c.content << ", " << c.clip.motion.num_joints() << " joints, "
+         << fixed(c.source_fps, 0) << " fps given, " << c.clip.motion.num_frames() << " frames at "
+         << fixed(c.clip.motion.fps, 0) << " fps\n";
+  emit(head.str() + "\n");
+  const std::vector<ForeignGroup> groups = foreign_groups(clips, ctx);
+  std::vector<std::string> methods{"interp"};
+  for (const std::string& m : args.methods)
+    if (m != "interp") methods.push_back(m);
+  options.root_forward = ctx.model->rig().root_forward;
+  for (mf::bench::Task task : args.tasks) {
+    // results[group][method] = rows
+    std::vector<std::vector<mf::bench::TaskResult>> results(groups.size());
+    std::vector<std::string> ran;
+    for (const std::string& method : methods) {
+      if (!mf::bench::method_supports(method, task)) continue;
+      ran.push_back(method);
+      for (size_t g = 0; g < groups.size(); ++g) {
+        std::cerr << "running foreign " << groups[g].name << " / " << mf::bench::task_name(task) << " / " << method
+                  << "\n";
+        mf::bench::ProtocolOptions o = options;
+        o.clip_to_model = groups[g].to_model;
+        results[g].push_back(mf::bench::run_task(task, groups[g].clips, stats, method, o, ctx));
+      }
+    }
+    if (ran.empty()) continue;
+    const size_t rows = results[0][0].rows.size();
+    for (size_t r = 0; r < rows; ++r) {
+      const mf::bench::RowResult& first = results[0][0].rows[r];
+      std::ostringstream t;
+      t << "#### " << mf::bench::task_name(task) << " "
+        << (first.label.empty() ? std::to_string(first.parameter) : first.label)
+        << ": L2P (ratio to interp), " << at::get_num_threads() << " thread(s)\n\n| group | windows |";
+      for (const std::string& m : ran) t << " " << m << " |";
+      t << "\n|---|---|";
+      for (size_t i = 0; i < ran.size(); ++i) t << "---|";
+      t << "\n";
+      // "all": the rig groups pooled (they partition the clips; every window of a row has as many frames).
+      std::vector<double> pooled(ran.size(), 0.0);
+      int pooled_windows = 0;
+      for (size_t g = 0; g < groups.size(); ++g) {
+        if (groups[g].name.rfind("rig ", 0) != 0) continue;
+        const int n = results[g][0].rows[r].metrics.windows;
+        pooled_windows += n;
+        for (size_t m = 0; m < ran.size(); ++m) pooled[m] += n * results[g][m].rows[r].metrics.l2p;
+      }
+      auto cells = [&](const std::string& name, int windows, const std::vector<double>& l2p) {
+        t << "| " << name << " | " << windows << " |";
+        for (size_t m = 0; m < ran.size(); ++m) {
+          t << " " << fixed(l2p[m], 3);
+          if (m > 0 && l2p[0] > 0) t << " (" << fixed(l2p[m] / l2p[0], 2) << "x)";
+          t << " |";
+        }
+        t << "\n";
+      };
+      if (pooled_windows > 0) {
+        for (double& v : pooled) v /= pooled_windows;
+        cells("all (rigs pooled)", pooled_windows, pooled);
+      }
+      for (size_t g = 0; g < groups.size(); ++g) {
+        std::vector<double> l2p;
+        for (size_t m = 0; m < ran.size(); ++m) l2p.push_back(results[g][m].rows[r].metrics.l2p);
+        cells(groups[g].name, results[g][0].rows[r].metrics.windows, l2p);
+      }
+      emit(t.str() + "\n");
+    }
+  }
 }
 
 int run(Args& args, const std::string& command) {
@@ -208,6 +336,7 @@ int run(Args& args, const std::string& command) {
   options.rig = args.rig;
   options.rig_anatomy = ctx.model_anatomy;
   if (!args.gaps.empty()) options.gap_lengths = args.gaps;
+  if (!args.spacings.empty()) options.keyframe_spacings = args.spacings;
   if (!args.resample_factors.empty() || !args.resample_ratios.empty()) {
     options.resample_ratios.clear();
     for (int k : args.resample_factors) options.resample_ratios.push_back({k, 1});
@@ -216,6 +345,10 @@ int run(Args& args, const std::string& command) {
   options.trajectory = args.trajectory;
   options.l2t = args.l2t || args.trajectory;
   if (!args.rig.empty()) emit("- rig: " + args.rig + " (bench/synthetic_rigs.h)\n\n");
+  if (args.dataset == "foreign") {
+    run_foreign(args, ctx, stats, options, emit);
+    args.tasks.clear();
+  }
   for (mf::bench::Task task : args.tasks) {
     for (const std::string& method : args.methods) {
       if (!mf::bench::method_supports(method, task)) {

@@ -71,6 +71,27 @@ Motion predict(const Motion& truth, const std::vector<int>& known, const Protoco
   return out;
 }
 
+using RunFn = std::function<Motion(const Motion&, const std::vector<int>&)>;
+
+// The truth and the prediction of window `w` with frames `known` given,
+// canonicalised at `anchor` (for the metrics, on the native or the model's rig).
+std::pair<Motion, Motion> predict_window(const std::vector<Clip>& clips, const Window& w, int anchor,
+                                         const std::vector<int>& known, const ProtocolOptions& options,
+                                         const RunFn& run, const std::string& method) {
+  const Motion raw = clips[w.clip].motion.slice(w.start, w.start + w.length);
+  if (options.clip_to_model.empty()) {
+    Motion truth = canonicalise(raw, anchor, options.root_forward);
+    Motion pred = predict(truth, known, options, run);
+    return {std::move(truth), std::move(pred)};
+  }
+  const Motion pred_user = run(hide_unknown_frames(raw, known), known);
+  check_prediction(pred_user, raw, method);
+  const Retargeter& to_model = *options.clip_to_model.at(w.clip);
+  const Motion truth = to_model.to_model(raw);
+  const RigidTransform t = canonical_transform(truth, anchor, options.root_forward);
+  return {transform_motion(truth, t), transform_motion(to_model.to_model(pred_user), t)};
+}
+
 }  // namespace
 
 const char* task_name(Task task) {
@@ -164,18 +185,23 @@ std::vector<TrajectoryPoint> truth_trajectory(const Motion& truth, int a, int b,
 // Gap filling of one window, with the ground-truth trajectory of the gap when
 // asked and the method follows one (the others, the baselines among them, run
 // without it: their rows are the references).
-Motion fill_gap(const Motion& truth, const std::vector<int>& known, int a, int b, const std::string& method,
-                const ProtocolOptions& options, const TaskContext& ctx) {
+std::pair<Motion, Motion> fill_gap(const std::vector<Clip>& clips, const Window& w, const std::vector<int>& known,
+                                   int a, int b, const std::string& method, const ProtocolOptions& options,
+                                   const TaskContext& ctx) {
+  const int anchor = options.context - 1;
   if (!options.trajectory || !resolve_method(method, ctx).follows_trajectory) {
-    return predict(truth, known, options, [&](const Motion& input, const std::vector<int>& k) {
+    return predict_window(clips, w, anchor, known, options, [&](const Motion& input, const std::vector<int>& k) {
       const auto gap = std::adjacent_find(k.begin(), k.end(), [](int x, int y) { return y != x + 1; });
       return run_fill(input, *gap + 1, *(gap + 1), method, ctx);
-    });
+    }, method);
   }
-  if (!options.rig.empty()) throw InputError("gap filling with a trajectory runs on the native rig only");
+  if (!options.rig.empty() || !options.clip_to_model.empty())
+    throw InputError("gap filling with a trajectory runs on the native rig only");
+  Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + w.length), anchor, options.root_forward);
   MotionConstraints c = MotionConstraints::full_pose(known);
   c.trajectory = truth_trajectory(truth, a, b, options.root_forward);
-  return run_constrained(hide_unknown_frames(truth, known), c, method, 0, ctx).motions.front();
+  Motion pred = run_constrained(hide_unknown_frames(truth, known), c, method, 0, ctx).motions.front();
+  return {std::move(truth), std::move(pred)};
 }
 
 TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stats, const std::string& method,
@@ -194,10 +220,8 @@ TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stat
     MetricAccumulator acc(stats, options.root_forward);
     double ms = 0.0;
     for (const Window& w : windows) {
-      const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), options.context - 1,
-                                        options.root_forward);
       const auto t0 = Clock::now();
-      const Motion pred = fill_gap(truth, known, a, b, method, options, ctx);
+      const auto [truth, pred] = fill_gap(clips, w, known, a, b, method, options, ctx);
       ms += ms_since(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, known);
@@ -231,11 +255,10 @@ TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats&
     int used = 0;
     for (const Window& w : windows) {
       if (evaluated.empty()) break;  // spacing 1: nothing to evaluate
-      const Motion truth = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, options.root_forward);
       const auto t0 = Clock::now();
-      const Motion pred = predict(truth, keys, options, [&](const Motion& input, const std::vector<int>& k) {
+      const auto [truth, pred] = predict_window(clips, w, 0, keys, options, [&](const Motion& input, const std::vector<int>& k) {
         return run_inbetween(input, k, method, ctx);
-      });
+      }, method);
       ms += ms_since(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, keys);
@@ -291,7 +314,9 @@ TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats
     MetricAccumulator acc(stats);
     double ms = 0.0;
     for (const Window& w : windows) {
-      const Motion full = canonicalise(clips[w.clip].motion.slice(w.start, w.start + length), 0, options.root_forward);
+      const bool foreign = !options.clip_to_model.empty();
+      const Motion raw = clips[w.clip].motion.slice(w.start, w.start + length);
+      const Motion full = foreign ? raw : canonicalise(raw, 0, options.root_forward);
       auto every = [&](int step) {
         Motion m = Motion::identity(full.skeleton, (length - 1) / step + 1, full.fps / step);
         for (int i = 0; i < m.num_frames(); ++i) {
@@ -300,12 +325,19 @@ TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats
         }
         return m;
       };
-      const Motion input = every(a), truth = every(b);
+      const Motion input = every(a), truth_user = every(b);
       const auto t0 = Clock::now();
-      const Motion pred = run_resample(input, truth.fps, method, nullptr, ctx);
+      const Motion pred_user = run_resample(input, truth_user.fps, method, nullptr, ctx);
       ms += ms_since(t0);
-      check_prediction(pred, truth, method);
-      acc.add(truth, pred, evaluated, known);
+      check_prediction(pred_user, truth_user, method);
+      if (!foreign) {
+        acc.add(truth_user, pred_user, evaluated, known);
+        continue;
+      }
+      const Retargeter& to_model = *options.clip_to_model.at(w.clip);
+      const Motion truth = to_model.to_model(truth_user);
+      const RigidTransform t = canonical_transform(truth, 0, options.root_forward);
+      acc.add(transform_motion(truth, t), transform_motion(to_model.to_model(pred_user), t), evaluated, known);
     }
     RowResult row;
     row.parameter = a;

@@ -95,6 +95,14 @@ struct ProtocolOptions {
   bool trajectory = false;
   /// Add the L2T column (MetricSummary::l2t) to the tables.
   bool l2t = false;
+  /// Clips on their own rigs (the foreign capture, bench/foreign_data.h): one
+  /// retargeter onto the model's rig per clip of `clips` (anatomies from the
+  /// whole clip). The method sees each window as the clip has it (its own
+  /// world, ground height and facing; unknown frames hidden), as a user's file
+  /// reaches the CLI; its result and the truth are then both mapped onto the
+  /// model's rig and canonicalised by the truth's transform for the metrics.
+  /// Empty: the clips are on the native rig.
+  std::vector<std::shared_ptr<const Retargeter>> clip_to_model;
 };
 
 /// The ground truth's trajectory rows (trajectory_features(), frames a..b-1)

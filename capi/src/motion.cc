@@ -88,20 +88,6 @@ std::string unit_name(double metres) {
   return "custom";
 }
 
-// The document's skeleton in file units (from its first frame: position
-// channels on non-root joints replace offsets), for unit detection.
-Skeleton skeleton_in_file_units(const BvhDocument& doc) {
-  BvhDocument first;
-  first.joints = doc.joints;
-  first.num_frames = 1;
-  first.frame_time = doc.frame_time;
-  const size_t row = std::min(doc.values.size(), static_cast<size_t>(doc.num_channels()));
-  first.values.assign(doc.values.begin(), doc.values.begin() + static_cast<std::ptrdiff_t>(row));
-  BvhUnits file_units;
-  file_units.length_scale = 1.0;
-  return motion_from_bvh(first, file_units).skeleton;
-}
-
 // Sets the handle's unit: `given` metres per unit, or (0) the one detected
 // from the document's skeleton.
 void set_unit(mf_motion* handle, const BvhDocument& doc, double given) {
@@ -112,7 +98,7 @@ void set_unit(mf_motion* handle, const BvhDocument& doc, double given) {
     return;
   }
   bool detected = false;
-  const LengthUnit unit = detect_length_unit(skeleton_in_file_units(doc), &detected);
+  const LengthUnit unit = detect_bvh_length_unit(doc, &detected);
   handle->length_scale = unit.metres;
   handle->unit = unit.name;
   handle->unit_detected = detected;

@@ -663,6 +663,7 @@ bool is_validation_clip(const std::string& name, int validation_percent) {
 
 std::string default_train_archive() { return env_or("MF_TRAIN_ARCHIVE", MF_DEFAULT_TRAIN_ARCHIVE); }
 std::string default_cache_dir() { return env_or("MF_CACHE_DIR", MF_DEFAULT_CACHE_DIR); }
+std::string default_foreign_archive() { return env_or("MF_FOREIGN_ARCHIVE", MF_DEFAULT_FOREIGN_ARCHIVE); }
 
 void save_clips(const std::string& path, const std::vector<Clip>& clips) { write_clips_file(path, clips, {}); }
 
@@ -701,6 +702,21 @@ Dataset load_dataset(const DatasetOptions& options) {
     std::fprintf(stderr, "mf dataset: %zu train, %zu validation, %zu skipped clips in %.2f s\n", ds.train.size(),
                  ds.validation.size(), ds.skipped.size(), seconds_since(t0));
   return ds;
+}
+
+std::vector<SourceBvhFile> list_source_bvh_files(const std::string& source_path, const std::string& cache_dir,
+                                                 bool verbose) {
+  DatasetOptions options;
+  options.source = source_path;
+  options.cache_dir = cache_dir;
+  options.use_cache = false;
+  const ResolvedSource source = resolve_source(options);
+  const fs::path root =
+      source.is_folder ? source.path : ensure_extracted(source.path, source.cache_dir, archive_key(source.path), verbose);
+  std::vector<SourceBvhFile> out;
+  for (const SourceFile& f : list_bvh_files(root)) out.push_back({f.rel, f.path.string()});
+  if (out.empty()) throw InputError("no .bvh file in " + source_path);
+  return out;
 }
 
 std::vector<Window> make_windows(const std::vector<Clip>& clips, int length, int stride, bool keep_short) {

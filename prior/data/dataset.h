@@ -84,12 +84,29 @@ uint64_t fnv1a64(const std::string& s);
 /// then quotes the first reasons).
 Dataset load_dataset(const DatasetOptions& options);
 
+/// A BVH file of a source: its path relative to the source's root
+/// ('/'-separated) and where it can be read.
+struct SourceBvhFile {
+  std::string relative;
+  std::string path;
+};
+
+/// The BVH files of `source` (a folder searched recursively, or an archive
+/// extracted into `cache_dir` as load_dataset() does), sorted by relative
+/// path. For readers of clips that are not on one rig (the foreign capture of
+/// the benchmark); the errors are load_dataset()'s.
+std::vector<SourceBvhFile> list_source_bvh_files(const std::string& source, const std::string& cache_dir,
+                                                 bool verbose);
+
 /// The default location of the shared training archive relative to the project
 /// root, and the default cache directory (`<project>/.cache`), as configured at
 /// build time; both can be overridden by the environment variables
 /// MF_TRAIN_ARCHIVE and MF_CACHE_DIR (when set and non-empty).
 std::string default_train_archive();
 std::string default_cache_dir();
+/// The shared archive of real capture on other rigs (`foreign/foreign.tar.xz`
+/// of the shared data; MF_FOREIGN_ARCHIVE overrides it).
+std::string default_foreign_archive();
 
 /// A window of a clip: frames [start, start + length) of clips[clip]. When the
 /// clip is shorter than the requested window length, the window is the whole

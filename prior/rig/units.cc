@@ -1,8 +1,10 @@
 #include "prior/rig/units.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "prior/motion/errors.h"
+#include "prior/motion/motion_bvh.h"
 #include "prior/rig/retarget.h"
 #include "prior/rig/rig_map.h"
 
@@ -37,6 +39,18 @@ LengthUnit detect_length_unit(const Skeleton& s, bool* detected) {
     if (!best || cost < best_cost) best = &c, best_cost = cost;
   }
   return {best->name, best->metres};
+}
+
+LengthUnit detect_bvh_length_unit(const BvhDocument& doc, bool* detected) {
+  BvhDocument first;
+  first.joints = doc.joints;
+  first.num_frames = 1;
+  first.frame_time = doc.frame_time;
+  const size_t row = std::min(doc.values.size(), static_cast<size_t>(doc.num_channels()));
+  first.values.assign(doc.values.begin(), doc.values.begin() + static_cast<std::ptrdiff_t>(row));
+  BvhUnits file_units;
+  file_units.length_scale = 1.0;
+  return detect_length_unit(motion_from_bvh(first, file_units).skeleton, detected);
 }
 
 }  // namespace mf

@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "prior/motion/bvh.h"
 #include "prior/motion/skeleton.h"
 
 namespace mf {
@@ -26,5 +27,9 @@ LengthUnit length_unit_from_name(const std::string& name);
 /// without legs the rig map can find gives centimetres (the BVH default) and
 /// `detected` false.
 LengthUnit detect_length_unit(const Skeleton& skeleton_in_file_units, bool* detected = nullptr);
+
+/// detect_length_unit() of a BVH document's skeleton in file units (read from
+/// its first frame: position channels on non-root joints replace offsets).
+LengthUnit detect_bvh_length_unit(const BvhDocument& doc, bool* detected = nullptr);
 
 }  // namespace mf
