@@ -14,6 +14,7 @@
 #include "tasks/baselines.h"
 #include "tasks/effector_ik.h"
 #include "tasks/foot_locking.h"
+#include "tasks/ground_level.h"
 #include "tasks/residuals.h"
 
 namespace mf {
@@ -172,6 +173,12 @@ bool has_full_rotation_key(const MotionConstraints& c) {
   return false;
 }
 
+// The ground under `motion` (on the model's rig) seen from the frames
+// `known`; a key in the air within a second of one on the ground does not lift it.
+std::vector<double> model_ground(const Motion& motion, const std::vector<int>& known, const NemfModel& prior) {
+  return ground_heights(motion, known, prior.rig(), static_cast<int>(std::lround(prior.config().fps)));
+}
+
 }  // namespace
 
 std::shared_ptr<const RigAnatomy> load_rig_anatomy_next_to(const std::string& prior_file, const Skeleton& model) {
@@ -216,7 +223,10 @@ Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, 
   check_model_rig(input.skeleton, ctx);
   RigMap map = model_rig_map(input.skeleton, ctx);
   RigAnatomy user = estimate_anatomy(input, map.user_parts, known);
-  take_rest_pose_frames(input.skeleton, map.user_parts, &user);
+  // Elbows bent enough in the frames read tell their hinge better than a rest pose can.
+  const std::array<double, 2> bend = mean_elbow_bend(input, map.user_parts, known);
+  constexpr double kMinBend = 0.15;  // mean sine of the bend: about 9 degrees
+  take_rest_pose_frames(input.skeleton, map.user_parts, &user, {bend[0] >= kMinBend, bend[1] >= kMinBend});
   return Retargeter(input.skeleton, model, std::move(map), std::move(user), *ctx.model_anatomy);
 }
 
@@ -239,7 +249,9 @@ Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known,
   const Motion reference = interpolate_motion(input, known);
   std::optional<Retargeter> rig;
   if (!native) rig.emplace(model_retargeter(input, known, ctx));
-  const Motion on_model = native ? reference : rig->to_model(reference);
+  Motion on_model = native ? reference : rig->to_model(reference);
+  const std::vector<double> ground = model_ground(on_model, known, prior);
+  shift_root_heights(&on_model, ground, -1.0);
 
   Motion result;
   if (same_frame_rate(input.fps, model_fps)) {
@@ -252,6 +264,7 @@ Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known,
     const Motion solved = complete(at_rate, rate_known);
     result = resample_cubic(solved, input.fps, input.num_frames());
   }
+  shift_root_heights(&result, ground, 1.0);
   Motion back = native ? result : rig->to_user(result, reference);
   back.skeleton = input.skeleton;
   back.fps = input.fps;
@@ -300,7 +313,20 @@ Motion resample_on_model_rig(const Motion& input, double fps, int frames, const 
                              const ResampleFn& resample) {
   if (!ctx.model || input.skeleton.same_as(ctx.model->rig().skeleton)) return resample(input, fps, frames);
   const Retargeter rig = model_retargeter(input, {}, ctx);
-  const Motion result = resample(rig.to_model(input), fps, frames);
+  Motion on_model = rig.to_model(input);
+  std::vector<int> all(static_cast<size_t>(input.num_frames()));
+  for (int f = 0; f < input.num_frames(); ++f) all[f] = f;
+  const std::vector<double> ground = model_ground(on_model, all, *ctx.model);
+  shift_root_heights(&on_model, ground, -1.0);
+  Motion result = resample(on_model, fps, frames);
+  // The ground at the output's times: the same time span, linear between input frames.
+  std::vector<double> out_ground(static_cast<size_t>(frames));
+  for (int k = 0; k < frames; ++k) {
+    const double t = frames > 1 ? double(k) * (input.num_frames() - 1) / (frames - 1) : 0.0;
+    const int a = std::min(static_cast<int>(t), input.num_frames() - 1), b = std::min(a + 1, input.num_frames() - 1);
+    out_ground[k] = ground[a] + (t - a) * (ground[b] - ground[a]);
+  }
+  shift_root_heights(&result, out_ground, 1.0);
   Motion back = rig.to_user(result, resample_cubic(input, fps, frames));
   back.skeleton = input.skeleton;
   return back;

@@ -15,6 +15,7 @@
 #include "prior/rig/rig_map.h"
 #include "prior/rig/units.h"
 #include "tasks/baselines.h"
+#include "tasks/ground_level.h"
 #include "tasks/model_rig.h"
 #include "tests/test_util.h"
 
@@ -175,6 +176,36 @@ TEST(RigMap, CmuAndUnrealLayouts) {
   EXPECT_EQ(u.names[q.arms[1].hand], "hand_r");
   // SMPL's FBX names carry an "m_avg_" prefix.
   EXPECT_EQ(name_side("m_avg_L_Hip"), 0);
+}
+
+TEST(RigMap, CmuAsfNamesMapByName) {
+  // CMU's original ASF names, one-letter sides glued to the part (the layout
+  // of cmu-daz/16_01.bvh in the foreign capture).
+  std::vector<std::pair<std::string, std::string>> asf = {
+      {"hip", ""}, {"lhipjoint", "hip"}, {"lfemur", "lhipjoint"}, {"ltibia", "lfemur"}, {"lfoot", "ltibia"},
+      {"ltoes", "lfoot"}, {"rhipjoint", "hip"}, {"rfemur", "rhipjoint"}, {"rtibia", "rfemur"}, {"rfoot", "rtibia"},
+      {"rtoes", "rfoot"}, {"lowerback", "hip"}, {"upperback", "lowerback"}, {"thorax", "upperback"},
+      {"lowerneck", "thorax"}, {"upperneck", "lowerneck"}, {"head", "upperneck"}, {"lclavicle", "thorax"},
+      {"lhumerus", "lclavicle"}, {"lradius", "lhumerus"}, {"lwrist", "lradius"}, {"lhand", "lwrist"},
+      {"lfingers", "lhand"}, {"lthumb", "lwrist"}, {"rclavicle", "thorax"}, {"rhumerus", "rclavicle"},
+      {"rradius", "rhumerus"}, {"rwrist", "rradius"}, {"rhand", "rwrist"}, {"rfingers", "rhand"},
+      {"rthumb", "rwrist"}};
+  const Skeleton c = named_skeleton(asf);
+  const RigParts p = find_rig_parts(c);
+  EXPECT_TRUE(p.missing().empty());
+  EXPECT_EQ(c.names[p.hips], "hip");
+  EXPECT_EQ(c.names[p.chest], "thorax");
+  EXPECT_EQ(c.names[p.legs[0].thigh], "lfemur");
+  EXPECT_EQ(c.names[p.legs[1].shin], "rtibia");
+  EXPECT_EQ(c.names[p.legs[0].foot], "lfoot");
+  EXPECT_EQ(c.names[p.arms[0].upper], "lhumerus");
+  EXPECT_EQ(c.names[p.arms[1].fore], "rradius");
+  EXPECT_EQ(c.names[p.arms[0].hand], "lwrist");
+  EXPECT_EQ(name_side("lfemur"), 0);
+  EXPECT_EQ(name_side("rhipjoint"), 1);
+  EXPECT_EQ(name_side("lowerback"), -1);  // not "l" + "owerback"
+  EXPECT_EQ(name_side("radius"), -1);
+  EXPECT_NO_THROW(mirror_counterparts(c));
 }
 
 TEST(RigMap, UnmappableRigListsWhatWasFound) {
@@ -479,6 +510,68 @@ TEST(ModelRig, OracleThroughTheAdapterGivesTheTruthOnTheUsersRig) {
       for (int f : unknown) EXPECT_LT(geodesic_angle(out.rotation(f, j), interp.rotation(f, j)), 1e-6);
     }
   }
+}
+
+// Real files put the floor anywhere (ReActIdle's BVH files read with their
+// feet 0.73 m below zero; climbing keys stand on a structure): the learned
+// methods see the motion on their training data's floor, and the result
+// comes back on the user's.
+TEST(ModelRig, TheModelSeesItsOwnFloorAndTheUserGetsTheirs) {
+  const TaskContext ctx = sample_rig_context();
+  const RigInfo& rig = ctx.model->rig();
+  auto lowest_foot = [&](const Motion& m, int f) {
+    const GlobalPose g = forward_kinematics(m.slice(f, f + 1));
+    double low = 1e9;
+    for (int k = 0; k < rig.num_feet(); ++k) low = std::min(low, g.position(0, rig.foot_joints[k]).y() - rig.foot_heights[k]);
+    return low;
+  };
+  for (const char* name : {"rigify", "cmu"}) {
+    SCOPED_TRACE(name);
+    bench::VariantMotion vm = bench::make_variant(sample(), sample_anatomy(), bench::rig_variant(name));
+    Motion truth = vm.motion;
+    for (Eigen::Vector3d& p : truth.root_positions) p.y() -= 0.73;
+    const int N = truth.num_frames();
+    std::vector<int> known;
+    const int step = static_cast<int>(std::lround(truth.fps / 2));
+    for (int f = 0; f < N - 1; f += step) known.push_back(f);
+    known.push_back(N - 1);
+    const Motion out = complete_on_model_rig(truth, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
+      for (int f : k) EXPECT_NEAR(lowest_foot(in, f), lowest_foot(sample(), f), 0.03) << "frame " << f;
+      return sample();
+    });
+    std::vector<int> unknown;
+    for (int f = 0, i = 0; f < N; ++f)
+      if (i < static_cast<int>(known.size()) && known[i] == f) ++i;
+      else unknown.push_back(f);
+    double err = 0;
+    for (int f : unknown) err += std::abs(out.root_positions[f].y() - truth.root_positions[f].y());
+    EXPECT_LT(err / unknown.size(), 0.02) << "mean root height error, metres";
+  }
+}
+
+// The ground under the keys: the lowest foot at each key, a key in the air not
+// lifting it, linear between keys.
+TEST(GroundLevel, LowestFootUnderTheKeysWithAJumpInBetween) {
+  const RigInfo rig = measure_rig(sample().skeleton, {&sample()});
+  Motion m = sample();
+  const int N = m.num_frames();
+  // A step up of 0.4 m from frame 30 on; frame 15 lifted 0.5 m (a jump).
+  ASSERT_GE(N, 61);
+  for (int f = 30; f < N; ++f) m.root_positions[f].y() += 0.4;
+  m.root_positions[15].y() += 0.5;
+  const std::vector<int> known{0, 15, 45, N - 1};
+  const std::vector<double> near = ground_heights(m, known, rig, 40);
+  ASSERT_EQ(static_cast<int>(near.size()), N);
+  EXPECT_NEAR(near[0], 0.0, 0.03);
+  EXPECT_NEAR(near[15], 0.0, 0.03) << "the jump key is within 40 frames of a key on the floor";
+  EXPECT_NEAR(near[45], 0.4, 0.03);
+  EXPECT_NEAR(near[30], 0.5 * (near[15] + near[45]), 1e-12) << "linear between keys";
+  EXPECT_NEAR(near[N - 1], 0.4, 0.03);
+  const std::vector<double> alone = ground_heights(m, known, rig, 5);
+  EXPECT_NEAR(alone[15], 0.5, 0.05) << "with no key on the floor near it, the jump key stands on its own feet";
+  Motion shifted = m;
+  shift_root_heights(&shifted, near, -1.0);
+  EXPECT_NEAR(shifted.root_positions[N - 1].y(), sample().root_positions[N - 1].y(), 0.03);
 }
 
 TEST(ModelRig, NativeRigAtOtherRatesIsResampledAroundTheModel) {

@@ -344,7 +344,34 @@ double leg_length(const Skeleton& s, const RigParts& p) {
 
 bool rest_pose_is_t_or_a(const Skeleton& s, const RigParts& parts) { return recognise_rest_pose(s, parts).has_value(); }
 
-bool take_rest_pose_frames(const Skeleton& s, const RigParts& parts, RigAnatomy* anatomy) {
+std::array<double, 2> mean_elbow_bend(const Motion& motion, const RigParts& parts, const std::vector<int>& frames) {
+  std::array<double, 2> bend{0.0, 0.0};
+  std::vector<int> listed = frames;
+  if (listed.empty())
+    for (int f = 0; f < motion.num_frames(); ++f) listed.push_back(f);
+  if (listed.empty()) return bend;
+  Motion poses = Motion::identity(motion.skeleton, static_cast<int>(listed.size()), motion.fps);
+  for (size_t i = 0; i < listed.size(); ++i) {
+    if (listed[i] < 0 || listed[i] >= motion.num_frames()) throw InputError("mean_elbow_bend: frame out of range");
+    poses.root_positions[i] = motion.root_positions[listed[i]];
+    for (int j = 0; j < motion.num_joints(); ++j) poses.rotation(static_cast<int>(i), j) = motion.rotation(listed[i], j);
+  }
+  const GlobalPose g = forward_kinematics(poses);
+  for (int s = 0; s < 2; ++s) {
+    const ArmParts& a = parts.arms[s];
+    if (a.upper < 0 || a.fore < 0 || a.hand < 0) continue;
+    for (int f = 0; f < poses.num_frames(); ++f) {
+      const Vector3d u = unit(g.position(f, a.fore) - g.position(f, a.upper));
+      const Vector3d v = unit(g.position(f, a.hand) - g.position(f, a.fore));
+      bend[s] += u.cross(v).norm();
+    }
+    bend[s] /= poses.num_frames();
+  }
+  return bend;
+}
+
+bool take_rest_pose_frames(const Skeleton& s, const RigParts& parts, RigAnatomy* anatomy,
+                           std::array<bool, 2> keep_elbow_frames) {
   const int J = s.num_joints();
   if (static_cast<int>(anatomy->frames.size()) != J || static_cast<int>(anatomy->toe_frames.size()) != J)
     throw InputError("take_rest_pose_frames: the anatomy does not match the skeleton's joints");
@@ -356,6 +383,7 @@ bool take_rest_pose_frames(const Skeleton& s, const RigParts& parts, RigAnatomy*
     for (int j = 0; j < J; ++j) {
       const Rule& r = rules[j];
       if (r.from < 0) continue;
+      if (r.second == Second::Elbow && keep_elbow_frames[r.side]) continue;
       (toes ? anatomy->toe_frames : anatomy->frames)[j] = rest_frame(r, *body);
     }
   }

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <array>
 #include <string>
 #include <vector>
 
@@ -69,7 +70,19 @@ RigAnatomy estimate_anatomy(const Motion& motion, const RigParts& parts, const s
 /// false (nothing changed) for any other rest. The rest pose is one pose the
 /// rig's author chose, where a few frames of motion mix the clip's poses into
 /// the frames (docs/RIGS.md).
-bool take_rest_pose_frames(const Skeleton& skeleton, const RigParts& parts, RigAnatomy* anatomy);
+///
+/// `keep_elbow_frames[side]`: that arm's joints whose second axis is the
+/// elbow's hinge (upper arm, forearm, hand and the joints between them) keep
+/// their frames. A T or A pose does not tell the elbow's hinge (palms down or
+/// forward look the same from the joints' positions), so real rigs need it
+/// measured from bent elbows (mean_elbow_bend()).
+bool take_rest_pose_frames(const Skeleton& skeleton, const RigParts& parts, RigAnatomy* anatomy,
+                           std::array<bool, 2> keep_elbow_frames = {false, false});
+
+/// Per arm (left, right), the mean over `frames` (all when empty) of the sine
+/// of the elbow's bend, from the joints' positions: how much estimate_anatomy()
+/// can measure of that elbow's hinge.
+std::array<double, 2> mean_elbow_bend(const Motion& motion, const RigParts& parts, const std::vector<int>& frames = {});
 /// Whether take_rest_pose_frames reads `skeleton`'s rest pose (a T or A pose).
 bool rest_pose_is_t_or_a(const Skeleton& skeleton, const RigParts& parts);
 

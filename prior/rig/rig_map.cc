@@ -58,6 +58,16 @@ bool is_side_word(const std::string& w, int* side) {
   return false;
 }
 
+// A word that names a body part of one side (as in CMU's ASF names after
+// their one-letter side: "femur", "humerus", "hipjoint").
+bool is_sided_part(const std::string& w) {
+  static const std::set<std::string> parts = {
+      "hipjoint", "femur",   "tibia",  "foot",    "toes",   "toe",   "clavicle", "humerus", "radius",
+      "ulna",     "wrist",   "hand",   "fingers", "thumb",  "thigh", "shin",     "forearm", "upperarm",
+      "shoulder", "collar",  "ankle",  "knee",    "elbow",  "upleg", "shldr",    "uparm",   "loarm"};
+  return parts.count(w) > 0;
+}
+
 // Side and the words without the side.
 int split_side(const std::string& name, std::vector<std::string>* rest) {
   int side = -1;
@@ -71,6 +81,10 @@ int split_side(const std::string& name, std::vector<std::string>* rest) {
     } else if (w.rfind("right", 0) == 0 && w.size() > 5) {
       side = 1;
       rest->push_back(w.substr(5));
+    } else if ((w[0] == 'l' || w[0] == 'r') && is_sided_part(w.substr(1))) {
+      // CMU's ASF names: "lfemur", "rhumerus", "lhipjoint".
+      side = w[0] == 'l' ? 0 : 1;
+      rest->push_back(w.substr(1));
     } else {
       rest->push_back(w);
     }
@@ -111,7 +125,8 @@ Kind classify(const std::string& name, int* side) {
   }
   if (core == "clavicle" || core == "collar" || core == "collarbone" || core == "clav") return Kind::Clavicle;
   if (core == "shoulder") return Kind::Shoulder;
-  if (core == "upperarm" || core == "arm" || core == "uparm" || core == "humerus") return Kind::UpperArm;
+  if (core == "upperarm" || core == "arm" || core == "uparm" || core == "humerus" || core == "shldr")
+    return Kind::UpperArm;
   if (core == "forearm" || core == "lowerarm" || core == "loarm" || core == "elbow" || core == "radius" ||
       core == "ulna")
     return Kind::Fore;
