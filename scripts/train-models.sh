@@ -17,10 +17,10 @@
 # output folder is never models/ unless --replace-shipped is given.
 #
 # --smoke runs every stage for a few steps on a slice of the data (the 17
-# "normal"-style clips of dataset 1, extracted from the archive into the
-# checkpoint folder) and writes small models of the shipped sizes; default
-# checkpoint folder checkpoints/smoke/, default output out/models-smoke/. It is
-# the CTest test train_models_smoke (tests/CMakeLists.txt).
+# "normal"-style clips of dataset 1 from the archive, or a folder's first 30
+# BVH files, copied into the checkpoint folder) and writes models of the
+# shipped sizes; default checkpoint folder checkpoints/smoke/, default output
+# out/models-smoke/. It is the CTest test train_models_smoke (tests/CMakeLists.txt).
 # --fresh deletes the checkpoint folder first. --dry-run prints the commands.
 #
 # Exit codes: 0 done; a failed stage's own (1, or 2 for bad input); 2 bad
@@ -74,7 +74,7 @@ else
 fi
 
 TRAIN=$BUILD/training/motionfield-train
-if [[ ! -f $DATA ]]; then
+if [[ ! -e $DATA ]]; then
   echo "train-models: no training data at $DATA (the Bandai Namco archive, see docs/MODEL_CARD.md): skipped" >&2
   exit 77
 fi
@@ -93,12 +93,19 @@ fi
 DATA_ARGS=(--data "$DATA")
 [[ -n $CACHE ]] && DATA_ARGS+=(--cache-dir "$CACHE")
 if ((SMOKE)); then
-  # The slice: dataset 1's "normal" style, 17 clips (14 training, 3 validation
-  # by the file-name split of prior/data/dataset.h), extracted once.
+  # The slice, made once: of the Bandai Namco archive, dataset 1's "normal"
+  # style (17 clips: 14 training, 3 validation by the file-name split of
+  # prior/data/dataset.h); of a folder, its first 30 BVH files by path.
   SLICE=$CK/data
   if [[ ! -d $SLICE ]] && ((!DRY)); then
     rm -rf "$SLICE.tmp" && mkdir -p "$SLICE.tmp"
-    tar -xJf "$DATA" -C "$SLICE.tmp" --wildcards '*/dataset-1_*_normal_*.bvh'
+    if [[ -d $DATA ]]; then
+      mapfile -t clips < <(find "$DATA" -iname '*.bvh' -type f | LC_ALL=C sort)
+      ((${#clips[@]})) || die "no BVH files in $DATA"
+      cp "${clips[@]:0:30}" "$SLICE.tmp/"
+    else
+      tar -xJf "$DATA" -C "$SLICE.tmp" --wildcards '*/dataset-1_*_normal_*.bvh'
+    fi
     mv "$SLICE.tmp" "$SLICE"
   fi
   DATA_ARGS=(--data "$SLICE" --cache-dir "$CK/cache")
