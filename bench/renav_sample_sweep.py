@@ -2,7 +2,7 @@
 
 The sample (samples/walk_keyframes.bvh) is re-navigated with the default model along
 straight paths along +x at 30 fps, one per speed; prints the mean and end distance (m)
-of the output's root from its path point (docs/BENCHMARKS.md, "Session 21").
+of the output's root from its path point (docs/BENCHMARKS.md, "Re-navigation").
 
     PYTHONPATH=python python3 bench/renav_sample_sweep.py [SPEED ...]
 """

@@ -121,7 +121,7 @@ enum class Penalty { Squared, Absolute };
 
 /// Weights of the energy terms (see the top of this file for each term's
 /// definition and unit). Defaults were chosen by measurement (docs/BENCHMARKS.md,
-/// "Latent solvers"; the rotation weight in "Session 14").
+/// "Energy weights").
 struct EnergyWeights {
   double rotation = 5.0;
   double position = 10.0;

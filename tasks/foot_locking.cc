@@ -74,7 +74,7 @@ Eigen::Vector3d lock_point(const GlobalPose& pose, int ankle, const std::vector<
 // distance to the lock point on its first frame: 0.27 m at once for a foot
 // 34 cm from the contact's mean three frames before it (the Blender add-on's
 // test); the squared weights start small and still hold the foot near the
-// contact (docs/BENCHMARKS.md, "Session 32"). A `fixed` frame (one the lock
+// contact (docs/BENCHMARKS.md, "Foot locking"). A `fixed` frame (one the lock
 // must not touch) within a ramp shortens it to start there from zero, so the
 // first free frame next to a key is not moved most of the way at once.
 void contact_goals(const GlobalPose& pose, int ankle, const std::vector<char>& on, const std::vector<char>& known,

@@ -263,7 +263,7 @@ SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const Mo
   window_ctx.window_count = static_cast<int>(plan.size());
   for (const WindowPlan& w : plan) {
     // A short window's tensors are too small for a second thread to pay; its
-    // operators' parallel regions would only cost (docs/BENCHMARKS.md, "Session 33").
+    // operators' parallel regions would only cost (docs/BENCHMARKS.md, "Threads").
     const ScopedComputeThreads threads(w.length < kNemfParallelFrames ? 1 : 0);
     window_ctx.window = static_cast<int>(&w - plan.data());
     const Motion src = window_source(input, out.motion, w);

@@ -21,7 +21,7 @@ namespace {
 // spline, with the prior's weight growing with the distance between input
 // frames: clamp((log2 r - 1) / 2, 0, 1), i.e. 0 at r = 2 (the spline alone,
 // no solve), 0.5 at r = 4, 1 at r = 8 and beyond. Chosen on the training split
-// (docs/BENCHMARKS.md, "Session 12: resampling"): at r = 2 the spline's error
+// (docs/BENCHMARKS.md, "Resampling"): at r = 2 the spline's error
 // is below the prior's reconstruction error and every prior weight loses (L2P
 // 0.071 / 0.077 / 0.097 at 0 / 0.25 / 0.5); at r = 4 the blend wins (0.335 /
 // 0.267 / 0.292 at 0 / 0.5 / 1); at r = 8 the solution alone does (1.348 /
@@ -58,7 +58,7 @@ bool upsample_by_solving(const Motion& in, double fps, int frames, const TaskCon
 // Input rates in any other ratio to the model's (24 -> 30, 30 -> 60, 30 ->
 // 24, 12 -> 30, ...) have no model frames to solve at. Measured at whole ratios
 // r = model fps / input fps with the path forced (training split, 100 windows,
-// L2P; docs/BENCHMARKS.md, "Session 13"), the
+// L2P; docs/BENCHMARKS.md, "Resampling with the prior"), the
 // encode / decode with the residual loses to the spline up to r = 6 (r = 2: 0.193
 // against 0.071; 4: 0.502 against 0.335; 6: 0.899 against 0.813), ties at 7
 // (0.987 / 0.976) and wins at 8 (1.226 / 1.348). So the spline serves inputs up

@@ -114,7 +114,7 @@ class NemfModel;
 // ---------------------------------------------------------------- the energy
 
 struct RenavWeights {
-  /// 2 since session 25: at 1 a path turned from the reference's own direction
+  /// 2: at 1 a path turned from the reference's own direction
   /// could be traded for a slower walk (docs/BENCHMARKS.md, "Re-navigation").
   double path = 2.0;
   double joints = 0.5;
@@ -233,7 +233,7 @@ constexpr double kMinPace = 0.5, kMaxPace = 2.0;
 /// has one point. (Matching the distance the reference covers over the
 /// compared frames instead also re-timed references whose start is slower or
 /// faster than their mean, at no gain in path error: docs/BENCHMARKS.md,
-/// "Session 21".)
+/// "Re-navigation".)
 double reference_pace(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double path_fps);
 
 /// The options of the methods "nemf" (L-BFGS) and "nemf-adam".

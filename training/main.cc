@@ -80,7 +80,7 @@ void add_run_options(CLI::App& cmd, Options& o, RunArgs& run) {
   cmd.add_option("--seed", o.seed, "random seed");
   cmd.add_option("--threads", o.threads,
                  "torch intra-op threads (1 when anything else runs: 30 steps took 1.4x less time on 2 threads than "
-                 "on 1 on an idle machine, 3.4x more with one busy process; docs/BENCHMARKS.md, \"Session 34\")");
+                 "on 1 on an idle machine, 3.4x more with one busy process; docs/BENCHMARKS.md, \"Threads\")");
   cmd.add_option("--max-train-clips", o.max_train_clips, "use at most N training clips (0 = all)");
   cmd.add_flag("--mirror", o.augmentation.mirror,
                "also train on every training clip's left/right mirror (doubles the data; give it again on --resume)");

@@ -84,7 +84,7 @@ void add_method(CLI::App* cmd, BatchJob& job,
   cmd->add_option("--max-iterations", job.max_iterations,
                   "iteration budget of the iterative methods per window (the\nlatent solvers' full-energy stage, "
                   "prior resampling,\nre-navigation); 0, the default, is each method's own.\nFewer are faster and "
-                  "rougher (0..100000; docs/BENCHMARKS.md, Session 34)")
+                  "rougher (0..100000; docs/BENCHMARKS.md, Iteration caps)")
       ->type_name("N")
       ->check(quiet(CLI::Range(0, 100000)));
 }

@@ -98,9 +98,9 @@ void print_outcome(const Outcome& o, size_t line, const Settings& settings) {
 }
 
 // --jobs, else one job per core's worth of --threads: jobs side by side use
-// the cores better than threads inside one job (docs/BENCHMARKS.md, "Session
-// 12"; a 128-frame solve is only 10-20 % faster on two threads, "Session 33",
-// and far slower when the cores are busy, "Session 34").
+// the cores better than threads inside one job (docs/BENCHMARKS.md, "Threads":
+// a 128-frame solve is only 3-20 % faster on two threads of an idle machine,
+// and far slower when the cores are busy).
 // At most 8 by default: every job holds its own solver's tensors.
 int batch_workers(const Settings& settings) {
   if (settings.jobs > 0) return settings.jobs;

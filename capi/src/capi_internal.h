@@ -188,7 +188,7 @@ TaskContext task_context(const mf_model* model, const mf_task_options& options);
 /// calling thread only (the process's libtorch setting untouched). More than
 /// one is a choice the caller makes: libtorch's OpenMP threads spin while they
 /// wait, and on a machine where another process holds a core a solve on two
-/// threads took 25-40x as long as on one (docs/BENCHMARKS.md, "Session 34").
+/// threads took 25-40x as long as on one (docs/BENCHMARKS.md, "Threads").
 class TaskThreads {
  public:
   TaskThreads();

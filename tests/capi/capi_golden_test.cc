@@ -43,8 +43,8 @@ struct GoldenCase {
 // The networks alone: measured differences up to 5e-6 element by element.
 constexpr double kNetworkTolerance = 1e-4;
 // Outputs of the prior's solver, whose iterations amplify rounding: measured
-// differences up to 8.0e-3 in the sketches across BLAS kernel sets (session 27's
-// two-stage start; 2.7e-2 element by element with the session-18 prior), while
+// differences up to 8.0e-3 in the sketches across BLAS kernel sets (the shipped
+// two-stage start; 2.7e-2 element by element with an earlier prior), while
 // replacing the prior or the two-stage model by another fine-tune moves the
 // largest entry of each case by 1.3e-2 to 1.8e-2.
 constexpr double kSolverTolerance = 1e-2;
