@@ -287,6 +287,52 @@ TEST(Retarget, VariantsRetargetToTheOriginal) {
   }
 }
 
+// Rigs without hands (ReActIdle's: the forearm is the arm's last joint, the
+// wrist its End Site) map shoulder, upper arm and forearm to the model's, not
+// one bone further down the arm, and retarget with the forearm continuing the
+// upper arm at rest.
+TEST(Retarget, ArmsWithoutHandsMapAndRetarget) {
+  const Motion& full = sample();
+  std::vector<int> kept;
+  for (int j = 0; j < full.num_joints(); ++j)
+    if (full.skeleton.names[j].rfind("Hand_", 0) != 0) kept.push_back(j);
+  Skeleton s;
+  std::vector<int> index(full.num_joints(), -1);
+  for (int j : kept) {
+    index[j] = static_cast<int>(s.names.size());
+    s.names.push_back(full.skeleton.names[j]);
+    s.parents.push_back(full.skeleton.parents[j] < 0 ? -1 : index[full.skeleton.parents[j]]);
+    s.offsets.push_back(full.skeleton.offsets[j]);
+  }
+  s.validate();
+  Motion handless = Motion::identity(s, full.num_frames(), full.fps);
+  for (int f = 0; f < full.num_frames(); ++f) {
+    handless.root_positions[f] = full.root_positions[f];
+    for (int j : kept) handless.rotation(f, index[j]) = full.rotation(f, j);
+  }
+  const RigParts parts = find_rig_parts(s);
+  EXPECT_TRUE(parts.missing().empty());
+  for (int side = 0; side < 2; ++side) {
+    const char* suffix = side == 0 ? "_L" : "_R";
+    EXPECT_EQ(s.names[parts.arms[side].upper], std::string("UpperArm") + suffix);
+    EXPECT_EQ(s.names[parts.arms[side].fore], std::string("LowerArm") + suffix);
+    EXPECT_EQ(parts.arms[side].hand, -1);
+    EXPECT_TRUE(parts.arms[side].hand_is_end);
+  }
+  RigMap map = map_rig(s, full.skeleton);
+  EXPECT_EQ(map.user_of_model[full.skeleton.find("LowerArm_L")], s.find("LowerArm_L"));
+  EXPECT_EQ(map.user_of_model[full.skeleton.find("Hand_L")], -1);
+  const Retargeter r(s, full.skeleton, map, estimate_anatomy(handless, map.user_parts), sample_anatomy());
+  const Motion on_model = r.to_model(handless);
+  for (const char* j : {"UpperArm_L", "LowerArm_L", "UpperArm_R", "LowerArm_R", "Shoulder_L", "Chest"}) {
+    const int m = full.skeleton.find(j);
+    double worst = 0;
+    for (int f = 0; f < full.num_frames(); ++f)
+      worst = std::max(worst, geodesic_angle(on_model.rotation(f, m).normalized(), full.rotation(f, m).normalized()));
+    EXPECT_LT(worst * 180 / M_PI, 1.0) << j;
+  }
+}
+
 // A rig whose rest pose is a T or A pose gives every part's frame from that
 // pose: a few frames then give the anatomy the whole motion gives,
 // where the cues of the motion alone do not. Random local frames and the

@@ -29,6 +29,10 @@ struct Rule {
   int from = -1, to = -1;
   Second second = Second::HipLateral;
   int side = 0;
+  /// A forearm without a hand joint (ArmParts::hand_is_end): `to` is `from`
+  /// and the first axis is the joint's own rest offset, the forearm continuing
+  /// the upper arm in the rest pose.
+  bool along_offset = false;
 };
 
 // The rule of every part joint; toe_rules: the feet measured along the toes.
@@ -47,6 +51,7 @@ std::vector<Rule> part_rules(const RigParts& p, int joints, bool along_toes) {
     set(a.shoulder, a.shoulder, a.upper, Second::Up);
     set(a.upper, a.upper, a.fore, Second::Elbow, s);
     set(a.fore, a.fore, a.hand, Second::Elbow, s);
+    if (a.hand < 0 && a.hand_is_end && a.fore >= 0) r[a.fore] = {a.fore, a.fore, Second::Elbow, s, true};
     set(a.hand, a.fore, a.hand, Second::Elbow, s);
     const LegParts& l = p.legs[s];
     set(l.thigh, l.thigh, l.shin, Second::Knee, s);
@@ -95,7 +100,13 @@ std::vector<Vector3d> rest_positions(const Skeleton& s) {
 struct Pose {
   const GlobalPose& g;
   int f;
+  const Skeleton& s;
   Vector3d p(int j) const { return g.position(f, j); }
+  // The wrist: the hand joint's position, or for an arm without one the
+  // forearm's end along its rest offset (ArmParts::hand_is_end).
+  Vector3d wrist(const ArmParts& a) const {
+    return a.hand >= 0 ? p(a.hand) : p(a.fore) + g.rotation(f, a.fore) * s.offsets[a.fore];
+  }
 };
 
 Vector3d second_axis(const Rule& r, const RigParts& parts, const Pose& pose) {
@@ -113,7 +124,7 @@ Vector3d second_axis(const Rule& r, const RigParts& parts, const Pose& pose) {
     }
     case Second::Elbow: {
       const ArmParts& a = parts.arms[r.side];
-      const Vector3d u = unit(pose.p(a.fore) - pose.p(a.upper)), v = unit(pose.p(a.hand) - pose.p(a.fore));
+      const Vector3d u = unit(pose.p(a.fore) - pose.p(a.upper)), v = unit(pose.wrist(a) - pose.p(a.fore));
       return u.cross(v) - 0.02 * arm_lat;  // elbows bend forwards: the hinge points right
     }
   }
@@ -144,6 +155,7 @@ Quaterniond frame_from(Vector3d first, Vector3d second) {
 // The body's directions in a rest pose recognised as a T or A pose.
 struct RestBody {
   std::vector<Vector3d> p;  // rest positions
+  std::vector<Vector3d> offsets;
   Vector3d up, left, forward;
 };
 
@@ -155,6 +167,7 @@ std::optional<RestBody> recognise_rest_pose(const Skeleton& s, const RigParts& p
   if (!parts.missing().empty()) return std::nullopt;
   RestBody b;
   b.p = rest_positions(s);
+  b.offsets = s.offsets;
   const auto dir = [&](int from, int to) { return unit(b.p[to] - b.p[from]); };
   // Rest poses stand along an axis of the file: that axis is up (the line from
   // the hips to the head leans with the spine's curve).
@@ -173,7 +186,7 @@ std::optional<RestBody> recognise_rest_pose(const Skeleton& s, const RigParts& p
     if (!near(dir(l.thigh, l.foot), -b.up, 25)) return std::nullopt;
     if (l.toe >= 0 && dir(l.foot, l.toe).dot(b.forward) < 0.3) return std::nullopt;
     const ArmParts& a = parts.arms[side];
-    const Vector3d upper = dir(a.upper, a.fore), fore = dir(a.fore, a.hand);
+    const Vector3d upper = dir(a.upper, a.fore), fore = a.hand >= 0 ? dir(a.fore, a.hand) : upper;
     const Vector3d out = side == 0 ? b.left : Vector3d(-b.left);
     // Straight arms out to the side, between 60 degrees below horizontal and 20 above.
     if (!near(upper, fore, 30) || !near(upper, out, 65) || std::abs(upper.dot(b.forward)) > 0.5 ||
@@ -193,7 +206,7 @@ Quaterniond rest_frame(const Rule& r, const RestBody& b) {
     case Second::Up: return frame_from(b.p[r.to] - b.p[r.from], b.up);
     case Second::Knee: return frame_from(b.p[r.to] - b.p[r.from], b.left);
     case Second::Elbow: {
-      const Vector3d first = unit(b.p[r.to] - b.p[r.from]);
+      const Vector3d first = unit(r.along_offset ? b.offsets[r.from] : Vector3d(b.p[r.to] - b.p[r.from]));
       return frame_from(first, first.cross(b.forward));
     }
   }
@@ -207,12 +220,12 @@ std::vector<Quaterniond> estimate_frames(const Motion& motion, const GlobalPose&
   add_between_rules(motion.skeleton, parts, &rules);
   std::vector<Vector3d> first(J, Vector3d::Zero()), second(J, Vector3d::Zero());
   for (int f : frames) {
-    const Pose pose{g, f};
+    const Pose pose{g, f, motion.skeleton};
     for (int j = 0; j < J; ++j) {
       const Rule& r = rules[j];
       if (r.from < 0) continue;
       const Quaterniond inv = g.rotation(f, j).conjugate();
-      first[j] += inv * unit(pose.p(r.to) - pose.p(r.from));
+      first[j] += r.along_offset ? unit(motion.skeleton.offsets[r.from]) : Vector3d(inv * unit(pose.p(r.to) - pose.p(r.from)));
       second[j] += inv * second_axis(r, parts, pose);
     }
   }
@@ -359,10 +372,11 @@ std::array<double, 2> mean_elbow_bend(const Motion& motion, const RigParts& part
   const GlobalPose g = forward_kinematics(poses);
   for (int s = 0; s < 2; ++s) {
     const ArmParts& a = parts.arms[s];
-    if (a.upper < 0 || a.fore < 0 || a.hand < 0) continue;
+    if (a.upper < 0 || a.fore < 0 || (a.hand < 0 && !a.hand_is_end)) continue;
     for (int f = 0; f < poses.num_frames(); ++f) {
-      const Vector3d u = unit(g.position(f, a.fore) - g.position(f, a.upper));
-      const Vector3d v = unit(g.position(f, a.hand) - g.position(f, a.fore));
+      const Pose pose{g, f, motion.skeleton};
+      const Vector3d u = unit(pose.p(a.fore) - pose.p(a.upper));
+      const Vector3d v = unit(pose.wrist(a) - pose.p(a.fore));
       bend[s] += u.cross(v).norm();
     }
     bend[s] /= poses.num_frames();

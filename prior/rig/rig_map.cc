@@ -325,6 +325,11 @@ struct PartFinder {
     for (int side = 0; side < 2; ++side) {
       ArmParts& a = p.arms[side];
       if (a.upper >= 0 && a.fore >= 0 && a.hand >= 0) continue;
+      // Named upper arm and forearm, the forearm a leaf: a rig without hands.
+      if (a.upper >= 0 && a.fore >= 0 && a.hand < 0 && t.kids[a.fore].empty()) {
+        a.hand_is_end = true;
+        continue;
+      }
       const int root = largest_child(p.chest, side);
       if (root < 0) continue;
       std::vector<int> chain;
@@ -405,7 +410,7 @@ std::vector<std::string> RigParts::missing() const {
     const std::string side = side_name(s);
     if (arms[s].upper < 0) m.push_back(side + " upper arm");
     if (arms[s].fore < 0) m.push_back(side + " forearm");
-    if (arms[s].hand < 0) m.push_back(side + " hand");
+    if (arms[s].hand < 0 && !arms[s].hand_is_end) m.push_back(side + " hand");
     if (legs[s].thigh < 0) m.push_back(side + " thigh");
     if (legs[s].shin < 0) m.push_back(side + " shin");
     if (legs[s].foot < 0) m.push_back(side + " foot");
@@ -422,7 +427,7 @@ std::string RigParts::part_of(int joint) const {
 namespace {
 
 // The user's parts as `user_of_model` assigns them through the model's parts.
-RigParts induced_parts(const RigParts& model, const std::vector<int>& user_of_model) {
+RigParts induced_parts(const RigParts& model, const std::vector<int>& user_of_model, const RigParts& user) {
   auto u = [&](int m) { return m < 0 ? -1 : user_of_model[m]; };
   RigParts p;
   p.hips = u(model.hips);
@@ -431,6 +436,7 @@ RigParts induced_parts(const RigParts& model, const std::vector<int>& user_of_mo
   p.chest = u(model.chest), p.neck = u(model.neck), p.head = u(model.head);
   for (int s = 0; s < 2; ++s) {
     p.arms[s] = {u(model.arms[s].shoulder), u(model.arms[s].upper), u(model.arms[s].fore), u(model.arms[s].hand)};
+    p.arms[s].hand_is_end = p.arms[s].hand < 0 && user.arms[s].hand_is_end && p.arms[s].fore == user.arms[s].fore;
     p.legs[s] = {u(model.legs[s].thigh), u(model.legs[s].shin), u(model.legs[s].foot), u(model.legs[s].toe)};
   }
   return p;
@@ -531,7 +537,7 @@ void check_map(const Skeleton& user, const Skeleton& model, RigMap* out) {
   const RigParts up = find_rig_parts(user);
   // Parts implied by the (possibly edited) map must make a humanoid whose
   // joints nest like the model's.
-  map.user_parts = induced_parts(map.model_parts, map.user_of_model);
+  map.user_parts = induced_parts(map.model_parts, map.user_of_model, up);
   const std::vector<std::string> missing = map.user_parts.missing();
   if (!missing.empty()) {
     std::string m;

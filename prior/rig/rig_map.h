@@ -31,6 +31,11 @@ namespace mf {
 /// The joints of one side's limbs; -1 where absent.
 struct ArmParts {
   int shoulder = -1, upper = -1, fore = -1, hand = -1;
+  /// No hand joint: the forearm is the chain's last joint and the wrist is
+  /// its BVH End Site (rigs without hands, such as ReActIdle's). The
+  /// retargeter then takes the forearm to continue the upper arm in the rest
+  /// pose (a straight elbow there, as in T and A poses).
+  bool hand_is_end = false;
 };
 struct LegParts {
   int thigh = -1, shin = -1, foot = -1, toe = -1;
