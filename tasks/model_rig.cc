@@ -222,11 +222,7 @@ Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, 
   const Skeleton& model = require_prior(ctx, "this method").rig().skeleton;
   check_model_rig(input.skeleton, ctx);
   RigMap map = model_rig_map(input.skeleton, ctx);
-  RigAnatomy user = estimate_anatomy(input, map.user_parts, known);
-  // Elbows bent enough in the frames read tell their hinge better than a rest pose can.
-  const std::array<double, 2> bend = mean_elbow_bend(input, map.user_parts, known);
-  constexpr double kMinBend = 0.15;  // mean sine of the bend: about 9 degrees
-  take_rest_pose_frames(input.skeleton, map.user_parts, &user, {bend[0] >= kMinBend, bend[1] >= kMinBend});
+  RigAnatomy user = user_rig_anatomy(input, map.user_parts, known);
   return Retargeter(input.skeleton, model, std::move(map), std::move(user), *ctx.model_anatomy);
 }
 

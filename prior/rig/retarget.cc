@@ -404,6 +404,14 @@ bool take_rest_pose_frames(const Skeleton& s, const RigParts& parts, RigAnatomy*
   return true;
 }
 
+RigAnatomy user_rig_anatomy(const Motion& motion, const RigParts& parts, const std::vector<int>& frames) {
+  RigAnatomy anatomy = estimate_anatomy(motion, parts, frames);
+  constexpr double kMinBend = 0.15;  // mean sine of the elbow's bend: about 9 degrees
+  const std::array<double, 2> bend = mean_elbow_bend(motion, parts, frames);
+  take_rest_pose_frames(motion.skeleton, parts, &anatomy, {bend[0] >= kMinBend, bend[1] >= kMinBend});
+  return anatomy;
+}
+
 RigAnatomy estimate_anatomy(const Motion& motion, const RigParts& parts, const std::vector<int>& frames_in) {
   const std::vector<std::string> missing = parts.missing();
   if (!missing.empty()) throw InputError("cannot measure the rig's anatomy: no " + missing.front());

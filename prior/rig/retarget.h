@@ -86,6 +86,13 @@ std::array<double, 2> mean_elbow_bend(const Motion& motion, const RigParts& part
 /// Whether take_rest_pose_frames reads `skeleton`'s rest pose (a T or A pose).
 bool rest_pose_is_t_or_a(const Skeleton& skeleton, const RigParts& parts);
 
+/// The anatomy of a user's rig for retargeting its motion: estimate_anatomy()
+/// on the frames `frames` (all when empty), then the rest pose's frames when
+/// it is a T or A pose (take_rest_pose_frames()), except for an arm whose
+/// elbow is bent on average by more than about 9 degrees in those frames
+/// (mean_elbow_bend() at least 0.15), whose measured hinge is kept.
+RigAnatomy user_rig_anatomy(const Motion& motion, const RigParts& parts, const std::vector<int>& frames = {});
+
 /// Fills anatomy->locked_axes from `motion` (mean_local must be set, e.g. by
 /// estimate_anatomy on the same motion): per joint, the principal directions
 /// of its local rotations about mean_local whose standard deviation is below
