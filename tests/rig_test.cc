@@ -4,9 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <limits>
 
+#include "bench/foreign_data.h"
 #include "bench/synthetic_rigs.h"
+#include "prior/data/dataset.h"
+#include "prior/model/model_file.h"
+#include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/motion_bvh.h"
 #include "prior/motion/rotations.h"
@@ -618,6 +623,31 @@ TEST(GroundLevel, LowestFootUnderTheKeysWithAJumpInBetween) {
   Motion shifted = m;
   shift_root_heights(&shifted, near, -1.0);
   EXPECT_NEAR(shifted.root_positions[N - 1].y(), sample().root_positions[N - 1].y(), 0.03);
+}
+
+// Every file of the foreign capture (real CMU and ReActIdle files on five rig
+// conventions) maps onto the shipped model's rig, by names where they have them.
+TEST(ModelRig, EveryFileOfTheForeignCaptureMapsOntoTheModel) {
+  const std::string archive = default_foreign_archive();
+  if (!std::filesystem::exists(archive)) GTEST_SKIP() << archive << " is not there";
+  const std::string model_path = std::string(MF_SOURCE_DIR) + "/models/motionfield-prior.mfm";
+  TaskContext ctx;
+  auto model = std::make_shared<const NemfModel>(load_nemf(model_path));
+  ctx.model = model;
+  ctx.model_anatomy = load_rig_anatomy_next_to(model_path, model->rig().skeleton);
+  ASSERT_TRUE(ctx.model_anatomy);
+  const bench::ForeignData data = bench::load_foreign_data(archive, default_cache_dir(), 30.0, false);
+  EXPECT_GE(data.train.size() + data.validation.size(), 62u);
+  for (const auto* split : {&data.train, &data.validation})
+    for (const bench::ForeignClip& c : *split) {
+      SCOPED_TRACE(c.clip.name);
+      RigMap map;
+      ASSERT_NO_THROW(map = model_rig_map(c.clip.motion.skeleton, ctx));
+      const Skeleton& m = model->rig().skeleton;
+      for (const char* j : {"Hips", "Chest", "Head", "UpperArm_L", "LowerArm_R", "UpperLeg_L", "Foot_R"})
+        EXPECT_GE(map.user_of_model[m.find(j)], 0) << j;
+      EXPECT_NO_THROW(model_retargeter(c.clip.motion, {}, ctx));
+    }
 }
 
 TEST(ModelRig, NativeRigAtOtherRatesIsResampledAroundTheModel) {
