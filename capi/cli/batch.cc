@@ -5,12 +5,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <map>
 #include <mutex>
 #include <sstream>
 #include <string>
-#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -34,28 +31,6 @@ std::vector<std::string> read_lines(const std::string& path) {
   return lines;
 }
 
-// The outputs of the batch's jobs so far: a job may not write what an earlier
-// line writes (the later result would silently replace the earlier one).
-class Outputs {
- public:
-  // Claims `out` for `line`; InputError naming the earlier line if it is taken.
-  void claim(const std::string& out, size_t line) {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    // Devices and FIFOs (/dev/null) may be written by every job.
-    if (fs::exists(out, ec) && !fs::is_regular_file(out, ec)) return;
-    fs::path key = fs::weakly_canonical(fs::absolute(out, ec), ec);
-    if (ec) key = fs::absolute(out).lexically_normal();
-    const auto [it, added] = lines_.emplace(key.string(), line);
-    if (!added)
-      throw InputError("line " + std::to_string(it->second) + " already writes " + out +
-                       ": refusing to overwrite another job's output (give each job its own \"out\")");
-  }
-
- private:
-  std::map<std::string, size_t> lines_;
-};
-
 // The job of one line; `label` gains the job's id once the line parses.
 BatchJob parse_line(const std::string& line, std::string* label) {
   JsonValue value;
@@ -76,6 +51,7 @@ BatchJob parse_line(const std::string& line, std::string* label) {
 struct Outcome {
   std::string label;
   BatchJob job;
+  OutputSet files;  ///< the job's files, checked (prepare_job)
   bool ok = false;
   JobReport report;
   Failure failure;
@@ -98,9 +74,10 @@ void print_outcome(const Outcome& o, size_t line, const Settings& settings) {
 }
 
 // --jobs, else one job per core's worth of --threads: jobs side by side use
-// the cores better than threads inside one job (docs/BENCHMARKS.md, "Session
-// 12"; a 128-frame solve is only 10-20 % faster on two threads, "Session 33",
-// and far slower when the cores are busy, "Session 34").
+// the cores better than threads inside one job (docs/BENCHMARKS.md, "one
+// thread per job"; a 128-frame solve is only 10-20 % faster on two threads,
+// "our parallel loops were serial", and far slower when the cores are busy,
+// "two threads are 25-40x slower on a busy machine").
 // At most 8 by default: every job holds its own solver's tensors.
 int batch_workers(const Settings& settings) {
   if (settings.jobs > 0) return settings.jobs;
@@ -117,13 +94,15 @@ int command_batch(const std::string& path, const Settings& settings) {
   const int workers = batch_workers(settings);
   if (settings.verbose) std::fprintf(stderr, "motionfield: batch: %d job%s at once\n", workers, workers == 1 ? "" : "s");
 
-  // Every line parsed and its output claimed first, in line order (so that
-  // which of two jobs writing one file is refused does not depend on timing);
-  // the model a job needs is loaded here too, once, before any worker runs.
+  // Every line parsed and its files checked first, in line order, against
+  // its own and every earlier line's (so that which of two jobs writing one
+  // file, or writing what another reads, is refused does not depend on
+  // timing); the model a job needs is loaded here too, once, before any
+  // worker runs.
   std::vector<size_t> line_of;
   std::vector<Outcome> outcomes;
   std::vector<char> runnable;
-  Outputs outputs;
+  OutputSet batch_files = OutputSet::create();
   for (size_t i = 0; i < lines.size(); ++i) {
     if (blank(lines[i])) continue;
     Outcome o;
@@ -131,7 +110,8 @@ int command_batch(const std::string& path, const Settings& settings) {
     bool ready = false;
     try {
       o.job = parse_line(lines[i], &o.label);
-      outputs.claim(o.job.out, i + 1);
+      o.files = prepare_job(o.job, settings);
+      batch_files.merge(o.files, "line " + std::to_string(i + 1));
       if (workers > 1) models.for_method(o.job.task == "renav" && o.job.method.empty() ? "nemf" : o.job.method);
       ready = true;
     } catch (...) {
@@ -147,7 +127,7 @@ int command_batch(const std::string& path, const Settings& settings) {
   const auto run = [&](size_t k, ProgressLine& line) {
     if (!runnable[k]) return;
     try {
-      outcomes[k].report = run_job(outcomes[k].job, settings, models, line);
+      outcomes[k].report = run_job(outcomes[k].job, std::move(outcomes[k].files), settings, models, line);
       outcomes[k].ok = true;
     } catch (...) {
       outcomes[k].failure = current_failure();
