@@ -707,6 +707,8 @@ inline Solution solve(const Model& model, const Motion& input, const Constraints
 /// commit(); destroyed uncommitted, it leaves no output behind.
 class OutputSet : public detail::Handle<mf_output_set, mf_output_set_destroy> {
  public:
+  using Handle::Handle;  // OutputSet() is no set; create() makes one
+
   /// An empty set (mf_output_set_create).
   static OutputSet create() {
     mf_output_set* out = nullptr;
@@ -729,9 +731,6 @@ class OutputSet : public detail::Handle<mf_output_set, mf_output_set_destroy> {
   void write(const std::string& path, const std::string& text) { write(path, text.data(), text.size()); }
   void write(const std::string& path, const std::vector<uint8_t>& bytes) { write(path, bytes.data(), bytes.size()); }
   void commit() { check(mf_output_set_commit(get())); }
-
- private:
-  explicit OutputSet(mf_output_set* set) : Handle(set) {}
 };
 
 }  // namespace motionfield
