@@ -290,6 +290,65 @@ TEST(CApiOutputs, RandomJobsEitherAreRefusedOrWriteEveryOutput) {
   EXPECT_GT(written, 50);
 }
 
+// Property: random batches of jobs over overlapping names. A job is refused
+// exactly when its own files clash (an output twice, an output that is its
+// input) or, at the merge, when it writes a file an earlier accepted job
+// reads or writes, or reads one an earlier job writes; devices never clash.
+TEST(CApiOutputs, RandomBatchesGiveEachWrittenFileToOneJob) {
+  ScratchDir d;
+  write_text(d / "a.bvh", "a");
+  write_text(d / "b.bvh", "b");
+  fs::create_hard_link(d / "a.bvh", d / "h.bvh");
+  fs::create_symlink("c.bvh", d / "l.bvh");
+  fs::create_directories(d / "sub");
+  // Each name and the file it is ("" for a device).
+  const std::vector<std::pair<std::string, std::string>> names = {
+      {d / "a.bvh", "a"}, {d / "h.bvh", "a"},      {d / "b.bvh", "b"},   {d / "sub/../b.bvh", "b"},
+      {d / "c.bvh", "c"}, {d.path + "/./c.bvh", "c"}, {d / "l.bvh", "c"}, {d / "e.json", "e"},
+      {"/dev/null", ""}};
+  std::mt19937 random(5252);
+  int merged = 0, refused_by_job = 0, refused_by_batch = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const SetPtr batch = make_set();
+    std::set<std::string> written, read;
+    for (int line = 1; line <= 5; ++line) {
+      const SetPtr job = make_set();
+      const auto& [in, in_file] = names[random() % names.size()];
+      ASSERT_EQ(mf_output_set_add_input(job.get(), in.c_str(), "input"), MF_OK);
+      std::set<std::string> outs;
+      bool job_ok = true, clash = false;
+      const int count = 1 + static_cast<int>(random() % 3);
+      for (int k = 0; k < count && job_ok; ++k) {
+        const auto& [out, file] = names[random() % names.size()];
+        const bool expected_ok = file.empty() || (file != in_file && outs.count(file) == 0);
+        job_ok = mf_output_set_add_output(job.get(), out.c_str(), "output") == MF_OK;
+        ASSERT_EQ(job_ok, expected_ok) << out << ": " << mf_last_error_message();
+        if (!file.empty()) outs.insert(file);
+      }
+      if (!job_ok) {
+        ++refused_by_job;
+        continue;
+      }
+      for (const std::string& f : outs) clash = clash || written.count(f) || read.count(f);
+      clash = clash || (!in_file.empty() && written.count(in_file));
+      const std::string label = "line " + std::to_string(line);
+      const int status = mf_output_set_merge(batch.get(), job.get(), label.c_str());
+      ASSERT_EQ(status, clash ? MF_ERROR_INVALID_ARGUMENT : MF_OK) << "trial " << trial << " " << label << ": "
+                                                                   << mf_last_error_message();
+      if (clash) {
+        ++refused_by_batch;
+        continue;
+      }
+      ++merged;
+      written.insert(outs.begin(), outs.end());
+      if (!in_file.empty()) read.insert(in_file);
+    }
+  }
+  EXPECT_GT(merged, 100);
+  EXPECT_GT(refused_by_job, 50);
+  EXPECT_GT(refused_by_batch, 100);
+}
+
 // Strict readers: a duplicate key is refused with the key and the place.
 TEST(CApiOutputs, ConstraintsWithADuplicateKeyAreRefused) {
   mf_constraints* c = nullptr;
