@@ -118,6 +118,7 @@ constexpr size_t kMaxBvhFileBytes = 512 * kMiB;    ///< BVH: an hour at 120 fps 
 constexpr size_t kMaxModelFileBytes = 2048 * kMiB; ///< model files (.mfm)
 constexpr size_t kMaxTextFileBytes = 64 * kMiB;    ///< path CSVs, rig anatomy
 constexpr size_t kMaxRigMapFileBytes = 1 * kMiB;   ///< rig map files
+constexpr size_t kMaxConstraintsFileBytes = 16 * kMiB;  ///< constraints files (mf_constraints_load_json)
 
 /// Reads a whole file of at most `max_bytes`. Throws FileError
 /// "cannot read the <what> <path>: <reason>" when it cannot be opened or read,
