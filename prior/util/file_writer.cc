@@ -36,18 +36,20 @@ int write_all(int fd, const char* data, size_t size) {
   return 0;
 }
 
-// Names under /dev and /proc stand for open files and devices (/dev/stdout,
-// /proc/self/fd/1): written in place whatever they lead to, never replaced.
-bool names_a_handle(const std::string& path) {
+// Names of open file descriptors (/dev/stdout, /dev/fd/N, /proc/self/fd/N):
+// written in place whatever they lead to (a terminal, a pipe, the file the
+// shell redirected to), never replaced by a rename.
+bool names_a_descriptor(const std::string& path) {
   std::error_code ec;
   const std::string p = fs::absolute(path, ec).lexically_normal().string();
-  return p.rfind("/dev/", 0) == 0 || p.rfind("/proc/", 0) == 0;
+  return p == "/dev/stdout" || p == "/dev/stderr" || p.rfind("/dev/fd/", 0) == 0 ||
+         (p.rfind("/proc/", 0) == 0 && p.find("/fd/") != std::string::npos);
 }
 
 // The file `path` names once the symbolic links of its last component are
 // followed (at most 40, as the kernel does); `path` itself when it is no link.
 std::string link_target(const std::string& path) {
-  if (names_a_handle(path)) return path;
+  if (names_a_descriptor(path)) return path;
   std::string p = path;
   for (int i = 0; i < 40; ++i) {
     std::error_code ec;
@@ -127,7 +129,7 @@ Staged stage(const std::string& path, const void* data, size_t size) {
   s.target = link_target(path);
   const char* bytes = static_cast<const char*>(data);
   struct stat st;
-  if (::stat(s.target.c_str(), &st) == 0 && (!S_ISREG(st.st_mode) || names_a_handle(path))) {
+  if (::stat(s.target.c_str(), &st) == 0 && (!S_ISREG(st.st_mode) || names_a_descriptor(path))) {
     if (S_ISDIR(st.st_mode)) throw FileError(cannot_write(path) + "it is a directory");
     s.in_place = true;
     s.bytes.assign(bytes, size);
@@ -144,7 +146,10 @@ Staged stage(const std::string& path, const void* data, size_t size) {
 }
 
 void write_in_place(const Staged& s) {
-  const int fd = ::open(s.target.c_str(), O_WRONLY | O_CLOEXEC);
+  // A regular file behind a descriptor's name is rewritten from its start, as `cp x /dev/stdout` does.
+  struct stat st;
+  const bool regular = ::stat(s.target.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+  const int fd = ::open(s.target.c_str(), O_WRONLY | O_CLOEXEC | (regular ? O_TRUNC : 0));
   if (fd < 0) throw FileError(cannot_write(s.path) + std::strerror(errno));
   int error = write_all(fd, s.bytes.data(), s.bytes.size());
   if (::close(fd) != 0 && error == 0) error = errno;

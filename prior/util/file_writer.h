@@ -7,8 +7,9 @@
 // name beside it (`.NAME.XXXXXXXX.tmp`, created exclusively, so no file of the
 // user's is ever overwritten or removed) and renamed over it, so a reader sees
 // the old file or the whole new one, never half of one. Anything else that
-// exists (a character device like /dev/null or /dev/full, a FIFO, a socket) is
-// written in place and stays what it is. A symbolic link is followed: the file
+// exists (a character device like /dev/null or /dev/full, a FIFO, a socket)
+// and the names of open descriptors (/dev/stdout, /dev/fd/N, /proc/self/fd/N)
+// are written in place and stay what they are. A symbolic link is followed: the file
 // it points to is replaced and the link kept. Every failure is a FileError
 // "cannot write <path>: <reason>" (strerror: "No space left on device",
 // "Permission denied", ...), and leaves no temporary file behind.

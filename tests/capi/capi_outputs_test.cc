@@ -4,6 +4,7 @@
 // the strict readers (duplicate JSON keys, the rig map's limit), and the
 // order of a task's checks (docs/RELIABILITY.md, "Outputs and clients").
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -202,6 +203,28 @@ TEST(CApiOutputs, ALinkedOutputKeepsItsLink) {
   ASSERT_EQ(mf_output_set_commit(s.get()), MF_OK) << describe(1);
   EXPECT_TRUE(fs::is_symlink(d / "link.json"));
   EXPECT_EQ(read_text(d / "target.json"), "new");
+}
+
+// The name of an open descriptor (/dev/fd/N, as /dev/stdout redirected to a
+// file) is written in place: the file it leads to keeps its inode and holds
+// exactly the new bytes; /dev itself is never written into.
+TEST(CApiOutputs, ADescriptorsNameIsWrittenInPlace) {
+  ScratchDir d;
+  write_text(d / "redirected.txt", "an older and longer content");
+  const int fd = ::open((d / "redirected.txt").c_str(), O_WRONLY);
+  ASSERT_GE(fd, 0);
+  struct stat before, after;
+  ASSERT_EQ(::stat((d / "redirected.txt").c_str(), &before), 0);
+  const SetPtr s = make_set();
+  const std::string name = "/dev/fd/" + std::to_string(fd);
+  ASSERT_EQ(mf_output_set_add_output(s.get(), name.c_str(), "output"), MF_OK) << describe(1);
+  ASSERT_EQ(write(s.get(), name, "new"), MF_OK) << describe(1);
+  ASSERT_EQ(mf_output_set_commit(s.get()), MF_OK) << describe(1);
+  ::close(fd);
+  ASSERT_EQ(::stat((d / "redirected.txt").c_str(), &after), 0);
+  EXPECT_EQ(before.st_ino, after.st_ino);
+  EXPECT_EQ(read_text(d / "redirected.txt"), "new");
+  EXPECT_TRUE(fs::is_symlink("/dev/fd") || fs::is_directory("/dev/fd"));
 }
 
 TEST(CApiOutputs, MergingJobsIsAllOrNothing) {
