@@ -885,6 +885,13 @@ if [ -c /dev/full ]; then
   expect_stderr "line 1: error: cannot write /dev/full: No space left on device" "batch: report onto /dev/full"
   expect_stderr "line 2: error: cannot write full.glb: No space left on device" "batch: glTF onto /dev/full"
   expect_absent "$OUT/j.bvh"
+  if [ -n "$TINY" ]; then
+    ln -s /dev/full "$OUT/a_1.bvh"
+    in_dir "$OUT" expect_rc 2 "an alternative onto a full device" -- "$MF" --model "$TINY" --threads 1 inbetween \
+      --in "$SMALL" --keyframes 0,39 --out a.bvh --alternatives 1 --method nemf --max-iterations 1
+    expect_stderr "cannot write a_1.bvh: No space left on device" "an alternative onto a full device: message"
+    expect_absent "$OUT/a.bvh"
+  fi
   [ -c /dev/full ] && pass || fail "/dev/full is no longer a character device"
 fi
 # 100: batch: a report naming its own output, another job's output, the input; a job reading another's output.

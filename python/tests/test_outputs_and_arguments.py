@@ -154,6 +154,11 @@ class OutputSetTest(unittest.TestCase):
         with open(self.path("o.bvh.tmp")) as f:
             self.assertEqual(f.read(), "mine")
         self.assertEqual(sorted(os.listdir(self.dir)), ["o.bvh", "o.bvh.tmp", "o.glb"])
+        if os.path.exists("/dev/full"):
+            with self.assertRaisesRegex(mf.FileError, "cannot write /dev/full: No space left on device"):
+                self.walk.save_bvh("/dev/full")
+            with self.assertRaisesRegex(mf.FileError, "cannot write /dev/full: No space left on device"):
+                self.walk.save_gltf("/dev/full", format="glb")
 
     def test_rig_map_files_have_the_cli_limit(self):
         with open(self.path("big.json"), "w") as f:
