@@ -173,7 +173,7 @@ MF_API int mf_printable_text(const char *text, size_t length, char *out, size_t 
  *  pays only on an otherwise idle machine: libtorch's OpenMP threads spin
  *  while they wait for each other, and with another process busy on one of two
  *  cores a 128-frame solve on two threads took 25-40x as long as on one
- *  (docs/BENCHMARKS.md, "Session 34"). Either way the BLAS library's own
+ *  (docs/BENCHMARKS.md, "one intra-op thread by default"). Either way the BLAS library's own
  *  thread pool is kept at one thread, since libtorch calls it from inside its
  *  own threads. Results may differ in the last bits between thread counts. */
 MF_API int mf_set_num_threads(int32_t num_threads);

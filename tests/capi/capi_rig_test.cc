@@ -425,12 +425,12 @@ TEST(CApiRig, RenavigatesAReferenceOnAnotherRig) {
   // and travels along +x. The path (1.22 m/s, 90 degrees off the sample's own +z) is 5.3 %
   // slower than the sample (1.29 m/s on this rig), so the reference is played at 0.947x
   // (mf::reference_pace). Without that the solver traded the path for the reference's
-  // style: the session-20 prior ended at x = 0.49 m (the session-15 prior 0.92 m); with it,
-  // 1.37 m. Session 25: with FK as one autograd node the solver went further down the same
+  // style: two earlier priors ended at x = 0.49 m and 0.92 m; with it, 1.37 m. With FK as one
+  // autograd node (docs/BENCHMARKS.md, "forward kinematics as one autograd node") the solver went further down the same
   // energy (2.03 against 5.50) and ended at 0.47 m: at path weight 1 the energy preferred a
   // slower walk to the path here; path weight 2 follows it (renav-bench: path error 33 %
   // lower). The bound asks for more than half the path. renav-bench measures path following
-  // at other paces on longer references (docs/BENCHMARKS.md, "Session 21").
+  // at other paces on longer references (docs/BENCHMARKS.md, "re-navigation at the path's pace").
   EXPECT_GT(root[3 * 39], 0.8f) << "the root ends at x = " << root[3 * 39] << " m, z = " << root[3 * 39 + 2]
                                 << " m; the path ends at x = 1.56 m, z = 0.39 m";
 }
