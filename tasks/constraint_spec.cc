@@ -7,6 +7,7 @@
 #include <set>
 
 #include "prior/motion/errors.h"
+#include "prior/util/strict_json.h"
 
 namespace mf {
 namespace {
@@ -161,12 +162,7 @@ void merge_key(const PoseKey& k, PoseKey* into) {
 }  // namespace
 
 ConstraintSpec ConstraintSpec::parse_json(const std::string& text, const std::string& source) {
-  json doc;
-  try {
-    doc = json::parse(text);
-  } catch (const json::exception& e) {
-    throw InputError(source + ": not valid JSON (" + std::string(e.what()) + ")");
-  }
+  const json doc = parse_json_strict(text, source);
   Fields top(doc, source + ":");
   ConstraintSpec spec;
   const json& keys = array_field(top, "keys");

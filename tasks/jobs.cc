@@ -27,11 +27,17 @@ void check_motion(const Motion& input) {
   if (!(std::isfinite(input.fps) && input.fps > 0)) throw InputError("the input motion's fps must be finite and positive");
 }
 
-// The method of a request, checked once with the motion: the method and the
-// models it needs, the motion itself, and its rig when the method needs the
-// model.
-const Method& checked_method(const std::string& method, const Motion& input, const TaskContext& ctx) {
+// What a request asks of its method.
+enum class Ask { kComplete, kResample };
+
+// The method of a request, checked once with the motion, in the order a user
+// thinks: the method exists and does the task, then the motion, then its rig
+// when the method needs the model (the frames come after, by the callers).
+const Method& checked_method(const std::string& method, const Motion& input, const TaskContext& ctx, Ask ask) {
   const Method& m = resolve_method(method, ctx);
+  if (ask == Ask::kComplete && !m.complete)
+    throw InputError("method '" + m.name + "' does not do in-betweening or gap filling");
+  if (ask == Ask::kResample && !m.resample) throw InputError("method '" + m.name + "' does not do resampling");
   check_motion(input);
   if (m.needs_model) check_model_rig(input.skeleton, ctx);
   return m;
@@ -45,7 +51,6 @@ void start(const TaskContext& ctx) { ctx.report(TaskProgress{}); }
 // run_known_frames and run_fill): methods that need the model run on the
 // model's rig and rate (tasks/model_rig.h).
 Motion complete_with(const Method& m, const Motion& input, const std::vector<int>& known, const TaskContext& ctx) {
-  if (!m.complete) throw InputError("method '" + m.name + "' does not do in-betweening or gap filling");
   start(ctx);
   if (!m.needs_model) return m.complete(input, known, ctx);
   return complete_on_model_rig(input, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
@@ -211,7 +216,7 @@ int resampled_frame_count(int frames, double fps_in, double fps_out, bool* round
 
 Motion run_known_frames(const Motion& input, const std::vector<int>& known, const std::string& method,
                         const TaskContext& ctx) {
-  const Method& m = checked_method(method, input, ctx);
+  const Method& m = checked_method(method, input, ctx, Ask::kComplete);
   validate_keyframes(known, input.num_frames());
   return complete_with(m, input, known, ctx);
 }
@@ -222,7 +227,7 @@ Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, con
 }
 
 Motion run_fill(const Motion& input, int a, int b, const std::string& method, const TaskContext& ctx) {
-  const Method& m = checked_method(method, input, ctx);
+  const Method& m = checked_method(method, input, ctx, Ask::kComplete);
   // Sorted, unique, in range and at least two (frame 0 and the last): valid keyframes.
   return complete_with(m, input, known_frames_outside_gap(input.num_frames(), a, b), ctx);
 }
@@ -246,9 +251,9 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
       throw InputError("method '" + m.name +
                        "' takes whole-pose keys only: partial keys, end-effector targets, contacts and alternatives "
                        "need a latent solver (nemf, nemf-detail, ...) or 'interp' (without alternatives)");
+    if (m.needs_model) check_model_rig(input.skeleton, ctx);  // the rig before the frames
     constraints.validate(input.num_frames(), input.num_joints());
     constraints.check_values(input);
-    if (m.needs_model) check_model_rig(input.skeleton, ctx);
     start(ctx);
     for (int v = 0; v <= alternatives; ++v) {
       auto solve = [&](const Motion& in, const MotionConstraints& c) {
@@ -269,8 +274,7 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
 
 Motion run_resample(const Motion& input, double fps, const std::string& method, std::vector<std::string>* warnings,
                     const TaskContext& ctx) {
-  const Method& m = checked_method(method.empty() ? default_resample_method(ctx) : method, input, ctx);
-  if (!m.resample) throw InputError("method '" + m.name + "' does not do resampling");
+  const Method& m = checked_method(method.empty() ? default_resample_method(ctx) : method, input, ctx, Ask::kResample);
   bool rounded = false;
   const int frames = resampled_frame_count(input.num_frames(), input.fps, fps, &rounded);
   if (rounded && warnings) {

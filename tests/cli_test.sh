@@ -741,7 +741,7 @@ for args in "inbetween --keyframes 0,99 --method interp" "resample --fps nan" "f
 done
 expect_rc 2 "a broken --model onto an existing file" -- "$MF" --model "$CAT/binary.bvh" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/keep.bvh"
 [ "$(cat "$TMP/keep.bvh")" = "an existing file" ] && pass || fail "a broken model changed the existing output"
-[ "$(find "$TMP" -maxdepth 1 -name 'keep.bvh.tmp*' | wc -l)" -eq 0 ] && pass || fail "a temporary file was left next to keep.bvh"
+[ "$(find "$TMP" -maxdepth 1 \( -name 'keep.bvh.tmp*' -o -name '.keep.bvh.*' \) | wc -l)" -eq 0 ] && pass || fail "a temporary file was left next to keep.bvh"
 # Model files truncated, empty or with a flipped byte (the tiny model and its transformers).
 if [ -x "$HELPER" ] && mkdir -p "$CAT/m" && "$HELPER" "$CAT/m/prior.mfm" --transformers; then
   head -c 1000 "$CAT/m/prior.mfm" >"$CAT/trunc.mfm"
@@ -813,6 +813,172 @@ expect_frames "$CAT/batch/j10.bvh" "$N"
 # Inputs are never modified.
 [ "$(cd "$CAT" && sha256sum ./*.bvh | sha256sum)" = "$sums_before" ] && pass || fail "a catalogue case modified its input"
 cmp -s "$CAT/batch/walk.bvh" "$SAMPLE" && pass || fail "batch modified its input"
+
+# ------------------------------------------------------------ outputs and clients (issue 52, docs/RELIABILITY.md)
+# Every output goes through the library's one writer (mf_output_set): no two
+# outputs of a job or a batch, and no output and input, are one file; devices
+# are written in place; a failure names its reason and leaves no output behind.
+OUT="$TMP/outputs"
+mkdir -p "$OUT"
+cp "$SAMPLE" "$OUT/in.bvh"
+# 96: --report naming --out is refused before anything runs; an existing file there is kept.
+in_dir "$OUT" expect_rc 2 "--report naming --out" -- "$MF" inbetween --in in.bvh --keyframes 0,60 --out o.bvh \
+  --report o.bvh --method interp
+expect_stderr "the report o.bvh is also the output o.bvh: refusing to write one file twice" "--report = --out: message"
+expect_absent "$OUT/o.bvh"
+printf 'mine\n' >"$OUT/o.bvh"
+in_dir "$OUT" expect_rc 2 "--report naming an existing --out" -- "$MF" inbetween --in in.bvh --keyframes 0,60 \
+  --out o.bvh --report ./o.bvh --method interp
+[ "$(cat "$OUT/o.bvh")" = mine ] && pass || fail "--report = --out changed the existing output"
+rm -f "$OUT/o.bvh"
+in_dir "$OUT" expect_rc 2 "--report naming the input" -- "$MF" inbetween --in in.bvh --keyframes 0,60 --out o.bvh \
+  --report in.bvh --method interp
+expect_stderr "the report in.bvh is the input in.bvh: refusing to overwrite it" "--report = --in: message"
+cmp -s "$OUT/in.bvh" "$SAMPLE" && pass || fail "--report = --in changed the input"
+# 97: the report beside a user's r.json.tmp: that file is never touched, no temporary file is left.
+printf 'mine\n' >"$OUT/r.json.tmp"
+in_dir "$OUT" expect_rc 0 "--report beside a user's r.json.tmp" -- "$MF" inbetween --in in.bvh --keyframes 0,60 \
+  --out t.bvh --report r.json --method interp
+[ "$(cat "$OUT/r.json.tmp")" = mine ] && pass || fail "the user's r.json.tmp was changed"
+grep -q '"solutions"' "$OUT/r.json" && pass || fail "--report beside r.json.tmp: the report"
+[ "$(find "$OUT" -name '.*.tmp' | wc -l)" -eq 0 ] && pass || fail "a temporary file was left behind"
+# 98: a report the system cannot write (a read-only directory; /proc as root): the reason, and the motion not left behind.
+if [ "$(id -u)" -ne 0 ]; then
+  mkdir -p "$OUT/ro" && chmod 555 "$OUT/ro"
+  RO="$OUT/ro/r.json"
+else
+  RO=/proc/motionfield-cli-test-report.json
+fi
+in_dir "$OUT" expect_rc 2 "--report into a read-only directory" -- "$MF" inbetween --in in.bvh --keyframes 0,60 \
+  --out m.bvh --report "$RO" --method interp
+expect_stderr "cannot write $RO: [A-Z]" "--report into a read-only directory: the reason"
+expect_absent "$OUT/m.bvh"
+# 99: devices, for every output kind: written in place, a full one fails with the reason and nothing is left.
+ln -s /dev/null "$OUT/null.glb"
+ln -s /dev/null "$OUT/null.gltf"
+in_dir "$OUT" expect_rc 0 "--report /dev/null" -- "$MF" inbetween --in in.bvh --keyframes 0,60 --out d.bvh \
+  --report /dev/null --method interp
+in_dir "$OUT" expect_rc 0 "glTF onto /dev/null (.glb)" -- "$MF" export in.bvh null.glb
+in_dir "$OUT" expect_rc 0 "glTF onto /dev/null (.gltf)" -- "$MF" export in.bvh null.gltf
+[ -c /dev/null ] && [ -L "$OUT/null.glb" ] && pass || fail "an output replaced /dev/null or the link to it"
+rm -f "$OUT/d.bvh"
+if [ -c /dev/full ]; then
+  ln -s /dev/full "$OUT/full.glb"
+  ln -s /dev/full "$OUT/full.gltf"
+  for args in "inbetween --keyframes 0,60 --method interp" "fill --gap 10:20 --method interp" \
+    "resample --fps 60 --method cubic"; do
+    # shellcheck disable=SC2086
+    in_dir "$OUT" expect_rc 2 "$args --out /dev/full" -- "$MF" $args --in in.bvh --out /dev/full
+    expect_stderr "cannot write /dev/full: No space left on device" "$args --out /dev/full: message"
+  done
+  for name in full.glb full.gltf; do
+    in_dir "$OUT" expect_rc 2 "export onto a full device ($name)" -- "$MF" export in.bvh "$name"
+    expect_stderr "cannot write $name: No space left on device" "export onto a full device ($name): message"
+  done
+  in_dir "$OUT" expect_rc 2 "--report /dev/full" -- "$MF" inbetween --in in.bvh --keyframes 0,60 --out d.bvh \
+    --report /dev/full --method interp
+  expect_stderr "cannot write /dev/full: No space left on device" "--report /dev/full: message"
+  expect_absent "$OUT/d.bvh"
+  printf '%s\n' '{"task": "inbetween", "in": "in.bvh", "out": "j.bvh", "keyframes": [0, 60], "method": "interp", "report": "/dev/full"}' \
+    '{"task": "resample", "in": "in.bvh", "out": "full.glb", "fps": 60, "method": "cubic"}' >"$OUT/full.jsonl"
+  in_dir "$OUT" expect_rc 2 "batch outputs onto a full device" -- "$MF" batch full.jsonl
+  expect_stderr "line 1: error: cannot write /dev/full: No space left on device" "batch: report onto /dev/full"
+  expect_stderr "line 2: error: cannot write full.glb: No space left on device" "batch: glTF onto /dev/full"
+  expect_absent "$OUT/j.bvh"
+  if [ -n "$TINY" ]; then
+    ln -s /dev/full "$OUT/a_1.bvh"
+    in_dir "$OUT" expect_rc 2 "an alternative onto a full device" -- "$MF" --model "$TINY" --threads 1 inbetween \
+      --in "$SMALL" --keyframes 0,39 --out a.bvh --alternatives 1 --method nemf --max-iterations 1
+    expect_stderr "cannot write a_1.bvh: No space left on device" "an alternative onto a full device: message"
+    expect_absent "$OUT/a.bvh"
+  fi
+  [ -c /dev/full ] && pass || fail "/dev/full is no longer a character device"
+fi
+# 100: batch: a report naming its own output, another job's output, the input; a job reading another's output.
+printf '%s\n' '{"task": "inbetween", "in": "in.bvh", "out": "b1.bvh", "keyframes": [0, 60], "method": "interp", "report": "b1.bvh"}' \
+  '{"task": "inbetween", "in": "in.bvh", "out": "b2.bvh", "keyframes": [0, 60], "method": "interp", "report": "b2.json"}' \
+  '{"task": "inbetween", "in": "in.bvh", "out": "b3.bvh", "keyframes": [0, 60], "method": "interp", "report": "./b2.bvh"}' \
+  '{"task": "inbetween", "in": "b2.bvh", "out": "b4.bvh", "keyframes": [0, 60], "method": "interp"}' \
+  '{"task": "inbetween", "in": "in.bvh", "out": "b5.bvh", "keyframes": [0, 60], "method": "interp", "report": "in.bvh"}' \
+  '{"task": "inbetween", "in": "in.bvh", "out": "b6.bvh", "keyframes": [0, 60], "method": "interp", "report": "b2.json"}' \
+  >"$OUT/b.jsonl"
+in_dir "$OUT" expect_rc 2 "batch: outputs that are other outputs or inputs" -- "$MF" batch b.jsonl
+expect_stderr "line 1: error: the report b1.bvh is also the output b1.bvh" "batch: report = out"
+expect_stderr "line 3: error: line 2 already writes ./b2.bvh: refusing to overwrite another job's output" \
+  "batch: a report naming another job's output"
+expect_stderr "line 4: error: line 2 writes b2.bvh, which this job reads" "batch: a job reading another's output"
+expect_stderr "line 5: error: the report in.bvh is the input in.bvh" "batch: a report naming the input"
+expect_stderr "line 6: error: line 2 already writes b2.json" "batch: two reports into one file"
+expect_stderr "6 jobs, 1 ok, 5 failed" "batch: outputs that are other outputs: summary"
+for f in b1.bvh b3.bvh b4.bvh b5.bvh b6.bvh; do expect_absent "$OUT/$f"; done
+grep -q '"solutions"' "$OUT/b2.json" && pass || fail "batch: the good job's report"
+cmp -s "$OUT/in.bvh" "$SAMPLE" && pass || fail "batch: an output changed the input"
+# 101: strict readers: a duplicate key in a constraints file; a rig map over its limit in every command.
+printf '{"keys": [{"frame": 30, "joints": ["Hips"]}], "keys": []}\n' >"$OUT/dup.json"
+catalogue "a constraints file with a duplicate key" 'dup.json: duplicate key "keys" in the top-level object' \
+  inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --constraints "$OUT/dup.json" --method interp
+{ printf '{"Hips": "Hips"'; head -c 1100000 /dev/zero | tr '\0' ' '; printf '}\n'; } >"$OUT/big-map.json"
+catalogue "rig --rig-map over 1 MiB" "cannot read rig map file .*big-map.json: larger than the limit of 1 MiB" \
+  --rig-map "$OUT/big-map.json" rig "$SAMPLE"
+catalogue "inbetween --rig-map over 1 MiB" "larger than the limit of 1 MiB" \
+  --rig-map "$OUT/big-map.json" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --method nemf
+# 102: the method against the task before the rig.
+if [ -n "$TINY" ]; then
+  catalogue "--method prior on a clip the model cannot map" "method 'prior' does not do in-betweening" \
+    --model "$TINY" inbetween --in "$SAMPLE" --keyframes 0,60 --out "$TMP/bad.bvh" --method prior
+fi
+# 103: every combination of --out, --alternatives and --report over names that overlap (another
+# spelling, a symbolic link, the input, an alternative's name): refused with nothing written, or
+# every output holds what it should and the input is unchanged.
+if [ -n "$TINY" ]; then
+  COMBO="$OUT/combo"
+  mkdir -p "$COMBO"
+  cp "$SMALL" "$COMBO/in.bvh"
+  ln -s o.bvh "$COMBO/link.bvh"
+  canon() { local n=${1#./}; [ "$n" = link.bvh ] && n=o.bvh; echo "$n"; }
+  alt_of() { local n=$1 d=""; case $n in */*) d=${n%/*}/; n=${n##*/};; esac; echo "$d${n%.*}_1.${n##*.}"; }
+  combos=0 refused=0
+  for out in o.bvh ./o.bvh link.bvh in.bvh o_1.bvh; do
+    for report in "" o.bvh ./o_1.bvh r.json in.bvh link.bvh link_1.bvh; do
+      for alts in 0 1; do
+        combos=$((combos + 1))
+        (cd "$COMBO" && rm -f o.bvh o_1.bvh o_1_1.bvh link_1.bvh r.json .*.tmp)
+        set -- --model "$TINY" --threads 1 inbetween --in in.bvh --keyframes 0,39 --out "$out" --method nemf \
+          --max-iterations 1 --alternatives "$alts"
+        [ -n "$report" ] && set -- "$@" --report "$report"
+        outputs=("$out")
+        [ "$alts" -eq 1 ] && outputs+=("$(alt_of "$out")")
+        [ -n "$report" ] && outputs+=("$report")
+        expected=0
+        seen=" in.bvh "
+        for o in "${outputs[@]}"; do
+          c=$(canon "$o")
+          case "$seen" in *" $c "*) expected=2 ;; esac
+          seen="$seen$c "
+        done
+        what="--out $out --alternatives $alts --report '$report'"
+        in_dir "$COMBO" expect_rc "$expected" "$what" -- "$MF" "$@"
+        if [ "$expected" -eq 2 ]; then
+          refused=$((refused + 1))
+          expect_stderr "refusing" "$what: message"
+          [ -z "$(cd "$COMBO" && ls -A | grep -v -x -e in.bvh -e link.bvh)" ] && pass || fail "$what wrote an output"
+        else
+          for o in "${outputs[@]}"; do
+            f="$COMBO/$o"
+            if [ "$o" = "$report" ]; then
+              grep -q '"solutions"' "$f" && pass || fail "$what: $o does not hold the report"
+            else
+              [ "$(frames_of "$f")" = 40 ] && pass || fail "$what: $o does not hold a motion"
+            fi
+          done
+        fi
+        cmp -s "$COMBO/in.bvh" "$SMALL" && pass || fail "$what changed the input"
+        [ -L "$COMBO/link.bvh" ] && pass || fail "$what replaced the link"
+      done
+    done
+  done
+  [ "$refused" -gt 10 ] && [ "$refused" -lt "$combos" ] && pass || fail "combinations: $refused of $combos refused"
+fi
 
 echo "cli_test: $((checks - failures)) of $checks checks passed"
 [ "$failures" -eq 0 ]

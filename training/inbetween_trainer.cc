@@ -684,8 +684,7 @@ void InbetweenRun::save_checkpoint() {
     return;
   }
   save_inbetweener(*model_, files_.last_model);
-  torch::save(*optimizer_, files_.last_optim + ".tmp");
-  fs::rename(files_.last_optim + ".tmp", files_.last_optim);
+  training::save_optimizer(*optimizer_, files_.last_optim);
   training::save_trainer_state(files_.last_state, state_);
   last_checkpoint_ = Clock::now();
 }

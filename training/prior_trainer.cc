@@ -556,7 +556,7 @@ void PriorRun::end_epoch(const EpochSums& local_sums, const Validation& v) {
   if (!dp_.writes()) return;
   if (best) save_nemf(model_, files_.best_model);
   save_nemf(model_, files_.last_model);
-  torch::save(optimizer_, files_.last_optim);
+  training::save_optimizer(optimizer_, files_.last_optim);
   training::save_trainer_state(files_.last_state, state_);
   {
     std::ofstream log(files_.log, std::ios::app);

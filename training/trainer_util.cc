@@ -3,14 +3,17 @@
 #include <ATen/ATen.h>
 #include <torch/optim/adam.h>
 #include <torch/optim/optimizer.h>
+#include <torch/serialize.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "prior/motion/errors.h"
+#include "prior/util/file_writer.h"
 
 namespace mf::training {
 
@@ -67,13 +70,19 @@ bool RunFiles::has_checkpoint() const {
 }
 
 void save_trainer_state(const std::string& path, const TrainerState& s) {
-  {
-    std::ofstream out(path + ".tmp");
-    out.precision(17);
-    out << "epoch " << s.epoch << "\nstep " << s.step << "\nminutes " << s.minutes << "\nbest " << s.best << "\nworld_size "
-        << s.world_size << "\n";
-  }
-  std::filesystem::rename(path + ".tmp", path);
+  std::ostringstream out;
+  out.precision(17);
+  out << "epoch " << s.epoch << "\nstep " << s.step << "\nminutes " << s.minutes << "\nbest " << s.best << "\nworld_size "
+      << s.world_size << "\n";
+  const std::string text = out.str();
+  write_file_atomically(path, text.data(), text.size());
+}
+
+void save_optimizer(const torch::optim::Optimizer& optimizer, const std::string& path) {
+  std::ostringstream bytes;
+  torch::save(optimizer, bytes);
+  const std::string data = bytes.str();
+  write_file_atomically(path, data.data(), data.size());
 }
 
 TrainerState load_trainer_state(const std::string& path) {

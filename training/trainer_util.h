@@ -59,6 +59,9 @@ struct TrainerState {
   int world_size = 1;    ///< processes of the data-parallel run (training/data_parallel.h); 1 in older files
 };
 void save_trainer_state(const std::string& path, const TrainerState& s);
+/// Saves an optimiser's state (torch::save) through the one file writer
+/// (prior/util/file_writer.h).
+void save_optimizer(const torch::optim::Optimizer& optimizer, const std::string& path);
 TrainerState load_trainer_state(const std::string& path);
 
 /// Cosine decay from lr to lr_final as progress goes 0 -> 1, after a linear

@@ -5,12 +5,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <map>
 #include <mutex>
 #include <sstream>
 #include <string>
-#include <system_error>
 #include <thread>
 #include <vector>
 
@@ -34,28 +31,6 @@ std::vector<std::string> read_lines(const std::string& path) {
   return lines;
 }
 
-// The outputs of the batch's jobs so far: a job may not write what an earlier
-// line writes (the later result would silently replace the earlier one).
-class Outputs {
- public:
-  // Claims `out` for `line`; InputError naming the earlier line if it is taken.
-  void claim(const std::string& out, size_t line) {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    // Devices and FIFOs (/dev/null) may be written by every job.
-    if (fs::exists(out, ec) && !fs::is_regular_file(out, ec)) return;
-    fs::path key = fs::weakly_canonical(fs::absolute(out, ec), ec);
-    if (ec) key = fs::absolute(out).lexically_normal();
-    const auto [it, added] = lines_.emplace(key.string(), line);
-    if (!added)
-      throw InputError("line " + std::to_string(it->second) + " already writes " + out +
-                       ": refusing to overwrite another job's output (give each job its own \"out\")");
-  }
-
- private:
-  std::map<std::string, size_t> lines_;
-};
-
 // The job of one line; `label` gains the job's id once the line parses.
 BatchJob parse_line(const std::string& line, std::string* label) {
   JsonValue value;
@@ -74,8 +49,11 @@ BatchJob parse_line(const std::string& line, std::string* label) {
 
 // One line's job once run: its report, or why it failed.
 struct Outcome {
+  size_t line = 0;        ///< 1-based
+  bool runnable = false;  ///< parsed and its files checked
   std::string label;
   BatchJob job;
+  OutputSet files;  ///< the job's files, checked (prepare_job)
   bool ok = false;
   JobReport report;
   Failure failure;
@@ -108,6 +86,34 @@ int batch_workers(const Settings& settings) {
   return std::clamp(cores / std::max(1, settings.threads), 1, 8);
 }
 
+// Every line parsed and its files checked first, in line order, against its
+// own and every earlier line's (so that which of two jobs writing one file,
+// or writing what another reads, is refused does not depend on timing); with
+// `load_models`, the model a job needs is loaded here too, once, before any
+// worker runs.
+std::vector<Outcome> prepare_lines(const std::vector<std::string>& lines, const std::string& path,
+                                   const Settings& settings, Models& models, bool load_models) {
+  std::vector<Outcome> outcomes;
+  OutputSet batch_files = OutputSet::create();
+  for (size_t i = 0; i < lines.size(); ++i) {
+    if (blank(lines[i])) continue;
+    Outcome o;
+    o.line = i + 1;
+    o.label = path + " line " + std::to_string(o.line);
+    try {
+      o.job = parse_line(lines[i], &o.label);
+      o.files = prepare_job(o.job, settings);
+      batch_files.merge(o.files, "line " + std::to_string(o.line));
+      if (load_models) models.for_method(o.job.task == "renav" && o.job.method.empty() ? "nemf" : o.job.method);
+      o.runnable = true;
+    } catch (...) {
+      o.failure = current_failure();
+    }
+    outcomes.push_back(std::move(o));
+  }
+  return outcomes;
+}
+
 }  // namespace
 
 int command_batch(const std::string& path, const Settings& settings) {
@@ -117,37 +123,14 @@ int command_batch(const std::string& path, const Settings& settings) {
   const int workers = batch_workers(settings);
   if (settings.verbose) std::fprintf(stderr, "motionfield: batch: %d job%s at once\n", workers, workers == 1 ? "" : "s");
 
-  // Every line parsed and its output claimed first, in line order (so that
-  // which of two jobs writing one file is refused does not depend on timing);
-  // the model a job needs is loaded here too, once, before any worker runs.
-  std::vector<size_t> line_of;
-  std::vector<Outcome> outcomes;
-  std::vector<char> runnable;
-  Outputs outputs;
-  for (size_t i = 0; i < lines.size(); ++i) {
-    if (blank(lines[i])) continue;
-    Outcome o;
-    o.label = path + " line " + std::to_string(i + 1);
-    bool ready = false;
-    try {
-      o.job = parse_line(lines[i], &o.label);
-      outputs.claim(o.job.out, i + 1);
-      if (workers > 1) models.for_method(o.job.task == "renav" && o.job.method.empty() ? "nemf" : o.job.method);
-      ready = true;
-    } catch (...) {
-      o.failure = current_failure();
-    }
-    line_of.push_back(i + 1);
-    outcomes.push_back(std::move(o));
-    runnable.push_back(ready ? 1 : 0);
-  }
+  std::vector<Outcome> outcomes = prepare_lines(lines, path, settings, models, workers > 1);
   const int total = static_cast<int>(outcomes.size());
 
   ProgressLine progress(ProgressLine::stderr_is_terminal() && !settings.quiet);
   const auto run = [&](size_t k, ProgressLine& line) {
-    if (!runnable[k]) return;
+    if (!outcomes[k].runnable) return;
     try {
-      outcomes[k].report = run_job(outcomes[k].job, settings, models, line);
+      outcomes[k].report = run_job(outcomes[k].job, std::move(outcomes[k].files), settings, models, line);
       outcomes[k].ok = true;
     } catch (...) {
       outcomes[k].failure = current_failure();
@@ -156,9 +139,9 @@ int command_batch(const std::string& path, const Settings& settings) {
   };
   if (workers <= 1) {
     for (size_t k = 0; k < outcomes.size(); ++k) {
-      progress.start("[" + std::to_string(k + 1) + "/" + std::to_string(total) + "] line " + std::to_string(line_of[k]));
+      progress.start("[" + std::to_string(k + 1) + "/" + std::to_string(total) + "] line " + std::to_string(outcomes[k].line));
       run(k, progress);
-      print_outcome(outcomes[k], line_of[k], settings);
+      print_outcome(outcomes[k], outcomes[k].line, settings);
     }
   } else {
     // Workers share the model (the C API's tasks are thread-safe on one model);
@@ -184,7 +167,7 @@ int command_batch(const std::string& path, const Settings& settings) {
         ++done;
         progress.clear();
         for (; printed < outcomes.size() && finished[printed]; ++printed)
-          print_outcome(outcomes[printed], line_of[printed], settings);
+          print_outcome(outcomes[printed], outcomes[printed].line, settings);
         jobs_done();
       }
     };

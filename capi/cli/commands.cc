@@ -154,7 +154,8 @@ void print_rig(const std::string& in, const JsonValue& d, const std::string& mod
 }
 
 int command_rig(const std::string& in, bool json, const Settings& settings) {
-  const std::string map = settings.rig_map.empty() ? "" : read_text_file(settings.rig_map, "rig map file");
+  // The library's reader of rig maps, with their limit (1 MiB), as the tasks read them.
+  const std::string map = settings.rig_map.empty() ? "" : rig_map_read_file(settings.rig_map);
   Models models(settings.model, settings.transformers());
   const Model& model = models.required("rig");
   const double length_scale = units_scale(settings.units, "--units (--length-scale)");

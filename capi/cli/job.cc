@@ -22,44 +22,8 @@ using Clock = std::chrono::steady_clock;
 
 constexpr char kStdio[] = "-";
 
-// Fails before any work when the output cannot be written (the C API would
-// only find out after the solve).
-void check_output_path(const std::string& out) {
-  namespace fs = std::filesystem;
-  if (out == kStdio) return;
-  const fs::path p(out);
-  std::error_code ec;
-  if (fs::is_directory(p, ec)) throw InputError("cannot write " + out + ": it is a directory");
-  const fs::path dir = p.parent_path();
-  if (!dir.empty() && !fs::is_directory(dir, ec))
-    throw InputError("cannot write " + out + ": directory " + dir.string() + " does not exist");
-}
-
-// Refuses an output that is one of the job's input files (same file by
-// device and inode: a.bvh, ./a.bvh and a hard link all match).
-void check_output_is_not_an_input(const BatchJob& job, const Settings& settings) {
-  if (job.out == kStdio) return;
-  const std::string rig_map = job.rig_map.empty() ? settings.rig_map : job.rig_map;
-  const std::pair<const std::string*, const char*> inputs[] = {{&job.in, "input"},
-                                                               {&job.path_file, "path file"},
-                                                               {&rig_map, "rig map file"},
-                                                               {&job.constraints_file, "constraints file"},
-                                                               {&job.trajectory_file, "trajectory file"}};
-  std::vector<std::string> outputs = {job.out};
-  for (int i = 1; i <= job.alternatives; ++i) outputs.push_back(alternative_path(job.out, i));
-  if (!job.report_file.empty()) outputs.push_back(job.report_file);
-  for (const std::string& out : outputs) {
-    for (const auto& [file, role] : inputs) {
-      std::error_code ec;
-      if (!file->empty() && *file != kStdio && std::filesystem::equivalent(*file, out, ec))
-        throw InputError("the output " + out + " is the " + role + " " + *file +
-                         ": refusing to overwrite it (name another output file)");
-    }
-  }
-}
-
-// What a job checks before reading anything: its method exists, re-navigation's numbers, the output path.
-void check_job(const BatchJob& job, const Settings& settings) {
+// What a job checks before reading anything: its method exists, re-navigation's numbers.
+void check_request(const BatchJob& job) {
   const bool renav = job.task == "renav";
   // Re-navigation has methods of its own, checked by mf_renav.
   if (!job.method.empty() && !renav) find_method(job.method);
@@ -70,9 +34,6 @@ void check_job(const BatchJob& job, const Settings& settings) {
   }
   if (job.out == kStdio && job.alternatives > 0)
     throw InputError("--alternatives writes OUT_1.bvh .. beside the output: name an output file, not -");
-  check_output_path(job.out);
-  if (!job.report_file.empty()) check_output_path(job.report_file);
-  check_output_is_not_an_input(job, settings);
 }
 
 // The job's constraints: its file or inline JSON, plus the known frames of
@@ -150,21 +111,6 @@ void write_stdout(const Motion& result) {
   if (!ok) throw Error(MF_ERROR_IO, std::string("cannot write the standard output: ") + std::strerror(errno));
 }
 
-// Writes `text` to `path` through a temporary file beside it, renamed over
-// the target, so that a failed write never leaves half a file.
-void write_text_file(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  bool ok = f && std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  if (f) ok = std::fclose(f) == 0 && ok;
-  std::error_code ec;
-  if (ok) std::filesystem::rename(tmp, path, ec);
-  if (!ok || ec) {
-    std::filesystem::remove(tmp, ec);
-    throw Error(MF_ERROR_IO, "cannot write " + path);
-  }
-}
-
 // The glTF format an output's name asks for: MF_GLTF_BINARY for .glb,
 // MF_GLTF_EMBEDDED for .gltf (any case), else -1 (BVH).
 int gltf_format_of(const std::string& out) {
@@ -175,30 +121,21 @@ int gltf_format_of(const std::string& out) {
   return ext == "glb" ? MF_GLTF_BINARY : ext == "gltf" ? MF_GLTF_EMBEDDED : -1;
 }
 
-// Writes `result` to `out`: "-" is standard output (BVH), a .glb or .gltf
-// name glTF 2.0, anything else BVH.
-void write_output(const Motion& result, const std::string& out) {
-  const int gltf = out == kStdio ? -1 : gltf_format_of(out);
-  if (out == kStdio)
-    write_stdout(result);
-  else if (gltf >= 0)
-    result.save_gltf(out, gltf);
+// Stages `result` for `out` in `files`: a .glb or .gltf name as glTF 2.0,
+// anything else as BVH.
+void stage_motion(OutputSet& files, const Motion& result, const std::string& out) {
+  const int gltf = gltf_format_of(out);
+  if (gltf >= 0)
+    files.write(out, result.to_gltf(gltf));
   else
-    result.save_bvh(out);
+    files.write(out, result.to_bvh());
 }
 
 double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
-}  // namespace
-
-std::string alternative_path(const std::string& out, int index) {
-  const std::filesystem::path p(out);
-  return (p.parent_path() / (p.stem().string() + "_" + std::to_string(index) + p.extension().string())).string();
-}
-
-JobReport run_job(const BatchJob& job, const Settings& settings, Models& models, ProgressLine& progress) {
-  const auto t0 = Clock::now();
-  check_job(job, settings);
+// Runs a job whose files `files` holds (prepare_job), from `t0` on.
+JobReport run_prepared_job(const BatchJob& job, OutputSet& files, Clock::time_point t0, const Settings& settings,
+                           Models& models, ProgressLine& progress) {
   // Export writes the input as it is read: no method, no model.
   const bool export_only = job.task == "export";
   static const Model kNoModel;
@@ -217,12 +154,16 @@ JobReport run_job(const BatchJob& job, const Settings& settings, Models& models,
   const Motion& result = export_only ? input : solved.motion;
   progress.clear();
   const auto t2 = Clock::now();
-  write_output(result, job.out);
+  // Every output staged, standard output written, then all put in place at
+  // once: a failure leaves none of them behind.
+  if (job.out != kStdio) stage_motion(files, result, job.out);
   for (size_t i = 0; i < solved.alternatives.size(); ++i) {
     report.alternatives.push_back(alternative_path(job.out, static_cast<int>(i) + 1));
-    write_output(solved.alternatives[i], report.alternatives.back());
+    stage_motion(files, solved.alternatives[i], report.alternatives.back());
   }
-  if (!job.report_file.empty()) write_text_file(job.report_file, solved.report + "\n");
+  if (!job.report_file.empty()) files.write(job.report_file, solved.report + "\n");
+  if (job.out == kStdio) write_stdout(result);
+  files.commit();
   report.constraints = solved.report;
   const auto t3 = Clock::now();
 
@@ -246,6 +187,39 @@ JobReport run_job(const BatchJob& job, const Settings& settings, Models& models,
                      .c_str());
   }
   return report;
+}
+
+}  // namespace
+
+std::string alternative_path(const std::string& out, int index) {
+  const std::filesystem::path p(out);
+  return (p.parent_path() / (p.stem().string() + "_" + std::to_string(index) + p.extension().string())).string();
+}
+
+OutputSet prepare_job(const BatchJob& job, const Settings& settings) {
+  check_request(job);
+  OutputSet files = OutputSet::create();
+  const std::string& rig_map = job.rig_map.empty() ? settings.rig_map : job.rig_map;
+  if (job.in != kStdio) files.add_input(job.in, "input");
+  files.add_input(job.path_file, "path file");
+  files.add_input(rig_map, "rig map file");
+  files.add_input(job.constraints_file, "constraints file");
+  files.add_input(job.trajectory_file, "trajectory file");
+  if (job.out != kStdio) files.add_output(job.out, "output");
+  for (int i = 1; i <= job.alternatives; ++i) files.add_output(alternative_path(job.out, i), "alternative");
+  if (!job.report_file.empty()) files.add_output(job.report_file, "report");
+  return files;
+}
+
+JobReport run_job(const BatchJob& job, const Settings& settings, Models& models, ProgressLine& progress) {
+  const auto t0 = Clock::now();
+  OutputSet files = prepare_job(job, settings);
+  return run_prepared_job(job, files, t0, settings, models, progress);
+}
+
+JobReport run_job(const BatchJob& job, OutputSet files, const Settings& settings, Models& models,
+                  ProgressLine& progress) {
+  return run_prepared_job(job, files, Clock::now(), settings, models, progress);
 }
 
 std::string job_json(const BatchJob& job, const JobReport* report, const Failure* failure, size_t line) {

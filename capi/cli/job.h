@@ -26,13 +26,24 @@ struct JobReport {
 /// Where alternative `index` (1..) of output `out` goes: OUT_1.bvh for OUT.bvh.
 std::string alternative_path(const std::string& out, int index);
 
+/// The files of `job`, checked before anything is read (mf_output_set): its
+/// inputs (input, path file, rig map, constraints and trajectory files) and
+/// every output (the output, its alternatives OUT_1.bvh .., its report); no
+/// two outputs, and no output and input, may be one file (by inode, through
+/// links: ./a.bvh and a.bvh match). Also checks that the method exists and
+/// re-navigation's numbers. Throws on the first problem.
+OutputSet prepare_job(const BatchJob& job, const Settings& settings);
+
 /// Runs `job` with the model `models` gives for its method, showing the
 /// solver's progress on `progress`. "-" as the input reads standard input, as
-/// the output writes standard output. Refuses, before reading anything, an
-/// output that is the job's input (or path or rig map file), by inode, so
-/// ./a.bvh and a.bvh match. With settings.verbose, prints what ran and how
-/// long each step took (stderr).
+/// the output writes standard output. Its files are checked first
+/// (prepare_job); its outputs are staged and put in place together at the
+/// end, so a failed job leaves none of them. With settings.verbose, prints
+/// what ran and how long each step took (stderr).
 JobReport run_job(const BatchJob& job, const Settings& settings, Models& models, ProgressLine& progress);
+/// The same with the files prepare_job gave (a batch checks them all first).
+JobReport run_job(const BatchJob& job, OutputSet files, const Settings& settings, Models& models,
+                  ProgressLine& progress);
 
 /// The --json summary of one job: {"task", "in", "out", "status": "ok" |
 /// "error", "method", "model", "frames_in", "frames_out", "timings_ms":

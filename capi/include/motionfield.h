@@ -795,6 +795,62 @@ MF_API int mf_constraints_load_trajectory_csv(mf_constraints *constraints, const
  *  mf_default_method). */
 MF_API int mf_solution_get_method(const mf_solution *solution, const char **name);
 
+/* ------------------------------------------------------------ output files
+ * The one safe writer every save above uses, for a job's several outputs at
+ * once (a motion, its alternatives, a report; the CLI's jobs and batches, the
+ * Python package's batch). A set holds the files a job reads and the files it
+ * writes, checked against each other as they are added: no two outputs, and
+ * no output and input, may be the same file (by device and inode through
+ * symbolic links and hard links; by absolute name for files not yet there;
+ * devices and FIFOs excepted). Outputs are staged with mf_output_set_write (a
+ * regular file into a temporary file with a unique name beside it, a device's
+ * bytes kept) and put in place by mf_output_set_commit (devices written in
+ * place, then every temporary file renamed over its target). Destroying a
+ * set that was not committed, or a failed commit, removes every temporary
+ * file: a failed job leaves none of its outputs behind and the files they
+ * would have replaced unchanged. Failures are MF_ERROR_IO "cannot write
+ * <path>: <reason>" (strerror: "No space left on device", "Permission
+ * denied"). A set belongs to one thread at a time. */
+typedef struct mf_output_set mf_output_set;
+
+MF_API int mf_output_set_create(mf_output_set **out);
+/** Accepts NULL; removes the temporary files of a set not committed. */
+MF_API void mf_output_set_destroy(mf_output_set *set);
+/** A file the job reads; `role` names it in messages ("input", "rig map
+ *  file"). "" adds nothing. MF_ERROR_INVALID_ARGUMENT "the output O is the
+ *  input I: refusing to overwrite it (name another output file)" when it is
+ *  an output added before. */
+MF_API int mf_output_set_add_input(mf_output_set *set, const char *path, const char *role);
+/** A file the job writes; `role` names it ("output", "alternative",
+ *  "report"). MF_ERROR_IO "cannot write O: it is a directory" / "cannot
+ *  write O: directory D does not exist"; MF_ERROR_INVALID_ARGUMENT when it is
+ *  an input or another output ("the report O is also the output P: refusing
+ *  to write one file twice (name another output file)"). Nothing is added on
+ *  failure. */
+MF_API int mf_output_set_add_output(mf_output_set *set, const char *path, const char *role);
+/** Adds every file of `job` (another set) to `set` under `label` ("line 3"),
+ *  or none: MF_ERROR_INVALID_ARGUMENT when one of them is the same file as
+ *  one of `set` and either is written ("line 2 already writes O: refusing to
+ *  overwrite another job's output (give each job its own output files)",
+ *  "line 2 reads O: ...", "line 2 writes I, which this job reads: ..."). For
+ *  a batch: its jobs may run side by side. */
+MF_API int mf_output_set_merge(mf_output_set *set, const mf_output_set *job, const char *label);
+/** Stages `size` bytes (`data` may be NULL when size is 0) for output
+ *  `path`, named exactly as it was added. MF_ERROR_IO when the temporary
+ *  file cannot be written; MF_ERROR_INVALID_ARGUMENT when `path` is no
+ *  output of the set. The motion's bytes come from
+ *  mf_motion_save_bvh_to_memory or mf_motion_save_gltf_to_memory. */
+MF_API int mf_output_set_write(mf_output_set *set, const char *path, const void *data, size_t size);
+/** Puts every staged output in place (once). On MF_ERROR_IO the outputs not
+ *  yet in place are removed. */
+MF_API int mf_output_set_commit(mf_output_set *set);
+
+/** The text of a rig map file (mf_task_options.rig_map_path), read with the
+ *  library's limit of 1 MiB and its checks (not a directory or a device):
+ *  MF_ERROR_IO "cannot read rig map file F: larger than the limit of 1 MiB
+ *  for a rig map file". For mf_rig_describe, which takes the text. */
+MF_API int mf_rig_map_read_file(const char *path, char *out, size_t capacity, size_t *needed);
+
 #ifdef __cplusplus
 }
 #endif

@@ -513,6 +513,13 @@ inline std::string rig_describe(const Model& model, const Motion& motion, const 
   });
 }
 
+/// mf_rig_map_read_file: a rig map file's text, within the library's limit.
+inline std::string rig_map_read_file(const std::string& path) {
+  return detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+    return mf_rig_map_read_file(path.c_str(), out, capacity, needed);
+  });
+}
+
 // ---------------------------------------------------------------- encode, decode
 
 /// mf_codec_options in C++ types.
@@ -692,6 +699,39 @@ inline Solution solve(const Model& model, const Motion& input, const Constraints
   const int status = mf_solve(model.get(), input.get(), constraints.get(), alternatives, call.options(), &out);
   return call.finish_handle(status, Solution(out));
 }
+
+// ---------------------------------------------------------------- output files
+
+/// mf_output_set: the files one job reads and writes, checked together as
+/// they are added, its outputs staged with write() and put in place by
+/// commit(); destroyed uncommitted, it leaves no output behind.
+class OutputSet : public detail::Handle<mf_output_set, mf_output_set_destroy> {
+ public:
+  using Handle::Handle;  // OutputSet() is no set; create() makes one
+
+  /// An empty set (mf_output_set_create).
+  static OutputSet create() {
+    mf_output_set* out = nullptr;
+    check(mf_output_set_create(&out));
+    return OutputSet(out);
+  }
+  void add_input(const std::string& path, const std::string& role) {
+    check(mf_output_set_add_input(get(), path.c_str(), role.c_str()));
+  }
+  void add_output(const std::string& path, const std::string& role) {
+    check(mf_output_set_add_output(get(), path.c_str(), role.c_str()));
+  }
+  /// Adds every file of `job` under `label` ("line 3"), or none.
+  void merge(const OutputSet& job, const std::string& label) {
+    check(mf_output_set_merge(get(), job.get(), label.c_str()));
+  }
+  void write(const std::string& path, const void* data, size_t size) {
+    check(mf_output_set_write(get(), path.c_str(), data, size));
+  }
+  void write(const std::string& path, const std::string& text) { write(path, text.data(), text.size()); }
+  void write(const std::string& path, const std::vector<uint8_t>& bytes) { write(path, bytes.data(), bytes.size()); }
+  void commit() { check(mf_output_set_commit(get())); }
+};
 
 }  // namespace motionfield
 

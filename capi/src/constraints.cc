@@ -12,9 +12,6 @@
 #include "tasks/jobs.h"
 #include "tasks/trajectory_csv.h"
 
-/// Largest constraints file mf_constraints_load_json reads.
-static constexpr size_t kMaxConstraintsFileBytes = 16u << 20;
-
 struct mf_constraints {
   mf::ConstraintSpec spec;
 };
@@ -102,7 +99,7 @@ int mf_constraints_load_json(const char* path, mf_constraints** out) {
   return guard([&] {
     require(path, "path");
     require(out, "out");
-    const std::string text = mf::read_file_limited(path, "constraints file", kMaxConstraintsFileBytes);
+    const std::string text = mf::read_file_limited(path, "constraints file", mf::kMaxConstraintsFileBytes);
     auto c = std::make_unique<mf_constraints>();
     c->spec = mf::ConstraintSpec::parse_json(text, path);
     *out = c.release();

@@ -64,3 +64,15 @@ int mf_rig_describe(const mf_model* model, const mf_motion* motion, const char* 
 }
 
 }  // extern "C"
+
+extern "C" {
+
+int mf_rig_map_read_file(const char* path, char* out, size_t capacity, size_t* needed) {
+  return guard([&] {
+    require(path, "path");
+    mf::capi::check_buffer_arguments(out, capacity, needed);
+    mf::capi::write_string(mf::read_rig_map_file(path), out, capacity, needed);  // FileError: MF_ERROR_IO
+  });
+}
+
+}  // extern "C"

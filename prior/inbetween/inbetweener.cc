@@ -16,6 +16,7 @@
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations_torch.h"
 #include "prior/util/binary_io.h"
+#include "prior/util/file_writer.h"
 
 namespace mf {
 

@@ -10,6 +10,7 @@
 
 #include "prior/motion/errors.h"
 #include "prior/util/binary_io.h"
+#include "prior/util/file_writer.h"
 
 namespace mf {
 

@@ -10,6 +10,7 @@
 #include <unordered_set>
 
 #include "prior/util/binary_io.h"
+#include "prior/util/file_writer.h"
 
 namespace mf {
 namespace {

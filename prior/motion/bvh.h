@@ -88,7 +88,7 @@ BvhDocument read_bvh_file(const std::string& path);
 /// End Site. Throws mf::InputError if validate() fails, num_frames < 1 or
 /// frame_time <= 0 (the reader would reject the output).
 std::string format_bvh(const BvhDocument& doc);
-/// Writes to `path` with write_file_atomically (prior/util/binary_io.h: a
+/// Writes to `path` with write_file_atomically (prior/util/file_writer.h: a
 /// temporary file and a rename, or in place for devices and FIFOs); throws
 /// FileError "cannot write <path>: <reason>" on I/O failure.
 void write_bvh_file(const std::string& path, const BvhDocument& doc);

@@ -10,6 +10,7 @@
 
 #include "prior/motion/errors.h"
 #include "prior/util/binary_io.h"
+#include "prior/util/file_writer.h"
 
 static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "glTF buffers are little-endian: the floats are copied as is");
 

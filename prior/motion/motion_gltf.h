@@ -38,7 +38,7 @@ bool gltf_format_from_path(const std::string& path, GltfFormat* format);
 std::vector<uint8_t> format_gltf(const Motion& motion, GltfFormat format);
 
 /// format_gltf, written to `path` with write_file_atomically
-/// (prior/util/binary_io.h); throws FileError "cannot write <path>: <reason>"
+/// (prior/util/file_writer.h); throws FileError "cannot write <path>: <reason>"
 /// on I/O failure.
 void write_gltf_file(const std::string& path, const Motion& motion, GltfFormat format);
 

@@ -9,6 +9,7 @@
 
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "prior/util/strict_json.h"
 
 namespace mf {
 namespace {
@@ -469,12 +470,7 @@ std::string RigAnatomy::to_json(const Skeleton& s) const {
 }
 
 RigAnatomy RigAnatomy::from_json(const std::string& text, const Skeleton& s, const std::string& source) {
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(source + ": not valid JSON (" + e.what() + ")");
-  }
+  nlohmann::json j = parse_json_strict(text, source);
   if (!j.is_object() || j.value("format", "") != "motionfield-rig-anatomy" || !j.contains("joints") ||
       !j["joints"].is_object() || !j.contains("leg_length") || !j["leg_length"].is_number())
     throw InputError(source + ": not a motionfield rig anatomy file");

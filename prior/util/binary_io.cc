@@ -20,21 +20,6 @@ std::string too_large(const std::string& path, const std::string& what, size_t m
   return "cannot read " + what + " " + path + ": larger than the limit of " + mib(max_bytes) + " for a " + what;
 }
 
-// Writes all of `data` to `fd`; 0 or the errno of the failure.
-int write_all(int fd, const char* data, size_t size) {
-  while (size > 0) {
-    const ssize_t n = ::write(fd, data, size);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      return errno;
-    }
-    if (n == 0) return EIO;
-    data += n;
-    size -= static_cast<size_t>(n);
-  }
-  return 0;
-}
-
 // Opens `path` for reading after the checks of read_file_limited (a
 // directory, a device or a regular file over `max_bytes` is refused);
 // `st` receives the open file's status.
@@ -127,33 +112,6 @@ FileBytes read_file_bytes(const std::string& path) {
   // writer must never see its reader close before the end.
   out.text_ = read_open_file(fd, st, path, what, kMaxModelFileBytes);
   return out;
-}
-
-void write_file_atomically(const std::string& path, const void* data, size_t size) {
-  const std::string cannot = "cannot write " + path + ": ";
-  const char* bytes = static_cast<const char*>(data);
-  struct stat st;
-  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
-    // A device (/dev/null, /dev/full, a terminal) or a FIFO: written in place, never replaced.
-    if (S_ISDIR(st.st_mode)) throw FileError(cannot + "it is a directory");
-    const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-    if (fd < 0) throw FileError(cannot + std::strerror(errno));
-    int error = write_all(fd, bytes, size);
-    if (::close(fd) != 0 && error == 0) error = errno;
-    if (error != 0) throw FileError(cannot + std::strerror(error));
-    return;
-  }
-  static std::atomic<unsigned> counter{0};
-  const std::string temp = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) throw FileError(cannot + std::strerror(errno) + " (creating " + temp + ")");
-  int error = write_all(fd, bytes, size);
-  if (::close(fd) != 0 && error == 0) error = errno;
-  if (error == 0 && ::rename(temp.c_str(), path.c_str()) != 0) error = errno;
-  if (error != 0) {
-    ::unlink(temp.c_str());
-    throw FileError(cannot + std::strerror(error));
-  }
 }
 
 }  // namespace mf

@@ -118,6 +118,7 @@ constexpr size_t kMaxBvhFileBytes = 512 * kMiB;    ///< BVH: an hour at 120 fps 
 constexpr size_t kMaxModelFileBytes = 2048 * kMiB; ///< model files (.mfm)
 constexpr size_t kMaxTextFileBytes = 64 * kMiB;    ///< path CSVs, rig anatomy
 constexpr size_t kMaxRigMapFileBytes = 1 * kMiB;   ///< rig map files
+constexpr size_t kMaxConstraintsFileBytes = 16 * kMiB;  ///< constraints files (mf_constraints_load_json)
 
 /// Reads a whole file of at most `max_bytes`. Throws FileError
 /// "cannot read the <what> <path>: <reason>" when it cannot be opened or read,
@@ -131,7 +132,8 @@ std::string read_file_limited(const std::string& path, const std::string& what, 
 /// model (a 22 MB copy took 150-300 ms; docs/BENCHMARKS.md, "Start-up").
 /// Pipes and files that cannot be mapped are read into memory instead.
 /// A mapped file must not be truncated while the object lives (the process
-/// would get SIGBUS); motionfield itself only ever replaces files by rename,
+/// would get SIGBUS); motionfield itself only ever replaces files by rename
+/// (prior/util/file_writer.h),
 /// which leaves a mapped file intact.
 class FileBytes {
  public:
@@ -156,15 +158,6 @@ class FileBytes {
 /// read_file_limited, kMaxModelFileBytes).
 FileBytes read_file_bytes(const std::string& path);
 
-/// Writes `size` bytes to `path`. A regular file (or a new one) is replaced
-/// through a temporary file in its directory and a rename, so a failure never
-/// leaves a half-written file; anything else that exists (a character device
-/// like /dev/null or /dev/stdout, a FIFO) is written directly, never replaced.
-/// Throws FileError "cannot write <path>: <reason>" (strerror: "No space left
-/// on device", "Permission denied", ...).
-void write_file_atomically(const std::string& path, const void* data, size_t size);
-inline void write_file_atomically(const std::string& path, const std::vector<uint8_t>& bytes) {
-  write_file_atomically(path, bytes.data(), bytes.size());
-}
+// The one file writer (write_file_atomically, OutputFiles) is prior/util/file_writer.h.
 
 }  // namespace mf

@@ -49,6 +49,8 @@ import ctypes
 import functools
 import inspect
 import json
+import math
+import numbers
 import os
 import threading
 import warnings
@@ -66,7 +68,7 @@ __all__ = [
     "version", "abi_version", "library_path", "set_num_threads", "get_num_threads",
     "Method", "methods", "find_method", "default_method", "default_model_path", "default_model",
     "printable_text",
-    "Model", "Motion", "CancelToken", "Progress", "Encoding",
+    "Model", "Motion", "CancelToken", "Progress", "Encoding", "OutputSet",
     "inbetween", "fill", "resample", "resample_frame_count", "encode",
     "Constraints", "Solution", "solve",
     "renav", "load_path_csv", "describe_rig", "length_unit_scale",
@@ -168,6 +170,80 @@ def _check(status: int) -> None:
     raise _ERRORS.get(status, Error)(message, status)
 
 
+# ------------------------------------------------------------------ arguments
+# Every argument is checked here before it crosses into C, as the CLI checks
+# its own (docs/RELIABILITY.md, "Outputs and clients"): TypeError for a wrong
+# type, InvalidArgumentError (a ValueError) for a wrong value, integers in
+# range (ctypes would wrap 2**32 + 30 around to 30), frames integral (30.5 is
+# no frame) and NaN and infinities named as such.
+
+_INT32_MIN, _INT32_MAX = -2**31, 2**31 - 1
+
+
+def _number_text(value: float) -> str:
+    if math.isnan(value):
+        return "nan"
+    if math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    return repr(value)
+
+
+def _int_arg(value: Any, what: str, low: int = _INT32_MIN, high: int = _INT32_MAX) -> int:
+    """`value` as an int in [low, high]: an integer, or a float with an integral value."""
+    if isinstance(value, (bool, np.bool_)):
+        raise TypeError("%s must be an integer, not bool" % what)
+    if isinstance(value, numbers.Integral):
+        v = int(value)
+    elif isinstance(value, numbers.Real):
+        f = float(value)
+        if not math.isfinite(f) or f != math.floor(f):
+            raise InvalidArgumentError("%s must be an integer, not %s" % (what, _number_text(f)))
+        v = int(f)
+    else:
+        raise TypeError("%s must be an integer, not %s" % (what, type(value).__name__))
+    if not low <= v <= high:
+        raise InvalidArgumentError("%s must be between %d and %d, not %d" % (what, low, high, v))
+    return v
+
+
+def _int_list(values: Any, what: str, low: int = _INT32_MIN, high: int = _INT32_MAX) -> npt.NDArray[np.int32]:
+    """A sequence (or array) of _int_arg values as a contiguous int32 array."""
+    if isinstance(values, np.ndarray):
+        items = values.reshape(-1).tolist()
+    elif isinstance(values, (str, bytes)) or not hasattr(values, "__iter__"):
+        raise TypeError("%s must be a sequence of integers, not %s" % (what, type(values).__name__))
+    else:
+        items = list(values)
+    out = np.empty(len(items), dtype=np.int32)
+    for i, v in enumerate(items):
+        out[i] = _int_arg(v, "%s item %d" % (what, i), low, high)
+    return out
+
+
+def _float_arg(value: Any, what: str) -> float:
+    """A real number (NaN and infinities are the library's to refuse, by name)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise TypeError("%s must be a number, not %s" % (what, type(value).__name__))
+    return float(value)
+
+
+def _str_arg(value: Any, what: str, optional: bool = False) -> Optional[str]:
+    if value is None and optional:
+        return None
+    if not isinstance(value, str):
+        raise TypeError("%s must be a str, not %s" % (what, type(value).__name__))
+    if "\0" in value:
+        raise InvalidArgumentError("%s contains a NUL character, which no name can hold" % what)
+    return value
+
+
+def _instance_arg(value: Any, cls: Type[Any], what: str, optional: bool = False) -> Any:
+    if (value is None and optional) or isinstance(value, cls):
+        return value
+    raise TypeError("%s must be a %s%s, not %s" % (what, cls.__name__, " or None" if optional else "",
+                                                    type(value).__name__))
+
+
 # ------------------------------------------------------------------ helpers
 
 
@@ -244,8 +320,7 @@ def _rig_map_args(rig_map: Optional[RigMap]) -> Tuple[Optional[str], Optional[st
         return rig_map, None
     if isinstance(rig_map, (str, os.PathLike)):
         return None, os.fspath(rig_map)
-    raise InvalidArgumentError("rig_map must be a dict, a JSON file's path or JSON text, not %s" %
-                               type(rig_map).__name__)
+    raise TypeError("rig_map must be a dict, a JSON file's path or JSON text, not %s" % type(rig_map).__name__)
 
 
 def _keywords_after(*old_order: str) -> Callable[[_F], _F]:
@@ -358,7 +433,7 @@ def set_num_threads(n: int) -> None:
     InvalidArgumentError
         If `n` is out of range.
     """
-    _check(_c.mf_set_num_threads(int(n)))
+    _check(_c.mf_set_num_threads(_int_arg(n, "n")))
 
 
 def get_num_threads() -> int:
@@ -938,7 +1013,7 @@ class Motion(_Skeletal):
             if len(joint_names) != joints or len(parents) != joints:
                 raise InvalidArgumentError("joint_names and parents must have one entry per joint (%d)" % joints)
             names = (ctypes.c_char_p * joints)(*[str(n).encode() for n in joint_names])
-            par = (ctypes.c_int32 * joints)(*[int(p) for p in parents])
+            par = (ctypes.c_int32 * joints)(*_int_list(parents, "parents").tolist())
             off = _float_array(offsets, (3,), "offsets")
             if off.shape[0] != joints:
                 raise InvalidArgumentError("offsets must have shape [%d, 3], not %s" % (joints, list(off.shape)))
@@ -1212,6 +1287,161 @@ class CancelToken(_Handle):
         return bool(v.value)
 
 
+class OutputSet(_Handle):
+    """The files one job reads and writes (mf_output_set): the one safe
+    writer of the C API, for several outputs at once.
+
+    Files are checked as they are added: no two outputs, and no output and
+    input, may be the same file (by inode, through links; devices excepted).
+    ``write()`` stages an output (a temporary file with a unique name beside
+    it; a device's bytes are kept and written in place), ``commit()`` puts
+    them all in place; closed or collected without ``commit()``, the set
+    leaves none of them behind.
+
+    Raises
+    ------
+    OutOfMemoryError
+        If the set cannot be made.
+    """
+
+    _destroy = staticmethod(_c.mf_output_set_destroy)
+
+    def __init__(self) -> None:
+        handle = ctypes.POINTER(_c.MfOutputSet)()
+        _check(_c.mf_output_set_create(ctypes.byref(handle)))
+        super().__init__(handle)
+
+    def add_input(self, path: PathLike, role: str = "input") -> None:
+        """Adds a file the job reads.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file as the user named it ("" adds nothing).
+        role : str
+            What it is, for messages ("input", "rig map file").
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        InvalidArgumentError
+            If it is an output added before ("the output O is the input I:
+            refusing to overwrite it (name another output file)").
+        """
+        _check(_c.mf_output_set_add_input(self._live(), os.fsencode(path), _str_arg(role, "role").encode()))
+
+    def add_output(self, path: PathLike, role: str = "output") -> None:
+        """Adds a file the job writes.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file as the user named it.
+        role : str
+            What it is, for messages ("output", "alternative", "report").
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        FileError
+            If it is a directory or its directory does not exist.
+        InvalidArgumentError
+            If it is an input or another output (nothing is added).
+        """
+        _check(_c.mf_output_set_add_output(self._live(), os.fsencode(path), _str_arg(role, "role").encode()))
+
+    def merge(self, job: "OutputSet", label: str) -> None:
+        """Adds every file of another job's set, or none (a batch's check).
+
+        Parameters
+        ----------
+        job : OutputSet
+            The job's files.
+        label : str
+            The job's name in later messages ("line 3").
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        InvalidArgumentError
+            If one of its files is one of this set's and either is written
+            ("line 2 already writes O: ...").
+        """
+        _instance_arg(job, OutputSet, "job")
+        _check(_c.mf_output_set_merge(self._live(), job._live(), _str_arg(label, "label").encode()))
+
+    def write(self, path: PathLike, data: Union[bytes, str]) -> None:
+        """Stages the bytes of an output.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The output, named as it was added.
+        data : bytes or str
+            Its bytes (a str is written as UTF-8).
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        FileError
+            If the temporary file cannot be written ("cannot write F: No
+            space left on device").
+        InvalidArgumentError
+            If `path` is no output of the set.
+        """
+        raw = data.encode() if isinstance(data, str) else bytes(data)
+        _check(_c.mf_output_set_write(self._live(), os.fsencode(path), raw, len(raw)))
+
+    def write_motion(self, path: PathLike, motion: "Motion") -> None:
+        """Stages a motion: glTF 2.0 for a .glb or .gltf name, BVH otherwise.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The output, named as it was added.
+        motion : Motion
+            The motion.
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        FileError
+            As write().
+        """
+        ext = os.path.splitext(os.fspath(path))[1].lower()
+        _instance_arg(motion, Motion, "motion")
+        self.write(path, motion.to_gltf_bytes(ext[1:]) if ext in (".glb", ".gltf") else motion.to_bvh_text())
+
+    def commit(self) -> None:
+        """Puts every staged output in place (devices written in place, files renamed), once.
+
+        Returns
+        -------
+        None
+
+        Raises
+        ------
+        FileError
+            With the file and the reason; the outputs not yet in place are removed.
+        """
+        _check(_c.mf_output_set_commit(self._live()))
+
+
 class Progress(NamedTuple):
     """What a progress callback is given.
 
@@ -1239,6 +1469,12 @@ class _TaskCall:
 
     def __init__(self, method: Optional[str], seed: int, progress: Optional[ProgressCallback],
                  cancel: Optional[CancelToken], rig_map: Optional[RigMap] = None, max_iterations: int = 0) -> None:
+        method = _str_arg(method, "method", optional=True)
+        seed = _int_arg(seed, "seed", 0, 2**64 - 1)
+        max_iterations = _int_arg(max_iterations, "max_iterations", 0, 100000)
+        if progress is not None and not callable(progress):
+            raise TypeError("progress must be callable, not %s" % type(progress).__name__)
+        _instance_arg(cancel, CancelToken, "cancel", optional=True)
         self.options = _c.MfTaskOptions()
         _check(_c.mf_task_options_init(ctypes.byref(self.options)))
         self._method = method.encode() if method else None
@@ -1246,8 +1482,8 @@ class _TaskCall:
         text, path = _rig_map_args(rig_map)
         self._rig_map = (text.encode() if text else None, path.encode() if path else None)
         self.options.rig_map, self.options.rig_map_path = self._rig_map
-        self.options.seed = int(seed)
-        self.options.max_iterations = int(max_iterations)
+        self.options.seed = seed
+        self.options.max_iterations = max_iterations
         self.error: Optional[BaseException] = None
         if progress is not None:
             def trampoline(_user_data: Any, p: Any) -> int:
@@ -1276,6 +1512,8 @@ def _task_model(model: Optional[Model], method: Optional[str]) -> Any:
     given model; else the default model when no method is named or the method
     needs a model (None when there is none: the default method is then one
     without a model); else none."""
+    _instance_arg(model, Model, "model", optional=True)
+    _str_arg(method, "method", optional=True)
     if model is None and (not method or _needs_model(method)):
         model = default_model()
     return model._live() if model is not None else None
@@ -1367,7 +1605,8 @@ def inbetween(motion: Motion, keyframes: Sequence[int], *, method: Optional[str]
     ------
     {task_raises}
     """
-    keys = np.ascontiguousarray(keyframes, dtype=np.int32).reshape(-1)
+    _instance_arg(motion, Motion, "motion")
+    keys = _int_list(keyframes, "keyframes")
     call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
     return call.run(_c.mf_inbetween, _task_model(model, method), motion._live(),
                     keys.ctypes.data_as(ctypes.POINTER(ctypes.c_int32)), keys.size)
@@ -1397,8 +1636,10 @@ def fill(motion: Motion, gap_begin: int, gap_end: int, *, method: Optional[str] 
     ------
     {task_raises}
     """
+    _instance_arg(motion, Motion, "motion")
+    begin, end = _int_arg(gap_begin, "gap_begin"), _int_arg(gap_end, "gap_end")
     call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
-    return call.run(_c.mf_fill, _task_model(model, method), motion._live(), int(gap_begin), int(gap_end))
+    return call.run(_c.mf_fill, _task_model(model, method), motion._live(), begin, end)
 
 
 @_task_doc
@@ -1429,8 +1670,10 @@ def resample(motion: Motion, fps: float, *, method: Optional[str] = None, model:
     ------
     {task_raises}
     """
+    _instance_arg(motion, Motion, "motion")
+    fps = _float_arg(fps, "fps")
     call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
-    return call.run(_c.mf_resample, _task_model(model, method), motion._live(), float(fps))
+    return call.run(_c.mf_resample, _task_model(model, method), motion._live(), fps)
 
 
 # ------------------------------------------------------------------ constraints
@@ -1516,7 +1759,7 @@ class Constraints(_Handle):
         InvalidArgumentError
             If a frame is negative.
         """
-        f = np.ascontiguousarray(frames, dtype=np.int32).reshape(-1)
+        f = _int_list(frames, "frames")
         _check(_c.mf_constraints_add_pose_keys(self._live(), f.ctypes.data_as(ctypes.POINTER(ctypes.c_int32)), f.size))
         return self
 
@@ -1544,9 +1787,12 @@ class Constraints(_Handle):
         """
         if root not in _ROOT_FLAGS:
             raise InvalidArgumentError("root must be None, 'none', 'position', 'rotation' or 'both', not %r" % (root,))
-        names = [j.encode() for j in joints]
+        frame = _int_arg(frame, "frame")
+        if isinstance(joints, str):
+            raise TypeError("joints must be a sequence of joint names, not str")
+        names = [_str_arg(j, "joints item %d" % i).encode() for i, j in enumerate(joints)]  # type: ignore[union-attr]
         arr = (ctypes.c_char_p * max(1, len(names)))(*names)
-        _check(_c.mf_constraints_add_partial_key(self._live(), int(frame), arr, len(names), _ROOT_FLAGS[root]))
+        _check(_c.mf_constraints_add_partial_key(self._live(), frame, arr, len(names), _ROOT_FLAGS[root]))
         return self
 
     def add_target(self, frame: int, joint: str, position: npt.ArrayLike, weight: float = 1.0) -> "Constraints":
@@ -1576,7 +1822,9 @@ class Constraints(_Handle):
         p = np.ascontiguousarray(position, dtype=np.float32).reshape(-1)
         if p.size != 3:
             raise InvalidArgumentError("position must have 3 values [x, y, z], not %d" % p.size)
-        _check(_c.mf_constraints_add_target(self._live(), int(frame), joint.encode(), _f32_ptr(p), float(weight)))
+        frame, weight = _int_arg(frame, "frame"), _float_arg(weight, "weight")
+        _check(_c.mf_constraints_add_target(self._live(), frame, _str_arg(joint, "joint").encode(),  # type: ignore[union-attr]
+                                            _f32_ptr(p), weight))
         return self
 
     def add_contact(self, joint: str, first: int, last: int) -> "Constraints":
@@ -1599,7 +1847,9 @@ class Constraints(_Handle):
         InvalidArgumentError
             If first >= last or a frame is negative.
         """
-        _check(_c.mf_constraints_add_contact(self._live(), joint.encode(), int(first), int(last)))
+        first, last = _int_arg(first, "first"), _int_arg(last, "last")
+        _check(_c.mf_constraints_add_contact(self._live(), _str_arg(joint, "joint").encode(),  # type: ignore[union-attr]
+                                             first, last))
         return self
 
     def add_trajectory(self, trajectory: npt.ArrayLike, rows: Optional[npt.ArrayLike] = None) -> "Constraints":
@@ -1765,21 +2015,28 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
     ------
     {task_raises}
     """
+    _instance_arg(motion, Motion, "motion")
+    alternatives = _int_arg(alternatives, "alternatives", 0, 16)
+    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
     if constraints is None:
         c = Constraints()
     elif isinstance(constraints, Constraints):
         c = Constraints(constraints.to_dict())
     elif isinstance(constraints, dict):
         c = Constraints(constraints)
-    else:
+    elif isinstance(constraints, (str, os.PathLike)):
         c = Constraints.load(constraints)
-    if len(keyframes):
-        c.add_keys(keyframes)
+    else:
+        raise TypeError("constraints must be a Constraints, a dict or a file's path, not %s" %
+                        type(constraints).__name__)
+    keys = _int_list(keyframes, "keyframes")
+    if len(keys):
+        c.add_keys(keys)
     for key in partial_keys:
         c.add_partial_key(key[0], key[1], key[2] if len(key) > 2 else None)  # type: ignore[misc]
     if isinstance(targets, dict):
         for joint, (frames, positions) in targets.items():
-            f = np.asarray(frames, dtype=np.int64).reshape(-1)
+            f = _int_list(frames, "targets[%r] frames" % (joint,))
             p = _float_array(positions, (3,), "positions").reshape(-1, 3)
             if len(f) != len(p):
                 raise InvalidArgumentError("targets[%r]: %d frames but %d positions" % (joint, len(f), len(p)))
@@ -1796,8 +2053,7 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
         c.add_trajectory(trajectory[0], trajectory[1])
     elif trajectory is not None:
         c.add_trajectory(trajectory)
-    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
-    handle = call.run(_c.mf_solve, _task_model(model, method), motion._live(), c._live(), int(alternatives),
+    handle = call.run(_c.mf_solve, _task_model(model, method), motion._live(), c._live(), alternatives,
                       out_type=_c.MfSolution)
     try:
         n = ctypes.c_int32(0)
@@ -1838,8 +2094,8 @@ def resample_frame_count(frames: int, fps_in: float, fps_out: float) -> Tuple[in
         If an argument is out of range.
     """
     n, rounded = ctypes.c_int32(0), ctypes.c_int32(0)
-    _check(_c.mf_resample_frame_count(int(frames), float(fps_in), float(fps_out), ctypes.byref(n),
-                                      ctypes.byref(rounded)))
+    _check(_c.mf_resample_frame_count(_int_arg(frames, "frames"), _float_arg(fps_in, "fps_in"),
+                                      _float_arg(fps_out, "fps_out"), ctypes.byref(n), ctypes.byref(rounded)))
     return n.value, bool(rounded.value)
 
 
@@ -1933,6 +2189,9 @@ def renav(reference: Motion, path: npt.ArrayLike, *, model: Optional[Model] = No
     ------
     {task_raises}
     """
+    _instance_arg(reference, Motion, "reference")
+    frames = _int_arg(frames, "frames")
+    fps = _float_arg(fps, "fps")
     xz = np.ascontiguousarray(path, dtype=np.float32)
     if xz.ndim != 2 or xz.shape[1] != 2:
         raise InvalidArgumentError("path must have shape [points, 2], not %s" % list(xz.shape))
@@ -1940,8 +2199,8 @@ def renav(reference: Motion, path: npt.ArrayLike, *, model: Optional[Model] = No
     o = _c.MfRenavOptions()
     _check(_c.mf_renav_options_init(ctypes.byref(o)))
     o.path_kind = _c.PATH_POLYLINE if polyline else _c.PATH_PER_FRAME
-    o.frame_count = int(frames)
-    o.fps = float(fps)
+    o.frame_count = frames
+    o.fps = fps
     call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
     return call.run(lambda *args: _c.mf_renav(*args[:4], ctypes.byref(o), *args[4:]), handle,
                     reference._live(), _f32_ptr(xz), xz.shape[0])
@@ -1978,11 +2237,11 @@ def describe_rig(motion: Motion, *, model: Optional[Model] = None, rig_map: Opti
     FileError
         If the rig map file cannot be read.
     """
-    model = _required_model(model, "describe_rig()")
+    _instance_arg(motion, Motion, "motion")
+    model = _required_model(_instance_arg(model, Model, "model", optional=True), "describe_rig()")
     text, path = _rig_map_args(rig_map)
-    if path is not None:
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
+    if path is not None:  # the library's reader of rig maps, with their limit
+        text = _read_string(_c.mf_rig_map_read_file, os.fsencode(path))
     try:
         out = _read_string(_c.mf_rig_describe, model._live(), motion._live(), text.encode() if text else None)
     except InvalidArgumentError as e:
@@ -2000,7 +2259,7 @@ _ROOTS = {"prior": _c.ROOT_FROM_PRIOR, "input": _c.ROOT_FROM_INPUT}
 def _codec_options(hop: int = 0, root: str = "prior") -> Any:
     o = _c.MfCodecOptions()
     _check(_c.mf_codec_options_init(ctypes.byref(o)))
-    o.hop = int(hop)
+    o.hop = _int_arg(hop, "hop")
     if root not in _ROOTS:
         raise InvalidArgumentError("root must be 'prior' or 'input', not %r" % (root,))
     o.root_source = _ROOTS[root]
@@ -2119,7 +2378,8 @@ class Encoding(_Handle):
         """
         o = _codec_options(root=root)
         out = ctypes.POINTER(_c.MfMotion)()
-        _check(_c.mf_decode(self._live(), float(fps), int(frame_count), ctypes.byref(o), ctypes.byref(out)))
+        _check(_c.mf_decode(self._live(), _float_arg(fps, "fps"), _int_arg(frame_count, "frame_count"), ctypes.byref(o),
+                            ctypes.byref(out)))
         return Motion._wrap(out)
 
     def decode_times(self, times: npt.ArrayLike, fps: float, root: str = "prior") -> Motion:
@@ -2190,7 +2450,8 @@ def encode(motion: Motion, *args: Any, model: Optional[Model] = None, hop: int =
             hop = args[1]
     elif args:
         raise TypeError("encode() takes 1 positional argument (the motion) and keywords, not %d" % (1 + len(args)))
-    model = _required_model(model, "encode()")
+    _instance_arg(motion, Motion, "motion")
+    model = _required_model(_instance_arg(model, Model, "model", optional=True), "encode()")
     o = _codec_options(hop=hop)
     out = ctypes.POINTER(_c.MfEncoding)()
     _check(_c.mf_encode(model._live(), motion._live(), ctypes.byref(o), ctypes.byref(out)))

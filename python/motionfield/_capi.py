@@ -67,6 +67,10 @@ class MfConstraints(ctypes.Structure):
     """Opaque mf_constraints."""
 
 
+class MfOutputSet(ctypes.Structure):
+    """Opaque mf_output_set."""
+
+
 class MfSolution(ctypes.Structure):
     """Opaque mf_solution."""
 
@@ -345,6 +349,16 @@ _declare("mf_solution_get_report_json", _int, _solution, ctypes.c_char_p, _size,
 _declare("mf_solution_get_method", _int, _solution, _P(_str))
 _declare("mf_constraints_add_trajectory", _int, _constraints, _P(_i32), _P(_f32), _size)
 _declare("mf_constraints_load_trajectory_csv", _int, _constraints, _str)
+
+_output_set = _P(MfOutputSet)
+_declare("mf_output_set_create", _int, _P(_output_set))
+_declare("mf_output_set_destroy", None, _output_set)
+_declare("mf_output_set_add_input", _int, _output_set, _str, _str)
+_declare("mf_output_set_add_output", _int, _output_set, _str, _str)
+_declare("mf_output_set_merge", _int, _output_set, _output_set, _str)
+_declare("mf_output_set_write", _int, _output_set, _str, ctypes.c_void_p, _size)
+_declare("mf_output_set_commit", _int, _output_set)
+_declare("mf_rig_map_read_file", _int, _str, ctypes.c_char_p, _size, _P(_size))
 
 if mf_abi_version() != ABI_VERSION:  # noqa: F821 (declared above)
     raise ImportError("%s has ABI version %d; this package needs %d" %

@@ -573,40 +573,6 @@ def read_lines(path: str) -> List[bytes]:
     return lines
 
 
-class Outputs:
-    """The outputs claimed so far: a job may not write what an earlier line writes."""
-
-    def __init__(self) -> None:
-        self._lines: Dict[str, int] = {}
-
-    def claim(self, out: str, line: int) -> None:
-        """Claims `out` for `line`; InputError naming the earlier line if it is taken.
-
-        Parameters
-        ----------
-        out : str
-            The output path as the job gives it.
-        line : int
-            The 1-based line.
-
-        Returns
-        -------
-        None
-
-        Raises
-        ------
-        InputError
-            If an earlier line writes the same file.
-        """
-        if os.path.exists(out) and not os.path.isfile(out):
-            return  # devices and FIFOs (/dev/null) may be written by every job
-        key = os.path.realpath(os.path.abspath(out))
-        if key in self._lines:
-            raise InputError("line %d already writes %s: refusing to overwrite another job's output "
-                             '(give each job its own "out")' % (self._lines[key], out))
-        self._lines[key] = line
-
-
 def _blank(line: bytes) -> bool:
     return not line.strip(b" \t\r\n")
 
@@ -625,19 +591,24 @@ def parse_line(line: bytes, label: List[str]) -> BatchJob:
     return job
 
 
-def read_batch(path: str) -> List[Entry]:
-    """Every non-blank line of a batch file parsed and its output claimed, in line order.
+def read_batch(path: str, settings: Optional["Settings"] = None) -> List[Entry]:
+    """Every non-blank line of a batch file parsed and its files checked, in
+    line order: against each other and every earlier line's (the CLI's
+    check, mf_output_set_merge).
 
     Parameters
     ----------
     path : str
         The JSON-lines file.
+    settings : Settings, optional
+        The run's options (the command line's rig map is a job's input).
 
     Returns
     -------
     list of Entry
-        One per non-blank line; a line that does not parse, or writes what an
-        earlier line writes, carries its Failure.
+        One per non-blank line; a line that does not parse, writes what an
+        earlier line writes or reads, or reads what it writes, carries its
+        Failure.
 
     Raises
     ------
@@ -645,7 +616,7 @@ def read_batch(path: str) -> List[Entry]:
         If the file cannot be read.
     """
     entries = []
-    outputs = Outputs()
+    batch_files = mf.OutputSet()
     for i, raw in enumerate(read_lines(path)):
         if _blank(raw):
             continue
@@ -653,7 +624,7 @@ def read_batch(path: str) -> List[Entry]:
         entry = Entry(i + 1, "", BatchJob())
         try:
             entry.job = parse_line(raw, label)
-            outputs.claim(entry.job.out_path, i + 1)
+            batch_files.merge(prepare_job(entry.job, settings or Settings()), "line %d" % (i + 1))
         except Exception as e:  # noqa: BLE001 (each failure is the line's)
             entry.failure = failure_of(e)
         entry.label = label[0]
@@ -791,39 +762,28 @@ class _FilePath(os.PathLike):  # type: ignore[type-arg]
         return self._path
 
 
-def _check_path(out: str) -> None:
-    if os.path.isdir(out):
-        raise InputError("cannot write %s: it is a directory" % out)
-    parent = os.path.dirname(out)
-    if parent and not os.path.isdir(parent):
-        raise InputError("cannot write %s: directory %s does not exist" % (out, parent))
+def prepare_job(job: BatchJob, settings: "Settings") -> mf.OutputSet:
+    """What a job checks before reading anything (the CLI's prepare_job): its
+    method exists, re-navigation's numbers, and its files (mf_output_set):
+    no two outputs, and no output and input, are one file.
 
+    Parameters
+    ----------
+    job : BatchJob
+        The job.
+    settings : Settings
+        The run's options.
 
-def _check_output(job: BatchJob, settings: Settings) -> None:
-    if job.out_path == _STDIO and job.alternatives > 0:
-        raise InputError("--alternatives writes OUT_1.bvh .. beside the output: name an output file, not -")
-    _check_path(job.out_path)
-    if job.report_file:
-        _check_path(job.report_file)
-    rig_map = job.rig_map or settings.rig_map
-    outputs = [job.out_path] + [alternative_path(job.out_path, i) for i in range(1, job.alternatives + 1)]
-    if job.report_file:
-        outputs.append(job.report_file)
-    for out in outputs:
-        for file, role in ((job.in_path, "input"), (job.path_file, "path file"), (rig_map, "rig map file"),
-                           (job.constraints_file, "constraints file"), (job.trajectory_file, "trajectory file")):
-            try:
-                same = bool(file) and file != _STDIO and os.path.samefile(file, out)
-            except OSError:
-                same = False
-            if same:
-                raise InputError("the output %s is the %s %s: refusing to overwrite it (name another output file)"
-                                 % (out, role, file))
+    Returns
+    -------
+    motionfield.OutputSet
+        The job's files, its outputs to be staged and committed.
 
-
-def check_job(job: BatchJob, settings: Settings) -> None:
-    """What a job checks before reading anything (the CLI's check_job): its
-    method exists, re-navigation's numbers, the output path."""
+    Raises
+    ------
+    InputError, motionfield.Error
+        On the first problem.
+    """
     renav = job.task == "renav"
     if job.method and not renav:
         mf.find_method(job.method)
@@ -832,7 +792,22 @@ def check_job(job: BatchJob, settings: Settings) -> None:
             raise InputError("renav: the fps must be positive")
         if job.polyline and job.frames != 0 and job.frames < 2:
             raise InputError("renav: the frame count must be at least 2")
-    _check_output(job, settings)
+    if job.out_path == _STDIO and job.alternatives > 0:
+        raise InputError("--alternatives writes OUT_1.bvh .. beside the output: name an output file, not -")
+    files = mf.OutputSet()
+    if job.in_path != _STDIO:
+        files.add_input(job.in_path, "input")
+    files.add_input(job.path_file, "path file")
+    files.add_input(job.rig_map or settings.rig_map, "rig map file")
+    files.add_input(job.constraints_file, "constraints file")
+    files.add_input(job.trajectory_file, "trajectory file")
+    if job.out_path != _STDIO:
+        files.add_output(job.out_path, "output")
+    for i in range(1, job.alternatives + 1):
+        files.add_output(alternative_path(job.out_path, i), "alternative")
+    if job.report_file:
+        files.add_output(job.report_file, "report")
+    return files
 
 
 def _solve_constrained(job: BatchJob, options: Dict[str, Any], motion: mf.Motion) -> "mf.Solution":
@@ -887,20 +862,6 @@ def alternative_path(out: str, index: int) -> str:
     return os.path.join(os.path.dirname(out), "%s_%d%s" % (stem, index, ext))
 
 
-def _write_atomically(path: str, text: str) -> None:
-    tmp = path + ".tmp"
-    try:
-        with open(tmp, "w", encoding="utf-8") as f:
-            f.write(text)
-        os.replace(tmp, path)
-    except OSError:
-        try:
-            os.remove(tmp)
-        except OSError:
-            pass
-        raise mf.FileError("cannot write " + path, None)
-
-
 def run_job(job: BatchJob, settings: Settings, models: Models) -> Outcome:
     """Runs one job end to end (the CLI's run_job): check, read, solve, write.
 
@@ -925,7 +886,7 @@ def run_job(job: BatchJob, settings: Settings, models: Models) -> Outcome:
     outcome = Outcome()
     try:
         t0 = time.perf_counter()
-        check_job(job, settings)
+        files = prepare_job(job, settings)
         model = models.for_method("nemf" if job.task == "renav" and not job.method else job.method)
         if not job.method and model is not None:
             outcome.asked_load_warnings = True
@@ -936,14 +897,16 @@ def run_job(job: BatchJob, settings: Settings, models: Models) -> Outcome:
         solved = _solve(job, settings, model, motion)
         result = solved.motion if isinstance(solved, mf.Solution) else solved
         t2 = time.perf_counter()
-        result.save_bvh(job.out_path)  # atomic: a temporary file in the same directory, then a rename
+        # Every output staged, then all put in place at once: a failure leaves none behind.
+        files.write_motion(job.out_path, result)
         alternatives: List[str] = []
         if isinstance(solved, mf.Solution):
             for i, m in enumerate(solved.motions[1:], 1):
                 alternatives.append(alternative_path(job.out_path, i))
-                m.save_bvh(alternatives[-1])
+                files.write_motion(alternatives[-1], m)
             if job.report_file:
-                _write_atomically(job.report_file, solved.report_json + "\n")
+                files.write(job.report_file, solved.report_json + "\n")
+        files.commit()
         t3 = time.perf_counter()
         ran = solved.method if isinstance(solved, mf.Solution) and solved.method else _method_name(job, model)
         r = JobReport(method=ran, model=models.path if model is not None else "",

@@ -146,7 +146,7 @@ class _Printer:
 
 
 def _run(args: argparse.Namespace, settings: mfb.Settings) -> int:
-    entries = mfb.read_batch(args.jobs)
+    entries = mfb.read_batch(args.jobs, settings)
     settings.preload_model = bool(settings.model) or any(mfb.needs_model(e.job) for e in entries if e.runnable)
     if settings.model:  # a --model that does not load fails the batch before any job, as in the CLI
         mfb.Models(settings.model, settings.transformers()).load_explicit()

@@ -85,6 +85,13 @@ WORKER_FAILURES = [
      "constraints": {"keys": [{"frame": 30, "joints": ["Tail"]}]}},
     {"task": "fill", "in": "walk.bvh", "out": "out/t1.bvh", "gap": [15, 45], "method": "interp", "trajectory": "t.csv"},
     {"task": "fill", "in": "walk.bvh", "out": "out/t2.bvh", "gap": [15, 45], "method": "nemf", "trajectory": "none.csv"},
+    # A report naming its own output, another job's output, the input (docs/RELIABILITY.md, "Outputs and clients").
+    {"task": "inbetween", "in": "walk.bvh", "out": "out/r2.bvh", "keyframes": [0, 60], "method": "interp",
+     "report": "out/r2.bvh"},
+    {"task": "inbetween", "in": "walk.bvh", "out": "out/r3.bvh", "keyframes": [0, 60], "method": "interp",
+     "report": "out/./fill.bvh"},
+    {"task": "inbetween", "in": "walk.bvh", "out": "out/r4.bvh", "keyframes": [0, 60], "method": "interp",
+     "report": "walk.bvh"},
 ]
 
 

@@ -369,5 +369,44 @@ TEST_F(CApiNull, ConstraintsAndSolutions) {
   mf_constraints_destroy(nullptr);
 }
 
+TEST_F(CApiNull, OutputSetsAndRigMapFiles) {
+  const std::string dir = test::scratch_dir("capi-null-outputs-" + std::to_string(::getpid()));
+  const std::string out = dir + "/o.bvh";
+  mf_output_set* const kSet = reinterpret_cast<mf_output_set*>(0x5eed);
+  mf_output_set* s = kSet;
+  EXPECT_REFUSES_NULL(mf_output_set_create(nullptr));
+  EXPECT_ACCEPTS(mf_output_set_create(&s));
+  ASSERT_NE(s, kSet);
+  mf_output_set* job = nullptr;
+  ASSERT_EQ(mf_output_set_create(&job), MF_OK);
+  EXPECT_REFUSES_NULL(mf_output_set_add_input(nullptr, "a.bvh", "input"));
+  EXPECT_REFUSES_NULL(mf_output_set_add_input(s, nullptr, "input"));
+  EXPECT_REFUSES_NULL(mf_output_set_add_input(s, "a.bvh", nullptr));
+  EXPECT_REFUSES_NULL(mf_output_set_add_output(nullptr, out.c_str(), "output"));
+  EXPECT_REFUSES_NULL(mf_output_set_add_output(s, nullptr, "output"));
+  EXPECT_REFUSES_NULL(mf_output_set_add_output(s, out.c_str(), nullptr));
+  EXPECT_ACCEPTS(mf_output_set_add_output(job, out.c_str(), "output"));
+  EXPECT_REFUSES_NULL(mf_output_set_merge(nullptr, job, "line 1"));
+  EXPECT_REFUSES_NULL(mf_output_set_merge(s, nullptr, "line 1"));
+  EXPECT_REFUSES_NULL(mf_output_set_merge(s, job, nullptr));
+  EXPECT_ACCEPTS(mf_output_set_merge(s, job, "line 1"));
+  EXPECT_REFUSES_NULL(mf_output_set_write(nullptr, out.c_str(), "x", 1));
+  EXPECT_REFUSES_NULL(mf_output_set_write(job, nullptr, "x", 1));
+  EXPECT_REFUSES_NULL(mf_output_set_write(job, out.c_str(), nullptr, 1));
+  EXPECT_ACCEPTS(mf_output_set_write(job, out.c_str(), nullptr, 0));  // no bytes: an empty file
+  EXPECT_REFUSES_NULL(mf_output_set_commit(nullptr));
+  EXPECT_ACCEPTS(mf_output_set_commit(job));
+  EXPECT_TRUE(std::filesystem::is_regular_file(out));
+  mf_output_set_destroy(job);
+  mf_output_set_destroy(s);
+  mf_output_set_destroy(nullptr);
+  EXPECT_REFUSES_NULL(mf_rig_map_read_file(nullptr, text_, sizeof text_, &needed_));
+  std::ofstream(dir + "/map.json") << "{}";
+  EXPECT_REFUSES_NULL(mf_rig_map_read_file((dir + "/map.json").c_str(), nullptr, 10, &needed_));
+  EXPECT_ACCEPTS(mf_rig_map_read_file((dir + "/map.json").c_str(), text_, sizeof text_, nullptr));
+  std::error_code ignored;
+  std::filesystem::remove_all(dir, ignored);
+}
+
 }  // namespace
 }  // namespace mf::capi_test

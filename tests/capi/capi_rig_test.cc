@@ -23,13 +23,6 @@ namespace {
 
 mf_motion* const kMotionSentinel = reinterpret_cast<mf_motion*>(0x5eed);
 
-std::string read_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 void write_text(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
 
 std::string scratch() { return test::scratch_dir("capi-rig-" + std::to_string(::getpid())); }

@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "prior/model/model_file.h"
 #include "tests/test_util.h"
@@ -103,6 +105,13 @@ int frame_count(const mf_motion* m) {
   int32_t n = -1;
   EXPECT_EQ(mf_motion_get_frame_count(m, &n), MF_OK);
   return n;
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
 }
 
 std::vector<std::string> methods_with(uint32_t flags) {

@@ -54,6 +54,9 @@ std::vector<float> root_positions(const mf_motion* m);
 std::vector<float> global_positions(const mf_motion* m);
 int frame_count(const mf_motion* m);
 
+/// The bytes of a whole file ("" when it cannot be read).
+std::string read_text(const std::string& path);
+
 /// Names of registered methods with all of `flags`.
 std::vector<std::string> methods_with(uint32_t flags);
 
