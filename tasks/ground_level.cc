@@ -26,10 +26,6 @@ std::vector<double> ground_heights(const Motion& motion, const std::vector<int>&
   for (size_t i = 0; i < known.size(); ++i)
     for (int k = 0; k < rig.num_feet(); ++k)
       lowest[i] = std::min(lowest[i], g.position(static_cast<int>(i), rig.foot_joints[k]).y() - rig.foot_heights[k]);
-  for (double& g : lowest) {  // none within the tolerance, all beyond twice it, smoothly in between
-    const double w = std::clamp((std::abs(g) - kGroundTolerance) / kGroundTolerance, 0.0, 1.0);
-    g *= w * w * (3.0 - 2.0 * w);
-  }
   std::vector<double> ground(known.size());
   for (size_t i = 0; i < known.size(); ++i) {
     ground[i] = lowest[i];

@@ -14,19 +14,16 @@
 
 namespace mf {
 
-/// Metres: a ground this close to the training data's floor is that floor.
-inline constexpr double kGroundTolerance = 0.03;
-
 /// The ground's height under every frame of `motion` (on the model's rig
 /// `rig`, metres), read from the frames `known` (sorted, non-empty): at each
 /// known frame, the lowest foot joint's height above its standing height
 /// (RigInfo::foot_heights); then, so that a key in the air does not lift the
 /// ground, the lowest of those within `envelope_frames` of each known frame;
 /// interpolated linearly between known frames and held before the first and
-/// after the last. At each known frame, a height within kGroundTolerance of
-/// zero counts as zero, one beyond twice that counts in full, with a
-/// smoothstep between: the training data's own feet stand within a few
-/// centimetres of its floor, and moving a motion by less only adds noise. Zero everywhere when the rig has no feet. Unknown
+/// after the last. Small offsets count too: on real CMU capture, where the
+/// retargeted floor is a few centimetres off the training data's, ignoring
+/// offsets under 3 cm made the transformer alone 4-17 % worse at gap 30
+/// (docs/BENCHMARKS.md, "Real capture on other rigs"). Zero everywhere when the rig has no feet. Unknown
 /// frames are never read.
 std::vector<double> ground_heights(const Motion& motion, const std::vector<int>& known, const RigInfo& rig,
                                    int envelope_frames);
