@@ -113,8 +113,11 @@ def _client(args: argparse.Namespace):  # type: ignore[no-untyped-def]
 
     if args.scheduler:
         return distributed.Client(args.scheduler), None
+    # CRITICAL, not ERROR: a worker process of our own cluster may log "Scheduler was unaware of this
+    # worker" while the cluster closes; that is not the user's business, and a job's failure comes back
+    # through its future.
     cluster = distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, silence_logs=logging.ERROR, memory_limit=0)
+                                       dashboard_address=None, silence_logs=logging.CRITICAL, memory_limit=0)
     return distributed.Client(cluster), cluster
 
 
