@@ -8,6 +8,7 @@ Named after test_motionfield.py on purpose (see test_same_as_cli.py).
 
 import inspect
 import os
+import pickle
 import re
 import typing
 import unittest
@@ -58,6 +59,23 @@ class VersionTest(unittest.TestCase):
 
     def test_py_typed(self):
         self.assertTrue(os.path.isfile(os.path.join(os.path.dirname(mf.__file__), "py.typed")))
+
+
+class ModulesTest(unittest.TestCase):
+    def test_public_names_are_the_package_s(self):
+        # Defined in private modules, named motionfield.X: reprs, help() and
+        # pickles (Dask sends errors between processes) say so.
+        for name in mf.__all__:
+            obj = getattr(mf, name)
+            if inspect.isclass(obj) or inspect.isfunction(obj):
+                self.assertEqual(obj.__module__, "motionfield", name)
+                self.assertEqual(obj.__qualname__, name)
+                typing.get_type_hints(obj)  # the annotations resolve in the package
+        error = pickle.loads(pickle.dumps(mf.InvalidArgumentError("bad frame", mf.InvalidArgumentError.status)))
+        self.assertIs(type(error), mf.InvalidArgumentError)
+        self.assertEqual((str(error), error.status_name), ("bad frame", "MF_ERROR_INVALID_ARGUMENT"))
+        self.assertEqual(pickle.loads(pickle.dumps(mf.Progress(3, 10, 0.5))), mf.Progress(3, 10, 0.5))
+        self.assertIn(b"motionfield", pickle.dumps(mf.Progress(3, 10, 0.5)))
 
 
 class DocumentationTest(unittest.TestCase):
