@@ -210,11 +210,8 @@ int run(Args& args, const std::string& command) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Args args;
-  CLI::App app{"Alternative solutions of gap filling on the validation clips (docs/BENCHMARKS.md, \"Alternatives\").",
-               "alternatives-bench"};
-  mf::cli::use_tool_defaults(app);
-  add_options(app, args);
-  return mf::cli::run(app, argc, argv,
-                      [&] { return run(args, mf::bench::command_line("alternatives-bench", argc, argv)); });
+  return mf::bench::benchmark_main<Args>(
+      argc, argv, "alternatives-bench",
+      "Alternative solutions of gap filling on the validation clips (docs/BENCHMARKS.md, \"Alternatives\").",
+      add_options, run);
 }

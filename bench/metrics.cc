@@ -18,11 +18,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
 void check_frames(const std::vector<int>& frames, int num_frames, const char* what) {
   for (int f : frames) {
     if (f < 0 || f >= num_frames) {

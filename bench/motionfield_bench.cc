@@ -423,11 +423,8 @@ int run(Args& args, const std::string& command) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Args args;
-  CLI::App app{"The LaFAN1-style benchmark of docs/BENCHMARKS.md: markdown tables of every (task, method) pair.",
-               "motionfield-bench"};
-  mf::cli::use_tool_defaults(app);
-  add_options(app, args);
-  return mf::cli::run(app, argc, argv,
-                      [&] { return run(args, mf::bench::command_line("motionfield-bench", argc, argv)); });
+  return mf::bench::benchmark_main<Args>(
+      argc, argv, "motionfield-bench",
+      "The LaFAN1-style benchmark of docs/BENCHMARKS.md: markdown tables of every (task, method) pair.", add_options,
+      run);
 }

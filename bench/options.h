@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "prior/data/dataset.h"
+#include "prior/util/command_line.h"
 #include "tasks/task_context.h"
 
 namespace mf::bench {
@@ -77,5 +78,18 @@ void add_number_options(CLI::App& app, std::map<std::string, double>& numbers, c
 
 /// "program arg1 arg2 ..." for the header of a report.
 std::string command_line(const std::string& program, int argc, char** argv);
+
+/// The main() of a benchmark program `name`: its options fill an `Args`
+/// (add_options(app, args)), then run(args, command_line(...)) is its body,
+/// with the exit codes of mf::cli::run.
+template <class Args>
+int benchmark_main(int argc, char** argv, const std::string& name, const std::string& description,
+                   void (*add_options)(CLI::App&, Args&), int (*run)(Args&, const std::string&)) {
+  Args args;
+  CLI::App app{description, name};
+  mf::cli::use_tool_defaults(app);
+  add_options(app, args);
+  return mf::cli::run(app, argc, argv, [&] { return run(args, command_line(name, argc, argv)); });
+}
 
 }  // namespace mf::bench

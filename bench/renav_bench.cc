@@ -504,11 +504,9 @@ int run(Args& args, const std::string& command) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Args args;
-  CLI::App app{"Re-navigation (tasks/renav.h) of validation clips along NeMF's test paths (docs/BENCHMARKS.md, "
-               "\"Re-navigation\"); details at the top of bench/renav_bench.cc.",
-               "renav-bench"};
-  mf::cli::use_tool_defaults(app);
-  add_options(app, args);
-  return mf::cli::run(app, argc, argv, [&] { return run(args, mf::bench::command_line("renav-bench", argc, argv)); });
+  return mf::bench::benchmark_main<Args>(
+      argc, argv, "renav-bench",
+      "Re-navigation (tasks/renav.h) of validation clips along NeMF's test paths (docs/BENCHMARKS.md, "
+      "\"Re-navigation\"); details at the top of bench/renav_bench.cc.",
+      add_options, run);
 }

@@ -735,11 +735,9 @@ int run(Args& args, const std::string& command) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Args args;
-  CLI::App app{"Quality and speed of the latent solvers against interpolation on the benchmark protocol's windows "
-               "(docs/BENCHMARKS.md, \"Latent solvers\"); the tasks are described at the top of bench/solver_bench.cc.",
-               "solver-bench"};
-  mf::cli::use_tool_defaults(app);
-  add_options(app, args);
-  return mf::cli::run(app, argc, argv, [&] { return run(args, mf::bench::command_line("solver-bench", argc, argv)); });
+  return mf::bench::benchmark_main<Args>(
+      argc, argv, "solver-bench",
+      "Quality and speed of the latent solvers against interpolation on the benchmark protocol's windows "
+      "(docs/BENCHMARKS.md, \"Latent solvers\"); the tasks are described at the top of bench/solver_bench.cc.",
+      add_options, run);
 }

@@ -326,11 +326,8 @@ int run(Args& args, const std::string& command) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Args args;
-  CLI::App app{"The latent solver's trajectory energy on the validation clips (docs/CONSTRAINTS.md, \"Trajectory\").",
-               "trajectory-bench"};
-  mf::cli::use_tool_defaults(app);
-  add_options(app, args);
-  return mf::cli::run(app, argc, argv,
-                      [&] { return run(args, mf::bench::command_line("trajectory-bench", argc, argv)); });
+  return mf::bench::benchmark_main<Args>(
+      argc, argv, "trajectory-bench",
+      "The latent solver's trajectory energy on the validation clips (docs/CONSTRAINTS.md, \"Trajectory\").",
+      add_options, run);
 }

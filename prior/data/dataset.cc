@@ -15,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <new>
@@ -177,6 +178,38 @@ class PayloadReader {
   std::string path_;
 };
 
+// One clip's record of the clips file; `buf` is scratch space.
+void write_clip(PayloadWriter& w, const Clip& c, const std::string& path, std::vector<double>& buf) {
+  const Motion& m = c.motion;
+  const int J = m.num_joints(), F = m.num_frames();
+  if (m.rotations.size() != static_cast<size_t>(J) * F)
+    throw InputError("cannot write clips file " + path + ": clip " + c.name + " has inconsistent sizes");
+  w.str(c.name);
+  w.pod<double>(m.fps);
+  w.pod<uint32_t>(static_cast<uint32_t>(J));
+  w.pod<uint32_t>(static_cast<uint32_t>(F));
+  for (int j = 0; j < J; ++j) {
+    w.str(m.skeleton.names[j]);
+    w.pod<int32_t>(m.skeleton.parents[j]);
+    const Eigen::Vector3d& o = m.skeleton.offsets[j];
+    const double off[3] = {o.x(), o.y(), o.z()};
+    w.bytes(off, sizeof off);
+  }
+  buf.resize(static_cast<size_t>(J) * F * 4);
+  for (size_t i = 0; i < m.rotations.size(); ++i) {
+    const Eigen::Quaterniond& q = m.rotations[i];
+    buf[4 * i] = q.w();
+    buf[4 * i + 1] = q.x();
+    buf[4 * i + 2] = q.y();
+    buf[4 * i + 3] = q.z();
+  }
+  w.bytes(buf.data(), buf.size() * sizeof(double));
+  buf.resize(static_cast<size_t>(F) * 3);
+  for (int f = 0; f < F; ++f)
+    for (int k = 0; k < 3; ++k) buf[3 * static_cast<size_t>(f) + k] = m.root_positions[f][k];
+  w.bytes(buf.data(), buf.size() * sizeof(double));
+}
+
 void write_clips_file(const std::string& path, const std::vector<Clip>& clips, const std::vector<std::string>& skipped) {
   const std::string tmp = path + temp_suffix();
   try {
@@ -187,36 +220,7 @@ void write_clips_file(const std::string& path, const std::vector<Clip>& clips, c
     PayloadWriter w(out);
     w.pod<uint64_t>(clips.size());
     std::vector<double> buf;
-    for (const Clip& c : clips) {
-      const Motion& m = c.motion;
-      const int J = m.num_joints(), F = m.num_frames();
-      if (m.rotations.size() != static_cast<size_t>(J) * F)
-        throw InputError("cannot write clips file " + path + ": clip " + c.name + " has inconsistent sizes");
-      w.str(c.name);
-      w.pod<double>(m.fps);
-      w.pod<uint32_t>(static_cast<uint32_t>(J));
-      w.pod<uint32_t>(static_cast<uint32_t>(F));
-      for (int j = 0; j < J; ++j) {
-        w.str(m.skeleton.names[j]);
-        w.pod<int32_t>(m.skeleton.parents[j]);
-        const Eigen::Vector3d& o = m.skeleton.offsets[j];
-        const double off[3] = {o.x(), o.y(), o.z()};
-        w.bytes(off, sizeof off);
-      }
-      buf.resize(static_cast<size_t>(J) * F * 4);
-      for (size_t i = 0; i < m.rotations.size(); ++i) {
-        const Eigen::Quaterniond& q = m.rotations[i];
-        buf[4 * i] = q.w();
-        buf[4 * i + 1] = q.x();
-        buf[4 * i + 2] = q.y();
-        buf[4 * i + 3] = q.z();
-      }
-      w.bytes(buf.data(), buf.size() * sizeof(double));
-      buf.resize(static_cast<size_t>(F) * 3);
-      for (int f = 0; f < F; ++f)
-        for (int k = 0; k < 3; ++k) buf[3 * static_cast<size_t>(f) + k] = m.root_positions[f][k];
-      w.bytes(buf.data(), buf.size() * sizeof(double));
-    }
+    for (const Clip& c : clips) write_clip(w, c, path, buf);
     w.pod<uint64_t>(skipped.size());
     for (const std::string& s : skipped) w.str(s.size() > kMaxStringBytes ? s.substr(0, kMaxStringBytes) : s);
     w.finish();
@@ -472,6 +476,24 @@ std::string skeleton_mismatch(const Skeleton& ref, const std::string& ref_name, 
   return {};
 }
 
+// Runs `worker` on `threads` threads (<= 0: one per hardware thread; at most
+// one per item of `items`), the calling thread among them, and waits for all.
+template <class Worker>
+void run_on_threads(int threads, size_t items, Worker& worker) {
+  size_t count = threads > 0 ? static_cast<size_t>(threads) : std::thread::hardware_concurrency();
+  count = std::clamp<size_t>(count, 1, std::max<size_t>(items, 1));
+  std::vector<std::thread> pool;
+  for (size_t t = 1; t < count; ++t) {
+    try {
+      pool.emplace_back(std::ref(worker));
+    } catch (const std::system_error&) {
+      break;  // fewer threads; the calling thread still does the work
+    }
+  }
+  worker();
+  for (std::thread& t : pool) t.join();
+}
+
 void parse_clips(const std::vector<SourceFile>& files, const DatasetOptions& options, std::vector<Clip>* clips,
                  std::vector<std::string>* skipped) {
   const size_t n = files.size();
@@ -503,18 +525,7 @@ void parse_clips(const std::vector<SourceFile>& files, const DatasetOptions& opt
       }
     }
   };
-  size_t threads = options.threads > 0 ? static_cast<size_t>(options.threads) : std::thread::hardware_concurrency();
-  threads = std::clamp<size_t>(threads, 1, std::max<size_t>(n, 1));
-  std::vector<std::thread> pool;
-  for (size_t t = 1; t < threads; ++t) {
-    try {
-      pool.emplace_back(worker);
-    } catch (const std::system_error&) {
-      break;  // fewer threads; the calling thread still does the work
-    }
-  }
-  worker();
-  for (std::thread& t : pool) t.join();
+  run_on_threads(options.threads, n, worker);
 
   // Sequential from here on: the outcome depends only on the sorted file list.
   const size_t first = clips->size();
@@ -646,15 +657,6 @@ std::string env_or(const char* var, const char* fallback) {
 }  // namespace
 
 // ---------------------------------------------------------------- public API
-
-uint64_t fnv1a64(const std::string& s) {
-  uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : s) {
-    h ^= c;
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
 
 bool is_validation_clip(const std::string& name, int validation_percent) {
   if (validation_percent <= 0) return false;

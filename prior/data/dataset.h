@@ -40,6 +40,7 @@
 
 #include "prior/motion/motion.h"
 #include "prior/motion/motion_bvh.h"
+#include "prior/util/binary_io.h"  // fnv1a64, the split's hash
 
 namespace mf {
 
@@ -73,9 +74,6 @@ struct Dataset {
 
 /// True when `name` (a base name) belongs to the validation split.
 bool is_validation_clip(const std::string& name, int validation_percent);
-/// FNV-1a, 64 bits, over the bytes of `s` (offset basis 0xcbf29ce484222325,
-/// prime 0x100000001b3).
-uint64_t fnv1a64(const std::string& s);
 
 /// Loads every clip (see the top of this file). Throws mf::InputError if the
 /// source does not exist or is neither a folder nor a supported archive, if the

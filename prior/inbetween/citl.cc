@@ -10,6 +10,7 @@
 #include <sstream>
 #include <tuple>
 
+#include "prior/inbetween/network_model.h"
 #include "prior/motion/errors.h"
 #include "prior/util/module_parameters.h"
 
@@ -240,14 +241,13 @@ struct CitlNetImpl : torch::nn::Module {
 };
 TORCH_MODULE(CitlNet);
 
-class CitlModel final : public InbetweenModel {
+class CitlModel final : public NetworkModel<CitlConfig, CitlNet> {
  public:
   CitlModel(const CitlConfig& config, const RigInfo& rig)
-      : InbetweenModel(rig), config_(config), net_(config, rig.num_joints()) {}
+      : NetworkModel(config, rig, CitlNet(config, rig.num_joints())) {}
 
   std::string kind() const override { return kCitlKind; }
   std::vector<std::string> stage_names() const override { return {"citl"}; }
-  std::map<std::string, double> hyperparameters() const override { return config_.to_map(); }
   std::string describe() const override {
     std::ostringstream s;
     s << "citl: keyframe encoder " << config_.layers << "x" << config_.width << ", interpolator "
@@ -265,22 +265,12 @@ class CitlModel final : public InbetweenModel {
                                        n.mean.reshape({D}), n.scale.reshape({D})));
     return out;
   }
-
-  std::vector<std::pair<std::string, at::Tensor>> named_parameters() const override {
-    return named_parameters_of(*net_);
-  }
-  void train(bool on) override { net_->train(on); }
-
- private:
-  CitlConfig config_;
-  mutable CitlNet net_;
 };
 
 }  // namespace
 
 std::unique_ptr<InbetweenModel> make_citl(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {
-  if (rig.num_joints() < 1) throw InputError("CITL: the rig has no joints");
-  return std::make_unique<CitlModel>(parse_config(hyperparameters), rig);
+  return make_network_model<CitlModel>("CITL", parse_config(hyperparameters), rig);
 }
 
 int64_t citl_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {

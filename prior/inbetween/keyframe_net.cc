@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "prior/inbetween/network_model.h"
 #include "prior/inbetween/transformer_blocks.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations_torch.h"
@@ -279,14 +280,13 @@ struct KeyframeNetImpl : torch::nn::Module {
 };
 TORCH_MODULE(KeyframeNet);
 
-class KeyframeModel final : public InbetweenModel {
+class KeyframeModel final : public NetworkModel<KeyframeConfig, KeyframeNet> {
  public:
   KeyframeModel(const KeyframeConfig& config, const RigInfo& rig)
-      : InbetweenModel(rig), config_(config), net_(config, rig) {}
+      : NetworkModel(config, rig, KeyframeNet(config, rig)) {}
 
   std::string kind() const override { return kKeyframeKind; }
   std::vector<std::string> stage_names() const override { return {"keyframe", "refine"}; }
-  std::map<std::string, double> hyperparameters() const override { return config_.to_map(); }
   std::string describe() const override {
     std::ostringstream s;
     s << "keyframe: KeyframeNet " << config_.layers << "x" << config_.width << ", RefineNet " << config_.layers << "x"
@@ -314,23 +314,13 @@ class KeyframeModel final : public InbetweenModel {
     return net_->forward(pose, known, batch.valid.to(n.options), trajectory, batch.trajectory.defined(), n.mean.reshape({D}),
                          n.scale.reshape({D}));
   }
-
-  std::vector<std::pair<std::string, at::Tensor>> named_parameters() const override {
-    return named_parameters_of(*net_);
-  }
-  void train(bool on) override { net_->train(on); }
-
- private:
-  KeyframeConfig config_;
-  mutable KeyframeNet net_;
 };
 
 }  // namespace
 
 std::unique_ptr<InbetweenModel> make_keyframe_net(const std::map<std::string, double>& hyperparameters,
                                                   const RigInfo& rig) {
-  if (rig.num_joints() < 1) throw InputError("keyframe: the rig has no joints");
-  return std::make_unique<KeyframeModel>(parse_config(hyperparameters), rig);
+  return make_network_model<KeyframeModel>("keyframe", parse_config(hyperparameters), rig);
 }
 
 int64_t keyframe_net_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "prior/inbetween/network_model.h"
 #include "prior/inbetween/transformer_blocks.h"
 #include "prior/motion/errors.h"
 #include "prior/util/module_parameters.h"
@@ -93,14 +94,13 @@ struct TwoStageNetImpl : torch::nn::Module {
 };
 TORCH_MODULE(TwoStageNet);
 
-class TwoStageModel final : public InbetweenModel {
+class TwoStageModel final : public NetworkModel<TwoStageConfig, TwoStageNet> {
  public:
   TwoStageModel(const TwoStageConfig& config, const RigInfo& rig)
-      : InbetweenModel(rig), config_(config), net_(config, rig.num_joints(), rig.num_feet()) {}
+      : NetworkModel(config, rig, TwoStageNet(config, rig.num_joints(), rig.num_feet())) {}
 
   std::string kind() const override { return kTwoStageKind; }
   std::vector<std::string> stage_names() const override { return {"context", "detail"}; }
-  std::map<std::string, double> hyperparameters() const override { return config_.to_map(); }
   std::string describe() const override {
     std::ostringstream s;
     s << "twostage: context " << config_.layers << "x" << config_.width << ", detail " << config_.layers << "x"
@@ -115,23 +115,13 @@ class TwoStageModel final : public InbetweenModel {
     return net_->forward(batch.pose.to(at::kFloat), batch.known.to(n.options), batch.valid.to(n.options),
                          n.mean.reshape({D}), n.scale.reshape({D}));
   }
-
-  std::vector<std::pair<std::string, at::Tensor>> named_parameters() const override {
-    return named_parameters_of(*net_);
-  }
-  void train(bool on) override { net_->train(on); }
-
- private:
-  TwoStageConfig config_;
-  mutable TwoStageNet net_;
 };
 
 }  // namespace
 
 std::unique_ptr<InbetweenModel> make_two_stage(const std::map<std::string, double>& hyperparameters,
                                                const RigInfo& rig) {
-  if (rig.num_joints() < 1) throw InputError("twostage: the rig has no joints");
-  return std::make_unique<TwoStageModel>(parse_config(hyperparameters), rig);
+  return make_network_model<TwoStageModel>("twostage", parse_config(hyperparameters), rig);
 }
 
 int64_t two_stage_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {

@@ -560,6 +560,22 @@ Retargeter::Retargeter(Skeleton user, Skeleton model, RigMap map, RigAnatomy use
   scale_ = model_leg / user_leg;
 }
 
+std::vector<int> Retargeter::source_joints(bool to_model) const {
+  std::vector<int> corr((to_model ? model_ : user_).num_joints(), -1);
+  for (int m = 0; m < model_.num_joints(); ++m) {
+    const int u = map_.user_of_model[m];
+    if (u < 0) continue;
+    if (to_model) corr[m] = u;
+    else corr[u] = m;
+  }
+  return corr;
+}
+
+const Quaterniond& Retargeter::joint_frame(const RigAnatomy& anatomy, const RigParts& parts, int j) const {
+  const bool foot = j == parts.legs[0].foot || j == parts.legs[1].foot;
+  return toes_ && foot ? anatomy.toe_frames[j] : anatomy.frames[j];
+}
+
 Motion Retargeter::transfer(const Motion& src, bool to_model, const Motion* reference) const {
   const Skeleton& D = to_model ? model_ : user_;
   const RigAnatomy& AS = to_model ? user_anatomy_ : model_anatomy_;
@@ -567,18 +583,7 @@ Motion Retargeter::transfer(const Motion& src, bool to_model, const Motion* refe
   const RigParts& PS = to_model ? map_.user_parts : map_.model_parts;
   const RigParts& PD = to_model ? map_.model_parts : map_.user_parts;
   const int JD = D.num_joints(), F = src.num_frames();
-  std::vector<int> corr(JD, -1);  // destination joint -> source joint
-  for (int m = 0; m < model_.num_joints(); ++m) {
-    const int u = map_.user_of_model[m];
-    if (u < 0) continue;
-    if (to_model) corr[m] = u;
-    else corr[u] = m;
-  }
-  const auto frame_of = [&](const RigAnatomy& a, const RigParts& p, int j) {
-    const bool foot = j == p.legs[0].foot || j == p.legs[1].foot;
-    return toes_ && foot ? a.toe_frames[j] : a.frames[j];
-  };
-
+  const std::vector<int> corr = source_joints(to_model);
   const std::vector<Between> between = between_joints(D, corr);
 
   const GlobalPose g = forward_kinematics(src);
@@ -593,13 +598,13 @@ Motion Retargeter::transfer(const Motion& src, bool to_model, const Motion* refe
     for (int j = 0; j < JD; ++j) {
       has_target[j] = corr[j] >= 0;
       if (has_target[j])
-        target[j] = g.rotation(f, corr[j]) * frame_of(AS, PS, corr[j]) * frame_of(AD, PD, j).conjugate();
+        target[j] = g.rotation(f, corr[j]) * joint_frame(AS, PS, corr[j]) * joint_frame(AD, PD, j).conjugate();
     }
     for (int j = 0; j < JD; ++j) {
       const Between& b = between[j];
       if (b.above < 0) continue;
-      const Quaterniond fa = target[b.above] * frame_of(AD, PD, b.above);
-      const Quaterniond fb = target[b.below] * frame_of(AD, PD, b.below);
+      const Quaterniond fa = target[b.above] * joint_frame(AD, PD, b.above);
+      const Quaterniond fb = target[b.below] * joint_frame(AD, PD, b.below);
       target[j] = slerp(fa, fb, b.s) * AD.frames[j].conjugate();
       has_target[j] = true;
     }

@@ -140,6 +140,11 @@ class Retargeter {
  private:
   // World anatomical frames -> local rotations on a rig, for the joints `set`.
   Motion transfer(const Motion& src, bool to_model, const Motion* reference) const;
+  /// For each joint of the destination rig, its source joint (-1: none).
+  std::vector<int> source_joints(bool to_model) const;
+  /// The anatomical frame of joint j the transfer uses: a foot's toe frame
+  /// when both rigs have toes.
+  const Eigen::Quaterniond& joint_frame(const RigAnatomy& anatomy, const RigParts& parts, int j) const;
 
   Skeleton user_, model_;
   RigMap map_;

@@ -94,13 +94,19 @@ class ByteReader {
   std::string what_;
 };
 
-/// FNV-1a 64-bit hash of a byte range.
+/// FNV-1a 64-bit hash (offset basis 0xcbf29ce484222325, prime 0x100000001b3)
+/// of a byte range: the project's one hash (model file checksums, dataset
+/// split and cache keys).
 inline uint64_t fnv1a64_bytes(const uint8_t* data, size_t n, uint64_t h = 0xcbf29ce484222325ULL) {
   for (size_t i = 0; i < n; ++i) {
     h ^= data[i];
     h *= 0x100000001b3ULL;
   }
   return h;
+}
+/// FNV-1a 64-bit hash of the bytes of `s`.
+inline uint64_t fnv1a64(const std::string& s) {
+  return fnv1a64_bytes(reinterpret_cast<const uint8_t*>(s.data()), s.size());
 }
 
 /// A file that cannot be opened, read or written (the C API's MF_ERROR_IO);
