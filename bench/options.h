@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "prior/data/dataset.h"
-#include "tasks/task_context.h"
+#include "tasks/context/task_context.h"
 
 namespace mf::bench {
 

@@ -1,4 +1,4 @@
-// renav-bench: re-navigation (tasks/renav.h) on validation clips along NeMF's
+// renav-bench: re-navigation (tasks/renav/renav.h) on validation clips along NeMF's
 // test paths: a straight line (0 -> 4 m), circles of radius 0.5 m and 1.5 m
 // (one full turn) and a sinusoid (4 m forward, amplitude 0.5 m, wavelength 2 m).
 // Each path is a polyline walked at the reference clip's mean ground speed
@@ -57,10 +57,10 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/interpolation.h"
 #include "prior/motion/motion_bvh.h"
-#include "tasks/renav.h"
-#include "tasks/soft_dtw.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
+#include "tasks/renav/renav.h"
+#include "tasks/renav/soft_dtw.h"
 
 namespace {
 
@@ -120,7 +120,7 @@ void add_options(CLI::App& app, Args& a) {
                                  {"w-continuity", "weight of the continuity with the previous window"},
                                  {"lock-ramp", "foot locking ramp in frames (negative: no foot locking)"},
                                  {"match-pace", "1: play the reference at the path's pace (the default), 0: as it is"}},
-                                "Solver settings (default: tasks/renav.h)");
+                                "Solver settings (default: tasks/renav/renav.h)");
 }
 
 mf::RenavOptions options_for(const Args& a, const std::string& method) {
@@ -505,7 +505,7 @@ int run(Args& args, const std::string& command) {
 
 int main(int argc, char** argv) {
   Args args;
-  CLI::App app{"Re-navigation (tasks/renav.h) of validation clips along NeMF's test paths (docs/BENCHMARKS.md, "
+  CLI::App app{"Re-navigation (tasks/renav/renav.h) of validation clips along NeMF's test paths (docs/BENCHMARKS.md, "
                "\"Re-navigation\"); details at the top of bench/renav_bench.cc.",
                "renav-bench"};
   mf::cli::use_tool_defaults(app);

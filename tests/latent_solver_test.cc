@@ -1,4 +1,4 @@
-// The latent solvers (tasks/latent_solver.h) on tiny random models: energy
+// The latent solvers (tasks/latent/latent_solver.h) on tiny random models: energy
 // decrease with L-BFGS and Adam, cancellation, exact known frames, unknown
 // values never read, determinism, partial and end-effector constraints, long
 // inputs in overlapping windows, and the registered methods.
@@ -16,8 +16,8 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations.h"
-#include "tasks/jobs.h"
-#include "tasks/latent_solver.h"
+#include "tasks/latent/latent_solver.h"
+#include "tasks/methods/jobs.h"
 #include "tests/test_util.h"
 
 namespace mf {

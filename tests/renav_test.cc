@@ -1,4 +1,4 @@
-// Re-navigation (tasks/renav.h) on tiny random models: path CSV parsing and
+// Re-navigation (tasks/renav/renav.h) on tiny random models: path CSV parsing and
 // its errors, polyline resampling by arc length, tangents, the energy (lower for
 // a motion that follows the path, gradients reaching the latent codes only),
 // the solve (energy decrease, cancellation, output length and frame rate,
@@ -14,7 +14,7 @@
 #include "prior/model/nemf.h"
 #include "prior/model/representation.h"
 #include "prior/motion/errors.h"
-#include "tasks/renav.h"
+#include "tasks/renav/renav.h"
 #include "tests/test_util.h"
 
 namespace mf {
