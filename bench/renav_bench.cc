@@ -124,7 +124,8 @@ void add_options(CLI::App& app, Args& a) {
 }
 
 mf::RenavOptions options_for(const Args& a, const std::string& method) {
-  mf::RenavOptions o = mf::default_renav_options(method == "nemf-adam" ? mf::RenavSolver::Adam : mf::RenavSolver::Lbfgs);
+  mf::RenavOptions o =
+      mf::default_renav_options(method == "nemf-adam" ? mf::LatentOptimizer::Adam : mf::LatentOptimizer::Lbfgs);
   std::map<std::string, double> n = a.numbers;
   auto take = [&](const char* key, auto* field) {
     auto it = n.find(key);
@@ -395,7 +396,7 @@ int run(Args& args, const std::string& command) {
     if (m == "turned") continue;
     const mf::RenavOptions o = options_for(args, m);
     const mf::RenavWeights& w = o.weights;
-    emit("- `" + m + "`: " + (o.solver == mf::RenavSolver::Adam ? "Adam" : "L-BFGS") + ", max iterations " +
+    emit("- `" + m + "`: " + (o.optimizer == mf::LatentOptimizer::Adam ? "Adam" : "L-BFGS") + ", max iterations " +
          (o.max_iterations ? std::to_string(o.max_iterations) : std::string("default")) + ", ftol " +
          fixed(o.function_tolerance, 6) + "; weights path " + fixed(w.path, 2) + ", joints " + fixed(w.joints, 2) +
          ", heading " + fixed(w.heading, 2) + ", foot skating " + fixed(w.foot_skating, 2) + ", continuity " +

@@ -173,7 +173,7 @@ void add_options(CLI::App& app, Args& a) {
 
 mf::LatentSolverOptions solver_options(const Args& a, const std::string& method) {
   mf::LatentSolverOptions o =
-      mf::default_solver_options(method == "nemf-adam" ? mf::SolverMethod::Adam : mf::SolverMethod::Lbfgs);
+      mf::default_solver_options(method == "nemf-adam" ? mf::LatentOptimizer::Adam : mf::LatentOptimizer::Lbfgs);
   std::map<std::string, double> n = a.numbers;
   auto take = [&](const char* key, auto* field) {
     auto it = n.find(key);
@@ -225,9 +225,9 @@ mf::LatentSolverOptions solver_options(const Args& a, const std::string& method)
 std::string describe(const mf::LatentSolverOptions& o) {
   std::ostringstream s;
   const mf::EnergyWeights& w = o.weights;
-  s << (o.method == mf::SolverMethod::Adam ? "Adam" : "L-BFGS") << ", max iterations "
+  s << (o.optimizer == mf::LatentOptimizer::Adam ? "Adam" : "L-BFGS") << ", max iterations "
     << (o.max_iterations ? std::to_string(o.max_iterations) : std::string("default"));
-  if (o.method == mf::SolverMethod::Lbfgs)
+  if (o.optimizer == mf::LatentOptimizer::Lbfgs)
     s << ", ftol " << o.function_tolerance << ", rank " << o.lbfgs_rank << ", keys-only stage "
       << (o.keyed_iterations >= 0 ? std::to_string(o.keyed_iterations) : std::string("default"));
   s << "; weights: rotation " << w.rotation << ", position " << w.position << ", root orientation "

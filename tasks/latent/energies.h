@@ -65,6 +65,7 @@
 #include "prior/motion/motion.h"
 #include "tasks/constraints/motion_constraints.h"
 #include "tasks/latent/latent_energy.h"
+#include "tasks/latent/window_solver.h"
 
 namespace mf {
 
@@ -151,14 +152,8 @@ struct EnergyWeights {
 EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& weights,
                             const at::Tensor& z_l, const at::Tensor& z_g);
 
-/// The solution of a window, canonical: local rotations [1, T, J, 3, 3] at
-/// frames 0..T-1, the GMP's root path [1, T, 3] aligned at the anchor frame
-/// and its foot contact probabilities [1, T, F] (RigInfo::foot_joints order).
-struct DecodedWindow {
-  at::Tensor local_rotations;
-  at::Tensor root_positions;
-  at::Tensor contacts;
-};
+/// The solution of a window (DecodedWindow, tasks/latent/window_solver.h),
+/// canonical, the GMP's root path aligned at the anchor frame.
 DecodedWindow decode_window(const NemfModel& model, const WindowProblem& problem, const at::Tensor& z_l,
                             const at::Tensor& z_g);
 

@@ -177,12 +177,12 @@ std::string LatentOptimizerSettings::validate() const {
   return e.str();
 }
 
-at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, LatentOptimizer method,
-                           const LatentOptimizerSettings& settings, const TaskContext& ctx, LatentOptimizerStats* stats,
-                           int iteration_offset, int iteration_total) {
+at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
+                           const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset,
+                           int iteration_total) {
   *stats = LatentOptimizerStats{};
   const int total = iteration_total > 0 ? iteration_total : settings.max_iterations;
-  return method == LatentOptimizer::Lbfgs
+  return settings.optimizer == LatentOptimizer::Lbfgs
              ? lbfgs(energy, x0, settings, ctx, iteration_offset, total, stats)
              : adam(energy, x0, settings, ctx, iteration_offset, total, stats);
 }

@@ -13,13 +13,16 @@
 
 namespace mf {
 
+/// The optimiser: L-BFGS (Ceres) or Adam (NeMF's reference). The methods
+/// "nemf" and "nemf-adam" of every latent-space task choose it.
 enum class LatentOptimizer { Lbfgs, Adam };
 
-/// The settings of both optimisers. The options of every latent-space task
+/// The optimiser and the settings of both. The options of every latent-space task
 /// embed them (LatentSolverOptions, RenavOptions derive from this struct) and
 /// set their own defaults; the values here are the latent solvers'
 /// (tasks/latent/latent_solver.h).
 struct LatentOptimizerSettings {
+  LatentOptimizer optimizer = LatentOptimizer::Lbfgs;
   /// Iteration cap. minimize_latent() runs at most this many iterations; in a
   /// task's options 0 means the task's default cap.
   int max_iterations = 0;
@@ -59,14 +62,14 @@ struct LatentOptimizerStats {
   std::string message;       ///< the stop reason
 };
 
-/// Minimises `energy` from x0 ([n] float) with `method`, at most
+/// Minimises `energy` from x0 ([n] float) with settings.optimizer, at most
 /// settings.max_iterations iterations; returns the solution ([n] float).
 /// Progress reports carry iteration = `iteration_offset` + this run's
 /// iteration and max_iterations = `iteration_total` (0: this run's cap).
 /// Throws CancelledError when the context asks to stop, mf::InputError for
 /// invalid settings, and rethrows any exception raised by the energy.
-at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, LatentOptimizer method,
-                           const LatentOptimizerSettings& settings, const TaskContext& ctx, LatentOptimizerStats* stats,
-                           int iteration_offset = 0, int iteration_total = 0);
+at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
+                           const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset = 0,
+                           int iteration_total = 0);
 
 }  // namespace mf

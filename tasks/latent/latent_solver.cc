@@ -8,6 +8,8 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <sstream>
 
 #include "prior/model/nemf.h"
@@ -29,7 +31,7 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-int default_iterations(SolverMethod m) { return m == SolverMethod::Adam ? 600 : 40; }
+int default_iterations(LatentOptimizer m) { return m == LatentOptimizer::Adam ? 600 : 40; }
 
 // A keys-only stage only pays where a dense term is left for the second stage.
 bool has_dense_term(const EnergyWeights& w) {
@@ -95,12 +97,9 @@ void check_completion(const NemfModel& model, const Motion& input, const MotionC
   constraints.check_values(input);
 }
 
-// One window of the solve, in solve order.
-struct WindowPlan {
-  int start = 0, length = 0;
-  /// Window frames [shared_begin, shared_end) shared with windows solved
-  /// before (none when shared_begin >= shared_end).
-  int shared_begin = 0, shared_end = 0;
+// One window of the solve, in solve order: where it lies (WindowSpan) and
+// what it is solved under.
+struct WindowPlan : WindowSpan {
   /// The caller's constraints of the window (window frames), and the same
   /// with full-pose keys at the shared frames (what the window is solved under).
   MotionConstraints user, constraints;
@@ -198,39 +197,6 @@ Motion window_source(const Motion& input, const Motion& out, const WindowPlan& w
   return src;
 }
 
-// The solution so far: the motion and the predictor's foot contact
-// probabilities [frames, feet].
-struct SolvedMotion {
-  Motion motion;
-  std::vector<float> contacts;
-  std::vector<char> solved;  // per frame
-};
-
-// Window `w`'s decoded solution cross-faded into `out` over the frames it
-// shares with windows solved before (its weight rising away from them; SLERP /
-// LERP, linear weights) and copied elsewhere.
-void blend_window(const WindowPlan& w, const Motion& piece, const at::Tensor& piece_contacts, int feet,
-                  SolvedMotion* out) {
-  const at::Tensor pc_tensor = piece_contacts.contiguous();
-  const float* pc = pc_tensor.data_ptr<float>();
-  const bool solved_before = w.shared_begin < w.shared_end && w.shared_begin == 0;
-  const int n_ov = w.shared_end - w.shared_begin;
-  for (int f = 0; f < w.length; ++f) {
-    const int g = w.start + f;
-    double wn = 1.0;
-    if (out->solved[g]) {
-      const int pos = solved_before ? f - w.shared_begin + 1 : w.shared_end - f;
-      wn = static_cast<double>(pos) / (n_ov + 1);
-    }
-    cross_fade_frame(piece, f, wn, &out->motion, g);
-    for (int k = 0; k < feet; ++k) {
-      float& c = out->contacts[static_cast<size_t>(g) * feet + k];
-      c = static_cast<float>(c * (1.0 - wn) + pc[f * feet + k] * wn);
-    }
-    out->solved[g] = 1;
-  }
-}
-
 // The start of an alternative solution: Gaussian noise on the codes
 // (LatentSolverOptions::start_noise), its own stream per window.
 InitialGuess perturbed(InitialGuess g, const LatentSolverOptions& o, int window) {
@@ -241,57 +207,58 @@ InitialGuess perturbed(InitialGuess g, const LatentSolverOptions& o, int window)
   return g;
 }
 
+// Solves window `w` of `input` from its initial codes (`whole`: the
+// initialiser's fill of the whole input, when there is one) given the
+// solution so far, and records its summary.
+SolvedWindow solve_window(const NemfModel& model, const Motion& input, const WindowPlan& w, const Motion& so_far,
+                          const LatentInitializer& init, const std::optional<Motion>& whole,
+                          const LatentSolverOptions& options, const TaskContext& ctx, const TaskContext& window_ctx,
+                          int iteration_offset, int iteration_total, CompletionReport* rep) {
+  // A short window's tensors are too small for a second thread to pay; its
+  // operators' parallel regions would only cost (docs/BENCHMARKS.md, "Threads").
+  const ScopedComputeThreads threads(w.length < kNemfParallelFrames ? 1 : 0);
+  const Motion src = window_source(input, so_far, w);
+  const WindowProblem problem = make_window_problem(model.rig(), src, 0, w.length, w.constraints, w.anchor);
+  InitRequest request;
+  request.model = &model;
+  request.window = &src;
+  request.constraints = &w.constraints;
+  request.anchor = w.anchor;
+  request.context = &ctx;
+  const InitialGuess start =
+      perturbed(whole ? encode_window(model, whole->slice(w.start, w.start + w.length), w.anchor)
+                      : init.initialize(request),
+                options, window_ctx.window);
+  LatentSolverOptions window_options = options;
+  window_options.keyed_iterations = w.caps.keyed;
+  window_options.max_iterations = w.caps.full;
+  const LatentSolution sol =
+      solve_latents(model, problem, start, window_options, window_ctx, iteration_offset, iteration_total);
+  rep->windows.push_back(sol.summary);
+  rep->window_starts.push_back(w.start);
+  return {decode_window(model, problem, sol.z_l, sol.z_g), problem.transform, sol.summary.iterations};
+}
+
 // Solves the windows of `plan` in order (the progress total is the sum of
-// their caps) and joins their solutions. With several windows, each starts
-// from its slice of the initialiser's fill of the whole input when it has one
-// (LatentInitializer::fill_input).
-SolvedMotion solve_windows(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
-                           const std::vector<WindowPlan>& plan, const LatentSolverOptions& options,
-                           const TaskContext& ctx, CompletionReport* rep) {
-  const RigInfo& rig = model.rig();
-  const int N = input.num_frames(), F = rig.num_feet();
+// their caps) and joins their solutions (WindowSolver). With several windows,
+// each starts from its slice of the initialiser's fill of the whole input
+// when it has one (LatentInitializer::fill_input).
+WindowedSolution solve_windows(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
+                               const std::vector<WindowPlan>& plan, const LatentSolverOptions& options,
+                               const TaskContext& ctx, CompletionReport* rep) {
   std::shared_ptr<const LatentInitializer> init = options.initializer;
   if (!init) init = std::make_shared<InterpolationEncoderInitializer>();
   int total = 0;
   for (const WindowPlan& w : plan) total += w.caps.keyed + w.caps.full;
   const std::optional<Motion> whole = plan.size() > 1 ? init->fill_input(input, constraints, ctx) : std::nullopt;
-
-  SolvedMotion out{Motion::identity(input.skeleton, N, input.fps), std::vector<float>(static_cast<size_t>(N) * F, 0.0f),
-                   std::vector<char>(N, 0)};
-  int iterations = 0;
-  TaskContext window_ctx = ctx;  // reports carry the window
-  window_ctx.window_count = static_cast<int>(plan.size());
-  for (const WindowPlan& w : plan) {
-    // A short window's tensors are too small for a second thread to pay; its
-    // operators' parallel regions would only cost (docs/BENCHMARKS.md, "Threads").
-    const ScopedComputeThreads threads(w.length < kNemfParallelFrames ? 1 : 0);
-    window_ctx.window = static_cast<int>(&w - plan.data());
-    const Motion src = window_source(input, out.motion, w);
-    const WindowProblem problem = make_window_problem(rig, src, 0, w.length, w.constraints, w.anchor);
-    InitRequest request;
-    request.model = &model;
-    request.window = &src;
-    request.constraints = &w.constraints;
-    request.anchor = w.anchor;
-    request.context = &ctx;
-    const InitialGuess start =
-        perturbed(whole ? encode_window(model, whole->slice(w.start, w.start + w.length), w.anchor)
-                        : init->initialize(request),
-                  options, window_ctx.window);
-    LatentSolverOptions window_options = options;
-    window_options.keyed_iterations = w.caps.keyed;
-    window_options.max_iterations = w.caps.full;
-    LatentSolution sol = solve_latents(model, problem, start, window_options, window_ctx, iterations, total);
-    iterations += sol.summary.iterations;
-    rep->windows.push_back(sol.summary);
-    rep->window_starts.push_back(w.start);
-
-    const DecodedWindow dec = decode_window(model, problem, sol.z_l, sol.z_g);
-    Motion piece = Motion::identity(input.skeleton, w.length, input.fps);
-    write_window(dec.local_rotations, dec.root_positions, problem.transform, &piece, 0);
-    blend_window(w, piece, dec.contacts, F, &out);
-  }
-  rep->iterations = iterations;
+  const WindowSolver solver(std::vector<WindowSpan>(plan.begin(), plan.end()), input.skeleton, input.num_frames(),
+                            input.fps, model.rig().num_feet());
+  WindowedSolution out = solver.solve(ctx, [&](int k, const WindowedSolution& so_far, const TaskContext& window_ctx,
+                                               int offset) {
+    return solve_window(model, input, plan[k], so_far.motion, *init, whole, options, ctx, window_ctx, offset, total,
+                        rep);
+  });
+  rep->iterations = out.iterations;
   return out;
 }
 
@@ -317,8 +284,8 @@ void make_known_values_exact(const RigInfo& rig, const Motion& input, const Moti
 
 WindowCaps window_caps(const LatentSolverOptions& o, const std::vector<int>& key_frames, bool has_effectors, int T) {
   WindowCaps caps;
-  if (o.method == SolverMethod::Adam) {
-    caps.full = o.max_iterations > 0 ? o.max_iterations : default_iterations(o.method);
+  if (o.optimizer == LatentOptimizer::Adam) {
+    caps.full = o.max_iterations > 0 ? o.max_iterations : default_iterations(o.optimizer);
     return caps;
   }
   std::vector<int> frames = key_frames;
@@ -335,7 +302,7 @@ WindowCaps window_caps(const LatentSolverOptions& o, const std::vector<int>& key
   if (o.max_iterations > 0) {
     caps.full = o.max_iterations;
   } else {
-    caps.full = long_window ? 60 : caps.keyed > 0 ? 20 : default_iterations(o.method);
+    caps.full = long_window ? 60 : caps.keyed > 0 ? 20 : default_iterations(o.optimizer);
   }
   return caps;
 }
@@ -358,9 +325,9 @@ std::string LatentSolverOptions::validate() const {
   return e.str();
 }
 
-LatentSolverOptions default_solver_options(SolverMethod method) {
+LatentSolverOptions default_solver_options(LatentOptimizer optimizer) {
   LatentSolverOptions o;
-  o.method = method;
+  o.optimizer = optimizer;
   return o;
 }
 
@@ -380,32 +347,18 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
                   problem.num_effectors() > 0 || problem.num_pin_steps() > 0 || problem.num_trajectory() > 0, problem.length);
   const int total = iteration_total > 0 ? iteration_total : caps.keyed + caps.full;
 
+  FirstStage first;
+  EnergyWeights keyed = options.weights;
+  keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
+  keyed.trajectory = keyed.trajectory_facing = 0.0;
+  const FlatLatentEnergy cheap(window_energy(model, problem, keyed), zl, zg);
+  if (caps.keyed > 0) first = {&cheap, caps.keyed};
   LatentSolution out;
-  SolveSummary& s = out.summary;
-  s.initial_terms = energy.terms(x0, &s.initial_energy);
-  at::Tensor x = x0;
-  if (caps.keyed > 0) {
-    EnergyWeights keyed = options.weights;
-    keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
-    keyed.trajectory = keyed.trajectory_facing = 0.0;
-    const FlatLatentEnergy cheap(window_energy(model, problem, keyed), zl, zg);
-    LatentOptimizerStats first;
-    x = minimize_latent(cheap.total(), x, options.method, options.capped(caps.keyed), ctx, &first, iteration_offset,
-                        total);
-    s.keyed_iterations = first.iterations;
-    s.evaluations += first.evaluations;
-  }
-  LatentOptimizerStats main;
-  x = minimize_latent(energy.total(), x, options.method, options.capped(caps.full), ctx, &main,
-                      iteration_offset + s.keyed_iterations, total);
-  s.iterations = s.keyed_iterations + main.iterations;
-  s.evaluations += main.evaluations;
-  s.converged = main.converged;
-  s.message = main.message;
-  s.final_terms = energy.terms(x, &s.final_energy);
+  const at::Tensor x = minimize_window(energy, x0, options.capped(caps.full), ctx, iteration_offset, total,
+                                       &out.summary, first);
   out.z_l = energy.z_l(x);
   out.z_g = energy.z_g(x);
-  s.wall_ms = ms_since(t0);
+  out.summary.wall_ms = ms_since(t0);
   return out;
 }
 
@@ -415,7 +368,7 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
   check_completion(model, input, constraints, options);
   const std::vector<WindowPlan> plan = plan_windows(model.config().window, input.num_frames(), constraints, options);
   CompletionReport rep;
-  SolvedMotion solved = solve_windows(model, input, constraints, plan, options, ctx, &rep);
+  WindowedSolution solved = solve_windows(model, input, constraints, plan, options, ctx, &rep);
   make_known_values_exact(model.rig(), input, constraints, options, solved.contacts, &solved.motion, &rep);
   rep.wall_ms = ms_since(t0);
   if (report) *report = std::move(rep);

@@ -56,7 +56,7 @@
 //    is also constrained by full-pose keys at the overlap frames, taken from
 //    the solution of its already solved neighbour, and the two solutions are
 //    cross-faded over the overlap (SLERP / LERP with linear weights), so
-//    there is no seam.
+//    there is no seam (the window loop of tasks/latent/window_solver.h).
 #pragma once
 
 #include <ATen/core/Tensor.h>
@@ -74,23 +74,20 @@
 #include "tasks/latent/energies.h"
 #include "tasks/latent/initializers.h"
 #include "tasks/latent/latent_optimizer.h"
+#include "tasks/latent/window_solver.h"
 
 namespace mf {
 
 class NemfModel;
 
-/// The optimiser of a latent solve (tasks/latent/latent_optimizer.h).
-using SolverMethod = LatentOptimizer;
-
-/// The options of complete_motion() and solve_latents(). The optimiser's
-/// settings are embedded (LatentOptimizerSettings, with its defaults:
+/// The options of complete_motion() and solve_latents(). The optimiser and its
+/// settings are embedded (LatentOptimizerSettings, with its defaults: L-BFGS,
 /// function tolerance 1e-3, gradient tolerance 1e-8, parameter tolerance
 /// 1e-6, L-BFGS rank 20; Adam lr 0.1, x0.7 every 200 iterations, stopping when
 /// the best energy improves by less than 1e-4 over 100 iterations).
 /// max_iterations is the cap per window (of the full-energy stage); 0 means
 /// the method's default (window_caps()).
 struct LatentSolverOptions : LatentOptimizerSettings {
-  SolverMethod method = SolverMethod::Lbfgs;
   EnergyWeights weights;
 
   /// L-BFGS only: first up to this many iterations on the terms that need
@@ -155,26 +152,12 @@ WindowCaps window_caps(const LatentSolverOptions& options, const std::vector<int
                        int T);
 
 /// The options of the registered methods: "nemf" (L-BFGS) and "nemf-adam".
-LatentSolverOptions default_solver_options(SolverMethod method = SolverMethod::Lbfgs);
-
-/// What one window's solve did.
-struct SolveSummary {
-  int iterations = 0;        ///< all stages
-  int keyed_iterations = 0;  ///< of them, in the keys-only first stage
-  int evaluations = 0;       ///< energy evaluations (with or without gradient)
-  bool converged = false;    ///< stopped by a tolerance, not by the iteration cap
-  double initial_energy = 0.0;
-  double final_energy = 0.0;
-  std::vector<std::pair<std::string, double>> initial_terms;  ///< weighted, as in EnergyTerms
-  std::vector<std::pair<std::string, double>> final_terms;
-  double wall_ms = 0.0;      ///< initialisation excluded
-  std::string message;       ///< the optimiser's stop reason
-};
+LatentSolverOptions default_solver_options(LatentOptimizer optimizer = LatentOptimizer::Lbfgs);
 
 struct LatentSolution {
   at::Tensor z_l;  ///< [1, zl]
   at::Tensor z_g;  ///< [1, zg]
-  SolveSummary summary;
+  SolveSummary summary;  ///< wall_ms: the minimisation, initialisation excluded
 };
 
 /// Optimises the codes of one window from `start`. `iteration_offset` and

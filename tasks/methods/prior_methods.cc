@@ -41,7 +41,7 @@ bool upsample_by_solving(const Motion& in, double fps, int frames, const TaskCon
     std::vector<int> known;
     for (int i = 0; i < n; i += static_cast<int>(r)) known.push_back(i);
     // 20 iterations: the setting the weights above were chosen with.
-    LatentSolverOptions solver = default_solver_options(SolverMethod::Lbfgs);
+    LatentSolverOptions solver = default_solver_options(LatentOptimizer::Lbfgs);
     solver.max_iterations = ctx.max_iterations > 0 ? ctx.max_iterations : 20;
     const Motion solved = complete_motion(*ctx.model, spline, MotionConstraints::full_pose(known), solver, ctx);
     // Key frames are equal in both, so they stay exact.

@@ -19,7 +19,7 @@ constexpr double kAlternativeStartNoise = 0.5;
 
 // `initializer` empty: the default (interpolation); else a make_initializer()
 // name whose transformer (`inbetweener` kind) comes from the context.
-Method solver_method(const std::string& name, const std::string& description, SolverMethod method,
+Method solver_method(const std::string& name, const std::string& description, LatentOptimizer optimizer,
                      const std::string& initializer = "", const std::string& inbetweener = "") {
   Method m;
   m.name = name;
@@ -27,7 +27,7 @@ Method solver_method(const std::string& name, const std::string& description, So
   m.needs_model = true;
   m.needs_inbetweener = inbetweener;
   m.follows_trajectory = true;  // the trajectory energy (tasks/latent/energies.h)
-  LatentSolverOptions options = default_solver_options(method);
+  LatentSolverOptions options = default_solver_options(optimizer);
   if (!initializer.empty()) options.initializer = make_initializer(initializer);
   m.complete = [options, method_name = name, inbetweener](const Motion& input, const std::vector<int>& known,
                                                    const TaskContext& ctx) {
@@ -61,16 +61,16 @@ Method solver_method(const std::string& name, const std::string& description, So
 std::vector<Method> solver_methods() {
   std::vector<Method> methods = {
       solver_method("nemf", "latent optimisation of the prior with L-BFGS (Ceres), NeMF's energies",
-                    SolverMethod::Lbfgs),
+                    LatentOptimizer::Lbfgs),
       solver_method("nemf-adam", "latent optimisation of the prior with Adam, 600 iterations (NeMF's reference)",
-                    SolverMethod::Adam)};
+                    LatentOptimizer::Adam)};
   // One per stage of every in-betweener kind: "nemf-context", "nemf-detail", "nemf-citl".
   for (const InbetweenerKind& kind : inbetweener_kinds()) {
     for (const InbetweenerStage& stage : kind.stages) {
       methods.push_back(solver_method("nemf-" + stage.name,
                                       "L-BFGS latent optimisation started from the " + kind.title + " (" +
                                           stage.description + ")",
-                                      SolverMethod::Lbfgs, stage.name + "-encoder", kind.name));
+                                      LatentOptimizer::Lbfgs, stage.name + "-encoder", kind.name));
     }
   }
   return methods;

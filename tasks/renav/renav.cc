@@ -45,7 +45,7 @@ double heading_yaw(const Eigen::Quaterniond& root, const Eigen::Vector3d& forwar
   return std::atan2(f.x(), f.z());
 }
 
-int default_iterations(RenavSolver s) { return s == RenavSolver::Adam ? 600 : 100; }
+int default_iterations(LatentOptimizer s) { return s == LatentOptimizer::Adam ? 600 : 100; }
 
 }  // namespace
 
@@ -272,10 +272,10 @@ RenavEnergy evaluate_renav_energy(const NemfModel& model, const RenavWindow& win
   return renav_motion_energy(model.rig(), model.config().fps, window, weights, rot, root, contacts);
 }
 
-RenavDecoded decode_renav_window(const NemfModel& model, const RenavWindow& window, const at::Tensor& z_l,
-                                 const at::Tensor& z_g) {
+DecodedWindow decode_renav_window(const NemfModel& model, const RenavWindow& window, const at::Tensor& z_l,
+                                  const at::Tensor& z_g) {
   at::NoGradGuard no_grad;
-  RenavDecoded d;
+  DecodedWindow d;
   d.local_rotations = model.decode(at::arange(window.length, at::kFloat), z_l, z_g);
   GmpOutput gmp = model.predict_global(d.local_rotations, GmpUse::Steering);
   d.root_positions = model.root_positions(d.local_rotations, gmp, window.start_xz);
@@ -322,9 +322,9 @@ std::string RenavOptions::validate() const {
   return e.str();
 }
 
-RenavOptions default_renav_options(RenavSolver solver) {
+RenavOptions default_renav_options(LatentOptimizer optimizer) {
   RenavOptions o;
-  o.solver = solver;
+  o.optimizer = optimizer;
   return o;
 }
 
@@ -390,13 +390,10 @@ std::vector<Eigen::Vector2d> path_at_model_rate(const std::vector<Eigen::Vector2
   return path_m;
 }
 
-// Output frames [begin, begin + length) of one window (model rate), the
-// reference segment it is compared with, and the frames it shares with the
-// window before.
-struct RenavSpan {
-  int begin = 0, length = 0;
+// One window (model rate; its shared frames are its first, shared with the
+// window before) and the reference segment it is compared with.
+struct RenavSpan : WindowSpan {
   int ref_begin = 0, ref_length = 0;
-  int shared = 0;
 };
 
 // The windows of an M-frame path with an R-frame reference (see the header:
@@ -407,16 +404,16 @@ std::vector<RenavSpan> renav_spans(int M, int R, int W, int overlap) {
   std::vector<RenavSpan> spans;
   for (size_t k = 0; k < starts.size(); ++k) {
     RenavSpan w;
-    w.begin = starts[k];
-    w.length = std::min(W, M - w.begin);
+    w.start = starts[k];
+    w.length = std::min(W, M - w.start);
     w.ref_length = std::min(R, w.length);
     if (R >= M) {
-      w.ref_begin = w.begin;  // time-aligned
+      w.ref_begin = w.start;  // time-aligned
     } else if (R > w.length && M > w.length) {
-      w.ref_begin = static_cast<int>(std::lround(static_cast<double>(w.begin) * (R - w.length) / (M - w.length)));
+      w.ref_begin = static_cast<int>(std::lround(static_cast<double>(w.start) * (R - w.length) / (M - w.length)));
     }
     w.ref_begin = std::clamp(w.ref_begin, 0, R - w.ref_length);
-    w.shared = k > 0 ? std::max(0, starts[k - 1] + std::min(W, M - starts[k - 1]) - w.begin) : 0;
+    w.shared_end = k > 0 ? std::max(0, starts[k - 1] + std::min(W, M - starts[k - 1]) - w.start) : 0;
     spans.push_back(w);
   }
   return spans;
@@ -467,6 +464,62 @@ void measure_path_error(const Motion& result, const std::vector<Eigen::Vector2d>
   rep->path_error_mean_cm = err_sum / N;
 }
 
+// Re-navigation at the model's rate: the reference played at the path's pace,
+// the path, the windows and the iteration cap of each.
+struct RenavPlan {
+  double pace = 1.0;
+  Motion reference;
+  std::vector<Eigen::Vector2d> path;
+  std::vector<RenavSpan> spans;
+  int cap = 0;
+};
+
+RenavPlan plan_renav(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
+                     double path_fps, const RenavOptions& options) {
+  const double fm = model.config().fps;
+  const int W = model.config().window;
+  RenavPlan plan;
+  if (options.match_pace) plan.pace = reference_pace(reference, path, path_fps);
+  Motion played = plan.pace == 1.0 ? reference : played_at_speed(reference, plan.pace);
+  if (std::floor((played.num_frames() - 1) * fm / played.fps + 1e-6) < 1.0) {
+    played = reference;  // too short to play faster: under two frames at the model's rate
+    plan.pace = 1.0;
+  }
+  plan.reference = reference_at_model_rate(played, fm);
+  plan.path = path_at_model_rate(path, path_fps, fm);
+  const int overlap = options.overlap > 0 ? std::min(options.overlap, W / 2) : std::max(1, W / 4);
+  plan.spans = renav_spans(static_cast<int>(plan.path.size()), plan.reference.num_frames(), W, overlap);
+  plan.cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.optimizer);
+  return plan;
+}
+
+// Solves window `k` of `plan` given the solution so far (model rate) from the
+// best of `inits`, and records its summary.
+SolvedWindow solve_renav_window(const NemfModel& model, const RenavPlan& plan, int k, const Motion& so_far,
+                                const RenavOptions& options, const std::vector<std::string>& inits, uint64_t seed,
+                                const TaskContext& window_ctx, int iteration_offset, RenavReport* rep) {
+  const auto t0 = Clock::now();
+  const RenavSpan& span = plan.spans[k];
+  const double fm = model.config().fps;
+  const int total = plan.cap * static_cast<int>(plan.spans.size());
+  window_ctx.report({iteration_offset, total, 0.0});
+  const RenavWindow window = make_renav_window(model, plan.reference, span.ref_begin, span.ref_length, plan.path,
+                                               span.start, span.length, k > 0 ? &so_far : nullptr, span.shared_end);
+  RenavWindowSummary sum;
+  sum.begin = span.start;
+  sum.length = span.length;
+  sum.reference_from = span.ref_begin * plan.pace / fm;
+  sum.reference_to = (span.ref_begin + span.ref_length - 1) * plan.pace / fm;
+  const FlatLatentEnergy energy(window_energy(model, window, options.weights), model.config().zl, model.config().zg);
+  const at::Tensor x0 = initial_codes(model, window, energy, inits, seed, k, &sum);
+  const at::Tensor x = minimize_window(energy, x0, options.capped(plan.cap), window_ctx, iteration_offset, total, &sum);
+  SolvedWindow solved{decode_renav_window(model, window, energy.z_l(x), energy.z_g(x)), window.transform,
+                      sum.iterations};
+  sum.wall_ms = ms_since(t0);
+  rep->windows.push_back(std::move(sum));
+  return solved;
+}
+
 }  // namespace
 
 Motion renavigate(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
@@ -474,79 +527,25 @@ Motion renavigate(const NemfModel& model, const Motion& reference, const std::ve
   const auto t0 = Clock::now();
   check_renav_input(model, reference, path, path_fps, options);
   const double fm = model.config().fps;
-  const int W = model.config().window;
-  // Everything at the model's rate, the reference at the path's pace.
-  RenavReport rep;
-  if (options.match_pace) rep.pace = reference_pace(reference, path, path_fps);
-  Motion played = rep.pace == 1.0 ? reference : played_at_speed(reference, rep.pace);
-  if (std::floor((played.num_frames() - 1) * fm / played.fps + 1e-6) < 1.0) {
-    played = reference;  // too short to play faster: under two frames at the model's rate
-    rep.pace = 1.0;
-  }
-  const Motion ref_m = reference_at_model_rate(played, fm);
-  const std::vector<Eigen::Vector2d> path_m = path_at_model_rate(path, path_fps, fm);
-  const int M = static_cast<int>(path_m.size());
-  const int overlap = options.overlap > 0 ? std::min(options.overlap, W / 2) : std::max(1, W / 4);
-  const std::vector<RenavSpan> spans = renav_spans(M, ref_m.num_frames(), W, overlap);
-  const int windows = static_cast<int>(spans.size());
-  const int cap = options.max_iterations > 0 ? options.max_iterations : default_iterations(options.solver);
+  const RenavPlan plan = plan_renav(model, reference, path, path_fps, options);
   const std::vector<std::string> inits = options.inits.empty() ? init_names() : options.inits;
-
-  Motion out = Motion::identity(reference.skeleton, M, fm);
+  RenavReport rep;
+  rep.pace = plan.pace;
   const int F = model.rig().num_feet();
-  std::vector<float> contacts(static_cast<size_t>(M) * F, 0.0f);
-  int iterations = 0;
-  TaskContext window_ctx = ctx;  // reports carry the window
-  window_ctx.window_count = windows;
-  for (int k = 0; k < windows; ++k) {
-    const auto tw = Clock::now();
-    const RenavSpan& span = spans[k];
-    window_ctx.window = k;
-    window_ctx.report({iterations, cap * windows, 0.0});
-    const RenavWindow window = make_renav_window(model, ref_m, span.ref_begin, span.ref_length, path_m, span.begin,
-                                                 span.length, k > 0 ? &out : nullptr, span.shared);
-    RenavWindowSummary sum;
-    sum.begin = span.begin;
-    sum.length = span.length;
-    sum.reference_from = span.ref_begin * rep.pace / fm;
-    sum.reference_to = (span.ref_begin + span.ref_length - 1) * rep.pace / fm;
-    const FlatLatentEnergy energy(window_energy(model, window, options.weights), model.config().zl,
-                                  model.config().zg);
-    const at::Tensor x0 = initial_codes(model, window, energy, inits, ctx.seed, k, &sum);
-    sum.initial_terms = energy.terms(x0, &sum.initial_energy);
-    LatentOptimizerStats stats;
-    const at::Tensor x = minimize_latent(energy.total(), x0, options.solver, options.capped(cap), window_ctx, &stats,
-                                         iterations, cap * windows);
-    sum.iterations = stats.iterations;
-    sum.evaluations = stats.evaluations;
-    sum.converged = stats.converged;
-    sum.message = stats.message;
-    sum.final_terms = energy.terms(x, &sum.final_energy);
-    iterations += sum.iterations;
+  const WindowSolver solver(std::vector<WindowSpan>(plan.spans.begin(), plan.spans.end()), reference.skeleton,
+                            static_cast<int>(plan.path.size()), fm, F);
+  WindowedSolution out = solver.solve(ctx, [&](int k, const WindowedSolution& so_far, const TaskContext& window_ctx,
+                                               int offset) {
+    return solve_renav_window(model, plan, k, so_far.motion, options, inits, ctx.seed, window_ctx, offset, &rep);
+  });
 
-    const RenavDecoded dec = decode_renav_window(model, window, energy.z_l(x), energy.z_g(x));
-    Motion piece = Motion::identity(reference.skeleton, span.length, fm);
-    write_window(dec.local_rotations, dec.root_positions, window.transform, &piece, 0);
-    const at::Tensor c = dec.contacts.reshape({-1, F}).to(at::kFloat).contiguous();
-    const float* cp = c.data_ptr<float>();
-    for (int f = 0; f < span.length; ++f) {
-      const double wn = f < span.shared ? static_cast<double>(f + 1) / (span.shared + 1) : 1.0;
-      cross_fade_frame(piece, f, wn, &out, span.begin + f);
-      for (int k = 0; k < F; ++k) {
-        float& v = contacts[static_cast<size_t>(span.begin + f) * F + k];
-        v = static_cast<float>((1.0 - wn) * v + wn * cp[static_cast<size_t>(f) * F + k]);
-      }
-    }
-    sum.wall_ms = ms_since(tw);
-    rep.windows.push_back(std::move(sum));
-  }
-
-  if (options.foot_lock_ramp >= 0 && F > 0) lock_feet(model.rig(), MotionConstraints{}, contacts, options.foot_lock_ramp, &out);
+  if (options.foot_lock_ramp >= 0 && F > 0)
+    lock_feet(model.rig(), MotionConstraints{}, out.contacts, options.foot_lock_ramp, &out.motion);
   const int N = static_cast<int>(path.size());
-  Motion result = same_frame_rate(path_fps, fm) ? out : resample_interpolate(out, path_fps, N);
+  Motion result = same_frame_rate(path_fps, fm) ? out.motion : resample_interpolate(out.motion, path_fps, N);
   result.fps = path_fps;
   measure_path_error(result, path, &rep);
-  rep.iterations = iterations;
+  rep.iterations = out.iterations;
   rep.wall_ms = ms_since(t0);
   if (report) *report = std::move(rep);
   return result;
@@ -591,11 +590,11 @@ Motion renavigate_on_model_rig(const Motion& reference, const std::vector<Eigen:
 Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double path_fps,
                  const std::string& method, const TaskContext& ctx, RenavReport* report) {
   const std::string m = method.empty() ? renav_methods().front() : method;
-  RenavSolver solver;
+  LatentOptimizer optimizer;
   if (m == "nemf") {
-    solver = RenavSolver::Lbfgs;
+    optimizer = LatentOptimizer::Lbfgs;
   } else if (m == "nemf-adam") {
-    solver = RenavSolver::Adam;
+    optimizer = LatentOptimizer::Adam;
   } else {
     std::string list;
     for (const std::string& n : renav_methods()) list += (list.empty() ? "" : ", ") + n;
@@ -608,7 +607,7 @@ Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& pa
     throw InputError("the reference's fps must be finite and positive");
   if (!std::isfinite(path_fps) || path_fps < 0) throw InputError("the path's frame rate must be finite and positive");
   const double fps = path_fps > 0 ? path_fps : reference.fps;
-  RenavOptions options = default_renav_options(solver);
+  RenavOptions options = default_renav_options(optimizer);
   if (ctx.max_iterations > 0) options.max_iterations = ctx.max_iterations;
   // renavigate() takes any frame rate itself; only another rig needs the adapter.
   if (!reference.skeleton.same_as(model.rig().skeleton))

@@ -50,7 +50,7 @@
 // the previous solution is at its first frame (position and heading), is
 // pulled toward that solution on the shared frames (continuity) and is
 // cross-faded with it there (SLERP / LERP, linear weights), so there is no
-// seam. Each window is compared with a reference segment of its own length:
+// seam (the window loop of tasks/latent/window_solver.h). Each window is compared with a reference segment of its own length:
 // the same frames of the reference when the reference is at least as long as
 // the (model-rate) path; otherwise segments spread evenly over the reference
 // (window k of K starts at reference frame round(s_k (R - T) / (M - T))), so
@@ -105,6 +105,7 @@
 #include "tasks/fixups/foot_locking.h"
 #include "tasks/latent/latent_energy.h"
 #include "tasks/latent/latent_optimizer.h"
+#include "tasks/latent/window_solver.h"
 #include "tasks/renav/soft_dtw.h"
 
 namespace mf {
@@ -175,20 +176,15 @@ RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindo
 RenavEnergy evaluate_renav_energy(const NemfModel& model, const RenavWindow& window, const RenavWeights& weights,
                                   const at::Tensor& z_l, const at::Tensor& z_g);
 
-/// The decoded window (no grad): local rotations [1, T, J, 3, 3], root
-/// positions [1, T, 3] and contact probabilities [1, T, F], canonical.
-struct RenavDecoded {
-  at::Tensor local_rotations, root_positions, contacts;
-};
-RenavDecoded decode_renav_window(const NemfModel& model, const RenavWindow& window, const at::Tensor& z_l,
+/// The decoded window (no grad, DecodedWindow of tasks/latent/window_solver.h):
+/// local rotations [1, T, J, 3, 3], root positions [1, T, 3] and contact
+/// probabilities [1, T, F], canonical.
+DecodedWindow decode_renav_window(const NemfModel& model, const RenavWindow& window, const at::Tensor& z_l,
                                  const at::Tensor& z_g);
 
 // ---------------------------------------------------------------- the solve
 
-/// The optimiser of a re-navigation (tasks/latent/latent_optimizer.h).
-using RenavSolver = LatentOptimizer;
-
-/// The options of renavigate(). The optimiser's settings are embedded
+/// The options of renavigate(). The optimiser and its settings are embedded
 /// (LatentOptimizerSettings) with re-navigation's defaults: max_iterations
 /// is the cap per window, 0 = the solver's default (L-BFGS 100, Adam 600);
 /// function tolerance 1e-5, gradient tolerance 1e-8, parameter tolerance
@@ -200,7 +196,6 @@ struct RenavOptions : LatentOptimizerSettings {
     parameter_tolerance = 1e-7;
   }
 
-  RenavSolver solver = RenavSolver::Lbfgs;
   RenavWeights weights;
   /// Initial z_g candidates tried, among "turned", "reference", "random"
   /// (see the top of this file); the lowest energy is kept. Empty = all three.
@@ -237,23 +232,17 @@ constexpr double kMinPace = 0.5, kMaxPace = 2.0;
 double reference_pace(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double path_fps);
 
 /// The options of the methods "nemf" (L-BFGS) and "nemf-adam".
-RenavOptions default_renav_options(RenavSolver solver = RenavSolver::Lbfgs);
+RenavOptions default_renav_options(LatentOptimizer optimizer = LatentOptimizer::Lbfgs);
 
-/// What one window's solve did.
-struct RenavWindowSummary {
+/// What one window's solve did: the optimiser's summary (wall_ms includes the
+/// window's initialisation) and where the window lies.
+struct RenavWindowSummary : SolveSummary {
   int begin = 0, length = 0;           ///< output frames (model fps)
   /// The span of the reference this window was compared with, in seconds of
   /// the reference as given (before match_pace played it faster or slower).
   double reference_from = 0.0, reference_to = 0.0;
   std::string init;                    ///< the initial z_g kept
   std::vector<std::pair<std::string, double>> init_energies;  ///< each candidate's energy
-  int iterations = 0;
-  int evaluations = 0;
-  bool converged = false;
-  double initial_energy = 0.0, final_energy = 0.0;
-  std::vector<std::pair<std::string, double>> initial_terms, final_terms;  ///< weighted
-  double wall_ms = 0.0;                ///< initialisation included
-  std::string message;
 };
 
 struct RenavReport {

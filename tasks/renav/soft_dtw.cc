@@ -512,24 +512,29 @@ class SoftDtwSequenceFunction : public torch::autograd::Function<SoftDtwSequence
         }
       });
     });
-    auto to_input = [&](const std::vector<double>& full, const at::Tensor& input, int64_t len) {
-      at::Tensor out = at::empty(input.sizes(), input.options().requires_grad(false));  // every element is written
-      AT_DISPATCH_FLOATING_TYPES(input.scalar_type(), "soft_dtw_sequences_grad", [&] {
-        scalar_t* o = out.data_ptr<scalar_t>();
-        const int64_t item = len * d;
-        if (input.size(0) == B) {
-          for (int64_t k = 0; k < B * item; ++k) o[k] = static_cast<scalar_t>(full[k]);
-        } else {
-          std::vector<double> sum(item, 0.0);
-          for (int64_t b = 0; b < B; ++b)
-            for (int64_t k = 0; k < item; ++k) sum[k] += full[b * item + k];
-          for (int64_t k = 0; k < item; ++k) o[k] = static_cast<scalar_t>(sum[k]);
-        }
-      });
-      return out;
-    };
-    return {need_x ? to_input(gx, x, m) : at::Tensor(), need_y ? to_input(gy, y, n) : at::Tensor(), at::Tensor(),
-            at::Tensor(), at::Tensor(), at::Tensor()};
+    return {need_x ? gradient_of_input(gx, x, B) : at::Tensor(), need_y ? gradient_of_input(gy, y, B) : at::Tensor(),
+            at::Tensor(), at::Tensor(), at::Tensor(), at::Tensor()};
+  }
+
+ private:
+  // The gradient of `input` [B or 1, len, d] from the per-item gradients
+  // `full` [B, len, d] (double): converted to the input's dtype, and summed
+  // over the batch in item order where the input was broadcast (batch 1).
+  static at::Tensor gradient_of_input(const std::vector<double>& full, const at::Tensor& input, int64_t B) {
+    at::Tensor out = at::empty(input.sizes(), input.options().requires_grad(false));  // every element is written
+    AT_DISPATCH_FLOATING_TYPES(input.scalar_type(), "soft_dtw_sequences_grad", [&] {
+      scalar_t* o = out.data_ptr<scalar_t>();
+      const int64_t item = input.size(1) * input.size(2);
+      if (input.size(0) == B) {
+        for (int64_t k = 0; k < B * item; ++k) o[k] = static_cast<scalar_t>(full[k]);
+      } else {
+        std::vector<double> sum(item, 0.0);
+        for (int64_t b = 0; b < B; ++b)
+          for (int64_t k = 0; k < item; ++k) sum[k] += full[b * item + k];
+        for (int64_t k = 0; k < item; ++k) o[k] = static_cast<scalar_t>(sum[k]);
+      }
+    });
+    return out;
   }
 };
 
