@@ -1,5 +1,5 @@
 // alternatives-bench: several distinct solutions of one request
-// (tasks/jobs.h run_constrained with alternatives) on the gap-filling windows
+// (tasks/methods/jobs.h run_constrained with alternatives) on the gap-filling windows
 // of the benchmark protocol (bench/protocol.h: 10 context frames, a gap of T,
 // the target frame), optionally with end-effector targets (both hands at the
 // gap's middle frame) and a contact pin (where a foot of the ground truth stays
@@ -34,8 +34,8 @@
 #include "prior/motion/errors.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
-#include "tasks/jobs.h"
-#include "tasks/model_rig.h"
+#include "tasks/context/model_rig.h"
+#include "tasks/methods/jobs.h"
 
 namespace {
 

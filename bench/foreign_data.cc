@@ -8,7 +8,7 @@
 #include "prior/motion/interpolation.h"
 #include "prior/motion/motion_bvh.h"
 #include "prior/rig/units.h"
-#include "tasks/jobs.h"
+#include "tasks/methods/jobs.h"
 
 namespace mf::bench {
 namespace {

@@ -1,9 +1,9 @@
 // foreign-training-set: the training part of the foreign capture
 // (bench/foreign_data.h; never its validation part) on the model's rig, as
 // BVH files a trainer reads beside the training data: each clip retargeted
-// with the product's own retargeter (tasks/model_rig.h, anatomy measured on
+// with the product's own retargeter (tasks/context/model_rig.h, anatomy measured on
 // the whole clip), at the model's frame rate, lowered onto the training data's
-// floor (tasks/ground_level.h), in centimetres like the training data.
+// floor (tasks/context/ground_level.h), in centimetres like the training data.
 #include <filesystem>
 #include <iostream>
 
@@ -13,8 +13,8 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/motion_bvh.h"
 #include "prior/util/command_line.h"
-#include "tasks/ground_level.h"
-#include "tasks/model_rig.h"
+#include "tasks/context/ground_level.h"
+#include "tasks/context/model_rig.h"
 
 namespace {
 

@@ -21,17 +21,17 @@
 #include "bench/prior_eval.h"
 #include "bench/protocol.h"
 #include "prior/data/dataset.h"
+#include "prior/inbetween/inbetweener.h"
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
-#include "prior/inbetween/inbetweener.h"
 #include "bench/foreign_data.h"
 #include "bench/synthetic_rigs.h"
-#include "tasks/jobs.h"
-#include "tasks/model_rig.h"
-#include "tasks/transformer_methods.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
+#include "tasks/context/model_rig.h"
+#include "tasks/methods/jobs.h"
+#include "tasks/methods/transformer_methods.h"
 
 namespace {
 

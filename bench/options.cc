@@ -6,7 +6,7 @@
 #include "prior/inbetween/inbetweener.h"
 #include "prior/rig/mirror.h"
 #include "prior/util/command_line.h"
-#include "tasks/inbetweener_files.h"
+#include "tasks/transformer/inbetweener_files.h"
 
 namespace mf::bench {
 

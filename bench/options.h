@@ -14,7 +14,7 @@
 
 #include "prior/data/dataset.h"
 #include "prior/util/command_line.h"
-#include "tasks/task_context.h"
+#include "tasks/context/task_context.h"
 
 namespace mf::bench {
 

@@ -18,7 +18,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "prior/motion/rotations_torch.h"
-#include "tasks/prior_codec.h"
+#include "tasks/latent/prior_codec.h"
 
 namespace mf::bench {
 namespace {

@@ -1,7 +1,7 @@
 // The prior's own evaluation in motionfield-bench (docs/BENCHMARKS.md, tasks
 // recon, fps, seams and sample): reconstruction, decoding at other frame rates,
 // seams between overlapping windows, and samples from N(0, I). Every task goes
-// through the codec of tasks/prior_codec.h, as the tasks and the C API do.
+// through the codec of tasks/latent/prior_codec.h, as the tasks and the C API do.
 //
 // Reconstruction metrics (NeMF, REFERENCE.md section 1), between a truth and
 // its reconstruction in the same world frame (the codec places the

@@ -13,8 +13,8 @@
 #include "prior/motion/errors.h"
 #include "bench/text.h"
 #include "bench/synthetic_rigs.h"
-#include "tasks/jobs.h"
 #include "prior/model/representation.h"
+#include "tasks/methods/jobs.h"
 
 namespace mf::bench {
 namespace {

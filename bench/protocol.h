@@ -1,6 +1,6 @@
 // The benchmark protocol of motionfield-bench (docs/BENCHMARKS.md): LaFAN1-style
 // windows cut from held-out clips, each task run through the task entry points
-// of tasks/jobs.h with a named method, and the metrics of bench/metrics.h
+// of tasks/methods/jobs.h with a named method, and the metrics of bench/metrics.h
 // summarised in one markdown table per (task, method).
 //
 // Tasks (defaults of ProtocolOptions):
@@ -38,8 +38,8 @@
 #include "bench/metrics.h"
 #include "prior/data/dataset.h"
 #include "prior/rig/retarget.h"
-#include "tasks/method.h"
-#include "tasks/motion_constraints.h"
+#include "tasks/constraints/motion_constraints.h"
+#include "tasks/methods/method.h"
 
 namespace mf::bench {
 

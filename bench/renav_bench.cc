@@ -1,4 +1,4 @@
-// renav-bench: re-navigation (tasks/renav.h) on validation clips along NeMF's
+// renav-bench: re-navigation (tasks/renav/renav.h) on validation clips along NeMF's
 // test paths: a straight line (0 -> 4 m), circles of radius 0.5 m and 1.5 m
 // (one full turn) and a sinusoid (4 m forward, amplitude 0.5 m, wavelength 2 m).
 // Each path is a polyline walked at the reference clip's mean ground speed
@@ -57,10 +57,10 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/interpolation.h"
 #include "prior/motion/motion_bvh.h"
-#include "tasks/renav.h"
-#include "tasks/soft_dtw.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
+#include "tasks/renav/renav.h"
+#include "tasks/renav/soft_dtw.h"
 
 namespace {
 
@@ -120,11 +120,12 @@ void add_options(CLI::App& app, Args& a) {
                                  {"w-continuity", "weight of the continuity with the previous window"},
                                  {"lock-ramp", "foot locking ramp in frames (negative: no foot locking)"},
                                  {"match-pace", "1: play the reference at the path's pace (the default), 0: as it is"}},
-                                "Solver settings (default: tasks/renav.h)");
+                                "Solver settings (default: tasks/renav/renav.h)");
 }
 
 mf::RenavOptions options_for(const Args& a, const std::string& method) {
-  mf::RenavOptions o = mf::default_renav_options(method == "nemf-adam" ? mf::RenavSolver::Adam : mf::RenavSolver::Lbfgs);
+  mf::RenavOptions o =
+      mf::default_renav_options(method == "nemf-adam" ? mf::LatentOptimizer::Adam : mf::LatentOptimizer::Lbfgs);
   std::map<std::string, double> n = a.numbers;
   auto take = [&](const char* key, auto* field) {
     auto it = n.find(key);
@@ -395,7 +396,7 @@ int run(Args& args, const std::string& command) {
     if (m == "turned") continue;
     const mf::RenavOptions o = options_for(args, m);
     const mf::RenavWeights& w = o.weights;
-    emit("- `" + m + "`: " + (o.solver == mf::RenavSolver::Adam ? "Adam" : "L-BFGS") + ", max iterations " +
+    emit("- `" + m + "`: " + (o.optimizer == mf::LatentOptimizer::Adam ? "Adam" : "L-BFGS") + ", max iterations " +
          (o.max_iterations ? std::to_string(o.max_iterations) : std::string("default")) + ", ftol " +
          fixed(o.function_tolerance, 6) + "; weights path " + fixed(w.path, 2) + ", joints " + fixed(w.joints, 2) +
          ", heading " + fixed(w.heading, 2) + ", foot skating " + fixed(w.foot_skating, 2) + ", continuity " +
@@ -506,7 +507,7 @@ int run(Args& args, const std::string& command) {
 int main(int argc, char** argv) {
   return mf::bench::benchmark_main<Args>(
       argc, argv, "renav-bench",
-      "Re-navigation (tasks/renav.h) of validation clips along NeMF's test paths (docs/BENCHMARKS.md, "
+      "Re-navigation (tasks/renav/renav.h) of validation clips along NeMF's test paths (docs/BENCHMARKS.md, "
       "\"Re-navigation\"); details at the top of bench/renav_bench.cc.",
       add_options, run);
 }

@@ -16,7 +16,7 @@
 #include "prior/model/model_file.h"
 #include "prior/motion/errors.h"
 #include "prior/util/command_line.h"
-#include "tasks/model_rig.h"
+#include "tasks/context/model_rig.h"
 
 namespace {
 

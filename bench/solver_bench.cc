@@ -1,4 +1,4 @@
-// solver-bench: quality and speed of the latent solvers (tasks/latent_solver.h)
+// solver-bench: quality and speed of the latent solvers (tasks/latent/latent_solver.h)
 // against interpolation, on the windows of the benchmark protocol
 // (bench/protocol.h: gap filling 10 + T + 1 frames, sparse keyframes in
 // 128-frame windows), with every solver setting on the command line so that
@@ -32,7 +32,7 @@
 // after the speed table, the operators run per energy evaluation and the time in
 // them (bench/op_profile.h; with --threads 1).
 //
-// Transformers (tasks/transformer_methods.h): --twostage/--citl FILE, else
+// Transformers (tasks/methods/transformer_methods.h): --twostage/--citl FILE, else
 // motionfield-twostage.mfm / motionfield-citl.mfm next to --model when they
 // exist. With them, --methods also takes "context", "detail", "citl" (one
 // pass of the transformer; no solver; speed = inference time per window) and
@@ -62,17 +62,17 @@
 #include "bench/text.h"
 #include "bench/protocol.h"
 #include "prior/data/dataset.h"
+#include "prior/inbetween/inbetweener.h"
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
-#include "tasks/baselines.h"
-#include "prior/inbetween/inbetweener.h"
-#include "tasks/initializers.h"
-#include "tasks/latent_solver.h"
-#include "tasks/transformer_methods.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
+#include "tasks/constraints/interpolation_fill.h"
+#include "tasks/latent/initializers.h"
+#include "tasks/latent/latent_solver.h"
+#include "tasks/methods/transformer_methods.h"
 
 namespace {
 
@@ -143,7 +143,7 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("--penalty", a.penalty, "squared or absolute (default: the solver's, squared)")
       ->check(CLI::IsMember({"squared", "absolute"}));
   app.add_option("--init", a.init,
-                 "the solver's initialiser (tasks/initializers.h; with the transformers also context-encoder, "
+                 "the solver's initialiser (tasks/latent/initializers.h; with the transformers also context-encoder, "
                  "detail-encoder, citl-encoder)");
   mf::bench::add_transformer_options(app, a.transformer_files);
   mf::bench::add_number_options(app, a.numbers,
@@ -155,7 +155,7 @@ void add_options(CLI::App& app, Args& a) {
                                  {"keyed-iterations", "L-BFGS iterations on the key-frame terms first (0: none)"},
                                  {"adam-iterations", "Adam iteration cap per window"},
                                  {"adam-tol", "Adam's convergence tolerance (relative improvement)"}},
-                                "Solver settings (default: tasks/latent_solver.h)");
+                                "Solver settings (default: tasks/latent/latent_solver.h)");
   mf::bench::add_number_options(app, a.numbers,
                                 {{"overwrite", "1: overwrite the known values in the output, 0: the raw solution"},
                                  {"lock-ramp", "foot-locking ramp in frames (negative: off)"},
@@ -168,12 +168,12 @@ void add_options(CLI::App& app, Args& a) {
                                  {"w-skate", "weight of foot skating"},
                                  {"w-smooth", "weight of smoothness"},
                                  {"w-effector", "weight of the end-effector targets"}},
-                                "Output and energy weights (default: tasks/latent_solver.h, tasks/energies.h)");
+                                "Output and energy weights (default: tasks/latent/latent_solver.h, tasks/latent/energies.h)");
 }
 
 mf::LatentSolverOptions solver_options(const Args& a, const std::string& method) {
   mf::LatentSolverOptions o =
-      mf::default_solver_options(method == "nemf-adam" ? mf::SolverMethod::Adam : mf::SolverMethod::Lbfgs);
+      mf::default_solver_options(method == "nemf-adam" ? mf::LatentOptimizer::Adam : mf::LatentOptimizer::Lbfgs);
   std::map<std::string, double> n = a.numbers;
   auto take = [&](const char* key, auto* field) {
     auto it = n.find(key);
@@ -225,9 +225,9 @@ mf::LatentSolverOptions solver_options(const Args& a, const std::string& method)
 std::string describe(const mf::LatentSolverOptions& o) {
   std::ostringstream s;
   const mf::EnergyWeights& w = o.weights;
-  s << (o.method == mf::SolverMethod::Adam ? "Adam" : "L-BFGS") << ", max iterations "
+  s << (o.optimizer == mf::LatentOptimizer::Adam ? "Adam" : "L-BFGS") << ", max iterations "
     << (o.max_iterations ? std::to_string(o.max_iterations) : std::string("default"));
-  if (o.method == mf::SolverMethod::Lbfgs)
+  if (o.optimizer == mf::LatentOptimizer::Lbfgs)
     s << ", ftol " << o.function_tolerance << ", rank " << o.lbfgs_rank << ", keys-only stage "
       << (o.keyed_iterations >= 0 ? std::to_string(o.keyed_iterations) : std::string("default"));
   s << "; weights: rotation " << w.rotation << ", position " << w.position << ", root orientation "

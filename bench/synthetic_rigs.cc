@@ -7,7 +7,7 @@
 
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
-#include "tasks/baselines.h"
+#include "tasks/constraints/interpolation_fill.h"
 
 namespace mf::bench {
 namespace {

@@ -1,4 +1,4 @@
-// trajectory-bench: the latent solver's trajectory energy (tasks/energies.h,
+// trajectory-bench: the latent solver's trajectory energy (tasks/latent/energies.h,
 // EnergyWeights::trajectory and trajectory_facing) on the gap-filling windows
 // of the benchmark protocol (bench/protocol.h: 10 context frames, a gap of T,
 // the target frame), with the ground truth's trajectory (root ground position
@@ -40,11 +40,11 @@
 #include "prior/motion/errors.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
-#include "tasks/baselines.h"
-#include "tasks/constraint_report.h"
-#include "tasks/jobs.h"
-#include "tasks/latent_solver.h"
-#include "tasks/model_rig.h"
+#include "tasks/constraints/constraint_report.h"
+#include "tasks/constraints/interpolation_fill.h"
+#include "tasks/context/model_rig.h"
+#include "tasks/latent/latent_solver.h"
+#include "tasks/methods/jobs.h"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Fuzz target: the constraints file format (tasks/constraint_spec.h) on any
+// Fuzz target: the constraints file format (tasks/constraints/constraint_spec.h) on any
 // bytes (the "trajectory" member included), resolved against a small skeleton
 // and validated for a 40-frame motion.
 // Contract checked: bad input throws mf::InputError naming the source; what
@@ -8,7 +8,7 @@
 
 #include "fuzz/fuzz_check.h"
 #include "prior/motion/errors.h"
-#include "tasks/constraint_spec.h"
+#include "tasks/constraints/constraint_spec.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

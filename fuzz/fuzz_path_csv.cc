@@ -1,4 +1,4 @@
-// Fuzz target: the path CSV reader (tasks/path_csv.h) on any bytes.
+// Fuzz target: the path CSV reader (tasks/constraints/path_csv.h) on any bytes.
 // Contract checked: bad input throws mf::InputError naming the source; a path
 // that parses has at least two points, all finite.
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "fuzz/fuzz_check.h"
 #include "prior/motion/errors.h"
-#include "tasks/path_csv.h"
+#include "tasks/constraints/path_csv.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -1,4 +1,4 @@
-#include "tasks/baselines.h"
+#include "tasks/constraints/interpolation_fill.h"
 
 #include <gtest/gtest.h>
 

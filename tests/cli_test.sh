@@ -98,7 +98,7 @@ for method in interp zerovel; do
   expect_rc 3 "inbetween $method changes unknown frames" -- "$DIFF" "$SAMPLE" "$TMP/kf-$method.bvh"
 done
 # --flag=value form, --threads anywhere, and the default method: with the
-# bundled model the measured best method (tasks/jobs.cc default_method(),
+# bundled model the measured best method (tasks/methods/jobs.cc default_method(),
 # docs/BENCHMARKS.md), which keeps the keyframes and is not interpolation;
 # without a model interpolation (tests/jobs_test.cc).
 if [ -f "$SRC/models/motionfield-prior.mfm" ]; then

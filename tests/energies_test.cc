@@ -1,4 +1,4 @@
-// Energies of the latent solvers (tasks/energies.h): zero at a perfect fit and
+// Energies of the latent solvers (tasks/latent/energies.h): zero at a perfect fit and
 // positive otherwise, gradients to the latents only, partial keys that never
 // read what they do not constrain, constraint validation, and the
 // interpolation initialiser.
@@ -13,9 +13,9 @@
 #include "prior/model/representation.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/kinematics_torch.h"
-#include "tasks/baselines.h"
-#include "tasks/energies.h"
-#include "tasks/initializers.h"
+#include "tasks/constraints/interpolation_fill.h"
+#include "tasks/latent/energies.h"
+#include "tasks/latent/initializers.h"
 #include "tests/test_util.h"
 
 namespace mf {

@@ -1,4 +1,4 @@
-// Foot locking after a solve (tasks/foot_locking.h) on a one-legged rig with a
+// Foot locking after a solve (tasks/fixups/foot_locking.h) on a one-legged rig with a
 // toe: a toe in contact is held whether its heel is planted (the foot turns
 // about the ankle) or lifted (the leg carries the foot, which keeps its
 // orientation), frames a key protects are not touched, and the ramp into a
@@ -12,8 +12,8 @@
 
 #include "prior/model/representation.h"
 #include "prior/motion/motion.h"
-#include "tasks/foot_locking.h"
-#include "tasks/motion_constraints.h"
+#include "tasks/constraints/motion_constraints.h"
+#include "tasks/fixups/foot_locking.h"
 
 namespace mf {
 namespace {

@@ -1,4 +1,4 @@
-#include "tasks/jobs.h"
+#include "tasks/methods/jobs.h"
 
 #include <gtest/gtest.h>
 
@@ -8,7 +8,7 @@
 #include <string>
 
 #include "prior/motion/errors.h"
-#include "tasks/baselines.h"
+#include "tasks/constraints/interpolation_fill.h"
 #include "tests/test_util.h"
 
 namespace mf {

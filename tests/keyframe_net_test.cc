@@ -10,7 +10,7 @@
 #include "prior/inbetween/keyframe_net.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations_torch.h"
-#include "tasks/inbetweener_fill.h"
+#include "tasks/transformer/inbetweener_fill.h"
 #include "tests/test_util.h"
 #include "training/salient_poses.h"
 

@@ -1,4 +1,4 @@
-// The latent solvers (tasks/latent_solver.h) on tiny random models: energy
+// The latent solvers (tasks/latent/latent_solver.h) on tiny random models: energy
 // decrease with L-BFGS and Adam, cancellation, exact known frames, unknown
 // values never read, determinism, partial and end-effector constraints, long
 // inputs in overlapping windows, and the registered methods.
@@ -16,8 +16,8 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations.h"
-#include "tasks/jobs.h"
-#include "tasks/latent_solver.h"
+#include "tasks/latent/latent_solver.h"
+#include "tasks/methods/jobs.h"
 #include "tests/test_util.h"
 
 namespace mf {
@@ -51,9 +51,9 @@ NemfModel tiny_model() {
   return standing_prior(rig);
 }
 
-LatentSolverOptions quick(SolverMethod method) {
+LatentSolverOptions quick(LatentOptimizer method) {
   LatentSolverOptions o = default_solver_options(method);
-  o.max_iterations = method == SolverMethod::Adam ? 60 : 20;
+  o.max_iterations = method == LatentOptimizer::Adam ? 60 : 20;
   return o;
 }
 
@@ -114,12 +114,12 @@ TEST(LatentSolver, LbfgsAndAdamBothReduceAKeyframeEnergy) {
   at::set_num_threads(1);
   NemfModel model = tiny_model();
   Reachable r = reachable_problem(model);
-  for (SolverMethod method : {SolverMethod::Lbfgs, SolverMethod::Adam}) {
+  for (LatentOptimizer method : {LatentOptimizer::Lbfgs, LatentOptimizer::Adam}) {
     LatentSolution s = solve_latents(model, r.problem, r.start, quick(method), {});
     EXPECT_GT(s.summary.iterations, 0);
     EXPECT_GE(s.summary.evaluations, s.summary.iterations);
     EXPECT_LT(s.summary.final_energy, 0.5 * s.summary.initial_energy)
-        << (method == SolverMethod::Adam ? "adam" : "lbfgs");
+        << (method == LatentOptimizer::Adam ? "adam" : "lbfgs");
     EXPECT_GT(s.summary.wall_ms, 0.0);
     ASSERT_EQ(s.summary.final_terms.size(), s.summary.initial_terms.size());
     double sum = 0.0;
@@ -146,7 +146,7 @@ TEST(LatentSolver, ProgressObservesAndCancels) {
   at::set_num_threads(1);
   NemfModel model = tiny_model();
   Reachable r = reachable_problem(model);
-  for (SolverMethod method : {SolverMethod::Lbfgs, SolverMethod::Adam}) {
+  for (LatentOptimizer method : {LatentOptimizer::Lbfgs, LatentOptimizer::Adam}) {
     std::vector<int> seen;
     TaskContext ctx;
     ctx.progress = [&](const TaskProgress& p) {
@@ -174,7 +174,8 @@ TEST(LatentSolver, KnownFramesComeOutExactlyAndUnknownFramesAreNeverRead) {
   Motion m = test::random_motion(model.rig().skeleton, 26, 30.0, 7);
   const std::vector<int> keys = {0, 6, 13, 25};
   CompletionReport report;
-  Motion out = complete_motion(model, m, MotionConstraints::full_pose(keys), quick(SolverMethod::Lbfgs), {}, &report);
+  Motion out =
+      complete_motion(model, m, MotionConstraints::full_pose(keys), quick(LatentOptimizer::Lbfgs), {}, &report);
   ASSERT_EQ(out.num_frames(), 26);
   for (int f : keys) {
     EXPECT_EQ(out.root_positions[f], m.root_positions[f]);
@@ -192,7 +193,7 @@ TEST(LatentSolver, KnownFramesComeOutExactlyAndUnknownFramesAreNeverRead) {
     for (int j = 0; j < m.num_joints(); ++j) poisoned.rotation(f, j) = Eigen::Quaterniond(nan, nan, nan, nan);
     poisoned.root_positions[f] = Eigen::Vector3d(nan, nan, nan);
   }
-  Motion again = complete_motion(model, poisoned, MotionConstraints::full_pose(keys), quick(SolverMethod::Lbfgs));
+  Motion again = complete_motion(model, poisoned, MotionConstraints::full_pose(keys), quick(LatentOptimizer::Lbfgs));
   EXPECT_EQ(max_abs_difference(out, again), 0.0);
 }
 
@@ -200,7 +201,7 @@ TEST(LatentSolver, DeterministicForTheSameInput) {
   at::set_num_threads(1);
   NemfModel model = tiny_model();
   Motion m = test::random_motion(model.rig().skeleton, 30, 30.0, 8);
-  for (SolverMethod method : {SolverMethod::Lbfgs, SolverMethod::Adam}) {
+  for (LatentOptimizer method : {LatentOptimizer::Lbfgs, LatentOptimizer::Adam}) {
     TaskContext ctx;
     ctx.seed = 5;
     Motion a = complete_motion(model, m, MotionConstraints::full_pose({0, 10, 29}), quick(method), ctx);
@@ -219,19 +220,19 @@ TEST(LatentSolver, PartialConstraintsIgnoreUnconstrainedJoints) {
   legs.joints = {3, 4};
   legs.root_position = false;
   c.keys.insert(c.keys.begin() + 1, legs);
-  Motion a = complete_motion(model, m, c, quick(SolverMethod::Lbfgs));
+  Motion a = complete_motion(model, m, c, quick(LatentOptimizer::Lbfgs));
   for (int j : {3, 4}) EXPECT_EQ(a.rotation(12, j).coeffs(), m.rotation(12, j).coeffs());
   // Whatever the other joints and the root hold at frame 12 does not matter.
   Motion other = m;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   for (int j : {0, 1, 2, 5, 6}) other.rotation(12, j) = Eigen::Quaterniond(nan, nan, nan, nan);
   other.root_positions[12] = Eigen::Vector3d(nan, nan, nan);
-  Motion b = complete_motion(model, other, c, quick(SolverMethod::Lbfgs));
+  Motion b = complete_motion(model, other, c, quick(LatentOptimizer::Lbfgs));
   EXPECT_EQ(max_abs_difference(a, b), 0.0);
   // A constrained joint does matter.
   Motion moved = m;
   moved.rotation(12, 4) = Eigen::Quaterniond(Eigen::AngleAxisd(1.0, Eigen::Vector3d::UnitX())) * m.rotation(12, 4);
-  Motion d = complete_motion(model, moved, c, quick(SolverMethod::Lbfgs));
+  Motion d = complete_motion(model, moved, c, quick(LatentOptimizer::Lbfgs));
   EXPECT_GT(max_abs_difference(a, d), 1e-3);
 }
 
@@ -240,7 +241,7 @@ TEST(LatentSolver, EndEffectorPullsTheJointTowardItsTarget) {
   NemfModel model = tiny_model();
   const int foot = model.rig().foot_joints[0];
   Motion m = gentle_motion(model.rig().skeleton, 24, 10);
-  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  LatentSolverOptions o = quick(LatentOptimizer::Lbfgs);
   o.max_iterations = 60;
   MotionConstraints c = MotionConstraints::full_pose({0, 23});
   const Eigen::Vector3d target = forward_kinematics(m).position(12, foot) + Eigen::Vector3d(0.08, 0.0, 0.0);
@@ -266,7 +267,7 @@ TEST(LatentSolver, LongInputsUseOverlappingWindowsWithoutSeams) {
   std::vector<int> keys;
   for (int f = 0; f < N; f += 6) keys.push_back(f);
   keys.push_back(N - 1);
-  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  LatentSolverOptions o = quick(LatentOptimizer::Lbfgs);
   o.overlap = 8;
   CompletionReport report;
   Motion out = complete_motion(model, m, MotionConstraints::full_pose(keys), o, {}, &report);
@@ -338,7 +339,7 @@ TEST(LatentSolver, FeetInContactAreLockedAndKnownFramesStay) {
   const NemfModel& model = *legged.model;
   ASSERT_EQ(model.rig().num_feet(), 2);
   Motion m = gentle_motion(s, 24, 14);
-  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  LatentSolverOptions o = quick(LatentOptimizer::Lbfgs);
   const std::vector<int> keys = {0, 23};
   Motion locked = complete_motion(model, m, MotionConstraints::full_pose(keys), o);
   o.foot_lock_ramp = -1;
@@ -376,7 +377,7 @@ TEST(LatentSolver, EndEffectorIkReachesTheTarget) {
   const Eigen::Vector3d target = forward_kinematics(m).position(12, 4) + Eigen::Vector3d(0.05, 0.03, -0.02);
   c.effectors.push_back({12, 4, target, 1.0});
   CompletionReport report;
-  Motion out = complete_motion(model, m, c, quick(SolverMethod::Lbfgs), {}, &report);
+  Motion out = complete_motion(model, m, c, quick(LatentOptimizer::Lbfgs), {}, &report);
   const GlobalPose p = forward_kinematics(out);
   EXPECT_LT((p.position(12, 4) - target).norm(), 1e-3);
   EXPECT_LT(report.effectors.max_cm, 0.1);
@@ -403,7 +404,7 @@ TEST(LatentSolver, EndEffectorBeyondTheLegsReachMovesTheRoot) {
   const Eigen::Vector3d target = hip + (pm.position(12, 4) - hip).normalized() * 0.89;
   c.effectors.push_back({12, 4, target, 1.0});
   CompletionReport report;
-  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  LatentSolverOptions o = quick(LatentOptimizer::Lbfgs);
   Motion out = complete_motion(model, m, c, o, {}, &report);
   EXPECT_LT((forward_kinematics(out).position(12, 4) - target).norm(), 1e-3);
   EXPECT_LT(report.effectors.max_cm, 0.1);
@@ -423,10 +424,10 @@ TEST(LatentSolver, HandTargetBeyondTheArmsReachSwingsTheShoulderThenMovesTheRoot
   const int shoulder = 8, upper = 9, hand = 11, f = 12;
   Motion m = gentle_motion(armed.skeleton, 24, 16);
   const MotionConstraints keys = MotionConstraints::full_pose({0, 23});
-  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  LatentSolverOptions o = quick(LatentOptimizer::Lbfgs);
   o.effector_falloff = -1;  // the solve alone: what the IK starts from
   const Motion solved = complete_motion(model, m, keys, o);
-  o.effector_falloff = quick(SolverMethod::Lbfgs).effector_falloff;
+  o.effector_falloff = quick(LatentOptimizer::Lbfgs).effector_falloff;
   const GlobalPose ps = forward_kinematics(solved);
   const Eigen::Vector3d P = ps.position(f, shoulder), hand_now = ps.position(f, hand);
   const double reach = 0.53;
@@ -466,7 +467,7 @@ TEST(LatentSolver, HandTargetBeyondTheArmsReachSwingsTheShoulderThenMovesTheRoot
 TEST(LatentSolver, BadInputIsAnInputError) {
   NemfModel model = tiny_model();
   Motion m = test::random_motion(model.rig().skeleton, 20, 30.0, 1);
-  LatentSolverOptions o = quick(SolverMethod::Lbfgs);
+  LatentSolverOptions o = quick(LatentOptimizer::Lbfgs);
   Skeleton other = model.rig().skeleton;
   other.names[2] = "Neck";
   Motion wrong = test::random_motion(other, 20, 30.0, 1);

@@ -1,7 +1,7 @@
-// The prior as a codec (tasks/prior_codec.h) on tiny random models: window
+// The prior as a codec (tasks/latent/prior_codec.h) on tiny random models: window
 // layout, blend weights, shapes at any frame rate, short and long clips, the
 // root path's anchoring, and resampling with the residual (known frames exact).
-#include "tasks/prior_codec.h"
+#include "tasks/latent/prior_codec.h"
 
 #include <ATen/ATen.h>
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "prior/motion/rotations_torch.h"
-#include "tasks/jobs.h"
+#include "tasks/methods/jobs.h"
 #include "tests/test_util.h"
 
 namespace mf {

@@ -1,4 +1,4 @@
-// Re-navigation (tasks/renav.h) on tiny random models: path CSV parsing and
+// Re-navigation (tasks/renav/renav.h) on tiny random models: path CSV parsing and
 // its errors, polyline resampling by arc length, tangents, the energy (lower for
 // a motion that follows the path, gradients reaching the latent codes only),
 // the solve (energy decrease, cancellation, output length and frame rate,
@@ -14,7 +14,7 @@
 #include "prior/model/nemf.h"
 #include "prior/model/representation.h"
 #include "prior/motion/errors.h"
-#include "tasks/renav.h"
+#include "tasks/renav/renav.h"
 #include "tests/test_util.h"
 
 namespace mf {
@@ -283,7 +283,7 @@ TEST(RenavEnergyTest, WindowStartsOnThePathWithTheReferencesFacing) {
 
 // ---------------------------------------------------------------- the solve
 
-RenavOptions quick(RenavSolver solver, int iterations) {
+RenavOptions quick(LatentOptimizer solver, int iterations) {
   RenavOptions o = default_renav_options(solver);
   o.max_iterations = iterations;
   return o;
@@ -294,7 +294,7 @@ TEST(Renavigate, DecreasesTheEnergyAndHasThePathsLength) {
   const Motion ref = test::random_motion(model->rig().skeleton, 40, 30.0, 11);
   const auto path = line_path(50, 0.04);  // 50 frames: two windows of 32
   RenavReport report;
-  const Motion out = renavigate(*model, ref, path, 30.0, quick(RenavSolver::Lbfgs, 25), {}, &report);
+  const Motion out = renavigate(*model, ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 25), {}, &report);
   EXPECT_EQ(out.num_frames(), 50);
   EXPECT_EQ(out.fps, 30.0);
   EXPECT_TRUE(out.skeleton.same_as(ref.skeleton));
@@ -321,7 +321,7 @@ TEST(Renavigate, PlaysTheReferenceAtThePathsPace) {
   Motion ref = test::random_motion(model->rig().skeleton, 40, 30.0, 11);
   for (int f = 0; f < 40; ++f) ref.root_positions[f] = Eigen::Vector3d(0.0, 0.9, 0.02 * f);  // 0.6 m/s
   const auto path = line_path(20, 0.04);  // 1.2 m/s
-  RenavOptions o = quick(RenavSolver::Lbfgs, 5);
+  RenavOptions o = quick(LatentOptimizer::Lbfgs, 5);
   RenavReport paced, as_is;
   const Motion a = renavigate(*model, ref, path, 30.0, o, {}, &paced);
   o.match_pace = false;
@@ -349,7 +349,7 @@ TEST(Renavigate, AdamAndOtherFrameRates) {
   const Motion ref = test::random_motion(model->rig().skeleton, 30, 30.0, 12);
   // 45 points at 60 fps: 22 model frames (one window), resampled back to 45 frames at 60 fps.
   RenavReport report;
-  const Motion out = renavigate(*model, ref, line_path(45, 0.02), 60.0, quick(RenavSolver::Adam, 30), {}, &report);
+  const Motion out = renavigate(*model, ref, line_path(45, 0.02), 60.0, quick(LatentOptimizer::Adam, 30), {}, &report);
   EXPECT_EQ(out.num_frames(), 45);
   EXPECT_EQ(out.fps, 60.0);
   ASSERT_EQ(report.windows.size(), 1u);
@@ -357,7 +357,7 @@ TEST(Renavigate, AdamAndOtherFrameRates) {
   EXPECT_LE(report.windows[0].final_energy, report.windows[0].initial_energy);
   // A reference at another frame rate is resampled to the model's.
   Motion ref60 = test::random_motion(model->rig().skeleton, 40, 60.0, 13);
-  const Motion out2 = renavigate(*model, ref60, line_path(20, 0.04), 30.0, quick(RenavSolver::Lbfgs, 5));
+  const Motion out2 = renavigate(*model, ref60, line_path(20, 0.04), 30.0, quick(LatentOptimizer::Lbfgs, 5));
   EXPECT_EQ(out2.num_frames(), 20);
 }
 
@@ -368,17 +368,17 @@ TEST(Renavigate, RespectsCancelAndProgress) {
   std::atomic<int> cancel{1};
   TaskContext ctx;
   ctx.cancel = &cancel;
-  EXPECT_THROW(renavigate(*model, ref, path, 30.0, quick(RenavSolver::Lbfgs, 50), ctx), CancelledError);
+  EXPECT_THROW(renavigate(*model, ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 50), ctx), CancelledError);
   int calls = 0;
   TaskContext ctx2;
   ctx2.progress = [&](const TaskProgress& p) {
     EXPECT_EQ(p.max_iterations, 50);
     return ++calls < 4;
   };
-  EXPECT_THROW(renavigate(*model, ref, path, 30.0, quick(RenavSolver::Lbfgs, 50), ctx2), CancelledError);
+  EXPECT_THROW(renavigate(*model, ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 50), ctx2), CancelledError);
   EXPECT_EQ(calls, 4);
   calls = 0;
-  EXPECT_THROW(renavigate(*model, ref, path, 30.0, quick(RenavSolver::Adam, 50), ctx2), CancelledError);
+  EXPECT_THROW(renavigate(*model, ref, path, 30.0, quick(LatentOptimizer::Adam, 50), ctx2), CancelledError);
   EXPECT_EQ(calls, 4);
 }
 
@@ -388,8 +388,8 @@ TEST(Renavigate, Deterministic) {
   const auto path = line_path(40, 0.03);
   TaskContext ctx;
   ctx.seed = 7;
-  const Motion a = renavigate(*model, ref, path, 30.0, quick(RenavSolver::Lbfgs, 10), ctx);
-  const Motion b = renavigate(*model, ref, path, 30.0, quick(RenavSolver::Lbfgs, 10), ctx);
+  const Motion a = renavigate(*model, ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 10), ctx);
+  const Motion b = renavigate(*model, ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 10), ctx);
   for (int f = 0; f < a.num_frames(); ++f) {
     ASSERT_EQ(a.root_positions[f], b.root_positions[f]) << f;
     for (int j = 0; j < a.num_joints(); ++j) ASSERT_EQ(a.rotation(f, j).coeffs(), b.rotation(f, j).coeffs());
@@ -416,7 +416,7 @@ TEST(Renavigate, FeetInContactAreLocked) {
       if (p.first == "gmp.output.bias") p.second.narrow(0, 4, 2).fill_(10.0f);  // contact everywhere
   }
   const auto path = line_path(40, 0.01);
-  RenavOptions locked = quick(RenavSolver::Lbfgs, 10), free = locked;
+  RenavOptions locked = quick(LatentOptimizer::Lbfgs, 10), free = locked;
   free.foot_lock_ramp = -1;
   const Motion a = renavigate(model, ref, path, 30.0, locked), b = renavigate(model, ref, path, 30.0, free);
   const auto travel = [](const Motion& m, int foot) {

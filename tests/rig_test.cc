@@ -1,6 +1,6 @@
 // Rig maps, unit detection and retargeting (prior/rig/), the synthetic rigs of
 // the benchmark (bench/synthetic_rigs.h) and the model-rig adapter of the tasks
-// (tasks/model_rig.h). Motion on the model's rig: the hand-made sample walk.
+// (tasks/context/model_rig.h). Motion on the model's rig: the hand-made sample walk.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,9 +19,9 @@
 #include "prior/rig/retarget.h"
 #include "prior/rig/rig_map.h"
 #include "prior/rig/units.h"
-#include "tasks/baselines.h"
-#include "tasks/ground_level.h"
-#include "tasks/model_rig.h"
+#include "tasks/constraints/interpolation_fill.h"
+#include "tasks/context/ground_level.h"
+#include "tasks/context/model_rig.h"
 #include "tests/test_util.h"
 
 namespace mf {

@@ -1,4 +1,4 @@
-#include "tasks/soft_dtw.h"
+#include "tasks/renav/soft_dtw.h"
 
 #include <ATen/ATen.h>
 #include <ATen/Parallel.h>

@@ -1,9 +1,9 @@
-// The trajectory as a task input: the CSV reader (tasks/trajectory_csv.h), the
-// constraints file's "trajectory" member (tasks/constraint_spec.h), the rows
+// The trajectory as a task input: the CSV reader (tasks/constraints/trajectory_csv.h), the
+// constraints file's "trajectory" member (tasks/constraints/constraint_spec.h), the rows
 // the solvers follow (MotionConstraints::followed_trajectory), the window
-// problem's rows and the trajectory energy terms (tasks/energies.h), the
-// report (tasks/constraint_report.h) and the refusal of methods that cannot
-// follow a trajectory (tasks/jobs.h run_constrained).
+// problem's rows and the trajectory energy terms (tasks/latent/energies.h), the
+// report (tasks/constraints/constraint_report.h) and the refusal of methods that cannot
+// follow a trajectory (tasks/methods/jobs.h run_constrained).
 #include <ATen/ATen.h>
 #include <ATen/Parallel.h>
 #include <gtest/gtest.h>
@@ -15,11 +15,11 @@
 #include "prior/model/nemf.h"
 #include "prior/model/representation.h"
 #include "prior/motion/errors.h"
-#include "tasks/constraint_report.h"
-#include "tasks/constraint_spec.h"
-#include "tasks/energies.h"
-#include "tasks/jobs.h"
-#include "tasks/trajectory_csv.h"
+#include "tasks/constraints/constraint_report.h"
+#include "tasks/constraints/constraint_spec.h"
+#include "tasks/constraints/trajectory_csv.h"
+#include "tasks/latent/energies.h"
+#include "tasks/methods/jobs.h"
 #include "tests/test_util.h"
 
 namespace mf {

@@ -17,11 +17,11 @@
 #include "prior/inbetween/inbetweener.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
-#include "tasks/baselines.h"
-#include "tasks/inbetweener_files.h"
-#include "tasks/initializers.h"
-#include "tasks/jobs.h"
-#include "tasks/transformer_methods.h"
+#include "tasks/constraints/interpolation_fill.h"
+#include "tasks/latent/initializers.h"
+#include "tasks/methods/jobs.h"
+#include "tasks/methods/transformer_methods.h"
+#include "tasks/transformer/inbetweener_files.h"
 #include "tests/test_util.h"
 
 namespace mf {

@@ -16,11 +16,11 @@
 #include "prior/motion/bvh.h"
 #include "prior/motion/motion.h"
 #include "prior/util/threads.h"
-#include "tasks/task_context.h"
+#include "tasks/context/task_context.h"
 
 
 /// The prior, the in-betweeners by kind and the rig anatomy loaded together
-/// (tasks/task_context.h ModelSet): mf_model_load loads the in-betweeners and
+/// (tasks/context/task_context.h ModelSet): mf_model_load loads the in-betweeners and
 /// the anatomy found next to the prior's file and keeps why a file there did
 /// not load; mf_model_with_inbetweener adds one.
 struct mf_model : mf::ModelSet {};

@@ -1,4 +1,4 @@
-// mf_encoding: the prior as a codec (tasks/prior_codec.h) at the C boundary.
+// mf_encoding: the prior as a codec (tasks/latent/prior_codec.h) at the C boundary.
 #include <ATen/ATen.h>
 
 #include <cmath>
@@ -6,8 +6,8 @@
 #include "capi/src/capi_internal.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
-#include "tasks/jobs.h"
-#include "tasks/prior_codec.h"
+#include "tasks/latent/prior_codec.h"
+#include "tasks/methods/jobs.h"
 
 struct mf_encoding {
   std::shared_ptr<const mf::NemfModel> model;

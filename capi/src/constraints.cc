@@ -1,5 +1,5 @@
-// Constraints beyond whole-pose keys (tasks/constraint_spec.h) and mf_solve
-// with its alternatives and reports (tasks/jobs.h run_constrained).
+// Constraints beyond whole-pose keys (tasks/constraints/constraint_spec.h) and mf_solve
+// with its alternatives and reports (tasks/methods/jobs.h run_constrained).
 #include <cmath>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -8,9 +8,9 @@
 
 #include "capi/src/capi_internal.h"
 #include "prior/util/binary_io.h"
-#include "tasks/constraint_spec.h"
-#include "tasks/jobs.h"
-#include "tasks/trajectory_csv.h"
+#include "tasks/constraints/constraint_spec.h"
+#include "tasks/constraints/trajectory_csv.h"
+#include "tasks/methods/jobs.h"
 
 struct mf_constraints {
   mf::ConstraintSpec spec;

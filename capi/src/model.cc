@@ -18,8 +18,8 @@
 #include "prior/motion/errors.h"
 #include "prior/rig/retarget.h"
 #include "prior/util/binary_io.h"
-#include "tasks/inbetweener_files.h"
-#include "tasks/model_rig.h"
+#include "tasks/context/model_rig.h"
+#include "tasks/transformer/inbetweener_files.h"
 
 namespace mf::capi {
 namespace {

@@ -1,4 +1,4 @@
-// Re-navigation along a new ground path (tasks/renav.h) and path CSV reading.
+// Re-navigation along a new ground path (tasks/renav/renav.h) and path CSV reading.
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -7,7 +7,7 @@
 #include "capi/src/capi_internal.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
-#include "tasks/renav.h"
+#include "tasks/renav/renav.h"
 
 using mf::capi::ApiError;
 using mf::capi::guard;

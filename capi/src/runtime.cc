@@ -8,8 +8,8 @@
 #include "capi/src/capi_internal.h"
 #include "prior/motion/errors.h"
 #include "prior/util/binary_io.h"
-#include "tasks/jobs.h"
 #include "prior/util/threads.h"
+#include "tasks/methods/jobs.h"
 
 namespace mf::capi {
 namespace {

@@ -1,4 +1,4 @@
-// The tasks: in-betweening, gap filling, resampling (tasks/jobs.h by method
+// The tasks: in-betweening, gap filling, resampling (tasks/methods/jobs.h by method
 // name), and the task context every task (re-navigation too) runs in.
 #include <cmath>
 #include <filesystem>
@@ -10,7 +10,7 @@
 #include "capi/src/capi_internal.h"
 #include "prior/motion/errors.h"
 #include "prior/rig/rig_map.h"
-#include "tasks/jobs.h"
+#include "tasks/methods/jobs.h"
 
 namespace mf::capi {
 namespace {

@@ -205,7 +205,7 @@ struct InbetweenerKind {
   /// methods follow a trajectory the caller gives.
   bool reads_trajectory = false;
   /// Its methods hold planted feet with the model's contact head (foot
-  /// locking in inbetweener_fill() of tasks/inbetweener_fill.h): set where it
+  /// locking in inbetweener_fill() of tasks/transformer/inbetweener_fill.h): set where it
   /// measured better (docs/BENCHMARKS.md, "Long transitions").
   bool locks_feet = false;
 };

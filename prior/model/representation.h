@@ -84,7 +84,7 @@ at::Tensor heading_rotation(const at::Tensor& root_rotations, const Eigen::Vecto
 /// position (x, z; the positions' unit) and its facing direction (the heading's
 /// forward unit vector, forward_x = sin(yaw), forward_z = cos(yaw)), from root
 /// rotations [..., 3, 3] and root positions [..., 3] in the same frame. The
-/// row format of MotionConstraints::trajectory (tasks/motion_constraints.h).
+/// row format of MotionConstraints::trajectory (tasks/constraints/motion_constraints.h).
 at::Tensor trajectory_features(const at::Tensor& root_rotations, const at::Tensor& root_positions,
                                const Eigen::Vector3d& root_forward);
 

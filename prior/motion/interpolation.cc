@@ -10,7 +10,7 @@
 namespace mf {
 namespace {
 
-// Cheap structural checks so that a caller who skipped tasks/jobs.h gets an
+// Cheap structural checks so that a caller who skipped tasks/methods/jobs.h gets an
 // InputError instead of an out-of-bounds read.
 void check_shape(const Motion& input) {
   const size_t frames = input.root_positions.size();

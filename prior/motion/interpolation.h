@@ -9,7 +9,7 @@
 // mf::InputError on arguments that would make them read out of bounds (known
 // frames empty, unsorted or out of range; a motion whose rotation count does not
 // match its frames and joints; a non-positive fps or output frame count); the
-// user-facing validation with friendlier messages is in tasks/jobs.h.
+// user-facing validation with friendlier messages is in tasks/methods/jobs.h.
 #pragma once
 
 #include <vector>
@@ -22,7 +22,7 @@ namespace mf {
 /// mf::slerp) between the surrounding known frames a < f < b at
 /// t = (f - a) / (b - a). Frames before the first known frame copy it, frames
 /// after the last copy the last. `known` must be sorted, unique, in range and
-/// non-empty (checked by the caller, see tasks/jobs.h). Output: the input's
+/// non-empty (checked by the caller, see tasks/methods/jobs.h). Output: the input's
 /// length and fps.
 Motion interpolate_motion(const Motion& input, const std::vector<int>& known);
 
@@ -47,7 +47,7 @@ double snap_frame_position(double s);
 /// Positions within 1e-5 relative of an integer copy that input frame exactly
 /// (BVH frame times carry about six digits: 0.0333333 s must still mean 30 fps);
 /// positions past the last input frame hold it. `frames` is the output frame
-/// count (see resampled_frame_count() in tasks/jobs.h); the output's fps is
+/// count (see resampled_frame_count() in tasks/methods/jobs.h); the output's fps is
 /// `new_fps`.
 Motion resample_interpolate(const Motion& input, double new_fps, int frames);
 

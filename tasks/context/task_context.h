@@ -1,0 +1,110 @@
+// The context every task method runs in: the models it may use (the prior,
+// the in-betweeners by kind, the prior rig's anatomy), the seed, and the
+// progress callback and cancel flag of long-running methods; and the checks
+// that a request fits it (the prior is loaded, a motion is on its skeleton).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace mf {
+
+class NemfModel;
+class InbetweenModel;
+struct RigAnatomy;
+struct RigInfo;
+struct Skeleton;
+
+/// Progress of a long-running method (a solver's iterations).
+struct TaskProgress {
+  int iteration = 0;
+  int max_iterations = 0;
+  double energy = 0.0;
+  /// The window being solved (0-based) and the window count; 0 and 0 when
+  /// the method does not work window by window. TaskContext::report fills
+  /// them from the context.
+  int window = 0;
+  int window_count = 0;
+};
+
+/// Thrown when a progress callback or the cancel flag stops a method.
+class CancelledError : public std::runtime_error {
+ public:
+  CancelledError() : std::runtime_error("cancelled") {}
+};
+
+/// The models a request may use, loaded together (the C API's mf_model holds
+/// one). Immutable once loaded, shared between threads; cheap to copy.
+struct ModelSet {
+  /// The prior; required by methods with needs_model, unused by the baselines.
+  std::shared_ptr<const NemfModel> model;
+  /// The in-betweeners by kind (prior/inbetween/inbetweener.h: the product's
+  /// kinds are inbetweener_kinds()), on the prior's skeleton and frozen
+  /// (set_requires_grad(false)). The C API loads each kind's file_name next
+  /// to the prior's file (tasks/transformer/inbetweener_files.h).
+  std::map<std::string, std::shared_ptr<const InbetweenModel>> inbetweeners;
+  /// Why a kind's file next to the prior did not load (absent kinds have no
+  /// entry): the missing-model error of a method that needs it quotes it.
+  std::map<std::string, std::string> inbetweener_errors;
+  /// The anatomy of the prior's rig (prior/rig/retarget.h), needed to serve
+  /// motions on other rigs; the C API loads motionfield-rig.json next to the
+  /// prior's file. Null: only the model's own rig is served.
+  std::shared_ptr<const RigAnatomy> model_anatomy;
+  /// Why that file did not load ("" when it did or is absent).
+  std::string model_anatomy_error;
+
+  /// The in-betweener of `kind`; null when not loaded.
+  const InbetweenModel* inbetweener(const std::string& kind) const {
+    auto it = inbetweeners.find(kind);
+    return it == inbetweeners.end() ? nullptr : it->second.get();
+  }
+  /// Adds (or replaces) the in-betweener of `model`'s kind and forgets that
+  /// kind's load error.
+  void add_inbetweener(std::shared_ptr<const InbetweenModel> model);
+};
+
+/// What a method may use besides its input: the models, the caller's rig map,
+/// the seed, progress and cancel. Cheap to copy.
+struct TaskContext : ModelSet {
+  /// A rig map's JSON text ({"user joint": "model joint" or null}) that
+  /// overrides the automatic map of another rig onto the model's; empty: automatic.
+  std::string rig_map;
+  /// Where `rig_map` came from (a file name) for its error messages; may be empty.
+  std::string rig_map_source;
+  uint64_t seed = 0;
+  /// Iteration budget of iterative methods (the latent solvers, prior
+  /// resampling, re-navigation): the most iterations of the full solve per
+  /// window; 0 = each method's default.
+  int max_iterations = 0;
+  /// Called now and then by long methods; returning false cancels.
+  std::function<bool(const TaskProgress&)> progress;
+  /// Non-zero cancels (thread-safe; set from any thread).
+  const std::atomic<int>* cancel = nullptr;
+  /// The window a windowed solver is on, and how many it has (0: not
+  /// windowed): set on a copy of the context per window, passed on in reports.
+  int window = 0;
+  int window_count = 0;
+
+  /// Calls `progress` (with this context's window) and checks `cancel`;
+  /// throws CancelledError when asked to stop.
+  void report(TaskProgress p) const {
+    p.window = window;
+    p.window_count = window_count;
+    if ((cancel && cancel->load() != 0) || (progress && !progress(p))) throw CancelledError();
+  }
+};
+
+/// The prior of `ctx`; throws mf::ModelMissingError "<what> needs a model
+/// (the prior), and none is loaded" when there is none.
+const NemfModel& require_prior(const TaskContext& ctx, const std::string& what);
+
+/// Throws mf::InputError "the <whose>'s skeleton does not match the model's:
+/// ..." unless `skeleton` has the joints (names) and parents of `rig`'s.
+void check_model_skeleton(const RigInfo& rig, const Skeleton& skeleton, const std::string& whose);
+
+}  // namespace mf

@@ -1,0 +1,493 @@
+#include "tasks/latent/energies.h"
+
+#include <ATen/ATen.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "prior/model/nemf.h"
+#include "prior/motion/errors.h"
+#include "prior/motion/kinematics_torch.h"
+#include "prior/motion/rotations_torch.h"
+#include "tasks/constraints/residuals.h"
+#include "tasks/context/task_context.h"
+
+namespace mf {
+namespace {
+
+Eigen::Matrix3d rot_y(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
+
+// sum(values * mask) / count, count > 0 known by the caller.
+at::Tensor masked_mean(const at::Tensor& values, const at::Tensor& mask, double count) {
+  return (values * mask).sum() / count;
+}
+
+// Squared penalty of a residual given as its square (d2) or as a non-negative value.
+at::Tensor penalty_of_squared(const at::Tensor& d2, Penalty p) {
+  return p == Penalty::Squared ? d2 : at::sqrt(d2 + 1e-12);
+}
+at::Tensor penalty_of_angle(const at::Tensor& angle, Penalty p) {
+  return p == Penalty::Squared ? angle.square() : angle;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// Window problems
+
+int WindowProblem::num_trajectory() const {
+  return trajectory_frames.defined() ? static_cast<int>(trajectory_frames.size(0)) : 0;
+}
+int WindowProblem::num_keys() const { return key_frames.defined() ? static_cast<int>(key_frames.size(0)) : 0; }
+int WindowProblem::num_pin_steps() const { return pin_from.defined() ? static_cast<int>(pin_from.size(0)) : 0; }
+
+int WindowProblem::num_effectors() const {
+  return effector_frames.defined() ? static_cast<int>(effector_frames.size(0)) : 0;
+}
+
+namespace {
+
+// Throws unless the window fits the motion, its keys lie inside it and
+// `anchor` is a key that fixes the root.
+void check_window(const RigInfo& rig, const Motion& motion, int begin, int length, const MotionConstraints& c,
+                  int anchor) {
+  check_model_skeleton(rig, motion.skeleton, "motion");
+  if (begin < 0 || length < 2 || begin + length > motion.num_frames())
+    throw InputError("window [" + std::to_string(begin) + ", " + std::to_string(begin + length) +
+                     ") does not fit the motion (at least 2 frames)");
+  int anchor_key = -1;
+  for (size_t k = 0; k < c.keys.size(); ++k) {
+    const int f = c.keys[k].frame;
+    if (f < 0 || f >= length) throw InputError("a key lies outside its window");
+    if (f == anchor && c.key_fixes_root(k)) anchor_key = static_cast<int>(k);
+  }
+  if (anchor_key < 0) throw InputError("the window's anchor frame must be a key that fixes the root");
+}
+
+// The pose keys' targets in the canonical frame (see WindowProblem).
+void set_key_targets(const RigInfo& rig, const Motion& motion, int begin, const MotionConstraints& c,
+                     WindowProblem* p) {
+  const Skeleton& s = rig.skeleton;
+  const int J = s.num_joints(), K = static_cast<int>(c.keys.size());
+  const Eigen::Matrix3d unturn = rot_y(-p->transform.yaw);
+  const Eigen::Vector3d origin(p->transform.x, 0.0, p->transform.z);
+  p->key_frames = at::empty({K}, at::kLong);
+  p->key_rotations = at::eye(3, at::kFloat).repeat({K, J, 1, 1}).contiguous();
+  p->key_rotation_mask = at::zeros({K, J}, at::kFloat);
+  p->key_position_mask = at::zeros({K, J}, at::kFloat);
+  p->key_root = at::zeros({K, 3}, at::kFloat);
+  p->key_root_mask = at::zeros({K}, at::kFloat);
+  int64_t* kf = p->key_frames.data_ptr<int64_t>();
+  float* rot = p->key_rotations.data_ptr<float>();
+  float* rmask = p->key_rotation_mask.data_ptr<float>();
+  float* pmask = p->key_position_mask.data_ptr<float>();
+  float* root = p->key_root.data_ptr<float>();
+  float* root_mask = p->key_root_mask.data_ptr<float>();
+  std::vector<char> chain(J);
+  for (int k = 0; k < K; ++k) {
+    const PoseKey& key = c.keys[k];
+    const int f = begin + key.frame;
+    kf[k] = key.frame;
+    for (int j = 0; j < J; ++j) {
+      const bool on = c.key_has_joint(k, j);
+      chain[j] = on && (j == 0 || chain[s.parents[j]]);
+      if (j > 0 && chain[j]) pmask[k * J + j] = 1.0f;
+      if (!on) continue;
+      rmask[k * J + j] = 1.0f;
+      Eigen::Matrix3d m = motion.rotation(f, j).normalized().toRotationMatrix();
+      if (j == 0) m = unturn * m;
+      float* out = rot + (static_cast<int64_t>(k) * J + j) * 9;
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) out[a * 3 + b] = static_cast<float>(m(a, b));
+    }
+    if (key.root_position) {
+      Eigen::Vector3d x = unturn * (motion.root_positions[f] - origin);
+      for (int a = 0; a < 3; ++a) root[k * 3 + a] = static_cast<float>(x[a]);
+      root_mask[k] = 1.0f;
+    }
+  }
+  at::Tensor offsets = offsets_tensor(s);
+  p->key_positions = forward_kinematics(s.parents, offsets, p->key_rotations, at::zeros({K, 3}, at::kFloat)).positions;
+}
+
+// The end-effector targets in the canonical frame.
+void set_effector_targets(int J, int length, const MotionConstraints& c, WindowProblem* p) {
+  const Eigen::Matrix3d unturn = rot_y(-p->transform.yaw);
+  const Eigen::Vector3d origin(p->transform.x, 0.0, p->transform.z);
+  const int E = static_cast<int>(c.effectors.size());
+  p->effector_frames = at::empty({E}, at::kLong);
+  p->effector_joints = at::empty({E}, at::kLong);
+  p->effector_targets = at::empty({E, 3}, at::kFloat);
+  p->effector_weights = at::empty({E}, at::kFloat);
+  for (int e = 0; e < E; ++e) {
+    const EffectorTarget& t = c.effectors[e];
+    if (t.frame < 0 || t.frame >= length) throw InputError("an end-effector target lies outside its window");
+    if (t.joint < 0 || t.joint >= J) throw InputError("end-effector joint out of range");
+    p->effector_frames[e] = t.frame;
+    p->effector_joints[e] = t.joint;
+    Eigen::Vector3d x = unturn * (t.position - origin);
+    for (int a = 0; a < 3; ++a) p->effector_targets[e][a] = static_cast<float>(x[a]);
+    p->effector_weights[e] = static_cast<float>(t.weight);
+  }
+}
+
+// The contact pins as pairs of consecutive pinned frames (flat frame * J +
+// joint indices into the window's [T, J] positions).
+void set_contact_pins(int J, int length, const MotionConstraints& c, WindowProblem* p) {
+  std::vector<int64_t> from, to;
+  for (const ContactPin& pin : c.contacts) {
+    if (pin.joint < 0 || pin.joint >= J) throw InputError("contact joint out of range");
+    for (int f = std::max(pin.first, 0) + 1; f <= std::min(pin.last, length - 1); ++f) {
+      from.push_back(static_cast<int64_t>(f - 1) * J + pin.joint);
+      to.push_back(static_cast<int64_t>(f) * J + pin.joint);
+    }
+  }
+  p->pin_from = at::tensor(from, at::kLong);
+  p->pin_to = at::tensor(to, at::kLong);
+}
+
+// The trajectory rows the solver follows, in the canonical frame.
+void set_trajectory_targets(int length, const MotionConstraints& c, WindowProblem* p) {
+  const std::vector<TrajectoryPoint> rows = c.followed_trajectory();
+  const Eigen::Matrix3d unturn = rot_y(-p->transform.yaw);
+  const Eigen::Vector3d origin(p->transform.x, 0.0, p->transform.z);
+  const int R = static_cast<int>(rows.size());
+  p->trajectory_frames = at::empty({R}, at::kLong);
+  p->trajectory_ground = at::empty({R, 2}, at::kFloat);
+  p->trajectory_forward = at::empty({R, 2}, at::kFloat);
+  int64_t* frames = p->trajectory_frames.data_ptr<int64_t>();
+  float* ground = p->trajectory_ground.data_ptr<float>();
+  float* forward = p->trajectory_forward.data_ptr<float>();
+  for (int r = 0; r < R; ++r) {
+    const TrajectoryPoint& t = rows[r];
+    if (t.frame < 0 || t.frame >= length) throw InputError("a trajectory row lies outside its window");
+    frames[r] = t.frame;
+    const Eigen::Vector3d x = unturn * (Eigen::Vector3d(t.x, 0.0, t.z) - origin);
+    const Eigen::Vector3d f = (unturn * Eigen::Vector3d(t.forward_x, 0.0, t.forward_z)).normalized();
+    ground[r * 2] = static_cast<float>(x.x());
+    ground[r * 2 + 1] = static_cast<float>(x.z());
+    forward[r * 2] = static_cast<float>(f.x());
+    forward[r * 2 + 1] = static_cast<float>(f.z());
+  }
+}
+
+}  // namespace
+
+WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int begin, int length,
+                                  const MotionConstraints& constraints, int anchor) {
+  check_window(rig, motion, begin, length, constraints, anchor);
+  WindowProblem p;
+  p.length = length;
+  p.anchor = anchor;
+  const Eigen::Quaterniond& r = motion.rotation(begin + anchor, 0);
+  Eigen::Vector3d f = r.normalized() * rig.root_forward;
+  p.transform.yaw = (f.x() * f.x() + f.z() * f.z() < 1e-12) ? 0.0 : std::atan2(f.x(), f.z());
+  p.transform.x = motion.root_positions[begin + anchor].x();
+  p.transform.z = motion.root_positions[begin + anchor].z();
+  set_key_targets(rig, motion, begin, constraints, &p);
+  set_effector_targets(rig.num_joints(), length, constraints, &p);
+  set_contact_pins(rig.num_joints(), length, constraints, &p);
+  set_trajectory_targets(length, constraints, &p);
+  return p;
+}
+
+// ---------------------------------------------------------------------------
+// Energies
+
+namespace {
+
+// The root path of a dense decode from its GMP output, its ground position at
+// the anchor moved to the anchor key's (the canonical origin).
+at::Tensor aligned_root_path(const NemfModel& model, const WindowProblem& problem, const at::Tensor& rotations,
+                             const GmpOutput& gmp) {
+  at::Tensor path = model.root_positions(rotations, gmp);  // [1, T, 3], starts at the origin
+  at::Tensor xz_mask = at::tensor({1.0f, 0.0f, 1.0f}, path.options());
+  at::Tensor shift = path.select(1, problem.anchor) * xz_mask;  // [1, 3]
+  return path - shift.unsqueeze(1);
+}
+
+// Where each frame takes its residual from: the keys a and b around it that
+// constrain the joint (or the root position) and the smoothstep weight of b.
+struct Brackets {
+  at::Tensor a, b;  // [n] int64 key indices
+  at::Tensor s;     // [n] float
+  at::Tensor has;   // [n] float: 0 where no key constrains the joint
+};
+
+// key_frame[k] = frame of key k; on[k] = whether key k constrains the series
+// (residual_bracket() over the frames of those keys, as key indices).
+void bracket_series(const std::vector<int64_t>& key_frame, const std::vector<char>& on, int T, int64_t* a, int64_t* b,
+                    float* s, float* has, int64_t stride) {
+  std::vector<std::pair<int64_t, int64_t>> keys;  // (frame, key index)
+  for (size_t k = 0; k < on.size(); ++k) {
+    if (on[k]) keys.emplace_back(key_frame[k], static_cast<int64_t>(k));
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<int> frames;
+  for (const auto& k : keys) frames.push_back(static_cast<int>(k.first));
+  for (int f = 0; f < T; ++f) {
+    const int64_t i = static_cast<int64_t>(f) * stride;
+    if (keys.empty()) {
+      a[i] = b[i] = 0;
+      s[i] = 0.0f;
+      has[i] = 0.0f;
+      continue;
+    }
+    const ResidualBracket br = residual_bracket(f, frames, ResidualRamp::Smoothstep);
+    has[i] = 1.0f;
+    a[i] = keys[br.a].second;
+    b[i] = keys[br.b].second;
+    s[i] = static_cast<float>(br.s);
+  }
+}
+
+// Brackets of every (frame, joint) [T * J] and of the root position [T].
+void residual_brackets(const WindowProblem& p, int J, Brackets* joints, Brackets* root) {
+  const int K = p.num_keys(), T = p.length;
+  const at::Tensor key_frames = p.key_frames.contiguous();
+  const std::vector<int64_t> frames(key_frames.data_ptr<int64_t>(), key_frames.data_ptr<int64_t>() + K);
+  const at::Tensor rmask = p.key_rotation_mask.contiguous();
+  const float* m = rmask.data_ptr<float>();
+  auto alloc = [](Brackets* br, int64_t n) {
+    br->a = at::empty({n}, at::kLong);
+    br->b = at::empty({n}, at::kLong);
+    br->s = at::empty({n}, at::kFloat);
+    br->has = at::empty({n}, at::kFloat);
+  };
+  alloc(joints, static_cast<int64_t>(T) * J);
+  alloc(root, T);
+  std::vector<char> on(K);
+  for (int j = 0; j < J; ++j) {
+    for (int k = 0; k < K; ++k) on[k] = m[k * J + j] > 0;
+    bracket_series(frames, on, T, joints->a.data_ptr<int64_t>() + j, joints->b.data_ptr<int64_t>() + j,
+                   joints->s.data_ptr<float>() + j, joints->has.data_ptr<float>() + j, J);
+  }
+  const at::Tensor rootmask = p.key_root_mask.contiguous();
+  for (int k = 0; k < K; ++k) on[k] = rootmask.data_ptr<float>()[k] > 0;
+  bracket_series(frames, on, T, root->a.data_ptr<int64_t>(), root->b.data_ptr<int64_t>(), root->s.data_ptr<float>(),
+                 root->has.data_ptr<float>(), 1);
+}
+
+// The window after the known-value overwrite of complete_motion(): the
+// residual at each key, blended between keys with smoothstep weights (the same
+// rule, in float and differentiable). rotations [1, T, J, 3, 3], path [1, T, 3].
+void blend_residuals(const WindowProblem& p, const at::Tensor& rotations, const at::Tensor& path,
+                     at::Tensor* out_rotations, at::Tensor* out_path) {
+  const int K = p.num_keys(), T = p.length;
+  const int J = static_cast<int>(rotations.size(2));
+  if (K == 0) {
+    *out_rotations = rotations;
+    *out_path = path;
+    return;
+  }
+  Brackets bj, br;
+  residual_brackets(p, J, &bj, &br);
+  const at::TensorOptions opt = rotations.options();
+  at::Tensor raw_keys = rotations.squeeze(0).index_select(0, p.key_frames);  // [K, J, 3, 3]
+  at::Tensor residual = torch_rot::matrix_to_quat(
+      torch_rot::matmul3(p.key_rotations.to(opt), raw_keys.transpose(-1, -2)));  // [K, J, 4]
+  at::Tensor flat = residual.reshape({K * J, 4});
+  at::Tensor joint_index = at::arange(J, at::kLong).repeat({T});
+  at::Tensor qa = flat.index_select(0, bj.a * J + joint_index);
+  at::Tensor qb = flat.index_select(0, bj.b * J + joint_index);
+  at::Tensor q = torch_rot::quat_slerp(qa, qb, bj.s.unsqueeze(-1));  // [T * J, 4]
+  at::Tensor identity = at::tensor({1.0f, 0.0f, 0.0f, 0.0f}, opt);
+  at::Tensor has = bj.has.unsqueeze(-1);
+  q = q * has + identity * (1 - has);
+  *out_rotations = torch_rot::matmul3(torch_rot::quat_to_matrix(q).view({1, T, J, 3, 3}), rotations);
+  at::Tensor d = p.key_root - path.squeeze(0).index_select(0, p.key_frames);  // [K, 3]
+  at::Tensor s = br.s.unsqueeze(-1);
+  at::Tensor correction = (d.index_select(0, br.a) * (1 - s) + d.index_select(0, br.b) * s) * br.has.unsqueeze(-1);
+  *out_path = path + correction.unsqueeze(0);
+}
+
+}  // namespace
+
+namespace {
+
+// Which terms are active (a positive weight and something to measure) and
+// how many items each averages over.
+struct ActiveTerms {
+  double n_rot = 0, n_root_rot = 0, n_pos = 0, n_root = 0;
+  bool rot = false, root_rot = false, pos = false, root = false, eff = false, pin = false, skate = false, smooth = false;
+  bool traj = false, facing = false;
+  bool dense = false;  // a term that needs the whole window decoded
+  bool keyed = false;  // a term that needs the key frames decoded
+};
+
+ActiveTerms active_terms(const RigInfo& rig, const WindowProblem& problem, const EnergyWeights& w) {
+  const int J = rig.num_joints(), T = problem.length;
+  ActiveTerms a;
+  if (problem.num_keys() > 0) {
+    a.n_rot = problem.key_rotation_mask.narrow(1, 1, J - 1).sum().item<double>();
+    a.n_root_rot = problem.key_rotation_mask.select(1, 0).sum().item<double>();
+    a.n_pos = problem.key_position_mask.sum().item<double>();
+    a.n_root = problem.key_root_mask.sum().item<double>();
+  }
+  a.rot = w.rotation > 0 && a.n_rot > 0;
+  a.root_rot = w.root_orientation > 0 && a.n_root_rot > 0;
+  a.pos = w.position > 0 && a.n_pos > 0;
+  a.root = w.root_translation > 0 && a.n_root > 0;
+  a.eff = w.effector > 0 && problem.num_effectors() > 0;
+  a.pin = w.contact > 0 && problem.num_pin_steps() > 0;
+  a.skate = w.foot_skating > 0 && rig.num_feet() > 0 && T >= 2;
+  a.smooth = w.smoothness > 0 && T >= 3;
+  a.traj = w.trajectory > 0 && problem.num_trajectory() > 0;
+  a.facing = w.trajectory_facing > 0 && problem.num_trajectory() > 0;
+  a.dense = a.root || a.eff || a.pin || a.traj || a.facing || a.skate || a.smooth;
+  a.keyed = a.rot || a.root_rot || a.pos;
+  return a;
+}
+
+void add_term(EnergyTerms* out, const char* name, double weight, const at::Tensor& value) {
+  out->terms.emplace_back(name, value * weight);
+}
+
+// The terms at the key frames: rotation, root orientation, position.
+// key_rot [K, J, 3, 3] decoded at the key frames; key_pos [K, J, 3] their
+// joint positions with the root at the origin when already computed (else
+// undefined).
+void add_key_terms(const Skeleton& skel, const WindowProblem& problem, const EnergyWeights& w, const ActiveTerms& a,
+                   const at::Tensor& key_rot, const at::Tensor& key_pos, const at::Tensor& offsets, EnergyTerms* out) {
+  const int J = skel.num_joints(), K = problem.num_keys();
+  const at::TensorOptions opt = offsets.options();  // the codes' (evaluate_energy)
+  if (a.rot || a.root_rot) {
+    at::Tensor pen = penalty_of_angle(torch_rot::geodesic_angle(key_rot, problem.key_rotations.to(opt)), w.penalty);
+    if (a.rot) {
+      add_term(out, "rotation", w.rotation,
+               masked_mean(pen.narrow(1, 1, J - 1), problem.key_rotation_mask.narrow(1, 1, J - 1), a.n_rot));
+    }
+    if (a.root_rot) {
+      add_term(out, "root_orientation", w.root_orientation,
+               masked_mean(pen.select(1, 0), problem.key_rotation_mask.select(1, 0), a.n_root_rot));
+    }
+  }
+  if (a.pos) {
+    at::Tensor p =
+        key_pos.defined() ? key_pos : forward_kinematics(skel.parents, offsets, key_rot, at::zeros({K, 3}, opt)).positions;
+    at::Tensor d2 = (p - problem.key_positions).square().sum(-1);  // [K, J]
+    add_term(out, "position", w.position,
+             masked_mean(penalty_of_squared(d2, w.penalty), problem.key_position_mask, a.n_pos));
+  }
+}
+
+// The trajectory terms on the output motion: ground position and facing of the
+// root at the rows' frames. rotations [1, T, J, 3, 3], path [1, T, 3].
+void add_trajectory_terms(const RigInfo& rig, const WindowProblem& problem, const EnergyWeights& w,
+                          const ActiveTerms& a, const at::Tensor& rotations, const at::Tensor& path, EnergyTerms* out) {
+  const at::Tensor frames = problem.trajectory_frames;
+  const at::Tensor root = rotations.squeeze(0).index_select(0, frames).select(1, 0);  // [R, 3, 3]
+  const at::Tensor features = trajectory_features(root, path.squeeze(0).index_select(0, frames), rig.root_forward);
+  if (a.traj) {
+    at::Tensor d2 = (features.narrow(-1, 0, 2) - problem.trajectory_ground).square().sum(-1);
+    add_term(out, "trajectory", w.trajectory, penalty_of_squared(d2, w.penalty).mean());
+  }
+  if (a.facing) {
+    at::Tensor d2 = (features.narrow(-1, 2, 2) - problem.trajectory_forward).square().sum(-1);
+    add_term(out, "trajectory_facing", w.trajectory_facing, penalty_of_squared(d2, w.penalty).mean());
+  }
+}
+
+// The terms on the output motion (see EnergyWeights::on_output): effector,
+// foot skating, smoothness. rotations [1, T, J, 3, 3], path [1, T, 3];
+// positions_at_origin [1, T, J, 3] the FK of rotations with the root at the origin.
+void add_output_terms(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& w,
+                      const ActiveTerms& a, const at::Tensor& rotations, const at::Tensor& path,
+                      const at::Tensor& positions_at_origin, const GmpOutput& gmp, const at::Tensor& offsets,
+                      EnergyTerms* out) {
+  const RigInfo& rig = model.rig();
+  const int J = rig.num_joints(), T = problem.length, E = problem.num_effectors();
+  const double fps = model.config().fps;
+  at::Tensor out_rot = rotations, out_path = path;
+  const bool blended = w.on_output && problem.num_keys() > 0;
+  if (blended) blend_residuals(problem, rotations, path, &out_rot, &out_path);
+  at::Tensor pos = blended ? forward_kinematics(rig.skeleton.parents, offsets, out_rot, out_path).positions
+                           : positions_at_origin + out_path.unsqueeze(2);  // [1, T, J, 3]
+  if (a.eff) {
+    at::Tensor idx = problem.effector_frames * J + problem.effector_joints;
+    at::Tensor p = pos.reshape({T * J, 3}).index_select(0, idx);
+    at::Tensor d2 = (p - problem.effector_targets).square().sum(-1);
+    add_term(out, "effector", w.effector, (penalty_of_squared(d2, w.penalty) * problem.effector_weights).sum() / E);
+  }
+  if (a.pin) {
+    at::Tensor flat = pos.reshape({T * J, 3});
+    at::Tensor v = (flat.index_select(0, problem.pin_to) - flat.index_select(0, problem.pin_from)) * fps;
+    add_term(out, "contact", w.contact, penalty_of_squared(v.square().sum(-1), w.penalty).mean());
+  }
+  if (a.traj || a.facing) add_trajectory_terms(rig, problem, w, a, out_rot, out_path, out);
+  if (a.skate) {
+    at::Tensor feet = at::tensor(std::vector<int64_t>(rig.foot_joints.begin(), rig.foot_joints.end()), at::kLong);
+    at::Tensor fp = pos.index_select(2, feet);                             // [1, T, F, 3]
+    at::Tensor v = (fp.narrow(1, 1, T - 1) - fp.narrow(1, 0, T - 1)) * fps;  // [1, T-1, F, 3]
+    at::Tensor speed2 = v.select(-1, 0).square() + v.select(-1, 2).square();
+    at::Tensor contact = at::sigmoid(gmp.contact_logits.narrow(1, 1, T - 1)).detach();
+    add_term(out, "foot_skating", w.foot_skating, (contact * speed2).mean());
+  }
+  if (a.smooth) {
+    at::Tensor rel = pos - out_path.unsqueeze(2);
+    at::Tensor acc = (rel.narrow(1, 2, T - 2) - 2 * rel.narrow(1, 1, T - 2) + rel.narrow(1, 0, T - 2)) * (fps * fps);
+    add_term(out, "smoothness", w.smoothness, acc.square().sum(-1).mean());
+  }
+}
+
+// The terms on the whole window: root translation, then the output terms.
+// dense_rot [1, T, J, 3, 3] decoded at every frame, dense_pos [1, T, J, 3] its
+// FK with the root at the origin.
+void add_dense_terms(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& w,
+                     const ActiveTerms& a, const at::Tensor& dense_rot, const at::Tensor& dense_pos,
+                     const at::Tensor& offsets, EnergyTerms* out) {
+  GmpOutput gmp = model.predict_global_from_inputs(gmp_inputs(dense_rot, dense_pos, model.rig()));
+  at::Tensor path = aligned_root_path(model, problem, dense_rot, gmp);  // [1, T, 3]
+  if (a.root) {
+    at::Tensor d2 = (path.squeeze(0).index_select(0, problem.key_frames) - problem.key_root).square().sum(-1);
+    add_term(out, "root_translation", w.root_translation,
+             masked_mean(penalty_of_squared(d2, w.penalty), problem.key_root_mask, a.n_root));
+  }
+  if (a.eff || a.pin || a.traj || a.facing || a.skate || a.smooth) add_output_terms(model, problem, w, a, dense_rot, path, dense_pos, gmp, offsets, out);
+}
+
+}  // namespace
+
+EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& w,
+                            const at::Tensor& z_l, const at::Tensor& z_g) {
+  const RigInfo& rig = model.rig();
+  const ActiveTerms a = active_terms(rig, problem, w);
+  const at::TensorOptions opt = z_l.options();
+  EnergyTerms out;
+  // Decode the whole window when a dense term needs it (the key frames then
+  // gathered from it), else only the key frames. One FK pass of the dense
+  // decode serves the GMP's input, the key positions and the output terms.
+  const at::Tensor offsets = offsets_tensor(rig.skeleton).to(opt);
+  at::Tensor dense_rot, dense_pos, key_rot, key_pos;
+  if (a.dense) {
+    dense_rot = model.decode(at::arange(problem.length, at::kFloat), z_l, z_g);  // [1, T, J, 3, 3]
+    dense_pos = forward_kinematics(rig.skeleton.parents, offsets, dense_rot, at::zeros({1, problem.length, 3}, opt))
+                    .positions;  // [1, T, J, 3]
+    if (a.keyed) {
+      key_rot = dense_rot.index_select(1, problem.key_frames).squeeze(0);
+      key_pos = dense_pos.index_select(1, problem.key_frames).squeeze(0);
+    }
+  } else if (a.keyed) {
+    key_rot = model.decode(problem.key_frames.to(at::kFloat), z_l, z_g).squeeze(0);  // [K, J, 3, 3]
+  }
+  if (a.keyed) add_key_terms(rig.skeleton, problem, w, a, key_rot, key_pos, offsets, &out);
+  if (a.dense) add_dense_terms(model, problem, w, a, dense_rot, dense_pos, offsets, &out);
+  if (w.latent_prior > 0) add_term(&out, "latent_prior", w.latent_prior, 0.5 * (z_l.square().sum() + z_g.square().sum()));
+  out.total = at::zeros({}, opt);
+  for (const auto& t : out.terms) out.total = out.total + t.second;
+  return out;
+}
+
+DecodedWindow decode_window(const NemfModel& model, const WindowProblem& problem, const at::Tensor& z_l,
+                            const at::Tensor& z_g) {
+  at::NoGradGuard no_grad;
+  DecodedWindow d;
+  d.local_rotations = model.decode(at::arange(problem.length, at::kFloat), z_l, z_g);
+  GmpOutput gmp = model.predict_global(d.local_rotations);
+  d.root_positions = aligned_root_path(model, problem, d.local_rotations, gmp);
+  d.contacts = at::sigmoid(gmp.contact_logits);
+  return d;
+}
+
+}  // namespace mf

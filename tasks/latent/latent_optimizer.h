@@ -1,0 +1,75 @@
+// The optimiser shared by every latent-space task (tasks/latent/latent_solver.h,
+// tasks/renav/renav.h): minimises a differentiable energy of a flat latent vector
+// x = [z_l, z_g] with L-BFGS (Ceres GradientProblemSolver, gradients from
+// torch autograd) or with Adam (NeMF's reference), reporting progress through
+// the task context once per iteration so that callers can observe and cancel.
+#pragma once
+
+#include <ATen/core/Tensor.h>
+#include <string>
+
+#include "tasks/context/task_context.h"
+#include "tasks/latent/latent_energy.h"
+
+namespace mf {
+
+/// The optimiser: L-BFGS (Ceres) or Adam (NeMF's reference). The methods
+/// "nemf" and "nemf-adam" of every latent-space task choose it.
+enum class LatentOptimizer { Lbfgs, Adam };
+
+/// The optimiser and the settings of both. The options of every latent-space task
+/// embed them (LatentSolverOptions, RenavOptions derive from this struct) and
+/// set their own defaults; the values here are the latent solvers'
+/// (tasks/latent/latent_solver.h).
+struct LatentOptimizerSettings {
+  LatentOptimizer optimizer = LatentOptimizer::Lbfgs;
+  /// Iteration cap. minimize_latent() runs at most this many iterations; in a
+  /// task's options 0 means the task's default cap.
+  int max_iterations = 0;
+  // L-BFGS (Ceres GradientProblemSolver semantics).
+  int lbfgs_rank = 20;               ///< memory of the Hessian approximation
+  /// Ceres' use_approximate_eigenvalue_bfgs_scaling: scales the initial
+  /// inverse Hessian (helps when the energy's scale is far from 1).
+  bool lbfgs_eigenvalue_scaling = false;
+  double function_tolerance = 1e-3;  ///< stop when |delta f| / f falls below this
+  double gradient_tolerance = 1e-8;  ///< ... or max |gradient| relative to the initial one below this
+  double parameter_tolerance = 1e-6; ///< ... or the step relative to |x| below this
+  // Adam (NeMF's reference): learning rate times `adam_decay` every
+  // `adam_decay_every` iterations; stops when the best energy improved by
+  // less than `adam_tolerance` (relative) over `adam_patience` iterations.
+  // The best x seen is returned.
+  double adam_lr = 0.1;
+  int adam_decay_every = 200;
+  double adam_decay = 0.7;
+  double adam_tolerance = 1e-4;
+  int adam_patience = 100;
+
+  /// Empty when valid, else what is wrong, each problem followed by "; ".
+  std::string validate() const;
+  /// These settings alone (without a task's other options), with the cap
+  /// `max_iterations`.
+  LatentOptimizerSettings capped(int max_iterations) const {
+    LatentOptimizerSettings s = *this;
+    s.max_iterations = max_iterations;
+    return s;
+  }
+};
+
+struct LatentOptimizerStats {
+  int iterations = 0;
+  int evaluations = 0;       ///< energy evaluations (with or without gradient)
+  bool converged = false;    ///< stopped by a tolerance, not by the iteration cap
+  std::string message;       ///< the stop reason
+};
+
+/// Minimises `energy` from x0 ([n] float) with settings.optimizer, at most
+/// settings.max_iterations iterations; returns the solution ([n] float).
+/// Progress reports carry iteration = `iteration_offset` + this run's
+/// iteration and max_iterations = `iteration_total` (0: this run's cap).
+/// Throws CancelledError when the context asks to stop, mf::InputError for
+/// invalid settings, and rethrows any exception raised by the energy.
+at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
+                           const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset = 0,
+                           int iteration_total = 0);
+
+}  // namespace mf

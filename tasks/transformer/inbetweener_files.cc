@@ -1,0 +1,70 @@
+#include "tasks/transformer/inbetweener_files.h"
+
+#include <filesystem>
+
+#include "prior/inbetween/inbetweener.h"
+#include "prior/model/nemf.h"
+#include "prior/motion/errors.h"
+
+namespace mf {
+
+std::string inbetweener_file_name(const std::string& kind) { return inbetweener_kind(kind).file_name; }
+
+std::string inbetweener_title(const std::string& kind) {
+  const InbetweenerKind* k = find_inbetweener_kind(kind);
+  return k ? k->title : kind;
+}
+
+std::string inbetweener_path_next_to(const std::string& prior_path, const std::string& kind) {
+  return (std::filesystem::path(prior_path).parent_path() / inbetweener_file_name(kind)).string();
+}
+
+std::shared_ptr<const InbetweenModel> frozen_inbetweener(std::unique_ptr<InbetweenModel> model,
+                                                         const std::string& source, const std::string& kind,
+                                                         const NemfModel* prior) {
+  if (!kind.empty() && model->kind() != kind)
+    throw InputError(source + " holds a '" + model->kind() + "' model, not the expected '" + kind + "'");
+  if (prior && !model->rig().skeleton.same_as(prior->rig().skeleton))
+    throw InputError(source + ": the " + inbetweener_title(model->kind()) + "'s skeleton (" +
+                     std::to_string(model->rig().num_joints()) + " joints) is not the prior's (" +
+                     std::to_string(prior->rig().num_joints()) + " joints): train it on the prior's data");
+  model->set_requires_grad(false);
+  model->train(false);
+  return std::shared_ptr<const InbetweenModel>(std::move(model));
+}
+
+std::shared_ptr<const InbetweenModel> load_frozen_inbetweener(const std::string& path, const std::string& kind,
+                                                              const NemfModel* prior) {
+  return frozen_inbetweener(load_inbetweener(path), path, kind, prior);
+}
+
+void load_inbetweeners_next_to(const std::string& prior_path, ModelSet* models) {
+  for (const InbetweenerKind& kind : inbetweener_kinds()) {
+    const std::string file = inbetweener_path_next_to(prior_path, kind.name);
+    std::error_code ec;
+    if (!std::filesystem::exists(file, ec)) continue;
+    try {
+      models->add_inbetweener(load_frozen_inbetweener(file, kind.name, models->model.get()));
+    } catch (const std::exception& e) {
+      models->inbetweener_errors[kind.name] = e.what();
+    }
+  }
+}
+
+std::string missing_inbetweener_message(const std::string& what, const std::string& kind) {
+  const InbetweenerKind* k = find_inbetweener_kind(kind);
+  const std::string file = k ? "models/" + k->file_name : "a '" + kind + "' in-betweener";
+  return what + " needs " + file + " (the " + inbetweener_title(kind) +
+         "), and it is not loaded: put it next to the prior's model file";
+}
+
+const InbetweenModel& require_inbetweener(const ModelSet& models, const std::string& kind, const std::string& what) {
+  if (const InbetweenModel* model = models.inbetweener(kind)) return *model;
+  std::string message = missing_inbetweener_message(what, kind);
+  auto why = models.inbetweener_errors.find(kind);
+  if (why != models.inbetweener_errors.end())
+    message += "; the file next to the prior did not load: " + why->second;
+  throw ModelMissingError(message);
+}
+
+}  // namespace mf

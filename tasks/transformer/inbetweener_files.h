@@ -1,0 +1,54 @@
+// The in-betweeners' model files (prior/inbetween/inbetweener.h): where each
+// kind's file is looked for (next to the prior's model file), loading one
+// ready to be shared between threads, and the error of a method whose
+// in-betweener is not loaded.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "tasks/context/task_context.h"
+
+namespace mf {
+
+class InbetweenModel;
+
+/// The file name of the product kind `kind` (InbetweenerKind::file_name);
+/// InputError listing the kinds otherwise.
+std::string inbetweener_file_name(const std::string& kind);
+
+/// What an in-betweener of `kind` is called in messages (InbetweenerKind::title;
+/// `kind` itself for a kind that is not the product's).
+std::string inbetweener_title(const std::string& kind);
+
+/// Where the in-betweener of `kind` is looked for next to the prior file
+/// `prior_path`: the same directory, inbetweener_file_name(kind).
+std::string inbetweener_path_next_to(const std::string& prior_path, const std::string& kind);
+
+/// Makes a loaded model ready to be shared between threads: checks that it is
+/// of `kind` (unless empty) and on the skeleton of `prior` (unless null), then
+/// freezes it (evaluation mode, no gradients). InputError naming `source`
+/// otherwise.
+std::shared_ptr<const InbetweenModel> frozen_inbetweener(std::unique_ptr<InbetweenModel> model,
+                                                         const std::string& source, const std::string& kind,
+                                                         const NemfModel* prior = nullptr);
+
+/// load_inbetweener(path), then frozen_inbetweener.
+std::shared_ptr<const InbetweenModel> load_frozen_inbetweener(const std::string& path, const std::string& kind,
+                                                              const NemfModel* prior = nullptr);
+
+/// Loads the file of every product kind that exists next to `prior_path` into
+/// `models` (whose prior must be set); a file that does not load is recorded
+/// in models->inbetweener_errors, so the prior alone stays usable.
+void load_inbetweeners_next_to(const std::string& prior_path, ModelSet* models);
+
+/// The error of a method or initialiser (`what`, e.g. "method 'citl'") whose
+/// in-betweener of `kind` is not loaded: names the file it needs.
+std::string missing_inbetweener_message(const std::string& what, const std::string& kind);
+
+/// The in-betweener of `kind` in `models`; throws mf::ModelMissingError with
+/// missing_inbetweener_message(what, kind), and why its file did not load
+/// when it did not, when it is not loaded.
+const InbetweenModel& require_inbetweener(const ModelSet& models, const std::string& kind, const std::string& what);
+
+}  // namespace mf

@@ -1,0 +1,302 @@
+#include "tasks/transformer/inbetweener_fill.h"
+
+#include <ATen/ATen.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "prior/inbetween/inbetweener.h"
+#include "prior/inbetween/keyframe_net.h"
+#include "prior/model/representation.h"
+#include "prior/motion/errors.h"
+#include "prior/motion/rotations.h"
+#include "tasks/constraints/interpolation_fill.h"
+#include "tasks/constraints/residuals.h"
+#include "tasks/fixups/foot_locking.h"
+#include "tasks/transformer/inbetweener_files.h"
+
+namespace mf {
+namespace {
+
+// Context before a gap, as in training: up to 10 known frames, or the
+// previous key when the keys are sparse (training spaces keys up to 40 apart).
+constexpr int kDenseContext = 10;
+constexpr int kSparseContext = 40;
+
+struct FillWindow {
+  int start = 0;       // a key fixing the root; the canonical frame
+  int owned_from = 0;  // frames (owned_from, end] are this window's output
+  int end = 0;         // a key fixing the root
+};
+
+// The keys of a motion by frame.
+struct KeyIndex {
+  std::vector<int> key_of;  // per frame, the index of its key or -1
+  std::vector<int> roots;   // frames of the keys that fix the root, increasing
+};
+
+KeyIndex index_keys(const MotionConstraints& c, int frames) {
+  KeyIndex index;
+  index.key_of.assign(frames, -1);
+  for (size_t k = 0; k < c.keys.size(); ++k) {
+    index.key_of[c.keys[k].frame] = static_cast<int>(k);
+    if (c.key_fixes_root(k)) index.roots.push_back(c.keys[k].frame);
+  }
+  return index;
+}
+
+// Validates the call; returns the stage whose output is used.
+int checked_stage(const InbetweenModel& model, int stage, const Motion& input, const MotionConstraints& c) {
+  const int J = input.num_joints();
+  const RigInfo& rig = model.rig();
+  if (J != rig.num_joints())
+    throw InputError("the motion has " + std::to_string(J) + " joints but the " + inbetweener_title(model.kind()) +
+                     "'s skeleton has " + std::to_string(rig.num_joints()));
+  c.validate(input.num_frames(), J);
+  const int stages = static_cast<int>(model.stage_names().size());
+  const int used_stage = stage < 0 ? stages - 1 : stage;
+  if (used_stage < 0 || used_stage >= stages)
+    throw InputError("the " + inbetweener_title(model.kind()) + " has " + std::to_string(stages) +
+                     " stage(s), not stage " + std::to_string(stage));
+  return used_stage;
+}
+
+// The windows that fill the gaps between the root-fixing keys `roots` (see
+// the header): each starts at a key with its context before the gap and
+// extends over as many gaps as fit in `W` frames.
+std::vector<FillWindow> plan_windows(const std::vector<int>& roots, int W, LongGapPolicy policy,
+                                     const std::string& title) {
+  const int R = static_cast<int>(roots.size());
+  std::vector<FillWindow> windows;
+  for (int i = 0; i + 1 < R;) {
+    if (roots[i + 1] - roots[i] <= 1) {
+      ++i;
+      continue;
+    }
+    if (roots[i + 1] - roots[i] + 1 > W) {
+      if (policy == LongGapPolicy::Throw) {
+        throw InputError("keys " + std::to_string(roots[i]) + " and " + std::to_string(roots[i + 1]) + " are " +
+                         std::to_string(roots[i + 1] - roots[i]) + " frames apart, but the " + title +
+                         " fills gaps of at most " + std::to_string(W - 2) + " frames (its window holds " +
+                         std::to_string(W) + "): add a key in between or use a latent solver method such as 'nemf'");
+      }
+      ++i;
+      continue;
+    }
+    const auto fits = [&](int p) { return roots[i + 1] - roots[p] + 1 <= W; };
+    int p = i;
+    while (p > 0 && roots[p - 1] >= roots[i] - (kDenseContext - 1) && fits(p - 1)) --p;
+    if (p == i && i > 0 && roots[i] - roots[i - 1] <= kSparseContext && fits(i - 1)) p = i - 1;
+    int q = i + 1;
+    while (q + 1 < R && roots[q + 1] - roots[p] + 1 <= W) ++q;
+    windows.push_back({roots[p], roots[i], roots[q]});
+    i = q;
+  }
+  return windows;
+}
+
+// The model's input for `windows` of `filled` (one batch padded to the longest
+// window, each canonical at its start) and each window's canonical transform.
+struct FillBatch {
+  InbetweenBatch batch;
+  std::vector<GroundTransform> transforms;
+};
+
+FillBatch make_batch(const InbetweenModel& model, const Motion& filled, const std::vector<FillWindow>& windows,
+                     const KeyIndex& keys, const MotionConstraints& c, const at::Tensor& world_trajectory) {
+  const RigInfo& rig = model.rig();
+  const int J = filled.num_joints();
+  const int B = static_cast<int>(windows.size());
+  int L = 0;
+  for (const FillWindow& w : windows) L = std::max(L, w.end - w.start + 1);
+  at::Tensor pose = at::zeros({B, L, model.pose_size()}, at::kFloat);
+  at::Tensor known = at::zeros({B, L, J + 1}, at::kFloat);
+  at::Tensor valid = at::zeros({B, L}, at::kFloat);
+  FillBatch out;
+  auto kn = known.accessor<float, 3>();
+  auto va = valid.accessor<float, 2>();
+  for (int b = 0; b < B; ++b) {
+    const FillWindow& w = windows[b];
+    const int T = w.end - w.start + 1;
+    out.transforms.push_back(canonical_transform(filled, w.start, rig));
+    const WindowTensors wt = window_tensors(filled, w.start, T, rig, 0);
+    pose.select(0, b).narrow(0, 0, T).copy_(pose_features(wt.local_rotations, wt.root_positions)[0]);
+    for (int t = 0; t < T; ++t) {
+      va[b][t] = 1.0f;
+      const int k = keys.key_of[w.start + t];
+      if (k < 0) continue;
+      for (int j = 0; j < J; ++j) kn[b][t][j] = c.key_has_joint(static_cast<size_t>(k), j) ? 1.0f : 0.0f;
+      kn[b][t][J] = c.keys[static_cast<size_t>(k)].root_position ? 1.0f : 0.0f;
+    }
+  }
+  out.batch = InbetweenBatch{pose * known_channel_mask(known, J), known, valid};
+  if (world_trajectory.defined()) {
+    std::vector<at::Tensor> rows;
+    for (int b = 0; b < B; ++b) {
+      const FillWindow& w = windows[b];
+      at::Tensor r = canonical_trajectory(world_trajectory.narrow(0, w.start, w.end - w.start + 1), out.transforms[b]);
+      rows.push_back(at::cat({r, r.narrow(0, r.size(0) - 1, 1).expand({L - r.size(0), 4})}, 0));  // padding: held
+    }
+    out.batch.trajectory = at::stack(rows);
+  }
+  return out;
+}
+
+// The residual at key frame f of `piece` (window frames from `start`): per
+// joint given * piece^-1 where the key gives the joint (else the identity),
+// and the root position's difference.
+void key_residual(const Motion& input, const MotionConstraints& c, const KeyIndex& keys, const Motion& piece,
+                  int start, int f, std::vector<Eigen::Quaterniond>* rotation, Eigen::Vector3d* root) {
+  const size_t k = static_cast<size_t>(keys.key_of[f]);
+  for (int j = 0; j < input.num_joints(); ++j) {
+    (*rotation)[j] = c.key_has_joint(k, j)
+                         ? Eigen::Quaterniond(input.rotation(f, j).normalized() * piece.rotation(f - start, j).conjugate())
+                         : Eigen::Quaterniond::Identity();
+  }
+  *root = input.root_positions[f] - piece.root_positions[f - start];
+}
+
+// Spreads the model's residual at the keys that bound each gap of window `w`
+// over the gap (see the header), so that the output does not jump next to a key.
+void spread_gap_residuals(const Motion& input, const MotionConstraints& c, const KeyIndex& keys, const FillWindow& w,
+                          Motion* piece) {
+  const int J = input.num_joints();
+  std::vector<int> bounds;
+  for (int f = w.owned_from; f <= w.end; ++f) {
+    const int k = keys.key_of[f];
+    if (k >= 0 && c.key_fixes_root(static_cast<size_t>(k))) bounds.push_back(f);
+  }
+  std::vector<Eigen::Quaterniond> residual_a(J), residual_b(J);
+  for (size_t i = 0; i + 1 < bounds.size(); ++i) {
+    const int a = bounds[i], b = bounds[i + 1];
+    if (b - a < 2) continue;
+    Eigen::Vector3d root_a, root_b;
+    key_residual(input, c, keys, *piece, w.start, a, &residual_a, &root_a);
+    key_residual(input, c, keys, *piece, w.start, b, &residual_b, &root_b);
+    for (int f = a + 1; f < b; ++f) {
+      const double s = smoothstep(static_cast<double>(f - a) / (b - a));
+      for (int j = 0; j < J; ++j) {
+        Eigen::Quaterniond& q = piece->rotation(f - w.start, j);
+        q = (slerp(Eigen::Quaterniond::Identity(), residual_a[j], 1.0 - s) *
+             slerp(Eigen::Quaterniond::Identity(), residual_b[j], s) * q)
+                .normalized();
+      }
+      piece->root_positions[f - w.start] += root_a * (1.0 - s) + root_b * s;
+    }
+  }
+}
+
+// The window's output: the unconstrained values of its frames (owned_from, end].
+void take_owned_frames(const Motion& piece, const FillWindow& w, const KeyIndex& keys, const MotionConstraints& c,
+                       Motion* out) {
+  for (int f = w.owned_from + 1; f <= w.end; ++f) {
+    const int k = keys.key_of[f];
+    for (int j = 0; j < out->num_joints(); ++j) {
+      if (k < 0 || !c.key_has_joint(static_cast<size_t>(k), j)) out->rotation(f, j) = piece.rotation(f - w.start, j);
+    }
+    if (k < 0 || !c.keys[static_cast<size_t>(k)].root_position)
+      out->root_positions[f] = piece.root_positions[f - w.start];
+  }
+}
+
+// Constrained values exactly as given.
+void copy_constrained(const Motion& input, const MotionConstraints& c, Motion* out) {
+  for (size_t k = 0; k < c.keys.size(); ++k) {
+    const PoseKey& key = c.keys[k];
+    for (int j = 0; j < input.num_joints(); ++j) {
+      if (c.key_has_joint(k, j)) out->rotation(key.frame, j) = input.rotation(key.frame, j);
+    }
+    if (key.root_position) out->root_positions[key.frame] = input.root_positions[key.frame];
+  }
+}
+
+}  // namespace
+
+at::Tensor constrained_trajectory(const Motion& input, const MotionConstraints& c, const RigInfo& rig) {
+  if (c.trajectory.empty()) return at::Tensor();
+  const int n = input.num_frames();
+  at::Tensor rows = at::zeros({1, n, 4}, at::kFloat);
+  at::Tensor xz_known = at::zeros({1, n}, at::kBool), facing_known = at::zeros({1, n}, at::kBool);
+  for (const TrajectoryPoint& p : c.trajectory) {
+    rows[0][p.frame] = at::tensor({p.x, p.z, p.forward_x, p.forward_z}, at::kDouble).to(at::kFloat);
+    xz_known[0][p.frame] = true;
+    facing_known[0][p.frame] = true;
+  }
+  for (size_t k = 0; k < c.keys.size(); ++k) {
+    const int f = c.keys[k].frame;
+    at::Tensor r = at::empty({3, 3}, at::kFloat), pos = at::empty({3}, at::kFloat);
+    const Eigen::Matrix3d m = input.rotation(f, 0).normalized().toRotationMatrix();
+    for (int a = 0; a < 3; ++a) {
+      pos[a] = input.root_positions[f][a];
+      for (int b = 0; b < 3; ++b) r[a][b] = m(a, b);
+    }
+    at::Tensor own = trajectory_features(r, pos, rig.root_forward);  // [4]
+    if (c.keys[k].root_position) {
+      rows[0][f].narrow(0, 0, 2).copy_(own.narrow(0, 0, 2));
+      xz_known[0][f] = true;
+    }
+    if (c.key_has_joint(k, 0)) {
+      rows[0][f].narrow(0, 2, 2).copy_(own.narrow(0, 2, 2));
+      facing_known[0][f] = true;
+    }
+  }
+  return interpolate_trajectory_rows(rows, xz_known, facing_known)[0];
+}
+
+at::Tensor canonical_trajectory(const at::Tensor& world, const GroundTransform& transform) {
+  if (world.dim() < 1 || world.size(-1) != 4) throw InputError("canonical_trajectory: rows must be [..., 4]");
+  const double c = std::cos(transform.yaw), s = std::sin(transform.yaw);
+  at::Tensor x = world.select(-1, 0) - transform.x, z = world.select(-1, 1) - transform.z;
+  at::Tensor fx = world.select(-1, 2), fz = world.select(-1, 3);
+  return at::stack({c * x - s * z, s * x + c * z, c * fx - s * fz, s * fx + c * fz}, -1);
+}
+
+Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
+                        const MotionConstraints& constraints, LongGapPolicy policy, bool foot_lock) {
+  const int used_stage = checked_stage(model, stage, input, constraints);
+  // Reads only the constrained values; every frame holds something sensible.
+  Motion out = fill_by_interpolation(input, constraints);
+  std::vector<float> contacts;  // [frames, feet] when the feet are locked
+  const KeyIndex keys = index_keys(constraints, input.num_frames());
+  const std::vector<FillWindow> windows =
+      plan_windows(keys.roots, model.window(), policy, inbetweener_title(model.kind()));
+  if (!windows.empty()) {
+    at::NoGradGuard no_grad;
+    const FillBatch fill =
+        make_batch(model, out, windows, keys, constraints, constrained_trajectory(input, constraints, model.rig()));
+    const InbetweenOutput result = model.forward(fill.batch);
+    if (used_stage >= static_cast<int>(result.stages.size()))
+      throw std::logic_error("the in-betweener returned fewer stages than stage_names() lists");
+    const at::Tensor stage_pose = result.stages[static_cast<size_t>(used_stage)].detach().to(at::kFloat).contiguous();
+    // The contact head reads the last stage: its contacts hold for that stage's pose only.
+    const bool lock = foot_lock && result.contact_logits.defined() &&
+                      used_stage == static_cast<int>(result.stages.size()) - 1;
+    const int feet = model.rig().num_feet();
+    const at::Tensor contact =
+        lock ? at::sigmoid(result.contact_logits.detach().to(at::kFloat)).contiguous() : at::Tensor();
+    if (lock) contacts.assign(static_cast<size_t>(input.num_frames()) * feet, 0.0f);
+    for (size_t b = 0; b < windows.size(); ++b) {
+      const FillWindow& w = windows[b];
+      const int T = w.end - w.start + 1;
+      at::Tensor rotations, root;
+      split_pose_features(stage_pose.narrow(0, static_cast<int64_t>(b), 1).narrow(1, 0, T), input.num_joints(),
+                          &rotations, &root);
+      Motion piece = Motion::identity(input.skeleton, T, input.fps);
+      write_window(rotations, root, fill.transforms[b], &piece, 0);
+      spread_gap_residuals(input, constraints, keys, w, &piece);
+      take_owned_frames(piece, w, keys, constraints, &out);
+      if (!lock) continue;
+      const auto c = contact.accessor<float, 3>();
+      for (int f = w.owned_from + 1; f <= w.end; ++f)
+        for (int k = 0; k < feet; ++k) contacts[static_cast<size_t>(f) * feet + k] = c[b][f - w.start][k];
+    }
+  }
+  copy_constrained(input, constraints, &out);
+  if (!contacts.empty()) lock_feet(model.rig(), constraints, contacts, kFootLockRamp, &out);
+  return out;
+}
+
+}  // namespace mf
