@@ -78,6 +78,8 @@ def _path(p: str) -> bytes:
 class CheckedJob:
     """One line parsed and its files checked by a JobRunner (check_line)."""
 
+    _destroy = _c.mf_job_destroy  # kept by the class: module globals are gone at interpreter exit
+
     def __init__(self, handle) -> None:  # type: ignore[no-untyped-def]
         self._handle = handle
 
@@ -93,7 +95,7 @@ class CheckedJob:
 
     def __del__(self) -> None:
         if getattr(self, "_handle", None):
-            _c.mf_job_destroy(self._handle)
+            type(self)._destroy(self._handle)
             self._handle = None
 
 
@@ -123,6 +125,8 @@ class JobRunner:
         When `model` does not load, or `units` is no unit.
     """
 
+    _destroy = _c.mf_job_runner_destroy
+
     def __init__(self, threads: int = 1, model: str = "", inbetweeners: Sequence[str] = (), rig_map: str = "",
                  units: str = "", verbose: bool = False, quiet: bool = False, preload_model: bool = False) -> None:
         o = _c.MfJobRunnerOptions()
@@ -142,7 +146,7 @@ class JobRunner:
 
     def __del__(self) -> None:
         if getattr(self, "_handle", None):
-            _c.mf_job_runner_destroy(self._handle)
+            type(self)._destroy(self._handle)
             self._handle = None
 
     def check_line(self, text: bytes, line: int, batch_path: str) -> CheckedJob:
