@@ -71,6 +71,26 @@ std::vector<Outcome> check_lines(const std::vector<std::string>& lines, const st
   return outcomes;
 }
 
+// Prints the batch's last line (on failures, with --verbose, or after a
+// progress line) and returns its exit code: 1 if a job hit an internal error,
+// else 2 if one had bad input, else 0.
+int summary(const std::string& path, const std::vector<Outcome>& outcomes, const Settings& settings,
+            bool progress_shown) {
+  const int total = static_cast<int>(outcomes.size());
+  int bad = 0, internal = 0;
+  for (const Outcome& o : outcomes)
+    if (o.result.exit_code != kExitOk) ++(o.result.exit_code == kExitBadInput ? bad : internal);
+  const int failed = bad + internal;
+  if (failed > 0 || settings.verbose || (progress_shown && !settings.quiet))
+    std::fprintf(stderr, "motionfield: %s\n",
+                 printable("batch " + path + ": " + std::to_string(total) + " jobs, " + std::to_string(total - failed) +
+                           " ok, " + std::to_string(failed) + " failed")
+                     .c_str());
+  if (internal > 0) return kExitInternal;
+  if (bad > 0) return kExitBadInput;
+  return kExitOk;
+}
+
 }  // namespace
 
 int command_batch(const std::string& path, const Settings& settings) {
@@ -130,18 +150,7 @@ int command_batch(const std::string& path, const Settings& settings) {
   }
   progress.clear();
 
-  int bad = 0, internal = 0;
-  for (const Outcome& o : outcomes)
-    if (o.result.exit_code != kExitOk) ++(o.result.exit_code == kExitBadInput ? bad : internal);
-  const int failed = bad + internal;
-  if (failed > 0 || settings.verbose || (progress.enabled() && !settings.quiet))
-    std::fprintf(stderr, "motionfield: %s\n",
-                 printable("batch " + path + ": " + std::to_string(total) + " jobs, " + std::to_string(total - failed) +
-                           " ok, " + std::to_string(failed) + " failed")
-                     .c_str());
-  if (internal > 0) return kExitInternal;
-  if (bad > 0) return kExitBadInput;
-  return kExitOk;
+  return summary(path, outcomes, settings, progress.enabled());
 }
 
 }  // namespace motionfield::cli
