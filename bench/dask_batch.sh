@@ -13,7 +13,7 @@ set -euo pipefail
 SRC=$(cd "$(dirname "$0")/.." && pwd)
 BUILD=$(cd "${1:-$SRC/build}" && pwd)
 N=${2:-16}
-MF="$BUILD/capi/motionfield"
+MF="$BUILD/cli/motionfield"
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/mf-dask-bench.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT
 
@@ -57,7 +57,7 @@ run() {
   fi
   awk -v n="$N" -v one="$one" -v all="$all" -v what="$* JOBS.jsonl" \
     'BEGIN { printf "| `%s` | %d | %.1f | %.2f | %.1f | %.2f |\n", what, n, all, n / all, one, (n - 1) / (all - one) }' |
-    sed "s|$BUILD/capi/||; s|/usr/bin/||"
+    sed "s|$BUILD/capi/||; s|$BUILD/cli/||; s|/usr/bin/||"
 }
 
 echo "| command | jobs | wall (s) | jobs/s | 1 job alone (s) | jobs/s after the first |"

@@ -1,6 +1,5 @@
 #include "bench/options.h"
 
-#include <filesystem>
 #include <iostream>
 
 #include "prior/inbetween/inbetweener.h"
@@ -21,15 +20,10 @@ void add_transformer_options(CLI::App& app, TransformerFiles& files) {
 }
 
 void load_transformers(const TransformerFiles& files, const std::string& model_path, ModelSet* models, bool verbose) {
-  for (const InbetweenerKind& kind : inbetweener_kinds()) {
-    auto given = files.by_kind.find(kind.name);
-    const bool named = given != files.by_kind.end() && !given->second.empty();
-    const std::string path = named ? given->second : inbetweener_path_next_to(model_path, kind.name);
-    std::error_code ec;
-    if (!named && !std::filesystem::exists(path, ec)) continue;
-    if (verbose) std::cerr << "loading " << kind.title << " " << path << "\n";
-    models->add_inbetweener(load_frozen_inbetweener(path, kind.name, models->model.get()));
-  }
+  InbetweenerLog log;
+  if (verbose)
+    log = [](const std::string& title, const std::string& path) { std::cerr << "loading " << title << " " << path << "\n"; };
+  load_inbetweeners(model_path, files.by_kind, true, models, log);
 }
 
 void add_data_options(CLI::App& app, DataSource& data) {

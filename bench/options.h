@@ -26,7 +26,9 @@ struct TransformerFiles {
 };
 void add_transformer_options(CLI::App& app, TransformerFiles& files);
 /// Loads the in-betweeners of `files` (or next to `model_path`) into `models`
-/// (checked against its prior's skeleton when it has one), logging each file to stderr when `verbose`.
+/// (checked against its prior's skeleton when it has one) with the model-set
+/// loader (tasks/transformer/inbetweener_files.h load_inbetweeners, strict: a file that
+/// does not load is an error), logging each file to stderr when `verbose`.
 void load_transformers(const TransformerFiles& files, const std::string& model_path, ModelSet* models, bool verbose);
 
 /// --source PATH, --cache-dir DIR: the clips (a BVH folder or archive) and the

@@ -14,7 +14,7 @@ if [ $# -ne 2 ]; then
   exit 2
 fi
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-MF="$1/capi/motionfield"
+MF="$1/cli/motionfield"
 OUT="$2"
 SAMPLE="$ROOT/samples/walk_keyframes.bvh"
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # End-to-end tests of the motionfield CLI on the bundled sample.
-#   usage: bash tests/cli_test.sh <path-to-motionfield> <source-dir> <path-to-mf_bvh_diff>
+#   usage: bash tests/cli_test.sh <path-to-motionfield> <source-dir> <path-to-mf_bvh_diff> [<path-to-mf_capi_tiny_model>]
 # Checks frame counts and frame times of every subcommand's output, that known
 # frames come back unchanged (with the test tool mf_bvh_diff, tests/tools), the
 # exit code 2 of every kind of bad input, and batch mode.
@@ -9,6 +9,8 @@ set -u
 MF=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
 SRC=$(cd "$2" && pwd)
 DIFF=$(cd "$(dirname "$3")" && pwd)/$(basename "$3")
+# The writer of tiny test models (capi/): CTest passes it.
+HELPER=${4:-$(dirname "$MF")/mf_capi_tiny_model}
 SAMPLE="$SRC/samples/walk_keyframes.bvh"
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/mf-cli-test.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT
@@ -218,8 +220,8 @@ MF_MODEL="$TMP/none.mfm" expect_rc 0 "baselines ignore the default model" -- \
 expect_rc 0 "renav --help" -- "$MF" renav --help
 grep -q "usage: motionfield renav" "$TMP/out" && pass || fail "renav --help prints its usage"
 TINY=${MF_TEST_MODEL:-}
-if [ -z "$TINY" ] && [ -x "$(dirname "$MF")/mf_capi_tiny_model" ]; then
-  "$(dirname "$MF")/mf_capi_tiny_model" "$TMP/tiny.mfm" && TINY="$TMP/tiny.mfm"
+if [ -z "$TINY" ] && [ -x "$HELPER" ]; then
+  "$HELPER" "$TMP/tiny.mfm" && TINY="$TMP/tiny.mfm"
 fi
 SMALL="$TMP/small.bvh"
 awk 'BEGIN {
@@ -321,7 +323,6 @@ MF_MODEL="$TMP/none.mfm" bad "renav without a model" renav --in "$SMALL" --path 
 # ------------------------------------------------------------ transformer methods
 # Tiny random transformers next to a tiny prior (mf_capi_tiny_model --transformers),
 # so no trained file is needed; a missing helper is a failure (CTest builds it).
-HELPER="$(dirname "$MF")/mf_capi_tiny_model"
 if [ -x "$HELPER" ] && mkdir -p "$TMP/tr" "$TMP/notr" && "$HELPER" "$TMP/tr/prior.mfm" --transformers &&
    "$HELPER" "$TMP/notr/prior.mfm"; then
   for method in context detail citl nemf-citl; do

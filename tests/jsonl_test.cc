@@ -1,13 +1,13 @@
-#include "capi/cli/jsonl.h"
+#include "capi/src/jobs/jsonl.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <string>
 
-#include "capi/cli/input_error.h"
+#include "motionfield.hpp"
 
-namespace motionfield::cli {
+namespace motionfield::jobs {
 namespace {
 
 // Parses `text`, expects a JsonError and returns its column (0 if none was thrown).
@@ -299,4 +299,4 @@ TEST(JsonlTest, BadJobsNameTheProblem) {
 }
 
 }  // namespace
-}  // namespace motionfield::cli
+}  // namespace motionfield::jobs

@@ -100,11 +100,11 @@ typedef struct mf_encoding mf_encoding;
 /* ================================================================ version */
 
 #define MF_VERSION_MAJOR 0
-#define MF_VERSION_MINOR 1
+#define MF_VERSION_MINOR 2
 #define MF_VERSION_PATCH 0
 /** MAJOR * 10000 + MINOR * 100 + PATCH */
 #define MF_VERSION_NUMBER (MF_VERSION_MAJOR * 10000 + MF_VERSION_MINOR * 100 + MF_VERSION_PATCH)
-#define MF_VERSION_STRING "0.1.0"
+#define MF_VERSION_STRING "0.2.0"
 /** The ABI major: the N of libmotionfield.so.N. */
 #define MF_ABI_VERSION 0
 
@@ -112,7 +112,7 @@ typedef struct mf_encoding mf_encoding;
 MF_API uint32_t mf_abi_version(void);
 /** MF_VERSION_NUMBER of the loaded library. */
 MF_API uint32_t mf_version_number(void);
-/** MF_VERSION_STRING of the loaded library, e.g. "0.1.0". Never NULL. */
+/** MF_VERSION_STRING of the loaded library, e.g. "0.2.0". Never NULL. */
 MF_API const char *mf_version_string(void);
 
 /* ================================================================ status */
@@ -850,6 +850,142 @@ MF_API int mf_output_set_commit(mf_output_set *set);
  *  MF_ERROR_IO "cannot read rig map file F: larger than the limit of 1 MiB
  *  for a rig map file". For mf_rig_describe, which takes the text. */
 MF_API int mf_rig_map_read_file(const char *path, char *out, size_t capacity, size_t *needed);
+
+/* ------------------------------------------------------------ model sets
+ * Since 0.2.0. */
+
+/** mf_model_load (path NULL: the default model, with the transformer
+ *  in-betweeners and the rig anatomy next to it), then every file of
+ *  `inbetweeners` (`count` paths, none NULL or empty) added in order as
+ *  mf_model_with_inbetweener adds it (replacing a loaded one of its kind): the
+ *  model set the CLI's --model, --twostage and --citl name. Errors are those
+ *  of the two functions. */
+MF_API int mf_model_load_set(const char *path, const char *const *inbetweeners, size_t count, mf_model **out);
+/** The transformer files that lay next to the model's file but did not load
+ *  (the methods that need them cannot run; the default method does without
+ *  them), one warning per line in the CLI's words ("" when every file there
+ *  loaded): a string getter. */
+MF_API int mf_model_get_load_warnings(const mf_model *model, char *out, size_t capacity, size_t *needed);
+
+/* ------------------------------------------------------------ batch jobs
+ * Since 0.2.0. The JSON-lines jobs of `motionfield batch` (docs/CLI.md:
+ * {"task": "inbetween" | "fill" | "resample" | "renav", "in": ..., "out": ...,
+ * ...}) parsed, checked and run by the library, with the CLI's messages: the
+ * one implementation the CLI, its single commands and the Python package's
+ * batch runners use.
+ *
+ * A runner holds what the jobs of one run share: the settings below, the
+ * model (the one named, or the default one loaded on first need and then kept
+ * for every job), and the files of the lines checked so far. A batch checks
+ * every line first, in line order (mf_job_runner_check_line: a line may not
+ * write what an earlier line writes or reads), then runs the checked jobs
+ * (mf_job_run), in any order and on several threads at once;
+ * mf_job_runner_run_line does both for one line on its own (a worker of a
+ * distributed run, whose lines were checked elsewhere). Each run gives a
+ * result: the exit code of the job (0 ok, 2 bad input, 1 internal error), the
+ * lines the CLI prints on stderr for it ("motionfield: JOBS.jsonl line 3 (id
+ * x): error: ...", warnings, the --verbose line) and its --json summary.
+ * Relative paths are relative to the current directory. A runner may be used
+ * from several threads at once; a checked job and a result belong to one
+ * thread at a time. */
+typedef struct mf_job_runner mf_job_runner;
+/** One line parsed and its files checked (runnable or not). */
+typedef struct mf_job mf_job;
+/** What a job run said. */
+typedef struct mf_job_result mf_job_result;
+
+/** mf_job_runner_options.flags: a line of what ran and how long it took. */
+#define MF_JOB_VERBOSE 1u
+/** mf_job_runner_options.flags: no warnings in the messages (errors stay). */
+#define MF_JOB_QUIET 2u
+/** mf_job_runner_options.flags: mf_job_runner_check_line loads the model a
+ *  job needs (a failed load is then that line's failure), so that the jobs
+ *  can run side by side on it. */
+#define MF_JOB_PRELOAD_MODEL 4u
+
+typedef struct mf_job_runner_options {
+  uint32_t struct_size;
+  /** MF_JOB_* flags. */
+  uint32_t flags;
+  /** Intra-op threads named in the --verbose line (mf_set_num_threads sets
+   *  them); 0: 1. */
+  int32_t threads;
+  /** The model file; NULL or "": the default model, loaded on first need. */
+  const char *model;
+  /** Transformer in-betweener files added to the model (mf_model_load_set). */
+  const char *const *inbetweeners;
+  size_t inbetweener_count;
+  /** The rig map file of every job without its own "rig_map"; NULL: none. */
+  const char *rig_map;
+  /** The BVH length unit of every job without its own "units" (a unit name,
+   *  "auto" or metres per unit); NULL or "": auto. */
+  const char *units;
+} mf_job_runner_options;
+
+MF_API int mf_job_runner_options_init(mf_job_runner_options *options);
+/** A runner; loads options->model when given (its load error otherwise). */
+MF_API int mf_job_runner_create(const mf_job_runner_options *options, mf_job_runner **out);
+/** Accepts NULL. Jobs and results made by the runner stay valid. */
+MF_API void mf_job_runner_destroy(mf_job_runner *runner);
+/** Parses line `line_number` (1-based) of the batch file `batch_path` (named
+ *  in messages), `length` bytes of `text` (no newline), and checks its files
+ *  against every line checked by this runner before. Always makes a job
+ *  (MF_OK); one that is not runnable gives its failure when run. */
+MF_API int mf_job_runner_check_line(mf_job_runner *runner, const char *text, size_t length, uint64_t line_number,
+                                    const char *batch_path, mf_job **out);
+/** 1 if the checked job will run, 0 if it failed its checks. */
+MF_API int mf_job_is_runnable(const mf_job *job);
+/** 1 if the job carries the model's load warnings (mf_model_get_load_warnings):
+ *  they go with the first runnable job of a batch that names no method. */
+MF_API int mf_job_has_load_warnings(const mf_job *job);
+/** Accepts NULL. */
+MF_API void mf_job_destroy(mf_job *job);
+
+/** mf_job_run_options.flags (mf_job_runner_run_line): a single command of the
+ *  CLI: "-" as "in" (standard input) or "out" (standard output, BVH) and the
+ *  task "export" accepted; messages without a line label and a summary
+ *  without "line". */
+#define MF_JOB_SINGLE 1u
+/** mf_job_run_options.flags (mf_job_runner_run_line): the job carries the
+ *  model's load warnings (see mf_job_has_load_warnings). */
+#define MF_JOB_LOAD_WARNINGS 2u
+
+typedef struct mf_job_run_options {
+  uint32_t struct_size;
+  /** MF_JOB_SINGLE, MF_JOB_LOAD_WARNINGS (mf_job_runner_run_line only). */
+  uint32_t flags;
+  /** Progress of the job's solver, on the calling thread; NULL: none. */
+  mf_progress_fn progress;
+  void *user_data;
+} mf_job_run_options;
+
+MF_API int mf_job_run_options_init(mf_job_run_options *options);
+/** Runs a checked job (once: the job is spent). Every failure of the job
+ *  itself is in the result (MF_OK). */
+MF_API int mf_job_run(mf_job_runner *runner, mf_job *job, const mf_job_run_options *options, mf_job_result **out);
+/** Parses, checks and runs one line on its own (no other line's files are
+ *  checked against it). Every failure of the job itself is in the result. */
+MF_API int mf_job_runner_run_line(mf_job_runner *runner, const char *text, size_t length, uint64_t line_number,
+                                  const char *batch_path, const mf_job_run_options *options, mf_job_result **out);
+/** Loads the runner's model now if not yet (the named one, else the default
+ *  one), as a job needing it would. `out` (may be NULL): a new handle of it,
+ *  or NULL when there is no model. MF_ERROR_INVALID_ARGUMENT "cannot load the
+ *  default model: ..." when the default model does not load. */
+MF_API int mf_job_runner_load_model(mf_job_runner *runner, mf_model **out);
+/** The loaded model's path ("" before one is loaded): a string getter. */
+MF_API int mf_job_runner_get_model_path(const mf_job_runner *runner, char *out, size_t capacity, size_t *needed);
+
+/** Accepts NULL. */
+MF_API void mf_job_result_destroy(mf_job_result *result);
+/** The job's exit code: 0 ok, 2 bad input, 1 internal error. */
+MF_API int mf_job_result_get_exit_code(const mf_job_result *result, int32_t *out);
+/** Its stderr lines, each "motionfield: ...\n" ("" for none): a string getter. */
+MF_API int mf_job_result_get_messages(const mf_job_result *result, char *out, size_t capacity, size_t *needed);
+/** Its --json summary, one line of JSON without the newline: {"line", "id",
+ *  "task", "in", "out", "status": "ok", "method", "model", "frames_in",
+ *  "frames_out", "timings_ms", "warnings", ...} or {..., "status": "error",
+ *  "exit_code", "error"}: a string getter. */
+MF_API int mf_job_result_get_json(const mf_job_result *result, char *out, size_t capacity, size_t *needed);
 
 #ifdef __cplusplus
 }

@@ -23,6 +23,8 @@
 #ifndef MOTIONFIELD_HPP
 #define MOTIONFIELD_HPP
 
+#include <charconv>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
@@ -115,7 +117,7 @@ T read_value(Get&& get) {
 
 // ---------------------------------------------------------------- library
 
-/// mf_version_string(): the loaded library's version, e.g. "0.1.0".
+/// mf_version_string(): the loaded library's version, e.g. "0.2.0".
 inline std::string version() { return mf_version_string(); }
 /// mf_abi_version(): the loaded library's ABI major (compare with MF_ABI_VERSION).
 inline uint32_t abi_version() { return mf_abi_version(); }
@@ -161,6 +163,20 @@ class Model : public detail::Handle<mf_model, mf_model_destroy> {
     mf_model* m = nullptr;
     check(mf_model_with_inbetweener(get(), path.c_str(), &m));
     return Model(m);
+  }
+  /// mf_model_load_set: the model at `path` ("" = the default model) with
+  /// the transformer files `inbetweeners` added in order.
+  static Model load_set(const std::string& path, const std::vector<std::string>& inbetweeners) {
+    std::vector<const char*> files;
+    for (const std::string& file : inbetweeners) files.push_back(file.c_str());
+    mf_model* m = nullptr;
+    check(mf_model_load_set(path.empty() ? nullptr : path.c_str(), files.data(), files.size(), &m));
+    return Model(m);
+  }
+  /// mf_model_get_load_warnings: the files next to the model that did not load, one warning per line.
+  std::string load_warnings() const {
+    return detail::read_string(
+        [&](char* out, size_t capacity, size_t* needed) { return mf_model_get_load_warnings(get(), out, capacity, needed); });
   }
   /// mf_model_has_inbetweener: kind "twostage" or "citl".
   bool has_inbetweener(const std::string& kind) const {
@@ -731,6 +747,221 @@ class OutputSet : public detail::Handle<mf_output_set, mf_output_set_destroy> {
   void write(const std::string& path, const std::string& text) { write(path, text.data(), text.size()); }
   void write(const std::string& path, const std::vector<uint8_t>& bytes) { write(path, bytes.data(), bytes.size()); }
   void commit() { check(mf_output_set_commit(get())); }
+};
+
+// ---------------------------------------------------------------- programs
+// How a program built on the library reports a failure, as the motionfield
+// CLI and the job runner (mf_job_result) do: exit codes, "motionfield: ..."
+// lines, the units option.
+
+constexpr int kExitOk = 0;
+constexpr int kExitInternal = 1;
+constexpr int kExitBadInput = 2;
+
+/// Bad input a program found itself (exit code 2): an Error with status
+/// MF_ERROR_INVALID_ARGUMENT whose message is meant for the user as is.
+class InputError : public Error {
+ public:
+  explicit InputError(const std::string& message) : Error(MF_ERROR_INVALID_ARGUMENT, message) {}
+};
+
+/// A failure as the user sees it: exit code 2 for bad input (the statuses
+/// MF_ERROR_INVALID_ARGUMENT, MF_ERROR_IO, MF_ERROR_MODEL and
+/// MF_ERROR_UNSUPPORTED), else 1 (internal); the message (for internal errors
+/// after the status name).
+struct Failure {
+  int exit_code = kExitInternal;
+  std::string message;
+};
+
+/// The Failure of the exception being handled; call only inside a catch block.
+inline Failure current_failure() {
+  try {
+    throw;
+  } catch (const Error& e) {
+    const int s = e.status();
+    if (s == MF_ERROR_INVALID_ARGUMENT || s == MF_ERROR_IO || s == MF_ERROR_MODEL || s == MF_ERROR_UNSUPPORTED)
+      return {kExitBadInput, e.what()};
+    return {kExitInternal, std::string(e.status_name()) + ": " + e.what()};
+  } catch (const std::exception& e) {
+    return {kExitInternal, e.what()};
+  } catch (...) {
+    return {kExitInternal, "unknown exception"};
+  }
+}
+
+/// printable_text(text), or a note when even that fails (out of memory):
+/// everything a program prints that holds a file name or input bytes.
+inline std::string printable(const std::string& text) {
+  try {
+    return printable_text(text);
+  } catch (...) {
+    return "(a message that could not be made printable)";
+  }
+}
+
+/// "motionfield: <prefix>error: <message>\n" ("internal error" for exit code 1), printable.
+inline std::string failure_line(const Failure& failure, const std::string& prefix = "") {
+  const char* kind = failure.exit_code == kExitBadInput ? "error" : "internal error";
+  return "motionfield: " + printable(prefix + kind + ": " + failure.message) + "\n";
+}
+
+/// Each line of `warnings` as "motionfield: <prefix>warning: <line>\n", printable.
+inline std::string warning_lines(const std::string& warnings, const std::string& prefix = "") {
+  std::string out;
+  for (size_t begin = 0; begin < warnings.size();) {
+    size_t end = warnings.find('\n', begin);
+    if (end == std::string::npos) end = warnings.size();
+    out += "motionfield: " + printable(prefix + "warning: " + warnings.substr(begin, end - begin)) + "\n";
+    begin = end + 1;
+  }
+  return out;
+}
+
+/// Metres per file unit of a units option (`what` names it in messages): ""
+/// or "auto" = 0 (detected), a unit name (length_unit_scale) or a positive
+/// number. InputError otherwise.
+inline double units_scale(const std::string& units, const std::string& what) {
+  if (units.empty() || units == "auto") return 0.0;
+  double v = 0;
+  const auto r = std::from_chars(units.data(), units.data() + units.size(), v);
+  if (r.ec == std::errc() && r.ptr == units.data() + units.size()) {
+    if (!(std::isfinite(v) && v > 0)) throw InputError(what + " must be positive, not " + units);
+    return v;
+  }
+  try {
+    return length_unit_scale(units);
+  } catch (const Error& e) {
+    throw InputError(what + ": " + e.what() + "; auto (the default) detects it");
+  }
+}
+
+// ---------------------------------------------------------------- batch jobs
+
+/// mf_job_runner_options in C++ types.
+struct JobRunnerOptions {
+  uint32_t flags = 0;                     ///< MF_JOB_VERBOSE, MF_JOB_QUIET, MF_JOB_PRELOAD_MODEL
+  int32_t threads = 1;                    ///< named in the --verbose line
+  std::string model;                      ///< "" = the default model
+  std::vector<std::string> inbetweeners;  ///< transformer files added to the model
+  std::string rig_map;                    ///< "" = none
+  std::string units;                      ///< "" = auto
+};
+
+/// mf_job_result: a job's exit code, stderr lines and --json summary.
+struct JobResult {
+  int32_t exit_code = 0;
+  std::string messages;  ///< each line "motionfield: ...\n"
+  std::string json;      ///< one line, no newline
+
+  /// Reads and destroys `result`.
+  static JobResult take(mf_job_result* result) {
+    detail::Handle<mf_job_result, mf_job_result_destroy> owned(result);
+    JobResult r;
+    check(mf_job_result_get_exit_code(result, &r.exit_code));
+    r.messages = detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+      return mf_job_result_get_messages(result, out, capacity, needed);
+    });
+    r.json = detail::read_string(
+        [&](char* out, size_t capacity, size_t* needed) { return mf_job_result_get_json(result, out, capacity, needed); });
+    return r;
+  }
+};
+
+/// mf_job: one line parsed and its files checked (JobRunner::check_line).
+class Job : public detail::Handle<mf_job, mf_job_destroy> {
+ public:
+  using Handle::Handle;
+  bool runnable() const { return mf_job_is_runnable(get()) != 0; }
+  bool has_load_warnings() const { return mf_job_has_load_warnings(get()) != 0; }
+};
+
+/// mf_job_runner: the jobs of one run (a batch file), checked and run with the CLI's messages.
+class JobRunner : public detail::Handle<mf_job_runner, mf_job_runner_destroy> {
+ public:
+  using Handle::Handle;
+
+  /// mf_job_runner_create: loads options.model when given.
+  static JobRunner create(const JobRunnerOptions& options) {
+    mf_job_runner_options c;
+    check(mf_job_runner_options_init(&c));
+    std::vector<const char*> files;
+    for (const std::string& file : options.inbetweeners) files.push_back(file.c_str());
+    c.flags = options.flags;
+    c.threads = options.threads;
+    c.model = options.model.c_str();
+    c.inbetweeners = files.data();
+    c.inbetweener_count = files.size();
+    c.rig_map = options.rig_map.empty() ? nullptr : options.rig_map.c_str();
+    c.units = options.units.c_str();
+    mf_job_runner* out = nullptr;
+    check(mf_job_runner_create(&c, &out));
+    return JobRunner(out);
+  }
+  /// mf_job_runner_check_line.
+  Job check_line(const std::string& text, uint64_t line, const std::string& batch_path) {
+    mf_job* out = nullptr;
+    check(mf_job_runner_check_line(get(), text.data(), text.size(), line, batch_path.c_str(), &out));
+    return Job(out);
+  }
+  /// mf_job_run, reporting progress to `progress` (may be empty; return false to cancel).
+  JobResult run(Job& job, const std::function<bool(const mf_progress&)>& progress = {}) {
+    Progress p{progress, nullptr};
+    const mf_job_run_options options = run_options(0, p);
+    mf_job_result* out = nullptr;
+    const int status = mf_job_run(get(), job.get(), &options, &out);
+    if (p.error) std::rethrow_exception(p.error);
+    check(status);
+    return JobResult::take(out);
+  }
+  /// mf_job_runner_run_line with `flags` (MF_JOB_SINGLE, MF_JOB_LOAD_WARNINGS).
+  JobResult run_line(const std::string& text, uint64_t line, const std::string& batch_path, uint32_t flags,
+                     const std::function<bool(const mf_progress&)>& progress = {}) {
+    Progress p{progress, nullptr};
+    const mf_job_run_options options = run_options(flags, p);
+    mf_job_result* out = nullptr;
+    const int status = mf_job_runner_run_line(get(), text.data(), text.size(), line, batch_path.c_str(), &options, &out);
+    if (p.error) std::rethrow_exception(p.error);
+    check(status);
+    return JobResult::take(out);
+  }
+  /// mf_job_runner_load_model: the model (an empty Model when there is none).
+  Model load_model() {
+    mf_model* out = nullptr;
+    check(mf_job_runner_load_model(get(), &out));
+    return Model(out);
+  }
+  /// mf_job_runner_get_model_path: "" before a model is loaded.
+  std::string model_path() const {
+    return detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+      return mf_job_runner_get_model_path(get(), out, capacity, needed);
+    });
+  }
+
+ private:
+  struct Progress {
+    const std::function<bool(const mf_progress&)>& fn;
+    std::exception_ptr error;
+  };
+  static int on_progress(void* self, const mf_progress* progress) noexcept {
+    Progress* p = static_cast<Progress*>(self);
+    try {
+      return p->fn(*progress) ? 0 : 1;
+    } catch (...) {
+      p->error = std::current_exception();
+      return 1;
+    }
+  }
+  static mf_job_run_options run_options(uint32_t flags, Progress& p) {
+    mf_job_run_options options;
+    check(mf_job_run_options_init(&options));
+    options.flags = flags;
+    if (p.fn) {
+      options.progress = &JobRunner::on_progress;
+      options.user_data = &p;
+    }
+    return options;
+  }
 };
 
 }  // namespace motionfield

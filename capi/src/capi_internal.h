@@ -176,6 +176,11 @@ void skeleton_joint_name(const Skeleton& s, int32_t joint, char* out, size_t cap
 void skeleton_parents(const Skeleton& s, int32_t* out, size_t capacity, size_t* needed);
 void skeleton_offsets(const Skeleton& s, float* out, size_t capacity, size_t* needed);
 
+/// The model set of mf_model_load_set: the prior at `path` (NULL: the
+/// default model), the in-betweeners and the rig anatomy next to it, then the
+/// `count` in-betweener files of `inbetweeners` added in order.
+std::unique_ptr<mf_model> load_model_set(const char* path, const char* const* inbetweeners, size_t count);
+
 /// A new motion handle carrying `motion` and the BVH layout of `like` (if any).
 mf_motion* derived_motion(Motion motion, const mf_motion& like);
 

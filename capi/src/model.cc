@@ -99,6 +99,28 @@ const NemfModel& get(const mf_model* model) {
 
 }  // namespace
 
+std::unique_ptr<mf_model> load_model_set(const char* path, const char* const* inbetweeners, size_t count) {
+  std::string file;
+  if (path) {
+    file = path;
+    if (file.empty()) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the model path is empty");
+  } else {
+    file = default_path();
+    if (file.empty())
+      throw ApiError(MF_ERROR_IO, "no default model: set MF_MODEL or install models/motionfield-prior.mfm (see README)");
+  }
+  const FileBytes bytes = read_file(file);
+  std::unique_ptr<mf_model> handle = load_bytes(bytes.data(), bytes.size(), file);
+  load_inbetweeners_next_to(file, handle.get());
+  load_anatomy(handle.get(), file);
+  for (size_t i = 0; i < count; ++i) {
+    require(inbetweeners[i], "an in-betweener path");
+    if (!*inbetweeners[i]) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the transformer model path is empty");
+    handle->add_inbetweener(load_inbetweener_file(inbetweeners[i], *handle));
+  }
+  return handle;
+}
+
 }  // namespace mf::capi
 
 using mf::capi::ApiError;
@@ -114,21 +136,29 @@ int mf_model_default_path(char* out, size_t capacity, size_t* needed) {
 int mf_model_load(const char* path, mf_model** out) {
   return guard([&] {
     require(out, "out");
-    std::string file;
-    if (path) {
-      file = path;
-      if (file.empty()) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the model path is empty");
-    } else {
-      file = mf::capi::default_path();
-      if (file.empty())
-        throw ApiError(MF_ERROR_IO,
-                       "no default model: set MF_MODEL or install models/motionfield-prior.mfm (see README)");
+    *out = mf::capi::load_model_set(path, nullptr, 0).release();
+  });
+}
+
+int mf_model_load_set(const char* path, const char* const* inbetweeners, size_t count, mf_model** out) {
+  return guard([&] {
+    require(out, "out");
+    if (count > 0) require(inbetweeners, "inbetweeners");
+    *out = mf::capi::load_model_set(path, inbetweeners, count).release();
+  });
+}
+
+int mf_model_get_load_warnings(const mf_model* model, char* out, size_t capacity, size_t* needed) {
+  return guard([&] {
+    require(model, "model");
+    std::string warnings;
+    for (const mf::InbetweenerKind& kind : mf::inbetweener_kinds()) {
+      const auto error = model->inbetweener_errors.find(kind.name);
+      if (error != model->inbetweener_errors.end() && !error->second.empty())
+        warnings += kind.file_name + " next to the model did not load, so the methods that need it cannot run "
+                    "and the default method does without it: " + error->second + "\n";
     }
-    const mf::FileBytes bytes = mf::capi::read_file(file);
-    std::unique_ptr<mf_model> handle = mf::capi::load_bytes(bytes.data(), bytes.size(), file);
-    mf::load_inbetweeners_next_to(file, handle.get());
-    mf::capi::load_anatomy(handle.get(), file);
-    *out = handle.release();
+    mf::capi::write_string(warnings, out, capacity, needed);
   });
 }
 

@@ -42,7 +42,7 @@ inline CLI::Option* repeatable(CLI::Option* option) {
 /// between the solver's iterations and takes it back, paying a page fault for
 /// each page touched again: 232k against 156k minor faults, and up to 30 %
 /// longer sparse solves, in whichever process lands in that state
-/// (docs/BENCHMARKS.md, "The heap setting"). The CLI sets the same (capi/cli/main.cc);
+/// (docs/BENCHMARKS.md, "The heap setting"). The CLI sets the same (cli/main.cc);
 /// the library leaves its host's allocator alone.
 inline void pad_heap_top() { mallopt(M_TOP_PAD, 64 << 20); }
 

@@ -75,6 +75,18 @@ class MfSolution(ctypes.Structure):
     """Opaque mf_solution."""
 
 
+class MfJobRunner(ctypes.Structure):
+    """Opaque mf_job_runner."""
+
+
+class MfJob(ctypes.Structure):
+    """Opaque mf_job."""
+
+
+class MfJobResult(ctypes.Structure):
+    """Opaque mf_job_result."""
+
+
 class MfConstraintReport(ctypes.Structure):
     _fields_ = [
         ("struct_size", ctypes.c_uint32),
@@ -154,6 +166,35 @@ class MfRenavOptions(ctypes.Structure):
         ("path_kind", ctypes.c_int32),
         ("frame_count", ctypes.c_int32),
         ("fps", ctypes.c_double),
+    ]
+
+
+JOB_VERBOSE = 1
+JOB_QUIET = 2
+JOB_PRELOAD_MODEL = 4
+JOB_SINGLE = 1
+JOB_LOAD_WARNINGS = 2
+
+
+class MfJobRunnerOptions(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("flags", ctypes.c_uint32),
+        ("threads", ctypes.c_int32),
+        ("model", ctypes.c_char_p),
+        ("inbetweeners", ctypes.POINTER(ctypes.c_char_p)),
+        ("inbetweener_count", ctypes.c_size_t),
+        ("rig_map", ctypes.c_char_p),
+        ("units", ctypes.c_char_p),
+    ]
+
+
+class MfJobRunOptions(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("flags", ctypes.c_uint32),
+        ("progress", PROGRESS_FN),
+        ("user_data", ctypes.c_void_p),
     ]
 
 
@@ -363,3 +404,27 @@ _declare("mf_rig_map_read_file", _int, _str, ctypes.c_char_p, _size, _P(_size))
 if mf_abi_version() != ABI_VERSION:  # noqa: F821 (declared above)
     raise ImportError("%s has ABI version %d; this package needs %d" %
                       (library_path, mf_abi_version(), ABI_VERSION))  # noqa: F821
+
+_declare("mf_model_load_set", _int, _str, _P(ctypes.c_char_p), _size, _P(_model))
+_declare("mf_model_get_load_warnings", _int, _model, ctypes.c_char_p, _size, _P(_size))
+
+_runner = _P(MfJobRunner)
+_job = _P(MfJob)
+_result = _P(MfJobResult)
+_declare("mf_job_runner_options_init", _int, _P(MfJobRunnerOptions))
+_declare("mf_job_runner_create", _int, _P(MfJobRunnerOptions), _P(_runner))
+_declare("mf_job_runner_destroy", None, _runner)
+_declare("mf_job_runner_check_line", _int, _runner, ctypes.c_char_p, _size, ctypes.c_uint64, _str, _P(_job))
+_declare("mf_job_is_runnable", _int, _job)
+_declare("mf_job_has_load_warnings", _int, _job)
+_declare("mf_job_destroy", None, _job)
+_declare("mf_job_run_options_init", _int, _P(MfJobRunOptions))
+_declare("mf_job_run", _int, _runner, _job, _P(MfJobRunOptions), _P(_result))
+_declare("mf_job_runner_run_line", _int, _runner, ctypes.c_char_p, _size, ctypes.c_uint64, _str,
+         _P(MfJobRunOptions), _P(_result))
+_declare("mf_job_runner_load_model", _int, _runner, _P(_model))
+_declare("mf_job_runner_get_model_path", _int, _runner, ctypes.c_char_p, _size, _P(_size))
+_declare("mf_job_result_destroy", None, _result)
+_declare("mf_job_result_get_exit_code", _int, _result, _P(_i32))
+_declare("mf_job_result_get_messages", _int, _result, ctypes.c_char_p, _size, _P(_size))
+_declare("mf_job_result_get_json", _int, _result, ctypes.c_char_p, _size, _P(_size))

@@ -7,7 +7,8 @@ Usage::
         [--rig-map FILE] [--units U] [--json] [--quiet] [--verbose]
 
 Reads the same JSON-lines jobs as ``motionfield batch JOBS.jsonl`` (one job
-per line, the same keys, checks and messages: motionfield.batch) and runs them
+per line, the same keys, checks and messages: the library's job runner,
+motionfield.jobs) and runs them
 on a ``distributed.Client``: a LocalCluster of N worker processes (one thread
 each) on this machine by default, or the scheduler at ADDRESS (its workers need
 this package and the library, and see the same file system). Each worker
@@ -25,14 +26,15 @@ On a terminal, a progress line on stderr counts the finished jobs.
 from __future__ import annotations
 
 import argparse
+import json
 import logging
 import os
 import sys
 import time
 import uuid
-from typing import Dict, List, Optional, Sequence
+from typing import Dict, Optional, Sequence
 
-from . import batch as mfb
+from . import jobs as mfj
 
 
 def _arguments(argv: Optional[Sequence[str]]) -> argparse.Namespace:
@@ -103,7 +105,7 @@ def _distributed():  # type: ignore[no-untyped-def]
     try:
         import distributed
     except ImportError as e:
-        raise mfb.InputError("python3 -m motionfield.dask needs Dask's distributed package (Debian: "
+        raise mfj.InputError("python3 -m motionfield.dask needs Dask's distributed package (Debian: "
                              "python3-distributed; `make deps` installs it): %s" % e) from None
     return distributed
 
@@ -124,66 +126,75 @@ def _client(args: argparse.Namespace):  # type: ignore[no-untyped-def]
 class _Printer:
     """Prints each line's messages in line order, as soon as every earlier line has finished."""
 
-    def __init__(self, entries: List[mfb.Entry], settings: mfb.Settings, progress: _ProgressLine) -> None:
-        self.entries, self.settings, self.progress = entries, settings, progress
-        self.outcomes: Dict[int, mfb.Outcome] = {}
+    def __init__(self, total: int, json_lines: bool, progress: _ProgressLine) -> None:
+        self.total, self.json_lines, self.progress = total, json_lines, progress
+        self.results: Dict[int, mfj.JobResult] = {}
         self.printed = 0
-        self.warned = False  # the model's load warnings go to the first job without a method, once
 
-    def finish(self, k: int, outcome: mfb.Outcome) -> None:
-        self.outcomes[k] = outcome
+    def finish(self, k: int, result: mfj.JobResult) -> None:
+        self.results[k] = result
         self.progress.clear()
-        while self.printed < len(self.entries) and self.printed in self.outcomes:
-            o = self.outcomes[self.printed]
-            if o.asked_load_warnings and not self.warned:
-                self.warned = True
-                if o.ok and o.report is not None:
-                    o.report.warnings = o.load_warnings + o.report.warnings
-            err, out = mfb.outcome_text(self.entries[self.printed], o, self.settings)
-            sys.stderr.write(err)
+        while self.printed < self.total and self.printed in self.results:
+            r = self.results[self.printed]
             sys.stderr.flush()
-            sys.stdout.write(out)
-            sys.stdout.flush()
+            sys.stderr.buffer.write(r.messages)
+            sys.stderr.flush()
+            if self.json_lines:
+                sys.stdout.flush()
+                sys.stdout.buffer.write(r.json + b"\n")
+                sys.stdout.flush()
             self.printed += 1
-        self.progress.draw(len(self.outcomes), sum(1 for x in self.outcomes.values() if not x.ok))
+        self.progress.draw(len(self.results), sum(1 for x in self.results.values() if x.exit_code != 0))
 
 
-def _run(args: argparse.Namespace, settings: mfb.Settings) -> int:
-    entries = mfb.read_batch(args.jobs, settings)
-    settings.preload_model = bool(settings.model) or any(mfb.needs_model(e.job) for e in entries if e.runnable)
-    if settings.model:  # a --model that does not load fails the batch before any job, as in the CLI
-        mfb.Models(settings.model, settings.transformers()).load_explicit()
-    progress = _ProgressLine(sys.stderr.isatty() and not settings.quiet, len(entries))
-    printer = _Printer(entries, settings, progress)
-    runnable = [k for k, e in enumerate(entries) if e.runnable]
+def _worker_failure(batch_path: str, line: int, err: BaseException) -> mfj.JobResult:
+    """The result of a job whose worker died: an internal error of its line."""
+    message = "the Dask worker running the job failed: %s" % (str(err) or type(err).__name__)
+    text = mfj.failure_line(message, mfj.EXIT_INTERNAL, "%s line %d: " % (batch_path, line))
+    summary = {"line": line, "status": "error", "exit_code": mfj.EXIT_INTERNAL, "error": mfj.printable(message)}
+    return mfj.JobResult(mfj.EXIT_INTERNAL, text.encode("utf-8"),
+                         json.dumps(summary, ensure_ascii=False, separators=(",", ":")).encode("utf-8"))
+
+
+def _run(args: argparse.Namespace, settings: dict) -> int:
+    lines = mfj.read_lines(args.jobs)
+    # Every line checked here first, in line order (as `motionfield batch --jobs N` does), the model a job
+    # needs loaded once; the workers then run the lines on their own runners.
+    runner = mfj.JobRunner(preload_model=True, **settings)
+    checked = [runner.check_line(text, n, args.jobs) for n, text in lines]
+    load_model = bool(runner.model_path)
+    progress = _ProgressLine(sys.stderr.isatty() and not settings["quiet"], len(lines))
+    printer = _Printer(len(lines), args.json, progress)
+    runnable = [k for k, job in enumerate(checked) if job.runnable]
     if runnable:
         distributed = _distributed()
         progress.draw(0, 0)
         client, cluster = _client(args)
         try:
             run = uuid.uuid4().hex[:12]  # task keys unique to this run: a shared scheduler merges equal keys
-            futures = {client.submit(mfb.run_job_in_process, entries[k].job, settings, pure=False,
-                                     key="motionfield-%s-line-%d" % (run, entries[k].line)): k for k in runnable}
-            for k, e in enumerate(entries):
-                if not e.runnable:
-                    printer.finish(k, mfb.Outcome(failure=e.failure))
+            futures = {client.submit(mfj.run_line_in_process, settings, load_model, lines[k][1], lines[k][0],
+                                     args.jobs, checked[k].has_load_warnings, settings["threads"], pure=False,
+                                     key="motionfield-%s-line-%d" % (run, lines[k][0])): k for k in runnable}
+            for k, job in enumerate(checked):
+                if not job.runnable:
+                    printer.finish(k, runner.run(job))
             for future in distributed.as_completed(futures):
                 k = futures[future]
                 try:
-                    outcome = future.result()
+                    result = future.result()
                 except Exception as err:  # noqa: BLE001 (a worker died: the job failed, the others go on)
-                    outcome = mfb.Outcome(failure=mfb.Failure(mfb.EXIT_INTERNAL, "the Dask worker running the job "
-                                                              "failed: %s" % (str(err) or type(err).__name__)))
-                printer.finish(k, outcome)
+                    result = _worker_failure(args.jobs, lines[k][0], err)
+                printer.finish(k, result)
         finally:
             client.close()
             if cluster is not None:
                 cluster.close()
     else:
-        for k, e in enumerate(entries):
-            printer.finish(k, mfb.Outcome(failure=e.failure))
+        for k, job in enumerate(checked):
+            printer.finish(k, runner.run(job))
     progress.clear()
-    line, code = mfb.summary(args.jobs, [printer.outcomes[k] for k in range(len(entries))], settings, progress.enabled)
+    line, code = mfj.summary(args.jobs, [printer.results[k].exit_code for k in range(len(lines))],
+                             settings["verbose"], settings["quiet"], progress.enabled)
     sys.stderr.write(line)
     return code
 
@@ -207,20 +218,24 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         For bad arguments (argparse, exit code 2).
     """
     args = _arguments(argv)
-    settings = mfb.Settings(threads=args.threads, verbose=args.verbose, quiet=args.quiet, json=args.json,
-                            model=args.model or "", twostage=tuple(args.twostage), citl=tuple(args.citl),
-                            rig_map=args.rig_map or "", units=args.units)
+    settings = dict(threads=args.threads, model=args.model or "", inbetweeners=list(args.twostage) + list(args.citl),
+                    rig_map=args.rig_map or "", units=args.units, verbose=args.verbose, quiet=args.quiet)
     try:
         import motionfield as mf
 
-        mf.set_num_threads(settings.threads)
-        if settings.verbose:
-            sys.stderr.write("motionfield: %d intra-op threads\n" % settings.threads)
+        mf.set_num_threads(args.threads)
+        if args.verbose:
+            sys.stderr.write("motionfield: %d intra-op threads\n" % args.threads)
         return _run(args, settings)
+    except mfj.InputError as e:
+        sys.stderr.write(mfj.failure_line(str(e)))
+        return mfj.EXIT_BAD_INPUT
     except Exception as e:  # noqa: BLE001 (the CLI's top-level handler: a message and an exit code)
-        failure = mfb.failure_of(e)
-        sys.stderr.write(mfb.failure_line(failure))
-        return failure.exit_code
+        bad = isinstance(e, (mf.InvalidArgumentError, mf.FileError, mf.ModelError, mf.UnsupportedError))
+        code = mfj.EXIT_BAD_INPUT if bad else mfj.EXIT_INTERNAL
+        message = str(e) if bad or not isinstance(e, mf.Error) else "%s: %s" % (e.status_name, e)
+        sys.stderr.write(mfj.failure_line(message or type(e).__name__, code))
+        return code
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """Python without arguments does what the CLI does without options: the same
 default model, the same default method, the same result.
 
-The CLI is $MF_CLI (CTest sets it), else the source tree's build/capi/motionfield.
+The CLI is $MF_CLI (CTest sets it), else the source tree's build/cli/motionfield.
 Named after test_motionfield.py on purpose: unittest discovers files in order,
 and test_motionfield.py checks that importing motionfield brings libtorch.
 """
@@ -32,7 +32,7 @@ def motion_numbers(text):
 class SameAsCliTest(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
-        cls.cli = os.environ.get("MF_CLI") or os.path.join(SOURCE, "build", "capi", "motionfield")
+        cls.cli = os.environ.get("MF_CLI") or os.path.join(SOURCE, "build", "cli", "motionfield")
         if not os.access(cls.cli, os.X_OK):
             raise AssertionError("no CLI at %s (set MF_CLI; CTest does)" % cls.cli)
         if mf.default_model_path() is None:

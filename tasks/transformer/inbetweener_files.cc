@@ -38,17 +38,26 @@ std::shared_ptr<const InbetweenModel> load_frozen_inbetweener(const std::string&
   return frozen_inbetweener(load_inbetweener(path), path, kind, prior);
 }
 
-void load_inbetweeners_next_to(const std::string& prior_path, ModelSet* models) {
+void load_inbetweeners(const std::string& prior_path, const std::map<std::string, std::string>& named, bool strict,
+                       ModelSet* models, const InbetweenerLog& log) {
   for (const InbetweenerKind& kind : inbetweener_kinds()) {
-    const std::string file = inbetweener_path_next_to(prior_path, kind.name);
+    const auto given = named.find(kind.name);
+    const bool is_named = given != named.end() && !given->second.empty();
+    const std::string file = is_named ? given->second : inbetweener_path_next_to(prior_path, kind.name);
     std::error_code ec;
-    if (!std::filesystem::exists(file, ec)) continue;
+    if (!is_named && !std::filesystem::exists(file, ec)) continue;
+    if (log) log(kind.title, file);
     try {
       models->add_inbetweener(load_frozen_inbetweener(file, kind.name, models->model.get()));
     } catch (const std::exception& e) {
+      if (is_named || strict) throw;
       models->inbetweener_errors[kind.name] = e.what();
     }
   }
+}
+
+void load_inbetweeners_next_to(const std::string& prior_path, ModelSet* models) {
+  load_inbetweeners(prior_path, {}, false, models);
 }
 
 std::string missing_inbetweener_message(const std::string& what, const std::string& kind) {

@@ -4,6 +4,8 @@
 // in-betweener is not loaded.
 #pragma once
 
+#include <functional>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -37,9 +39,21 @@ std::shared_ptr<const InbetweenModel> frozen_inbetweener(std::unique_ptr<Inbetwe
 std::shared_ptr<const InbetweenModel> load_frozen_inbetweener(const std::string& path, const std::string& kind,
                                                               const NemfModel* prior = nullptr);
 
-/// Loads the file of every product kind that exists next to `prior_path` into
-/// `models` (whose prior must be set); a file that does not load is recorded
-/// in models->inbetweener_errors, so the prior alone stays usable.
+/// Told the title and the path of each in-betweener file before it loads.
+using InbetweenerLog = std::function<void(const std::string& title, const std::string& path)>;
+
+/// Loads the in-betweener of every product kind into `models` (whose prior
+/// must be set): the file `named` gives for the kind, else the one next to
+/// `prior_path` when it exists. A named file that does not load throws; one
+/// next to the prior is recorded in models->inbetweener_errors (the prior
+/// alone stays usable), or thrown when `strict`. The one loader of the
+/// in-betweeners of a model set: the C API's model loading and the
+/// benchmark programs use it.
+void load_inbetweeners(const std::string& prior_path, const std::map<std::string, std::string>& named, bool strict,
+                       ModelSet* models, const InbetweenerLog& log = {});
+
+/// load_inbetweeners with no named file, not strict: every file that exists
+/// next to `prior_path`.
 void load_inbetweeners_next_to(const std::string& prior_path, ModelSet* models);
 
 /// The error of a method or initialiser (`what`, e.g. "method 'citl'") whose

@@ -6,16 +6,29 @@
 #include <string>
 
 #include "cli.h"
-#include "jsonl.h"
 
 namespace motionfield::cli {
+
+/// The options of a task command (inbetween, fill, resample, renav, export)
+/// that go into its job line as they are (commands.cc task_line).
+struct JobOptions {
+  std::string in, out;
+  std::string method;            ///< "" = the default method
+  int max_iterations = 0;        ///< 0: each method's own
+  double fps = 0.0;              ///< resample: the target fps; renav: the output's (0 = the reference's)
+  int frames = 0;                ///< renav --frames (0 = from the speed)
+  std::string constraints_file;  ///< inbetween and fill: --constraints
+  std::string trajectory_file;   ///< --trajectory
+  int alternatives = 0;          ///< --alternatives
+  std::string report_file;       ///< --report
+};
 
 /// Everything the command line sets. The task commands (inbetween, fill,
 /// resample, renav) fill `job` directly, except the values that need parsing
 /// or checking first (keyframes, gap, path).
 struct Arguments {
   Settings settings;
-  BatchJob job;
+  JobOptions job;
   std::string keyframes;  ///< inbetween --keyframes, as given
   std::string gap;        ///< fill --gap, as given
   std::string path;       ///< renav --path

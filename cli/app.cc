@@ -69,7 +69,7 @@ const CLI::Validator kNonEmpty(
     [](const std::string& value) { return value.empty() ? std::string("needs a value") : std::string(); }, "");
 
 // --in and --out of the task commands.
-void add_task_files(CLI::App* cmd, BatchJob& job, const std::string& in_help) {
+void add_task_files(CLI::App* cmd, JobOptions& job, const std::string& in_help) {
   cmd->add_option("-i,--in", job.in, in_help + "; - reads standard input")->required()->type_name("PATH");
   cmd->add_option("-o,--out", job.out,
                   "output: BVH, or glTF 2.0 for a name ending in .glb\n(binary) or .gltf (JSON); a file is replaced "
@@ -78,7 +78,7 @@ void add_task_files(CLI::App* cmd, BatchJob& job, const std::string& in_help) {
       ->type_name("PATH");
 }
 
-void add_method(CLI::App* cmd, BatchJob& job,
+void add_method(CLI::App* cmd, JobOptions& job,
                 const std::string& help = "one of the methods below (default: the best available)") {
   cmd->add_option("--method", job.method, help)->type_name("M")->check(kNonEmpty);
   cmd->add_option("--max-iterations", job.max_iterations,
@@ -90,7 +90,7 @@ void add_method(CLI::App* cmd, BatchJob& job,
 }
 
 // --constraints, --alternatives and --report of inbetween and fill.
-void add_constraints(CLI::App* cmd, BatchJob& job) {
+void add_constraints(CLI::App* cmd, JobOptions& job) {
   cmd->add_option("--constraints", job.constraints_file,
                   "a constraints file (JSON, docs/CONSTRAINTS.md): partial keys,\nend-effector targets, contacts")
       ->type_name("FILE")

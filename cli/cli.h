@@ -1,15 +1,15 @@
-// What the parts of the motionfield CLI share: the exit codes, the global
-// settings, and how a failure becomes a message and an exit code.
+// What the parts of the motionfield CLI share: the global settings, printing
+// a failure or warnings (the exit codes, Failure and the lines themselves are
+// motionfield.hpp's, as the library's job runner makes them), and reading a
+// file the CLI reads itself.
 #pragma once
 
 #include <string>
 #include <vector>
 
-namespace motionfield::cli {
+#include "motionfield.hpp"
 
-constexpr int kExitOk = 0;
-constexpr int kExitInternal = 1;
-constexpr int kExitBadInput = 2;
+namespace motionfield::cli {
 
 /// The global options (motionfield --help).
 struct Settings {
@@ -28,28 +28,12 @@ struct Settings {
   std::vector<std::string> transformers() const;
 };
 
-/// A failure as the user sees it: exit code 2 for bad input (InputError, and
-/// the C API's invalid-argument, I/O, model and unsupported statuses), else 1
-/// (internal); the message (for internal errors with the status name).
-struct Failure {
-  int exit_code = kExitInternal;
-  std::string message;
-};
-
-/// The Failure of the exception being handled; call only inside a catch block.
-Failure current_failure();
-
-/// `text` safe to print (the library's mf_printable_text: control bytes and
-/// escape sequences escaped, at most MF_MESSAGE_MAX_BYTES): everything the CLI
-/// prints that holds a file name or bytes of the input goes through it.
-std::string printable(const std::string& text);
-
-/// Prints "motionfield: <prefix>error: ..." or "...internal error: ..." on
-/// stderr (printable).
+/// Prints failure_line(failure, prefix) (motionfield.hpp: "motionfield:
+/// <prefix>error: ..." or "...internal error: ...", printable) on stderr.
 void print_failure(const Failure& failure, const std::string& prefix = "");
 
-/// Prints each line of `warnings` as "motionfield: <prefix>warning: <line>" on
-/// stderr (printable).
+/// Prints warning_lines(warnings, prefix) (motionfield.hpp: "motionfield:
+/// <prefix>warning: <line>" per line, printable) on stderr.
 void print_warnings(const std::string& warnings, const std::string& prefix = "");
 
 /// The limit of a batch file or rig map file the CLI reads itself.
@@ -61,10 +45,5 @@ constexpr size_t kMaxCliTextFileBytes = size_t{64} << 20;
 /// <path>: <reason>".
 std::string read_text_file(const std::string& path, const std::string& what,
                            size_t max_bytes = kMaxCliTextFileBytes);
-
-/// Metres per file unit of --units / a batch job's "units": "" or "auto" = 0
-/// (detected), a unit name (mf_length_unit_scale) or a positive number.
-/// `what` names the option in messages.
-double units_scale(const std::string& units, const std::string& what);
 
 }  // namespace motionfield::cli

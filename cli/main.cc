@@ -3,10 +3,10 @@
 // API through motionfield.hpp, like any other program: it includes nothing of
 // the library's internals (the build gives it no path to them).
 //   app.cc       the command line (CLI11): options and help texts
-//   commands.cc  the commands; batch.cc the batch command
-//   job.cc       one job end to end (and its --json summary); models.cc which
-//                model it runs with; progress.cc the progress bar
-//   jsonl.cc     the batch file's JSON lines
+//   commands.cc  the commands; batch.cc the batch command; progress.cc the
+//                progress bar
+// Every job (a batch line, a task command) is parsed, checked and run by the
+// library's job runner (mf_job_runner, capi/src/jobs/).
 // Exit codes: 0 ok, 2 bad input, 1 internal error; every message goes to
 // stderr, prefixed with "motionfield: ", with control characters escaped
 // (cli.h printable).
@@ -22,6 +22,7 @@
 
 namespace {
 
+using namespace motionfield;
 using namespace motionfield::cli;
 
 // A parse error as "motionfield: error: ..." with the command's help to see.

@@ -1,4 +1,4 @@
-#include "job.h"
+#include "capi/src/jobs/job.h"
 
 #include <nlohmann/json.hpp>
 
@@ -13,9 +13,8 @@
 #include <sstream>
 #include <system_error>
 
-#include "input_error.h"
 
-namespace motionfield::cli {
+namespace motionfield::jobs {
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -80,12 +79,12 @@ Motion solve_task(const BatchJob& job, const Model& model, const Motion& input, 
   throw InputError("unknown task '" + job.task + "'");
 }
 
-Solved solve(const BatchJob& job, const Settings& settings, const Model& model, const Motion& input,
-             ProgressLine& progress) {
+Solved solve(const BatchJob& job, const JobSettings& settings, const Model& model, const Motion& input,
+             const ProgressFn& progress) {
   TaskOptions options(job.method);
   options.max_iterations = job.max_iterations;
   options.rig_map_path = job.rig_map.empty() ? settings.rig_map : job.rig_map;
-  if (progress.enabled()) options.progress = [&progress](const mf_progress& p) { return progress.update(p); };
+  options.progress = progress;
   if (job.constrained()) {
     const Solution s = motionfield::solve(model, input, job_constraints(job, input), job.alternatives, options);
     Solved out{s.motion(0), {}, s.report_json(), s.method()};
@@ -133,60 +132,28 @@ void stage_motion(OutputSet& files, const Motion& result, const std::string& out
 
 double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
-// Runs a job whose files `files` holds (prepare_job), from `t0` on.
-JobReport run_prepared_job(const BatchJob& job, OutputSet& files, Clock::time_point t0, const Settings& settings,
-                           Models& models, ProgressLine& progress) {
-  // Export writes the input as it is read: no method, no model.
-  const bool export_only = job.task == "export";
-  static const Model kNoModel;
-  // Re-navigation always needs the prior, whatever the method.
-  const Model& model =
-      export_only ? kNoModel : models.for_method(job.task == "renav" && job.method.empty() ? "nemf" : job.method);
-  JobReport report;
-  if (job.method.empty() && !export_only) report.warnings = models.load_warnings();  // what the default method lost
-  // Standard input through its device file: the library reads pipes and
-  // redirected files with its size limit, and refuses a terminal.
-  const Motion input = Motion::load_bvh(job.in == kStdio ? "/dev/stdin" : job.in,
-                                        units_scale(job.units.empty() ? settings.units : job.units,
-                                                    job.units.empty() ? "--units (--length-scale)" : "\"units\""));
-  const auto t1 = Clock::now();
-  const Solved solved = export_only ? Solved{} : solve(job, settings, model, input, progress);
-  const Motion& result = export_only ? input : solved.motion;
-  progress.clear();
-  const auto t2 = Clock::now();
-  // Every output staged, standard output written, then all put in place at
-  // once: a failure leaves none of them behind.
+// The line --verbose prints for a job that ran.
+std::string verbose_line(const BatchJob& job, const JobReport& report, int threads) {
+  char line[512];
+  std::snprintf(line, sizeof line, ": %d -> %d frames, method %s, %d threads; read %.1f ms, solve %.1f ms, write %.1f ms",
+                report.frames_in, report.frames_out, report.method.c_str(), threads, report.read_ms, report.solve_ms,
+                report.write_ms);
+  return job.task + " " + job.in + " -> " + job.out + ", model " +
+         (report.model.empty() ? std::string("none") : report.model) + line;
+}
+
+// Stages every output of a solved job (the motion unless it goes to standard
+// output, the alternatives, the report) and returns the alternatives' files.
+std::vector<std::string> stage_outputs(const BatchJob& job, OutputSet& files, const Solved& solved,
+                                       const Motion& result) {
+  std::vector<std::string> alternatives;
   if (job.out != kStdio) stage_motion(files, result, job.out);
   for (size_t i = 0; i < solved.alternatives.size(); ++i) {
-    report.alternatives.push_back(alternative_path(job.out, static_cast<int>(i) + 1));
-    stage_motion(files, solved.alternatives[i], report.alternatives.back());
+    alternatives.push_back(alternative_path(job.out, static_cast<int>(i) + 1));
+    stage_motion(files, solved.alternatives[i], alternatives.back());
   }
   if (!job.report_file.empty()) files.write(job.report_file, solved.report + "\n");
-  if (job.out == kStdio) write_stdout(result);
-  files.commit();
-  report.constraints = solved.report;
-  const auto t3 = Clock::now();
-
-  report.method = solved.method.empty() ? method_name(job, model) : solved.method;
-  report.model = model ? models.path() : "";
-  report.frames_in = input.frame_count();
-  report.frames_out = result.frame_count();
-  report.read_ms = ms(t1 - t0);
-  report.solve_ms = ms(t2 - t1);
-  report.write_ms = ms(t3 - t2);
-  report.warnings += result.warnings();
-  if (settings.verbose) {
-    char line[512];
-    std::snprintf(line, sizeof line,
-                  ": %d -> %d frames, method %s, %d threads; read %.1f ms, solve %.1f ms, write %.1f ms",
-                  report.frames_in, report.frames_out, report.method.c_str(), settings.threads, report.read_ms,
-                  report.solve_ms, report.write_ms);
-    std::fprintf(stderr, "motionfield: %s\n",
-                 printable(job.task + " " + job.in + " -> " + job.out + ", model " +
-                           (report.model.empty() ? std::string("none") : report.model) + line)
-                     .c_str());
-  }
-  return report;
+  return alternatives;
 }
 
 }  // namespace
@@ -196,7 +163,7 @@ std::string alternative_path(const std::string& out, int index) {
   return (p.parent_path() / (p.stem().string() + "_" + std::to_string(index) + p.extension().string())).string();
 }
 
-OutputSet prepare_job(const BatchJob& job, const Settings& settings) {
+OutputSet prepare_job(const BatchJob& job, const JobSettings& settings) {
   check_request(job);
   OutputSet files = OutputSet::create();
   const std::string& rig_map = job.rig_map.empty() ? settings.rig_map : job.rig_map;
@@ -211,15 +178,45 @@ OutputSet prepare_job(const BatchJob& job, const Settings& settings) {
   return files;
 }
 
-JobReport run_job(const BatchJob& job, const Settings& settings, Models& models, ProgressLine& progress) {
+JobReport run_job(const BatchJob& job, OutputSet files, const JobSettings& settings, Models& models,
+                  const ProgressFn& progress, bool load_warnings) {
   const auto t0 = Clock::now();
-  OutputSet files = prepare_job(job, settings);
-  return run_prepared_job(job, files, t0, settings, models, progress);
-}
+  // Export writes the input as it is read: no method, no model.
+  const bool export_only = job.task == "export";
+  static const Model kNoModel;
+  // Re-navigation always needs the prior, whatever the method.
+  const Model& model =
+      export_only ? kNoModel : models.for_method(job.task == "renav" && job.method.empty() ? "nemf" : job.method);
+  JobReport report;
+  // What the default method lost.
+  if (load_warnings && job.method.empty() && !export_only) report.warnings = Models::load_warnings_of(model);
+  // Standard input through its device file: the library reads pipes and
+  // redirected files with its size limit, and refuses a terminal.
+  const Motion input = Motion::load_bvh(job.in == kStdio ? "/dev/stdin" : job.in,
+                                        units_scale(job.units.empty() ? settings.units : job.units,
+                                                    job.units.empty() ? "--units (--length-scale)" : "\"units\""));
+  const auto t1 = Clock::now();
+  const Solved solved = export_only ? Solved{} : solve(job, settings, model, input, progress);
+  const Motion& result = export_only ? input : solved.motion;
+  const auto t2 = Clock::now();
+  // Every output staged, standard output written, then all put in place at
+  // once: a failure leaves none of them behind.
+  report.alternatives = stage_outputs(job, files, solved, result);
+  if (job.out == kStdio) write_stdout(result);
+  files.commit();
+  report.constraints = solved.report;
+  const auto t3 = Clock::now();
 
-JobReport run_job(const BatchJob& job, OutputSet files, const Settings& settings, Models& models,
-                  ProgressLine& progress) {
-  return run_prepared_job(job, files, Clock::now(), settings, models, progress);
+  report.method = solved.method.empty() ? method_name(job, model) : solved.method;
+  report.model = model ? models.path() : "";
+  report.frames_in = input.frame_count();
+  report.frames_out = result.frame_count();
+  report.read_ms = ms(t1 - t0);
+  report.solve_ms = ms(t2 - t1);
+  report.write_ms = ms(t3 - t2);
+  report.warnings += result.warnings();
+  if (settings.verbose) report.verbose = verbose_line(job, report, settings.threads);
+  return report;
 }
 
 std::string job_json(const BatchJob& job, const JobReport* report, const Failure* failure, size_t line) {
@@ -256,4 +253,4 @@ std::string job_json(const BatchJob& job, const JobReport* report, const Failure
   return j.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
-}  // namespace motionfield::cli
+}  // namespace motionfield::jobs

@@ -1,16 +1,15 @@
-#include "models.h"
+#include "capi/src/jobs/models.h"
 
 #include <utility>
 
-#include "input_error.h"
-#include "jsonl.h"
 
-namespace motionfield::cli {
+namespace motionfield::jobs {
 
 Models::Models(std::string explicit_path, std::vector<std::string> transformers)
     : explicit_path_(std::move(explicit_path)), transformers_(std::move(transformers)) {}
 
 void Models::load_explicit() {
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (explicit_path_.empty() || model_) return;
   use(Model::load(explicit_path_), explicit_path_);
 }
@@ -21,6 +20,7 @@ const Model& Models::for_method(const std::string& method) {
     return model_;
   }
   const bool needs = !method.empty() && find_method(method).needs_model();
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (!method.empty() && !needs) return model_;  // empty: no --model, and the default one is not loaded
   load_default();
   if (needs && !model_)
@@ -28,14 +28,9 @@ const Model& Models::for_method(const std::string& method) {
   return model_;
 }
 
-const Model& Models::required(const std::string& what) {
-  if (!explicit_path_.empty()) {
-    load_explicit();
-    return model_;
-  }
-  load_default();
-  if (!model_) throw InputError(what + " needs the model, and none is installed (name one with --model)");
-  return model_;
+std::string Models::path() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return path_;
 }
 
 // Remembers a failed load, so that every job of a batch reports it.
@@ -57,25 +52,7 @@ void Models::load_default() {
   use(std::move(model), path);
 }
 
-std::string Models::load_warnings_of(const Model& model) {
-  if (!model) return "";
-  std::string out;
-  const JsonValue d = parse_json(model.describe());
-  const JsonValue& kinds = *d.find("inbetweeners");
-  for (size_t i = 0; i < kinds.keys().size(); ++i) {
-    const JsonValue& k = kinds.values()[i];
-    const std::string& error = k.find("error")->as_string();
-    if (!error.empty())
-      out += k.find("file")->as_string() + " next to the model did not load, so the methods that need it cannot run "
-             "and the default method does without it: " + error + "\n";
-  }
-  return out;
-}
-
-std::string Models::load_warnings() {
-  if (!model_ || warned_.exchange(true)) return "";
-  return load_warnings_of(model_);
-}
+std::string Models::load_warnings_of(const Model& model) { return model ? model.load_warnings() : ""; }
 
 void Models::use(Model model, const std::string& path) {
   for (const std::string& file : transformers_) model = model.with_inbetweener(file);
@@ -83,4 +60,4 @@ void Models::use(Model model, const std::string& path) {
   path_ = path;
 }
 
-}  // namespace motionfield::cli
+}  // namespace motionfield::jobs

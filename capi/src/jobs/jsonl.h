@@ -1,4 +1,4 @@
-// JSON Lines for `motionfield batch`: strict JSON (RFC 8259) parsed by
+// The JSON lines of batch jobs (`motionfield batch`, mf_job_runner): strict JSON (RFC 8259) parsed by
 // nlohmann-json's SAX parser into a small value type, and the translation of
 // one parsed line into a batch job.
 //
@@ -20,9 +20,9 @@
 #include <string>
 #include <vector>
 
-#include "input_error.h"
+#include "motionfield.hpp"
 
-namespace motionfield::cli {
+namespace motionfield::jobs {
 
 constexpr int kJsonMaxDepth = 64;
 
@@ -141,7 +141,9 @@ struct BatchJob {
 /// integer in 0..16, "report" a file name; no string
 /// may contain a NUL, "\u0000", which would cut a file name). Range checks
 /// (keyframes within the clip, fps positive, ...) are the library's, once the
-/// input is read.
-BatchJob batch_job_from_json(const JsonValue& line);
+/// input is read. `single` (a single command of the CLI): the task "export"
+/// ("in" and "out" only) is accepted too, and a resample's "fps" may be the
+/// text of a number ("nan", which JSON cannot hold, for the library's check).
+BatchJob batch_job_from_json(const JsonValue& line, bool single = false);
 
-}  // namespace motionfield::cli
+}  // namespace motionfield::jobs

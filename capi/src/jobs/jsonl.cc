@@ -1,4 +1,4 @@
-#include "jsonl.h"
+#include "capi/src/jobs/jsonl.h"
 
 #include <nlohmann/json.hpp>
 
@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <iterator>
 #include <limits>
@@ -13,9 +14,8 @@
 #include <set>
 #include <utility>
 
-#include "input_error.h"
 
-namespace motionfield::cli {
+namespace motionfield::jobs {
 
 JsonError::JsonError(int column, const std::string& message)
     : std::runtime_error("column " + std::to_string(column) + ": " + message), column_(column) {}
@@ -300,6 +300,19 @@ class Builder : public nlohmann::json_sax<nlohmann::json> {
 
 std::string where(const std::string& key) { return "\"" + key + "\""; }
 
+// "fps": a number; for a single command also its text ("nan", "inf": what JSON
+// cannot hold, left for the library's own check).
+double fps_value(const JsonValue& f, bool single) {
+  if (single && f.is_string()) {
+    const std::string& text = f.as_string();
+    char* end = nullptr;
+    const double v = std::strtod(text.c_str(), &end);
+    if (!text.empty() && end == text.c_str() + text.size()) return v;
+  }
+  if (!f.is_number()) throw InputError(std::string("\"fps\" must be a number, not ") + json_type_name(f.type()));
+  return f.as_number();
+}
+
 const JsonValue& required(const JsonValue& obj, const std::string& key, const std::string& task) {
   const JsonValue* v = obj.find(key);
   if (!v) throw InputError("missing key " + where(key) + (task.empty() ? "" : " (needed by task \"" + task + "\")"));
@@ -352,6 +365,47 @@ void read_constraints(const JsonValue& line, BatchJob* job) {
   if (const JsonValue* r = line.find("report")) job->report_file = string_value(*r, "report", false);
 }
 
+// The keys of job->task: keyframes, gap, fps, the path of a re-navigation, constraints.
+void read_task_keys(const JsonValue& line, bool single, BatchJob* job_out) {
+  BatchJob& job = *job_out;
+  if (job.task == "inbetween" || job.task == "fill") read_constraints(line, &job);
+  if (job.task == "inbetween") {
+    job.keyframes = int_array(required(line, "keyframes", job.task), "keyframes");
+    job.has_keyframes = true;
+  } else if (job.task == "fill") {
+    if (const JsonValue* k = line.find("keyframes")) {
+      job.keyframes = int_array(*k, "keyframes");
+      job.has_keyframes = true;
+    } else {
+      const JsonValue& g = required(line, "gap", job.task);
+      if (!g.is_array() || g.as_array().size() != 2)
+        throw InputError("\"gap\" must be an array of two integers [A, B], not " +
+                         (g.is_array() ? g.dump() : std::string(json_type_name(g.type()))));
+      job.gap_begin = int_value(g.as_array()[0], "\"gap\" item 0");
+      job.gap_end = int_value(g.as_array()[1], "\"gap\" item 1");
+      job.has_gap = true;
+    }
+  } else if (job.task == "resample") {
+    job.fps = fps_value(required(line, "fps", job.task), single);
+  } else {  // renav
+    const JsonValue* path = line.find("path");
+    const JsonValue* polyline = line.find("polyline");
+    if ((path != nullptr) == (polyline != nullptr))
+      throw InputError("task \"renav\" needs exactly one of \"path\" and \"polyline\"");
+    job.polyline = polyline != nullptr;
+    job.path_file = string_value(job.polyline ? *polyline : *path, job.polyline ? "polyline" : "path", false);
+    if (const JsonValue* f = line.find("fps")) {
+      if (!f->is_number()) throw InputError(std::string("\"fps\" must be a number, not ") + json_type_name(f->type()));
+      job.fps = f->as_number();
+      if (!(job.fps > 0)) throw InputError("\"fps\" must be positive, not " + f->dump());
+    }
+    if (const JsonValue* n = line.find("frames")) {
+      if (!job.polyline) throw InputError("\"frames\" goes with \"polyline\" (a \"path\" has one point per frame)");
+      job.frames = int_value(*n, "\"frames\"");
+    }
+  }
+}
+
 }  // namespace
 
 std::string JsonValue::dump() const {
@@ -383,16 +437,18 @@ const char* json_type_name(JsonValue::Type type) {
   return "unknown";
 }
 
-BatchJob batch_job_from_json(const JsonValue& line) {
+BatchJob batch_job_from_json(const JsonValue& line, bool single) {
   if (!line.is_object()) throw InputError(std::string("a job must be a JSON object, not ") + json_type_name(line.type()));
   BatchJob job;
   if (const JsonValue* id = line.find("id")) job.id = id->is_string() ? id->as_string() : id->dump();
   job.task = string_value(required(line, "task", ""), "task", false);
-  if (job.task != "inbetween" && job.task != "fill" && job.task != "resample" && job.task != "renav")
+  const bool export_only = single && job.task == "export";
+  if (job.task != "inbetween" && job.task != "fill" && job.task != "resample" && job.task != "renav" && !export_only)
     throw InputError("unknown task \"" + job.task +
                      "\" (expected \"inbetween\", \"fill\", \"resample\" or \"renav\")");
   job.in = string_value(required(line, "in", job.task), "in", false);
   job.out = string_value(required(line, "out", job.task), "out", false);
+  if (export_only) return job;
   if (const JsonValue* m = line.find("method")) job.method = string_value(*m, "method", false);
   if (const JsonValue* n = line.find("max_iterations")) {
     job.max_iterations = int_value(*n, "\"max_iterations\"");
@@ -412,45 +468,8 @@ BatchJob batch_job_from_json(const JsonValue& line) {
     }
   }
 
-  if (job.task == "inbetween" || job.task == "fill") read_constraints(line, &job);
-  if (job.task == "inbetween") {
-    job.keyframes = int_array(required(line, "keyframes", job.task), "keyframes");
-    job.has_keyframes = true;
-  } else if (job.task == "fill") {
-    if (const JsonValue* k = line.find("keyframes")) {
-      job.keyframes = int_array(*k, "keyframes");
-      job.has_keyframes = true;
-    } else {
-      const JsonValue& g = required(line, "gap", job.task);
-      if (!g.is_array() || g.as_array().size() != 2)
-        throw InputError("\"gap\" must be an array of two integers [A, B], not " +
-                         (g.is_array() ? g.dump() : std::string(json_type_name(g.type()))));
-      job.gap_begin = int_value(g.as_array()[0], "\"gap\" item 0");
-      job.gap_end = int_value(g.as_array()[1], "\"gap\" item 1");
-      job.has_gap = true;
-    }
-  } else if (job.task == "resample") {
-    const JsonValue& f = required(line, "fps", job.task);
-    if (!f.is_number()) throw InputError(std::string("\"fps\" must be a number, not ") + json_type_name(f.type()));
-    job.fps = f.as_number();
-  } else {  // renav
-    const JsonValue* path = line.find("path");
-    const JsonValue* polyline = line.find("polyline");
-    if ((path != nullptr) == (polyline != nullptr))
-      throw InputError("task \"renav\" needs exactly one of \"path\" and \"polyline\"");
-    job.polyline = polyline != nullptr;
-    job.path_file = string_value(job.polyline ? *polyline : *path, job.polyline ? "polyline" : "path", false);
-    if (const JsonValue* f = line.find("fps")) {
-      if (!f->is_number()) throw InputError(std::string("\"fps\" must be a number, not ") + json_type_name(f->type()));
-      job.fps = f->as_number();
-      if (!(job.fps > 0)) throw InputError("\"fps\" must be positive, not " + f->dump());
-    }
-    if (const JsonValue* n = line.find("frames")) {
-      if (!job.polyline) throw InputError("\"frames\" goes with \"polyline\" (a \"path\" has one point per frame)");
-      job.frames = int_value(*n, "\"frames\"");
-    }
-  }
+  read_task_keys(line, single, &job);
   return job;
 }
 
-}  // namespace motionfield::cli
+}  // namespace motionfield::jobs

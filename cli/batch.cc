@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <mutex>
 #include <sstream>
 #include <string>
@@ -12,10 +13,7 @@
 #include <vector>
 
 #include "commands.h"
-#include "input_error.h"
-#include "job.h"
-#include "jsonl.h"
-#include "models.h"
+#include "motionfield.hpp"
 #include "progress.h"
 
 namespace motionfield::cli {
@@ -31,48 +29,20 @@ std::vector<std::string> read_lines(const std::string& path) {
   return lines;
 }
 
-// The job of one line; `label` gains the job's id once the line parses.
-BatchJob parse_line(const std::string& line, std::string* label) {
-  JsonValue value;
-  try {
-    value = parse_json(line);
-  } catch (const JsonError& e) {
-    throw InputError(std::string("invalid JSON: ") + e.what());
-  }
-  if (const JsonValue* id = value.find("id"))
-    *label += " (id " + (id->is_string() ? id->as_string() : id->dump()) + ")";
-  BatchJob job = batch_job_from_json(value);
-  if (job.in == "-" || job.out == "-")
-    throw InputError("\"-\" (standard input or output) is for single commands, not batch jobs");
-  return job;
-}
-
-// One line's job once run: its report, or why it failed.
+// One line's job, checked by the library, then what its run said.
 struct Outcome {
-  size_t line = 0;        ///< 1-based
-  bool runnable = false;  ///< parsed and its files checked
-  std::string label;
-  BatchJob job;
-  OutputSet files;  ///< the job's files, checked (prepare_job)
-  bool ok = false;
-  JobReport report;
-  Failure failure;
+  size_t line = 0;  ///< 1-based
+  Job job;
+  JobResult result;
 };
 
-// Prints what a finished line says (warnings or the failure; its --json line).
-void print_outcome(const Outcome& o, size_t line, const Settings& settings) {
-  if (o.ok) {
-    if (!settings.quiet) print_warnings(o.report.warnings, o.label + ": ");
-    if (settings.json) std::printf("%s\n", job_json(o.job, &o.report, nullptr, line).c_str());
-  } else {
-    print_failure(o.failure, o.label + ": ");
-    if (settings.json) {
-      Failure shown = o.failure;
-      shown.message = printable(o.failure.message);
-      std::printf("%s\n", job_json(o.job, nullptr, &shown, line).c_str());
-    }
+// Prints what a finished line says (its stderr lines; its --json line).
+void print_outcome(const Outcome& o, const Settings& settings) {
+  std::fputs(o.result.messages.c_str(), stderr);
+  if (settings.json) {
+    std::printf("%s\n", o.result.json.c_str());
+    std::fflush(stdout);
   }
-  if (settings.json) std::fflush(stdout);
 }
 
 // --jobs, else one job per core's worth of --threads: jobs side by side use
@@ -87,61 +57,63 @@ int batch_workers(const Settings& settings) {
 }
 
 // Every line parsed and its files checked first, in line order, against its
-// own and every earlier line's (so that which of two jobs writing one file,
-// or writing what another reads, is refused does not depend on timing); with
-// `load_models`, the model a job needs is loaded here too, once, before any
-// worker runs.
-std::vector<Outcome> prepare_lines(const std::vector<std::string>& lines, const std::string& path,
-                                   const Settings& settings, Models& models, bool load_models) {
+// own and every earlier line's (the runner keeps them); with --jobs N, the
+// model a job needs is loaded here too, once, before any worker runs.
+std::vector<Outcome> check_lines(const std::vector<std::string>& lines, const std::string& path, JobRunner& runner) {
   std::vector<Outcome> outcomes;
-  OutputSet batch_files = OutputSet::create();
   for (size_t i = 0; i < lines.size(); ++i) {
     if (blank(lines[i])) continue;
     Outcome o;
     o.line = i + 1;
-    o.label = path + " line " + std::to_string(o.line);
-    try {
-      o.job = parse_line(lines[i], &o.label);
-      o.files = prepare_job(o.job, settings);
-      batch_files.merge(o.files, "line " + std::to_string(o.line));
-      if (load_models) models.for_method(o.job.task == "renav" && o.job.method.empty() ? "nemf" : o.job.method);
-      o.runnable = true;
-    } catch (...) {
-      o.failure = current_failure();
-    }
+    o.job = runner.check_line(lines[i], o.line, path);
     outcomes.push_back(std::move(o));
   }
   return outcomes;
+}
+
+// Prints the batch's last line (on failures, with --verbose, or after a
+// progress line) and returns its exit code: 1 if a job hit an internal error,
+// else 2 if one had bad input, else 0.
+int summary(const std::string& path, const std::vector<Outcome>& outcomes, const Settings& settings,
+            bool progress_shown) {
+  const int total = static_cast<int>(outcomes.size());
+  int bad = 0, internal = 0;
+  for (const Outcome& o : outcomes)
+    if (o.result.exit_code != kExitOk) ++(o.result.exit_code == kExitBadInput ? bad : internal);
+  const int failed = bad + internal;
+  if (failed > 0 || settings.verbose || (progress_shown && !settings.quiet))
+    std::fprintf(stderr, "motionfield: %s\n",
+                 printable("batch " + path + ": " + std::to_string(total) + " jobs, " + std::to_string(total - failed) +
+                           " ok, " + std::to_string(failed) + " failed")
+                     .c_str());
+  if (internal > 0) return kExitInternal;
+  if (bad > 0) return kExitBadInput;
+  return kExitOk;
 }
 
 }  // namespace
 
 int command_batch(const std::string& path, const Settings& settings) {
   const std::vector<std::string> lines = read_lines(path);
-  Models models(settings.model, settings.transformers());
-  models.load_explicit();
   const int workers = batch_workers(settings);
+  JobRunner runner = make_runner(settings, workers > 1 ? MF_JOB_PRELOAD_MODEL : 0u);
   if (settings.verbose) std::fprintf(stderr, "motionfield: batch: %d job%s at once\n", workers, workers == 1 ? "" : "s");
 
-  std::vector<Outcome> outcomes = prepare_lines(lines, path, settings, models, workers > 1);
+  std::vector<Outcome> outcomes = check_lines(lines, path, runner);
   const int total = static_cast<int>(outcomes.size());
 
   ProgressLine progress(ProgressLine::stderr_is_terminal() && !settings.quiet);
   const auto run = [&](size_t k, ProgressLine& line) {
-    if (!outcomes[k].runnable) return;
-    try {
-      outcomes[k].report = run_job(outcomes[k].job, std::move(outcomes[k].files), settings, models, line);
-      outcomes[k].ok = true;
-    } catch (...) {
-      outcomes[k].failure = current_failure();
-    }
+    std::function<bool(const mf_progress&)> report;
+    if (line.enabled()) report = [&line](const mf_progress& p) { return line.update(p); };
+    outcomes[k].result = runner.run(outcomes[k].job, report);
     line.clear();
   };
   if (workers <= 1) {
     for (size_t k = 0; k < outcomes.size(); ++k) {
       progress.start("[" + std::to_string(k + 1) + "/" + std::to_string(total) + "] line " + std::to_string(outcomes[k].line));
       run(k, progress);
-      print_outcome(outcomes[k], outcomes[k].line, settings);
+      print_outcome(outcomes[k], settings);
     }
   } else {
     // Workers share the model (the C API's tasks are thread-safe on one model);
@@ -167,7 +139,7 @@ int command_batch(const std::string& path, const Settings& settings) {
         ++done;
         progress.clear();
         for (; printed < outcomes.size() && finished[printed]; ++printed)
-          print_outcome(outcomes[printed], outcomes[printed].line, settings);
+          print_outcome(outcomes[printed], settings);
         jobs_done();
       }
     };
@@ -178,18 +150,7 @@ int command_batch(const std::string& path, const Settings& settings) {
   }
   progress.clear();
 
-  int bad = 0, internal = 0;
-  for (const Outcome& o : outcomes)
-    if (!o.ok) ++(o.failure.exit_code == kExitBadInput ? bad : internal);
-  const int failed = bad + internal;
-  if (failed > 0 || settings.verbose || (progress.enabled() && !settings.quiet))
-    std::fprintf(stderr, "motionfield: %s\n",
-                 printable("batch " + path + ": " + std::to_string(total) + " jobs, " + std::to_string(total - failed) +
-                           " ok, " + std::to_string(failed) + " failed")
-                     .c_str());
-  if (internal > 0) return kExitInternal;
-  if (bad > 0) return kExitBadInput;
-  return kExitOk;
+  return summary(path, outcomes, settings, progress.enabled());
 }
 
 }  // namespace motionfield::cli
