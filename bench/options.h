@@ -78,6 +78,16 @@ using NamedHelp = std::vector<std::pair<std::string, std::string>>;
 void add_number_options(CLI::App& app, std::map<std::string, double>& numbers, const NamedHelp& options,
                         const std::string& group);
 
+/// Moves numbers[key], when given, into *field (converted to its type) and
+/// erases it, so that what is left over at the end was not used.
+template <class T>
+void take_number(std::map<std::string, double>& numbers, const char* key, T* field) {
+  auto it = numbers.find(key);
+  if (it == numbers.end()) return;
+  *field = static_cast<T>(it->second);
+  numbers.erase(it);
+}
+
 /// "program arg1 arg2 ..." for the header of a report.
 std::string command_line(const std::string& program, int argc, char** argv);
 

@@ -127,12 +127,7 @@ mf::RenavOptions options_for(const Args& a, const std::string& method) {
   mf::RenavOptions o =
       mf::default_renav_options(method == "nemf-adam" ? mf::LatentOptimizer::Adam : mf::LatentOptimizer::Lbfgs);
   std::map<std::string, double> n = a.numbers;
-  auto take = [&](const char* key, auto* field) {
-    auto it = n.find(key);
-    if (it == n.end()) return;
-    *field = static_cast<std::remove_reference_t<decltype(*field)>>(it->second);
-    n.erase(it);
-  };
+  auto take = [&](const char* key, auto* field) { mf::bench::take_number(n, key, field); };
   if (method == "nemf") {
     take("iterations", &o.max_iterations);
     n.erase("adam-iterations");

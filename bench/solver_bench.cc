@@ -175,12 +175,7 @@ mf::LatentSolverOptions solver_options(const Args& a, const std::string& method)
   mf::LatentSolverOptions o =
       mf::default_solver_options(method == "nemf-adam" ? mf::LatentOptimizer::Adam : mf::LatentOptimizer::Lbfgs);
   std::map<std::string, double> n = a.numbers;
-  auto take = [&](const char* key, auto* field) {
-    auto it = n.find(key);
-    if (it == n.end()) return;
-    *field = static_cast<std::remove_reference_t<decltype(*field)>>(it->second);
-    n.erase(it);
-  };
+  auto take = [&](const char* key, auto* field) { mf::bench::take_number(n, key, field); };
   if (method == "nemf" || !transformer_initializer(method).empty()) {
     take("iterations", &o.max_iterations);
     take("ftol", &o.function_tolerance);
