@@ -112,21 +112,23 @@ void add_options(CLI::App& app, Args& a) {
                                 {{"iterations", "L-BFGS iteration cap per window (0: the default)"},
                                  {"adam-iterations", "Adam iteration cap per window (0: the default)"},
                                  {"ftol", "relative function tolerance"},
-                                 {"overlap", "frames shared by consecutive windows"},
-                                 {"w-path", "weight of the root path"},
+                                 {"overlap", "frames shared by consecutive windows"}},
+                                "Solver settings (default: tasks/renav/renav.h)");
+  mf::bench::add_number_options(app, a.numbers,
+                                {{"w-path", "weight of the root path"},
                                  {"w-joints", "weight of the soft-DTW divergence of the joints"},
                                  {"w-heading", "weight of the soft-DTW divergence of the heading"},
                                  {"w-skate", "weight of foot skating"},
                                  {"w-continuity", "weight of the continuity with the previous window"},
                                  {"lock-ramp", "foot locking ramp in frames (negative: no foot locking)"},
                                  {"match-pace", "1: play the reference at the path's pace (the default), 0: as it is"}},
-                                "Solver settings (default: tasks/renav/renav.h)");
+                                "Energy weights and output (default: tasks/renav/renav.h)");
 }
 
 mf::RenavOptions options_for(const Args& a, const std::string& method) {
+  std::map<std::string, double> n = a.numbers;
   mf::RenavOptions o =
       mf::default_renav_options(method == "nemf-adam" ? mf::LatentOptimizer::Adam : mf::LatentOptimizer::Lbfgs);
-  std::map<std::string, double> n = a.numbers;
   auto take = [&](const char* key, auto* field) { mf::bench::take_number(n, key, field); };
   if (method == "nemf") {
     take("iterations", &o.max_iterations);
