@@ -136,7 +136,7 @@ def files(paths):
 def main():
     signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # quiet under `| head`
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--max", type=int, default=80, help="longest allowed function, in lines (default 80)")
+    parser.add_argument("--max", type=int, default=60, help="longest allowed function, in lines (default 60)")
     parser.add_argument("--all", action="store_true", help="list every function, not only the long ones")
     parser.add_argument("paths", nargs="*", default=DEFAULT_PATHS)
     args = parser.parse_args()
