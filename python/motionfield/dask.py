@@ -117,7 +117,10 @@ def _client(args: argparse.Namespace):  # type: ignore[no-untyped-def]
         return distributed.Client(args.scheduler), None
     # CRITICAL, not ERROR: a worker process of our own cluster may log "Scheduler was unaware of this
     # worker" while the cluster closes; that is not the user's business, and a job's failure comes back
-    # through its future.
+    # through its future. Likewise the worker's warning that its scratch directory took over a second
+    # on a loaded machine (a Python warning in the spawned process, so it goes through the environment).
+    scratch = "ignore:Creating scratch directories"
+    os.environ["PYTHONWARNINGS"] = ",".join(w for w in (os.environ.get("PYTHONWARNINGS"), scratch) if w)
     cluster = distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
                                        dashboard_address=None, silence_logs=logging.CRITICAL, memory_limit=0)
     return distributed.Client(cluster), cluster
