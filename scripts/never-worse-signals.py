@@ -56,11 +56,15 @@ def data_energy(row, stage):
     return sum(vals) if vals else np.nan
 
 
+RULE_SIGNAL = "final data terms (nemf-detail)"
+RULE_SIGNAL_PER_CM = "final data terms / key motion"
 SIGNALS = {
     "final data terms (nemf-detail)": lambda w: data_energy(w["nemf-detail"], "final"),
     "initial data terms (detail start, encoded)": lambda w: data_energy(w["nemf-detail"], "initial"),
     "final / initial data terms": lambda w: data_energy(w["nemf-detail"], "final")
     / max(data_energy(w["nemf-detail"], "initial"), 1e-12),
+    "final data terms / key motion": lambda w: data_energy(w["nemf-detail"], "final")
+    / max(number(w["interp"], "key_motion_cm"), 1e-6),
     "final rotation term": lambda w: number(w["nemf-detail"], "final.rotation"),
     "final position term": lambda w: number(w["nemf-detail"], "final.position"),
     "final total energy": lambda w: sum(
@@ -183,11 +187,29 @@ def quantile_table(eval_items):
         print(f"| {name} | " + " | ".join(cells) + " |")
 
 
+def fixed_rule(task, row, eval_items, t, t_per_cm):
+    """The fallback "interpolation when the final data terms exceed t and, divided by the key
+    motion, t_per_cm", per group."""
+    interp, nemf, _, idx, signals = arrays(eval_items)
+    data = np.nan_to_num(signals[RULE_SIGNAL], nan=-np.inf)
+    per_cm = np.nan_to_num(signals[RULE_SIGNAL_PER_CM], nan=-np.inf)
+    s = np.where((data > t) & (per_cm > t_per_cm), 1.0, 0.0)
+    cells = []
+    for g, i in idx.items():
+        h, hf = hard_ratio(s[i], nemf[i], interp[i], 0.5)
+        cells.append(f"{g[1]} ({g[0]}): {nemf[i].mean() / interp[i].mean():.3f} -> {h:.3f} ({hf:.2f} fall back)")
+    print(f"\nFixed rule on {task} {row}, {RULE_SIGNAL} > {t:g} and per cm of key motion > {t_per_cm:g}: " + "; ".join(cells) + "\n")
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("csv", nargs="+", help="the windows to evaluate on")
     ap.add_argument("--tune-csv", nargs="+", default=None,
                     help="choose the thresholds on these windows instead (they are left out of the evaluation)")
+    ap.add_argument("--fixed", type=float, default=None,
+                    help="also report the fallback at this threshold of the final data terms")
+    ap.add_argument("--fixed-per-cm", type=float, default=0.0,
+                    help="with --fixed: fall back only when the final data terms per cm of key motion also exceed this")
     args = ap.parse_args()
     windows = load(args.csv)
     tune_windows = load(args.tune_csv) if args.tune_csv else windows
@@ -201,6 +223,8 @@ def main():
         if (task, row) in tune_rows:
             report_row(task, row, tune_rows[(task, row)], items, label)
             quantile_table(items)
+        if args.fixed is not None:
+            fixed_rule(task, row, items, args.fixed, args.fixed_per_cm)
 
 
 if __name__ == "__main__":
