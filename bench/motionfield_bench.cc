@@ -73,6 +73,7 @@ struct Args {
   bool l2t = false;
   std::string dataset = "bandai";  // or "foreign": real capture on other rigs (bench/foreign_data.h)
   std::string foreign_source = mf::default_foreign_archive();
+  std::string windows_csv;  // per-window scores and signals (bench/window_log.h)
 };
 
 void add_options(CLI::App& app, Args& args) {
@@ -119,6 +120,10 @@ void add_options(CLI::App& app, Args& args) {
                  "gets it, scored on the model's rig, with tables per rig convention and content")
       ->check(CLI::IsMember({"bandai", "foreign"}));
   app.add_option("--foreign-source", args.foreign_source, "the foreign capture (folder or archive)");
+  app.add_option("--windows-csv", args.windows_csv,
+                 "also write one CSV row per (task row, window, method) of the gap, sparse and resample tables: the "
+                 "window's L2P and L2Q and the signals of bench/window_log.h (foreign: the windows of the content "
+                 "groups)");
   app.add_flag("--print-stats", args.print_stats,
                "add the table of training statistics (position mean / std, standing heights)");
 }
@@ -198,7 +203,8 @@ std::vector<ForeignGroup> foreign_groups(const std::vector<mf::bench::ForeignCli
 // ratio to interpolation's, per group of clips (all, per rig convention, per
 // content).
 void run_foreign(const Args& args, const mf::TaskContext& ctx, const mf::bench::EvalStats& stats,
-                 mf::bench::ProtocolOptions options, const std::function<void(const std::string&)>& emit) {
+                 mf::bench::ProtocolOptions options, const std::function<void(const std::string&)>& emit,
+                 mf::bench::WindowLog* log) {
   const mf::bench::ForeignData data =
       mf::bench::load_foreign_data(args.foreign_source, args.data.cache_dir, ctx.model->config().fps, true);
   const std::vector<mf::bench::ForeignClip>& clips = args.split.split == "train" ? data.train : data.validation;
@@ -210,6 +216,8 @@ void run_foreign(const Args& args, const mf::TaskContext& ctx, const mf::bench::
          << fixed(c.source_fps, 0) << " fps given, " << c.clip.motion.num_frames() << " frames at "
          << fixed(c.clip.motion.fps, 0) << " fps\n";
   emit(head.str() + "\n");
+  if (log)
+    for (const mf::bench::ForeignClip& c : clips) log->set_labels(c.clip.name, {c.convention, c.content});
   const std::vector<ForeignGroup> groups = foreign_groups(clips, ctx);
   std::vector<std::string> methods{"interp"};
   for (const std::string& m : args.methods)
@@ -227,7 +235,10 @@ void run_foreign(const Args& args, const mf::TaskContext& ctx, const mf::bench::
                   << "\n";
         mf::bench::ProtocolOptions o = options;
         o.clip_to_model = groups[g].to_model;
+        // The content groups partition the clips: each window is logged once.
+        o.window_log = groups[g].name.rfind("content: ", 0) == 0 ? log : nullptr;
         results[g].push_back(mf::bench::run_task(task, groups[g].clips, stats, method, o, ctx));
+        if (o.window_log) o.window_log->write_csv(args.windows_csv);  // so far, in case the run is stopped
       }
     }
     if (ran.empty()) continue;
@@ -345,8 +356,10 @@ int run(Args& args, const std::string& command) {
   options.trajectory = args.trajectory;
   options.l2t = args.l2t || args.trajectory;
   if (!args.rig.empty()) emit("- rig: " + args.rig + " (bench/synthetic_rigs.h)\n\n");
+  mf::bench::WindowLog window_log(args.dataset, {args.rig.empty() ? "native" : args.rig, ""});
+  if (!args.windows_csv.empty()) options.window_log = &window_log;
   if (args.dataset == "foreign") {
-    run_foreign(args, ctx, stats, options, emit);
+    run_foreign(args, ctx, stats, options, emit, options.window_log);
     args.tasks.clear();
   }
   for (mf::bench::Task task : args.tasks) {
@@ -386,6 +399,7 @@ int run(Args& args, const std::string& command) {
       std::cerr << "running " << mf::bench::task_name(task) << " / " << method << "\n";
       const mf::bench::TaskResult result = mf::bench::run_task(task, clips, stats, method, options, ctx);
       emit(mf::bench::format_table(result, args.l2p_axes) + "\n");
+      if (options.window_log) window_log.write_csv(args.windows_csv);  // so far, in case the run is stopped
     }
   }
 

@@ -92,6 +92,27 @@ std::pair<Motion, Motion> predict_window(const std::vector<Clip>& clips, const W
   return {transform_motion(truth, t), transform_motion(to_model.to_model(pred_user), t)};
 }
 
+// `ctx`, with a sink for the method's diagnostics when windows are logged.
+TaskContext logging_context(const TaskContext& ctx, const ProtocolOptions& options,
+                            std::vector<std::pair<std::string, double>>* diagnostics) {
+  TaskContext c = ctx;
+  if (options.window_log) c.diagnostics = diagnostics;
+  return c;
+}
+
+// Records a scored window in options.window_log, when set.
+void log_window(const ProtocolOptions& options, const EvalStats& stats, const Clip& clip, Task task,
+                const std::string& row, const Window& w, const std::string& method, ScoredWindow scored) {
+  if (!options.window_log) return;
+  WindowRecord r;
+  r.clip = clip.name;
+  r.task = task_name(task);
+  r.row = row;
+  r.method = method;
+  r.start = w.start;
+  options.window_log->add(stats, std::move(r), scored);
+}
+
 }  // namespace
 
 const char* task_name(Task task) {
@@ -220,11 +241,15 @@ TaskResult run_gap_filling(const std::vector<Clip>& clips, const EvalStats& stat
     MetricAccumulator acc(stats, options.root_forward);
     double ms = 0.0;
     for (const Window& w : windows) {
+      std::vector<std::pair<std::string, double>> diagnostics;
+      const TaskContext window_ctx = logging_context(ctx, options, &diagnostics);
       const auto t0 = Clock::now();
-      const auto [truth, pred] = fill_gap(clips, w, known, a, b, method, options, ctx);
+      const auto [truth, pred] = fill_gap(clips, w, known, a, b, method, options, window_ctx);
       ms += ms_since(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, known);
+      log_window(options, stats, clips[w.clip], Task::Gap, std::to_string(T), w, method,
+                 {&truth, &pred, &evaluated, &known, std::move(diagnostics)});
     }
     RowResult row;
     row.parameter = T;
@@ -255,13 +280,17 @@ TaskResult run_sparse_keyframes(const std::vector<Clip>& clips, const EvalStats&
     int used = 0;
     for (const Window& w : windows) {
       if (evaluated.empty()) break;  // spacing 1: nothing to evaluate
+      std::vector<std::pair<std::string, double>> diagnostics;
+      const TaskContext window_ctx = logging_context(ctx, options, &diagnostics);
       const auto t0 = Clock::now();
       const auto [truth, pred] = predict_window(clips, w, 0, keys, options, [&](const Motion& input, const std::vector<int>& k) {
-        return run_inbetween(input, k, method, ctx);
+        return run_inbetween(input, k, method, window_ctx);
       }, method);
       ms += ms_since(t0);
       check_prediction(pred, truth, method);
       acc.add(truth, pred, evaluated, keys);
+      log_window(options, stats, clips[w.clip], Task::Sparse, std::to_string(k), w, method,
+                 {&truth, &pred, &evaluated, &keys, std::move(diagnostics)});
       ++used;
     }
     RowResult row;
@@ -326,18 +355,23 @@ TaskResult run_resampling(const std::vector<Clip>& clips, const EvalStats& stats
         return m;
       };
       const Motion input = every(a), truth_user = every(b);
+      std::vector<std::pair<std::string, double>> diagnostics;
+      const TaskContext window_ctx = logging_context(ctx, options, &diagnostics);
       const auto t0 = Clock::now();
-      const Motion pred_user = run_resample(input, truth_user.fps, method, nullptr, ctx);
+      const Motion pred_user = run_resample(input, truth_user.fps, method, nullptr, window_ctx);
       ms += ms_since(t0);
       check_prediction(pred_user, truth_user, method);
-      if (!foreign) {
-        acc.add(truth_user, pred_user, evaluated, known);
-        continue;
+      Motion truth = truth_user, pred = pred_user;
+      if (foreign) {
+        const Retargeter& to_model = *options.clip_to_model.at(w.clip);
+        truth = to_model.to_model(truth_user);
+        const RigidTransform t = canonical_transform(truth, 0, options.root_forward);
+        truth = transform_motion(truth, t);
+        pred = transform_motion(to_model.to_model(pred_user), t);
       }
-      const Retargeter& to_model = *options.clip_to_model.at(w.clip);
-      const Motion truth = to_model.to_model(truth_user);
-      const RigidTransform t = canonical_transform(truth, 0, options.root_forward);
-      acc.add(transform_motion(truth, t), transform_motion(to_model.to_model(pred_user), t), evaluated, known);
+      acc.add(truth, pred, evaluated, known);
+      log_window(options, stats, clips[w.clip], Task::Resample, ratio.label(), w, method,
+                 {&truth, &pred, &evaluated, &known, std::move(diagnostics)});
     }
     RowResult row;
     row.parameter = a;

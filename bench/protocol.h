@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/window_log.h"
 #include "prior/data/dataset.h"
 #include "prior/rig/retarget.h"
 #include "tasks/constraints/motion_constraints.h"
@@ -103,6 +104,9 @@ struct ProtocolOptions {
   /// model's rig and canonicalised by the truth's transform for the metrics.
   /// Empty: the clips are on the native rig.
   std::vector<std::shared_ptr<const Retargeter>> clip_to_model;
+  /// When set, every scored window is also recorded there (bench/window_log.h),
+  /// with the method's diagnostics (TaskContext::diagnostics). Not owned.
+  WindowLog* window_log = nullptr;
 };
 
 /// The ground truth's trajectory rows (trajectory_features(), frames a..b-1)

@@ -197,6 +197,28 @@ TEST(LatentSolver, KnownFramesComeOutExactlyAndUnknownFramesAreNeverRead) {
   EXPECT_EQ(max_abs_difference(out, again), 0.0);
 }
 
+TEST(LatentSolver, DiagnosticsCarryEachWindowsEnergyTerms) {
+  at::set_num_threads(1);
+  NemfModel model = tiny_model();
+  Motion m = test::random_motion(model.rig().skeleton, 26, 30.0, 7);
+  std::vector<std::pair<std::string, double>> diagnostics;
+  TaskContext ctx;
+  ctx.diagnostics = &diagnostics;
+  CompletionReport report;
+  const Motion out =
+      complete_motion(model, m, MotionConstraints::full_pose({0, 6, 13, 25}), quick(LatentOptimizer::Lbfgs), ctx, &report);
+  ASSERT_EQ(report.windows.size(), 1u);
+  std::vector<std::pair<std::string, double>> expected;
+  for (const auto& [name, value] : report.windows[0].initial_terms) expected.emplace_back("initial." + name, value);
+  for (const auto& [name, value] : report.windows[0].final_terms) expected.emplace_back("final." + name, value);
+  ASSERT_FALSE(expected.empty());
+  EXPECT_EQ(diagnostics, expected);
+  // The sink changes nothing in the result.
+  const Motion plain = complete_motion(model, m, MotionConstraints::full_pose({0, 6, 13, 25}),
+                                       quick(LatentOptimizer::Lbfgs));
+  EXPECT_EQ(max_abs_difference(out, plain), 0.0);
+}
+
 TEST(LatentSolver, DeterministicForTheSameInput) {
   at::set_num_threads(1);
   NemfModel model = tiny_model();

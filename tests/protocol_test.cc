@@ -4,7 +4,9 @@
 #include <ATen/ATen.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "prior/model/nemf.h"
@@ -223,6 +225,76 @@ TEST(ProtocolTest, TheContextReachesMethodsThatNeedTheModel) {
   EXPECT_LT(r.rows[0].metrics.known.position_max_cm, 1e-6);
   EXPECT_LT(r.rows[0].metrics.known.rotation_max_deg, 1e-6);
   EXPECT_GT(r.rows[0].metrics.mpjpe_cm, 0.0);
+}
+
+// Splits CSV text into rows of cells (no quoting in the window log).
+std::vector<std::vector<std::string>> csv_rows(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    std::vector<std::string> cells;
+    std::string cell;
+    std::istringstream in(line);
+    while (std::getline(in, cell, ',')) cells.push_back(cell);
+    if (!line.empty() && line.back() == ',') cells.push_back("");
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+TEST(ProtocolTest, WindowLogHasOneRowPerWindowAndMethod) {
+  const EvalStats stats = small_stats();
+  std::vector<Clip> val = {make_clip("v1", linear_root_motion(100, 21)), make_clip("v2", linear_root_motion(60, 22))};
+  WindowLog log("bandai", {"native", ""});
+  ProtocolOptions options;
+  options.gap_lengths = {5, 30};
+  options.window_log = &log;
+  run_gap_filling(val, stats, "interp", options);
+  run_gap_filling(val, stats, "zerovel", options);
+  const auto rows = csv_rows(log.csv());
+  const std::vector<std::string> header = {"dataset", "rig", "content", "clip", "task", "row",
+                                           "method", "start", "l2p", "l2q", "l2p_to_interp", "key_motion_cm"};
+  ASSERT_EQ(rows.size(), 1u + 2 * (5 + 3));  // windows of T = 5 and 30 (GapFillingCounts...), two methods
+  EXPECT_EQ(rows[0], header);
+  for (size_t i = 1; i < rows.size(); ++i) {
+    ASSERT_EQ(rows[i].size(), header.size()) << i;
+    EXPECT_EQ(rows[i][0], "bandai");
+    EXPECT_EQ(rows[i][4], "gap");
+  }
+  EXPECT_EQ(rows[1][3], "v1");
+  EXPECT_EQ(rows[1][5], "5");
+  EXPECT_EQ(rows[1][6], "interp");
+  EXPECT_EQ(rows[1][10], "");  // interpolation is the reference itself
+  // Interpolation is exact on these clips: zero velocity's distance to it is its error.
+  for (const WindowRecord& r : log.records()) {
+    EXPECT_GT(r.key_motion_cm, 0.0);
+    if (r.method == "interp") {
+      EXPECT_NEAR(r.l2p, 0.0, 1e-6);
+    } else {
+      EXPECT_GT(r.l2p, 0.0);
+      EXPECT_NEAR(r.l2p_to_interp, r.l2p, 1e-6);
+    }
+  }
+}
+
+TEST(ProtocolTest, WindowLogKeepsTheSolversEnergyTerms) {
+  const EvalStats stats = small_stats();
+  std::vector<Clip> val = {make_clip("v", test::random_motion(test::small_skeleton(), 40, 30.0, 50))};
+  TaskContext ctx;
+  ctx.model = std::make_shared<const NemfModel>(test::tiny_prior());
+  ctx.max_iterations = 2;
+  WindowLog log("bandai");
+  ProtocolOptions options;
+  options.gap_lengths = {5};
+  options.window_log = &log;
+  run_gap_filling(val, stats, "nemf", options, ctx);
+  ASSERT_EQ(log.records().size(), 1u);  // 16 frames at 0 (40 would need 56)
+  const auto rows = csv_rows(log.csv());
+  ASSERT_EQ(rows.size(), 2u);
+  const auto column = std::find(rows[0].begin(), rows[0].end(), "final.rotation");
+  ASSERT_NE(column, rows[0].end());
+  EXPECT_GE(std::stod(rows[1][column - rows[0].begin()]), 0.0);
+  EXPECT_NE(std::find(rows[0].begin(), rows[0].end(), "initial.rotation"), rows[0].end());
 }
 
 TEST(ProtocolTest, ResamplingRowsPerFactorKeepEveryKthFrame) {

@@ -11,6 +11,8 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace mf {
 
@@ -89,6 +91,12 @@ struct TaskContext : ModelSet {
   /// windowed): set on a copy of the context per window, passed on in reports.
   int window = 0;
   int window_count = 0;
+  /// Where methods append named numbers about their solve, for benchmarks
+  /// and diagnostics (the latent solvers: each window's energy terms before
+  /// and after the minimisation, complete_motion() in
+  /// tasks/latent/latent_solver.h). Null: none are kept. Not thread-safe: one
+  /// sink per concurrent call.
+  std::vector<std::pair<std::string, double>>* diagnostics = nullptr;
 
   /// Calls `progress` (with this context's window) and checks `cancel`;
   /// throws CancelledError when asked to stop.

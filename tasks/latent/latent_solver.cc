@@ -280,6 +280,16 @@ void make_known_values_exact(const RigInfo& rig, const Motion& input, const Moti
   rep->effectors = effector_error(*out, constraints);
 }
 
+// Each window's weighted energy terms, "initial.<term>" and "final.<term>",
+// one entry per window and term (TaskContext::diagnostics).
+void append_term_diagnostics(const std::vector<SolveSummary>& windows,
+                             std::vector<std::pair<std::string, double>>* out) {
+  for (const SolveSummary& s : windows) {
+    for (const auto& [name, value] : s.initial_terms) out->emplace_back("initial." + name, value);
+    for (const auto& [name, value] : s.final_terms) out->emplace_back("final." + name, value);
+  }
+}
+
 }  // namespace
 
 WindowCaps window_caps(const LatentSolverOptions& o, const std::vector<int>& key_frames, bool has_effectors, int T) {
@@ -371,6 +381,7 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
   WindowedSolution solved = solve_windows(model, input, constraints, plan, options, ctx, &rep);
   make_known_values_exact(model.rig(), input, constraints, options, solved.contacts, &solved.motion, &rep);
   rep.wall_ms = ms_since(t0);
+  if (ctx.diagnostics) append_term_diagnostics(rep.windows, ctx.diagnostics);
   if (report) *report = std::move(rep);
   return std::move(solved.motion);
 }

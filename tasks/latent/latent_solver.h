@@ -181,7 +181,9 @@ struct CompletionReport {
 
 /// Completes `input` under `constraints` (validated; unconstrained values of
 /// the input are never read). The output has the input's skeleton, length and
-/// fps. Throws mf::InputError on bad constraints, a skeleton that does not
+/// fps. With ctx.diagnostics, each window's weighted energy terms before and
+/// after its minimisation are appended to it ("initial.<term>",
+/// "final.<term>"; one entry per window and term). Throws mf::InputError on bad constraints, a skeleton that does not
 /// match the model or bad options; CancelledError when cancelled.
 Motion complete_motion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
                        const LatentSolverOptions& options, const TaskContext& ctx = {},
