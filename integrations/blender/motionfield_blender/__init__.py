@@ -31,7 +31,7 @@ bl_info = {
 import bpy
 from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
-from . import animation, convert, engine
+from . import animation, convert, engine, motion_io, rig_info
 
 # ------------------------------------------------------------------ preferences
 
@@ -109,7 +109,8 @@ class MotionfieldSettings(bpy.types.PropertyGroup):
                                         "automatic map (docs/RIGS.md); empty: automatic")
     root_bone: StringProperty(name="Root bone",
                               description="The bone whose translation moves the character; its tree is "
-                                          "converted. Empty: the armature's root bone")
+                                          "converted. Empty: found from the action (the first bone below "
+                                          "static container bones that moves)")
     seed: IntProperty(name="Seed", min=0, default=0)
     max_iterations: IntProperty(name="Iterations", min=0, default=0,
                                 description="Iteration budget of the solvers (per window of the full solve); "
@@ -152,7 +153,8 @@ class _TaskOperator:
         s = context.scene.motionfield
         self.mf = _mf()
         self.obj = context.active_object
-        self.rig = convert.Rig(self.obj, s.root_bone, convert.metres_per_unit(context.scene, self.obj))
+        self.rig = convert.Rig(self.obj, rig_info.root_name(s, self.obj),
+                               convert.metres_per_unit(context.scene, self.obj))
         self.keyed = animation.keyed_frames(self.obj, self.rig.names)
         if len(self.keyed) < 2:
             raise ValueError("the action has fewer than two keyed frames on the rig's bones")
@@ -400,7 +402,56 @@ class MOTIONFIELD_OT_follow_path(_TaskOperator, bpy.types.Operator):
         return run, finish
 
 
+class MOTIONFIELD_OT_set_root(bpy.types.Operator):
+    """Use this bone as the root bone (empty: find the root from the action)"""
+    bl_idname = "motionfield.set_root"
+    bl_label = "Set root bone"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    bone: StringProperty(name="Bone")
+
+    def execute(self, context):
+        context.scene.motionfield.root_bone = self.bone
+        return {'FINISHED'}
+
+
 # ------------------------------------------------------------------ panel
+
+
+def draw_rig(layout, context, mf):
+    """The rig box: the root bone (found or set, with a one-click change) and
+    the library's map of the rig onto the model's."""
+    s, obj = context.scene.motionfield, context.active_object
+    box = layout.box()
+    box.label(text="Rig", icon='ARMATURE_DATA')
+    if obj is None or obj.type != 'ARMATURE':
+        box.label(text="Select an armature")
+        return
+    try:
+        root = rig_info.root_name(s, obj)
+    except convert.RigError as e:
+        box.label(text=str(e), icon='ERROR')
+        return
+    row = box.row(align=True)
+    row.label(text="Root bone: %s (%s)" % (root, "set" if s.root_bone else "found"), icon='BONE_DATA')
+    active = context.active_bone
+    if s.root_bone:
+        row.operator(MOTIONFIELD_OT_set_root.bl_idname, text="Find", icon='LOOP_BACK').bone = ""
+    elif active is not None and active.name != root:
+        row.operator(MOTIONFIELD_OT_set_root.bl_idname, text="Use %s" % active.name, icon='EYEDROPPER').bone = \
+            active.name
+    model = None
+    try:
+        model = engine.model(bpy.path.abspath(s.model_path))
+    except Exception as e:  # no model: the map cannot be told
+        box.label(text="Model: %s" % e, icon='ERROR')
+        return
+    d, error = rig_info.describe(mf, obj, root, convert.metres_per_unit(context.scene, obj),
+                                 bpy.path.abspath(s.rig_map) if s.rig_map else "", model)
+    if error:
+        box.label(text="Rig map: %s" % error, icon='ERROR')
+    else:
+        box.label(text="Rig map: " + rig_info.summary(d), icon='CHECKMARK')
 
 
 class MOTIONFIELD_PT_panel(bpy.types.Panel):
@@ -418,6 +469,7 @@ class MOTIONFIELD_PT_panel(bpy.types.Panel):
             layout.label(text=str(e), icon='ERROR')
             return
         obj = context.active_object
+        draw_rig(layout, context, _mf())
         col = layout.column()
         col.prop(s, "model_path")
         col.prop(s, "rig_map")
@@ -440,8 +492,8 @@ class MOTIONFIELD_PT_panel(bpy.types.Panel):
         box.operator(MOTIONFIELD_OT_follow_path.bl_idname)
 
 
-_classes = (MOTIONFIELD_AP_preferences, MotionfieldSettings, MOTIONFIELD_OT_inbetween, MOTIONFIELD_OT_fill,
-            MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path, MOTIONFIELD_PT_panel)
+_classes = (MOTIONFIELD_AP_preferences, MotionfieldSettings, MOTIONFIELD_OT_set_root, MOTIONFIELD_OT_inbetween,
+            MOTIONFIELD_OT_fill, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path, MOTIONFIELD_PT_panel)
 
 
 def register():

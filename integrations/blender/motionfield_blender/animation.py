@@ -115,15 +115,9 @@ def insert_keys(obj, rig, sampled, values, new, keyed):
     return written
 
 
-def new_action_with(obj, rig, motion_rot, motion_root, first_frame, suffix, parent_pose):
-    """A copy of the armature's action whose rig channels are replaced by the
-    motion from `first_frame` on; assigned to the armature. The old action is
-    kept (fake user) so that nothing is lost."""
-    old = obj.animation_data.action
-    act = old.copy()
-    act.name = old.name + suffix
-    old.use_fake_user = True
-    mats = convert.pose_matrices(rig, motion_rot, motion_root)
+def motion_channels(obj, rig, mats, parent_pose):
+    """{(bone, path): [value per frame]} of the armature-space matrices `mats`
+    (pose_matrices()), continuous from frame to frame."""
     chans = channel_paths(obj, rig)
     seqs = {(b, p): [] for b, p, _, _ in chans}
     for mf in mats:
@@ -134,8 +128,13 @@ def new_action_with(obj, rig, motion_rot, motion_root, first_frame, suffix, pare
             prev = seq[-1] if seq else None
             seq.append(convert.euler_from_basis(m, mode, prev) if p == "rotation_euler"
                        else convert.channel_from_basis(m, p, prev))
-    obj.animation_data.action = act
-    fcurves = fcurves_of(obj, act)
+    return seqs
+
+
+def write_channels(obj, action, seqs, first_frame, interpolation):
+    """Replaces the keys of the channels in `seqs` in `action` by one key a
+    frame from `first_frame` on."""
+    fcurves = fcurves_of(obj, action)
     for (b, p), seq in seqs.items():
         for c in range(len(seq[0])):
             fc = _fcurve(fcurves, b, p, c, True)
@@ -146,6 +145,51 @@ def new_action_with(obj, rig, motion_rot, motion_root, first_frame, suffix, pare
                 co += [float(first_frame + i), float(v[c])]
             fc.keyframe_points.foreach_set("co", co)
             for k in fc.keyframe_points:
-                k.interpolation = 'LINEAR'
+                k.interpolation = interpolation
             fc.update()
+
+
+def new_action_with(obj, rig, motion_rot, motion_root, first_frame, suffix, parent_pose):
+    """A copy of the armature's action whose rig channels are replaced by the
+    motion from `first_frame` on; assigned to the armature. The old action is
+    kept (fake user) so that nothing is lost."""
+    old = obj.animation_data.action
+    act = old.copy()
+    act.name = old.name + suffix
+    old.use_fake_user = True
+    seqs = motion_channels(obj, rig, convert.pose_matrices(rig, motion_rot, motion_root), parent_pose)
+    obj.animation_data.action = act
+    write_channels(obj, act, seqs, first_frame, 'LINEAR')
     return act
+
+
+def moving_bones(obj):
+    """Names of the bones whose keyed channels change over the action."""
+    out = set()
+    if obj.animation_data is None or obj.animation_data.action is None:
+        return out
+    for fc in fcurves_of(obj):
+        name = bone_of(fc.data_path)
+        if name is None or name in out or len(fc.keyframe_points) < 2:
+            continue
+        values = [0.0] * (2 * len(fc.keyframe_points))
+        fc.keyframe_points.foreach_get("co", values)
+        if max(values[1::2]) - min(values[1::2]) > EPS:
+            out.add(name)
+    return out
+
+
+def travel_root(obj):
+    """The bone that carries the character: from the armature's root bone (of
+    the biggest tree) down through static container bones (a BVH import's
+    `joint_Root` above `Hips`, Unreal's `root` above `pelvis`) to the first
+    bone that moves, following the child with the biggest tree; the armature's
+    root bone when nothing below it moves."""
+    bone = convert.default_root(obj.data)
+    moving = moving_bones(obj)
+    while bone.name not in moving and bone.children:
+        main = max(bone.children, key=lambda b: (len(b.children_recursive), b.name))
+        if not main.children or not any(b.name in moving for b in [main] + list(main.children_recursive)):
+            break
+        bone = main
+    return bone

@@ -1,0 +1,87 @@
+"""Headless test of an animator's session with the add-on (walk_session.py):
+
+    blender -b --factory-startup --python-exit-code 1 --python test_workflow.py
+
+Environment as test_addon.py's (CMake's test sets it).
+"""
+
+import os
+import sys
+import time
+
+import bpy
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path[:0] = [HERE, os.environ.get("MF_BLENDER_ADDON_DIR", os.path.dirname(HERE))]
+import motionfield_blender as addon  # noqa: E402
+import walk_session  # noqa: E402
+from motionfield_blender import animation, engine, rig_info  # noqa: E402
+
+FAILURES = []
+T0 = time.time()
+
+
+def check(cond, what):
+    if not cond:
+        FAILURES.append(what)
+        print("FAIL:", what)
+
+
+def log(*a):
+    print("[%5.1fs]" % (time.time() - T0), *a, flush=True)
+
+
+def snapshot(action, bone):
+    prefix = 'pose.bones["%s"]' % bone
+    return {(fc.data_path, fc.array_index): [tuple(k.co) for k in fc.keyframe_points]
+            for fc in action.fcurves if fc.data_path.startswith(prefix)}
+
+
+def key_frames(obj, path):
+    fc = obj.animation_data.action.fcurves.find(path, index=0)
+    return sorted(int(round(k.co[0])) for k in fc.keyframe_points)
+
+
+mf = engine.load()
+addon.register()
+s = bpy.context.scene.motionfield
+
+# ------------------------------------------------------------------ the root (static container above Hips)
+obj, motion, keys = walk_session.setup(mf)
+check(keys == [1, 21, 41, 61], "keys every 20 frames: %s" % keys)
+bpy.ops.object.mode_set(mode='EDIT')  # Unreal-like: IK bones beside the skeleton under the container
+ik = obj.data.edit_bones.new("ik_foot_root")
+ik.head, ik.tail, ik.parent = (0.0, 0.0, 0.0), (0.0, 0.1, 0.0), obj.data.edit_bones["joint_Root"]
+leaf = obj.data.edit_bones.new("ik_foot_l")
+leaf.head, leaf.tail, leaf.parent = (0.1, 0.0, 0.0), (0.1, 0.1, 0.0), ik
+bpy.ops.object.mode_set(mode='OBJECT')
+check("Hips" in animation.moving_bones(obj) and "joint_Root" not in animation.moving_bones(obj),
+      "moving bones: %s" % sorted(animation.moving_bones(obj))[:4])
+check(animation.travel_root(obj).name == "Hips", "the travel is on Hips: %s" % animation.travel_root(obj).name)
+check(rig_info.root_name(s, obj) == "Hips", "the default root is the found one")
+model = engine.model()
+d, error = rig_info.describe(mf, obj, "Hips", 1.0, "", model)
+check(error is None and len(d["map"]) == 21, "the rig maps onto the model's 21 joints: %s" % error)
+check(rig_info.summary(d).startswith("21 of 21 model joints mapped (21 by name"), rig_info.summary(d) if d else "")
+bpy.ops.motionfield.set_root(bone="joint_Root")
+check(rig_info.root_name(s, obj) == "joint_Root", "one-click override")
+bpy.ops.motionfield.set_root(bone="")
+check(rig_info.root_name(s, obj) == "Hips", "back to the found root")
+
+between = [f for f in range(1, 62) if f not in keys]
+blender = walk_session.errors(obj, motion, between)
+container = snapshot(obj.animation_data.action, "joint_Root")
+check(bpy.ops.motionfield.inbetween('EXEC_DEFAULT') == {'FINISHED'}, "in-between finished")
+ours = walk_session.errors(obj, motion, between)
+log("blender %.3f %.3f m, in-between %.3f %.3f m" % (blender + ours))
+check(snapshot(obj.animation_data.action, "joint_Root") == container, "the container root keeps its keys")
+check(key_frames(obj, 'pose.bones["Hips"].location') == list(range(1, 62)), "the travel is keyed on Hips")
+check(ours[1] < blender[1], "feet closer to the sample than Blender's interpolation: %.3f vs %.3f m"
+      % (ours[1], blender[1]))
+check(ours[0] < blender[0], "joints closer than Blender's interpolation: %.3f vs %.3f m" % (ours[0], blender[0]))
+log("root")
+
+addon.unregister()
+log("done,", len(FAILURES), "failures")
+if FAILURES:
+    sys.exit(1)
