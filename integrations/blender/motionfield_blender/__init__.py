@@ -253,7 +253,7 @@ def _range(scene, s, obj, names):
 
 
 class MOTIONFIELD_OT_inbetween(_TaskOperator, bpy.types.Operator):
-    """Solve every frame between the keyed ones; keys only the frames that were not keyed"""
+    """Solve every frame between the animator's keys; writes generated keys (breakdowns) on the other frames, replacing earlier generated ones"""
     bl_idname = "motionfield.inbetween"
     bl_label = "In-between"
 
@@ -402,6 +402,22 @@ class MOTIONFIELD_OT_follow_path(_TaskOperator, bpy.types.Operator):
         return run, finish
 
 
+class MOTIONFIELD_OT_clear_generated(bpy.types.Operator):
+    """Remove the keys In-between and Fill gap generated from the active armature's action (the animator's keys stay)"""
+    bl_idname = "motionfield.clear_generated"
+    bl_label = "Clear generated"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        return _TaskOperator.poll(context)
+
+    def execute(self, context):
+        n = animation.clear_generated(context.active_object)
+        self.report({'INFO'}, "motionfield: removed the generated keys of %d frames" % n)
+        return {'FINISHED'}
+
+
 class MOTIONFIELD_OT_set_root(bpy.types.Operator):
     """Use this bone as the root bone (empty: find the root from the action)"""
     bl_idname = "motionfield.set_root"
@@ -482,6 +498,7 @@ class MOTIONFIELD_PT_panel(bpy.types.Panel):
         box.prop(s, "range_mode")
         box.operator(MOTIONFIELD_OT_inbetween.bl_idname)
         box.operator(MOTIONFIELD_OT_fill.bl_idname)
+        box.operator(MOTIONFIELD_OT_clear_generated.bl_idname)
         box = layout.box()
         box.prop(s, "resample_method")
         box.prop(s, "source_fps")
@@ -493,7 +510,7 @@ class MOTIONFIELD_PT_panel(bpy.types.Panel):
 
 
 _classes = (MOTIONFIELD_AP_preferences, MotionfieldSettings, MOTIONFIELD_OT_set_root, MOTIONFIELD_OT_inbetween,
-            MOTIONFIELD_OT_fill, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path, MOTIONFIELD_PT_panel)
+            MOTIONFIELD_OT_fill, MOTIONFIELD_OT_clear_generated, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path, MOTIONFIELD_PT_panel)
 
 
 def register():

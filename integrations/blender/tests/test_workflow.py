@@ -10,6 +10,7 @@ import sys
 import time
 
 import bpy
+from mathutils import Quaternion
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.environ.get("MF_BLENDER_ADDON_DIR", os.path.dirname(HERE))]
@@ -80,6 +81,40 @@ check(ours[1] < blender[1], "feet closer to the sample than Blender's interpolat
       % (ours[1], blender[1]))
 check(ours[0] < blender[0], "joints closer than Blender's interpolation: %.3f vs %.3f m" % (ours[0], blender[0]))
 log("root")
+
+# ------------------------------------------------------------------ generated keys apart from the animator's
+kind = animation._generated_type()
+action = obj.animation_data.action
+types = {}
+for fc in action.fcurves:
+    if animation.bone_of(fc.data_path) in ("Hips", "UpperLeg_L"):
+        for k in fc.keyframe_points:
+            types.setdefault(k.type, set()).add(int(round(k.co[0])))
+check(types == {'KEYFRAME': set(keys), kind: set(between)}, "generated keys are %s, the animator's keyframes: %s"
+      % (kind, {t: sorted(f)[:3] for t, f in types.items()}))
+check(animation.generated_frames(action) == set(between), "the action records the generated frames")
+check(animation.keyed_frames(obj, list(motion.joint_names)) == keys, "generated keys are not the animator's")
+scene = bpy.context.scene
+scene.frame_set(21)  # the animator tweaks the key on frame 21: raises the left arm
+arm = obj.pose.bones["UpperArm_L"]
+arm.rotation_quaternion = arm.rotation_quaternion @ Quaternion((0.0, 1.0, 0.0), 0.6)
+arm.keyframe_insert("rotation_quaternion", frame=21)
+before = {(fc.data_path, fc.array_index): {int(round(k.co[0])): k.co[1] for k in fc.keyframe_points}
+          for fc in action.fcurves}
+check(bpy.ops.motionfield.inbetween('EXEC_DEFAULT') == {'FINISHED'}, "regenerate after a tweak finished")
+after = {(fc.data_path, fc.array_index): {int(round(k.co[0])): k.co[1] for k in fc.keyframe_points}
+         for fc in action.fcurves}
+check(after.keys() == before.keys() and all(after[c].keys() == before[c].keys() for c in before),
+      "regenerating keys the same frames")
+check(all(abs(after[c][f] - before[c][f]) < 1e-6 for c in before for f in keys if f in before[c]),
+      "regenerating keeps the animator's keys")
+moved = [f for f in between if any(abs(after[c][f] - before[c][f]) > 1e-3 for c in before if f in before[c])]
+check(set(range(12, 31)) - {21} <= set(moved), "regenerating changes the generated frames around the tweak: %s" % moved)
+check(bpy.ops.motionfield.clear_generated('EXEC_DEFAULT') == {'FINISHED'}, "clear generated")
+left = {int(round(k.co[0])) for fc in action.fcurves for k in fc.keyframe_points}
+check(left == set(keys), "clear generated leaves the animator's keys: %s" % sorted(left))
+check(not animation.generated_frames(action), "clear generated forgets the generated frames")
+log("generated keys")
 
 addon.unregister()
 log("done,", len(FAILURES), "failures")
