@@ -28,6 +28,8 @@ bl_info = {
     "category": "Animation",
 }
 
+import time
+
 import bpy
 from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
@@ -137,11 +139,25 @@ def _method_arg(value):
     return None if value in ("", "DEFAULT") else value
 
 
+REDRAWN = {'VIEW_3D', 'DOPESHEET_EDITOR', 'GRAPH_EDITOR', 'NLA_EDITOR', 'TIMELINE'}
+
+
+def redraw(context):
+    """Tags the 3D views and the animation editors of every window for redraw:
+    new keys show at once, not at the next scrub."""
+    for window in context.window_manager.windows:
+        for area in window.screen.areas:
+            if area.type in REDRAWN:
+                area.tag_redraw()
+
+
 class _TaskOperator:
     """prepare() reads the armature and returns (run, finish); execute() runs
     inline (scripts, background mode), invoke() on a thread with Esc."""
 
     bl_options = {'REGISTER', 'UNDO'}
+    completes = False  # an in-betweening / gap-filling operator (its default method is mf_default_method's)
+    method_label = ""
 
     @classmethod
     def poll(cls, context):
@@ -165,6 +181,7 @@ class _TaskOperator:
         needs = m is None or any(x.name == m and x.needs_model for x in self.mf.methods())
         kw = {"method": m, "seed": s.seed, "max_iterations": s.max_iterations,
               "model": engine.model(bpy.path.abspath(s.model_path)) if needs else None}
+        self.method_label = m or (self.mf.default_method(model=kw["model"]) if self.completes else "the default method")
         if s.rig_map:
             kw["rig_map"] = bpy.path.abspath(s.rig_map)
         return kw
@@ -175,6 +192,7 @@ class _TaskOperator:
                                           offsets=self.rig.offsets)
 
     def _start(self, context):
+        self._t0 = time.time()
         try:
             self._setup(context)
             run, self._finish = self.prepare(context)
@@ -187,6 +205,7 @@ class _TaskOperator:
     def _end(self, context):
         wm = context.window_manager
         wm.progress_end()
+        redraw(context)
         job = self._job
         if job.error is not None:
             cancelled = isinstance(job.error, self.mf.CancelledError)
@@ -194,9 +213,11 @@ class _TaskOperator:
                         "motionfield: cancelled, nothing changed" if cancelled else "motionfield: %s" % job.error)
             return {'CANCELLED'}
         message = self._finish(context, job.result)
+        redraw(context)
         if job.result.warnings:
             self.report({'WARNING'}, "motionfield: %s" % job.result.warnings)
-        self.report({'INFO'}, "motionfield: %s" % message)
+        self.report({'INFO'}, "motionfield: %s with %s in %.1f s" % (message, self.method_label or "the default method",
+                                                                     time.time() - self._t0))
         return {'FINISHED'}
 
     def execute(self, context):
@@ -257,6 +278,8 @@ class MOTIONFIELD_OT_inbetween(_TaskOperator, bpy.types.Operator):
     bl_idname = "motionfield.inbetween"
     bl_label = "In-between"
 
+    completes = True
+
     def prepare(self, context):
         scene, s = context.scene, context.scene.motionfield
         lo, hi = _range(scene, s, self.obj, self.rig.names)
@@ -307,6 +330,7 @@ class MOTIONFIELD_OT_fill(_TaskOperator, bpy.types.Operator):
     bl_label = "Fill gap"
 
     CONTEXT_FRAMES = 60
+    completes = True
 
     def prepare(self, context):
         scene, s = context.scene, context.scene.motionfield
@@ -328,7 +352,7 @@ class MOTIONFIELD_OT_fill(_TaskOperator, bpy.types.Operator):
             values = animation.channel_values(self.obj, self.rig, sampled, result.rotations,
                                               result.root_positions, new)
             animation.insert_keys(self.obj, self.rig, sampled, values, new, set(self.keyed))
-            return "filled frames %d..%d" % gap
+            return "keyed %d frames (%d..%d)" % (len(new), gap[0], gap[1])
         return run, finish
 
 
@@ -414,6 +438,7 @@ class MOTIONFIELD_OT_clear_generated(bpy.types.Operator):
 
     def execute(self, context):
         n = animation.clear_generated(context.active_object)
+        redraw(context)
         self.report({'INFO'}, "motionfield: removed the generated keys of %d frames" % n)
         return {'FINISHED'}
 
