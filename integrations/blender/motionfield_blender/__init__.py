@@ -77,15 +77,30 @@ def _mf():
 _enum_keep = {}  # Blender needs the enum item strings kept alive
 
 
+def _default_label(kind, mf, model):
+    if kind == "complete":
+        return mf.default_method(model=model)
+    if kind == "resample":
+        return "prior" if model is not None else "cubic"
+    return "nemf"
+
+
 def _method_items(kind):
+    """The enum items of the methods for `kind` that can run with the settings'
+    model: a method whose transformer file is missing is not offered."""
     def items(self, context):
-        out = [("DEFAULT", "Default", "The library's default method for this task (mf_default_method)")]
+        out = []
         try:
-            for m in _mf().methods():
-                if (kind == "complete" and m.completes) or (kind == "resample" and m.resamples):
+            mf = _mf()
+            model = engine.model_or_none(bpy.path.abspath(self.model_path))
+            out.append(("DEFAULT", "Default (%s)" % _default_label(kind, mf, model),
+                        "The library's default method for this task with the model"))
+            for m in mf.methods():
+                if ((kind == "complete" and m.completes) or (kind == "resample" and m.resamples)) and \
+                        engine.can_run(m, model):
                     out.append((m.name, m.name, m.description))
         except Exception:  # the package is missing: the panel says so
-            pass
+            out = out or [("DEFAULT", "Default", "The library's default method for this task")]
         if kind == "renav":
             out += [("nemf", "nemf", "L-BFGS on the prior's latent codes"),
                     ("nemf-adam", "nemf-adam", "NeMF's Adam reference (slower)")]

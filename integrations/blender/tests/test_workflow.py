@@ -7,6 +7,7 @@ Environment as test_addon.py's (CMake's test sets it).
 
 import os
 import sys
+import tempfile
 import time
 
 import bpy
@@ -115,6 +116,20 @@ left = {int(round(k.co[0])) for fc in action.fcurves for k in fc.keyframe_points
 check(left == set(keys), "clear generated leaves the animator's keys: %s" % sorted(left))
 check(not animation.generated_frames(action), "clear generated forgets the generated frames")
 log("generated keys")
+
+# ------------------------------------------------------------------ only the methods that can run are offered
+with tempfile.TemporaryDirectory() as d:
+    alone = os.path.join(d, "prior-alone.mfm")  # the prior without the transformer files next to it
+    os.symlink(engine.default_model_path(), alone)
+    items = lambda: [i[0] for i in addon._method_items("complete")(s, bpy.context)]  # noqa: E731
+    everything = items()
+    s.model_path = alone
+    check(items() == ["DEFAULT", "interp", "zerovel", "nemf", "nemf-adam"],
+          "with the prior alone only its methods are offered: %s" % items())
+    check(addon._method_items("complete")(s, bpy.context)[0][1] == "Default (nemf)", "the default is named")
+    s.model_path = ""
+check(len(everything) == 15 and everything[0] == "DEFAULT", "every method with the bundled models: %s" % everything)
+log("methods offered")
 
 addon.unregister()
 log("done,", len(FAILURES), "failures")
