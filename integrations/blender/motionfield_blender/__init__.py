@@ -31,7 +31,8 @@ bl_info = {
 import time
 
 import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from . import animation, convert, engine, motion_io, rig_info
 
@@ -471,6 +472,80 @@ class MOTIONFIELD_OT_set_root(bpy.types.Operator):
         return {'FINISHED'}
 
 
+# ------------------------------------------------------------------ import and export
+
+UNIT_ITEMS = [("auto", "Automatic", "From the leg length (centimetres when no legs are found)"),
+              ("cm", "Centimetres", ""), ("m", "Metres", ""), ("mm", "Millimetres", ""), ("in", "Inches", "")]
+
+
+class MOTIONFIELD_OT_import_motion(bpy.types.Operator, ImportHelper):
+    """Import a BVH motion as an armature and its action with motionfield's reader (any Python version)"""
+    bl_idname = "motionfield.import_motion"
+    bl_label = "Import motion (motionfield)"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    filename_ext = ".bvh"
+    filter_glob: StringProperty(default="*.bvh", options={'HIDDEN'})
+    units: EnumProperty(name="File units", items=UNIT_ITEMS, default="auto")
+    rotation_mode: EnumProperty(name="Rotation", default='QUATERNION', items=[
+        ('QUATERNION', "Quaternion", "Bones rotate in quaternions"),
+        ('XYZ', "Euler XYZ", "Bones rotate in XYZ Euler angles")])
+    use_scene_fps: BoolProperty(name="Scene frame rate from the file", default=True,
+                                description="Set the scene's frame rate to the file's and its frame range to the "
+                                            "motion's (one key a frame either way)")
+
+    def execute(self, context):
+        try:
+            if context.object is not None and context.object.mode != 'OBJECT':
+                bpy.ops.object.mode_set(mode='OBJECT')
+            obj, motion = motion_io.import_motion(context, _mf(), self.filepath, self.units, self.rotation_mode)
+        except Exception as e:
+            self.report({'ERROR'}, "motionfield: %s" % e)
+            return {'CANCELLED'}
+        scene = context.scene
+        if self.use_scene_fps:
+            fps = max(1, round(motion.fps))
+            scene.render.fps, scene.render.fps_base = fps, fps / motion.fps
+            scene.frame_end = scene.frame_start + motion.frame_count - 1
+        redraw(context)
+        self.report({'INFO'}, "motionfield: imported %r: %d joints, %d frames at %g fps"
+                    % (obj.name, motion.joint_count, motion.frame_count, motion.fps))
+        return {'FINISHED'}
+
+
+class MOTIONFIELD_OT_export_motion(bpy.types.Operator, ExportHelper):
+    """Export the active armature's action as BVH with motionfield's writer (metres, the armature's rest pose)"""
+    bl_idname = "motionfield.export_motion"
+    bl_label = "Export motion (motionfield)"
+
+    filename_ext = ".bvh"
+    filter_glob: StringProperty(default="*.bvh", options={'HIDDEN'})
+
+    @classmethod
+    def poll(cls, context):
+        return _TaskOperator.poll(context)
+
+    def execute(self, context):
+        obj, scene = context.active_object, context.scene
+        first, last = (int(round(f)) for f in obj.animation_data.action.frame_range)
+        try:
+            motion = motion_io.export_motion(context, _mf(), obj, rig_info.root_name(scene.motionfield, obj),
+                                             self.filepath, list(range(first, last + 1)), _scene_fps(scene))
+        except Exception as e:
+            self.report({'ERROR'}, "motionfield: %s" % e)
+            return {'CANCELLED'}
+        self.report({'INFO'}, "motionfield: wrote %d frames to %s" % (motion.frame_count, self.filepath))
+        return {'FINISHED'}
+
+
+def _menu_import(self, context):
+    self.layout.operator(MOTIONFIELD_OT_import_motion.bl_idname, text="Motion (motionfield) (.bvh)")
+
+
+def _menu_export(self, context):
+    self.layout.operator(MOTIONFIELD_OT_export_motion.bl_idname, text="Motion (motionfield) (.bvh)")
+
+
 # ------------------------------------------------------------------ panel
 
 
@@ -550,16 +625,21 @@ class MOTIONFIELD_PT_panel(bpy.types.Panel):
 
 
 _classes = (MOTIONFIELD_AP_preferences, MotionfieldSettings, MOTIONFIELD_OT_set_root, MOTIONFIELD_OT_inbetween,
-            MOTIONFIELD_OT_fill, MOTIONFIELD_OT_clear_generated, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path, MOTIONFIELD_PT_panel)
+            MOTIONFIELD_OT_fill, MOTIONFIELD_OT_clear_generated, MOTIONFIELD_OT_import_motion,
+            MOTIONFIELD_OT_export_motion, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path, MOTIONFIELD_PT_panel)
 
 
 def register():
     for c in _classes:
         bpy.utils.register_class(c)
     bpy.types.Scene.motionfield = PointerProperty(type=MotionfieldSettings)
+    bpy.types.TOPBAR_MT_file_import.append(_menu_import)
+    bpy.types.TOPBAR_MT_file_export.append(_menu_export)
 
 
 def unregister():
+    bpy.types.TOPBAR_MT_file_export.remove(_menu_export)
+    bpy.types.TOPBAR_MT_file_import.remove(_menu_import)
     del bpy.types.Scene.motionfield
     for c in reversed(_classes):
         bpy.utils.unregister_class(c)

@@ -5,6 +5,7 @@
 Environment as test_addon.py's (CMake's test sets it).
 """
 
+import glob
 import os
 import sys
 import tempfile
@@ -130,6 +131,67 @@ with tempfile.TemporaryDirectory() as d:
     s.model_path = ""
 check(len(everything) == 15 and everything[0] == "DEFAULT", "every method with the bundled models: %s" % everything)
 log("methods offered")
+
+# ------------------------------------------------------------------ import and export through the library
+# The sample with the joint names of other tools (everything else unchanged).
+MIXAMO = {"Chest": "Spine2", "UpperArm": "Arm", "LowerArm": "ForeArm", "UpperLeg": "UpLeg", "LowerLeg": "Leg",
+          "Toes": "ToeBase"}
+DAZ = {"Hips": "hip", "Spine": "abdomen", "Chest": "chest", "Neck": "neck", "Head": "head", "Shoulder": "Collar",
+       "UpperArm": "Shldr", "LowerArm": "ForeArm", "Hand": "Hand", "UpperLeg": "Thigh", "LowerLeg": "Shin",
+       "Foot": "Foot", "Toes": "Toe"}  # Daz Studio's Genesis 1 / Poser names
+
+
+def renamed(name, style):
+    part, _, side = name.partition("_")
+    if style == "mixamo":
+        word = {"L": "Left", "R": "Right"}.get(side, "")
+        return "mixamorig:" + word + MIXAMO.get(part, part)
+    return side.lower() + DAZ[part]
+
+
+def styled_sample(style, path):
+    with open(walk_session.SAMPLE) as f:
+        text = f.read()
+    for n in motion.joint_names:
+        text = text.replace("JOINT %s\n" % n, "JOINT %s\n" % renamed(n, style))
+    with open(path, "w") as f:
+        f.write(text)
+    return [renamed(n, style) for n in motion.joint_names]
+
+
+def check_import(path, names):
+    """Imports `path` with the operator; the armature's bone heads are the
+    library's joint positions on every frame, and the rig maps onto the model's."""
+    before = set(bpy.data.objects)
+    check(bpy.ops.motionfield.import_motion(filepath=path) == {'FINISHED'}, "import %s" % path)
+    new = [o for o in bpy.data.objects if o not in before]
+    check(len(new) == 1 and new[0].type == 'ARMATURE', "import made one armature: %s" % new)
+    imported, want = new[0], mf.Motion.load_bvh(path)
+    check(sorted(b.name for b in imported.data.bones) == sorted(names), "bones of %s" % path)
+    frames = list(range(1, want.frame_count + 1))
+    check(bpy.context.scene.frame_end == want.frame_count and abs(addon._scene_fps(bpy.context.scene) - want.fps)
+          < 1e-6, "the scene takes the file's frames and rate")
+    err = walk_session.errors(imported, want, frames, names=want.joint_names)
+    check(err[0] < 1e-5, "imported %s: bone heads %g m from the file's joints" % (path, err[0]))
+    d, error = rig_info.describe(mf, imported, rig_info.root_name(s, imported), 1.0, "", model)
+    check(error is None and len(d["map"]) == 21, "%s maps onto the model's rig: %s" % (path, error or d["map"]))
+    return imported, want
+
+
+with tempfile.TemporaryDirectory() as d:
+    samples = sorted(glob.glob(os.path.join(os.path.dirname(walk_session.SAMPLE), "*.bvh")))
+    files = [(p, list(mf.Motion.load_bvh(p).joint_names)) for p in samples]
+    files += [(os.path.join(d, st + ".bvh"), styled_sample(st, os.path.join(d, st + ".bvh"))) for st in ("mixamo", "daz")]
+    for path, names in files:
+        imported, want = check_import(path, names)
+    out = os.path.join(d, "export.bvh")
+    bpy.context.view_layer.objects.active = imported
+    check(bpy.ops.motionfield.export_motion(filepath=out) == {'FINISHED'}, "export")
+    back = mf.Motion.load_bvh(out)
+    order = [list(back.joint_names).index(n) for n in want.joint_names]
+    err = float(abs(back.global_positions[:, order] - want.global_positions).max())
+    check(back.frame_count == want.frame_count and err < 1e-4, "export gives the joints back: %g m" % err)
+log("import and export")
 
 addon.unregister()
 log("done,", len(FAILURES), "failures")

@@ -62,12 +62,13 @@ def setup(mf, fps=24, every=20, container=True):
     return obj, motion, keys
 
 
-def errors(obj, motion, frames, first=1):
+def errors(obj, motion, frames, first=1, names=None):
     """(mean joint error, mean feet error) in metres of the armature's bone
-    heads on `frames` against the motion's joint positions."""
+    heads on `frames` against the motion's joint positions; `names`: the
+    bones of the motion's joints (by default the sample's joint names)."""
     scene = bpy.context.scene
-    names = list(motion.joint_names)
-    feet = [names.index(n) for n in FEET]
+    names = list(names or motion.joint_names)
+    feet = [names.index(n) for n in FEET if n in names] or [0]
     total = foot = 0.0
     for f in frames:
         scene.frame_set(f)
