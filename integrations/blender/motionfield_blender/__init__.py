@@ -34,7 +34,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from . import animation, convert, engine, motion_io, rig_info
+from . import animation, convert, engine, motion_io, panel, rig_info
 
 # ------------------------------------------------------------------ preferences
 
@@ -138,8 +138,10 @@ class MotionfieldSettings(bpy.types.PropertyGroup):
         ('PREVIEW', "Preview", "Within the preview range (the scene range when off)"),
         ('SELECTED', "Selected keys", "Within the span of the selected keys"),
     ])
-    source_fps: FloatProperty(name="Source fps", default=60.0, min=1.0, max=1000.0,
-                              description="Frame rate the keyed frames were sampled at (one frame each)")
+    source_fps: FloatProperty(name="Source frame rate", default=0.0, min=0.0, max=1000.0,
+                              description="Frame rate the action's frames were sampled at (one frame each); "
+                                          "0: the action's own (its file's, when imported with motionfield), "
+                                          "else the scene's")
     path_object: PointerProperty(name="Path", type=bpy.types.Object, poll=_is_curve,
                                  description="Curve object whose ground path (first spline) to follow")
 
@@ -149,6 +151,31 @@ class MotionfieldSettings(bpy.types.PropertyGroup):
 
 def _scene_fps(scene):
     return scene.render.fps / scene.render.fps_base
+
+
+def source_fps(context, obj):
+    """(the frame rate the action's frames are taken at, the scene's)."""
+    scene = context.scene
+    fps = scene.motionfield.source_fps or obj.animation_data.action.get(motion_io.FPS_PROP, 0.0)
+    return (fps or _scene_fps(scene)), _scene_fps(scene)
+
+
+def progress_text(label, progress):
+    """The status bar's line for (iteration, max_iterations, window, window_count):
+    the budget is an upper bound (the solvers stop when they converge)."""
+    i, n, w, count = progress
+    parts = ["window %d of %d" % (w + 1, count)] if count > 1 else []
+    if n:
+        parts.append("iteration %d (at most %d)" % (i, n))
+    return "motionfield %s: %s (Esc cancels)" % (label, ", ".join(parts) or "working")
+
+
+def progress_fraction(progress):
+    """0..1 for the progress bar: windows done when solved in windows, else the budget used."""
+    i, n, w, count = progress
+    if count > 1:
+        return w / count
+    return min(1.0, i / n) if n else 0.0
 
 
 def _method_arg(value):
@@ -167,6 +194,18 @@ def redraw(context):
                 area.tag_redraw()
 
 
+def has_action(cls, context):
+    """Whether the active object is an armature with an action; else says why
+    on the greyed button (poll_message_set)."""
+    obj = context.active_object
+    why = ("Select an armature" if obj is None or obj.type != 'ARMATURE' else
+           "The armature has no action: key a few poses first"
+           if obj.animation_data is None or obj.animation_data.action is None else None)
+    if why and hasattr(cls, "poll_message_set"):
+        cls.poll_message_set(why)
+    return why is None
+
+
 class _TaskOperator:
     """prepare() reads the armature and returns (run, finish); execute() runs
     inline (scripts, background mode), invoke() on a thread with Esc."""
@@ -177,9 +216,7 @@ class _TaskOperator:
 
     @classmethod
     def poll(cls, context):
-        obj = context.active_object
-        return (obj is not None and obj.type == 'ARMATURE' and obj.animation_data is not None
-                and obj.animation_data.action is not None)
+        return has_action(cls, context)
 
     def _setup(self, context):
         s = context.scene.motionfield
@@ -214,7 +251,7 @@ class _TaskOperator:
             run, self._finish = self.prepare(context)
             self._job = engine.Job(run)
         except Exception as e:
-            self.report({'ERROR'}, "motionfield: %s" % e)
+            self.report({'ERROR'}, panel.wrap("motionfield: %s" % e))
             return False
         return True
 
@@ -226,12 +263,13 @@ class _TaskOperator:
         if job.error is not None:
             cancelled = isinstance(job.error, self.mf.CancelledError)
             self.report({'WARNING'} if cancelled else {'ERROR'},
-                        "motionfield: cancelled, nothing changed" if cancelled else "motionfield: %s" % job.error)
+                        "motionfield: cancelled, nothing changed" if cancelled else
+                        panel.wrap("motionfield: %s" % job.error))
             return {'CANCELLED'}
         message = self._finish(context, job.result)
         redraw(context)
         if job.result.warnings:
-            self.report({'WARNING'}, "motionfield: %s" % job.result.warnings)
+            self.report({'WARNING'}, panel.wrap("motionfield: %s" % job.result.warnings))
         self.report({'INFO'}, "motionfield: %s with %s in %.1f s" % (message, self.method_label or "the default method",
                                                                      time.time() - self._t0))
         return {'FINISHED'}
@@ -243,8 +281,7 @@ class _TaskOperator:
         wm.progress_begin(0, 100)
 
         def shown(progress):
-            i, n = progress
-            wm.progress_update(int(100 * i / n) if n else 0)
+            wm.progress_update(int(100 * progress_fraction(progress)))
             return False
         self._job.run_inline(shown)
         return self._end(context)
@@ -265,11 +302,8 @@ class _TaskOperator:
             job.cancel()
         if event.type != 'TIMER':
             return {'RUNNING_MODAL'} if not job.done else {'PASS_THROUGH'}
-        i, n = job.progress
-        context.window_manager.progress_update(int(100 * i / n) if n else 0)
-        context.workspace.status_text_set("motionfield %s: iteration %d of %d (Esc cancels)"
-                                          % (self.bl_label, i, n) if n else
-                                          "motionfield %s: working (Esc cancels)" % self.bl_label)
+        context.window_manager.progress_update(int(100 * progress_fraction(job.progress)))
+        context.workspace.status_text_set(progress_text(self.bl_label, job.progress))
         if not job.done:
             return {'RUNNING_MODAL'}
         job.join()
@@ -290,7 +324,7 @@ def _range(scene, s, obj, names):
 
 
 class MOTIONFIELD_OT_inbetween(_TaskOperator, bpy.types.Operator):
-    """Solve every frame between the animator's keys; writes generated keys (breakdowns) on the other frames, replacing earlier generated ones"""
+    """Solve every frame between the animator's keys: generated keys (breakdowns) on the others, replacing earlier ones"""
     bl_idname = "motionfield.inbetween"
     bl_label = "In-between"
 
@@ -377,14 +411,24 @@ class MOTIONFIELD_OT_resample(_TaskOperator, bpy.types.Operator):
     bl_idname = "motionfield.resample"
     bl_label = "Resample"
 
+    @classmethod
+    def poll(cls, context):
+        if not has_action(cls, context):
+            return False
+        source, fps = source_fps(context, context.active_object)
+        if abs(source - fps) < 1e-6:
+            cls.poll_message_set("The source frame rate is the scene's (%g fps): set it under Resample" % fps)
+            return False
+        return True
+
     def prepare(self, context):
         scene, s = context.scene, context.scene.motionfield
-        fps = _scene_fps(scene)
-        if abs(s.source_fps - fps) < 1e-6:
+        source, fps = source_fps(context, self.obj)
+        if abs(source - fps) < 1e-6:
             raise ValueError("the source frame rate is the scene's (%g): nothing to resample" % fps)
         frames = list(range(self.keyed[0], self.keyed[-1] + 1))
         sampled = convert.read_frames(scene, self.obj, self.rig, frames)
-        motion = self.motion(sampled, s.source_fps)
+        motion = self.motion(sampled, source)
         kw = self.task_kwargs(context, s.resample_method)
 
         def run(progress, cancel):
@@ -419,6 +463,15 @@ class MOTIONFIELD_OT_follow_path(_TaskOperator, bpy.types.Operator):
     bl_idname = "motionfield.follow_path"
     bl_label = "Follow path"
 
+    @classmethod
+    def poll(cls, context):
+        if not has_action(cls, context):
+            return False
+        if context.scene.motionfield.path_object is None:
+            cls.poll_message_set("Choose a path curve first")
+            return False
+        return True
+
     def prepare(self, context):
         scene, s = context.scene, context.scene.motionfield
         if s.path_object is None:
@@ -450,7 +503,7 @@ class MOTIONFIELD_OT_clear_generated(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context):
-        return _TaskOperator.poll(context)
+        return has_action(cls, context)
 
     def execute(self, context):
         n = animation.clear_generated(context.active_object)
@@ -500,7 +553,7 @@ class MOTIONFIELD_OT_import_motion(bpy.types.Operator, ImportHelper):
                 bpy.ops.object.mode_set(mode='OBJECT')
             obj, motion = motion_io.import_motion(context, _mf(), self.filepath, self.units, self.rotation_mode)
         except Exception as e:
-            self.report({'ERROR'}, "motionfield: %s" % e)
+            self.report({'ERROR'}, panel.wrap("motionfield: %s" % e))
             return {'CANCELLED'}
         scene = context.scene
         if self.use_scene_fps:
@@ -523,7 +576,7 @@ class MOTIONFIELD_OT_export_motion(bpy.types.Operator, ExportHelper):
 
     @classmethod
     def poll(cls, context):
-        return _TaskOperator.poll(context)
+        return has_action(cls, context)
 
     def execute(self, context):
         obj, scene = context.active_object, context.scene
@@ -532,7 +585,7 @@ class MOTIONFIELD_OT_export_motion(bpy.types.Operator, ExportHelper):
             motion = motion_io.export_motion(context, _mf(), obj, rig_info.root_name(scene.motionfield, obj),
                                              self.filepath, list(range(first, last + 1)), _scene_fps(scene))
         except Exception as e:
-            self.report({'ERROR'}, "motionfield: %s" % e)
+            self.report({'ERROR'}, panel.wrap("motionfield: %s" % e))
             return {'CANCELLED'}
         self.report({'INFO'}, "motionfield: wrote %d frames to %s" % (motion.frame_count, self.filepath))
         return {'FINISHED'}
@@ -546,87 +599,9 @@ def _menu_export(self, context):
     self.layout.operator(MOTIONFIELD_OT_export_motion.bl_idname, text="Motion (motionfield) (.bvh)")
 
 
-# ------------------------------------------------------------------ panel
-
-
-def draw_rig(layout, context, mf):
-    """The rig box: the root bone (found or set, with a one-click change) and
-    the library's map of the rig onto the model's."""
-    s, obj = context.scene.motionfield, context.active_object
-    box = layout.box()
-    box.label(text="Rig", icon='ARMATURE_DATA')
-    if obj is None or obj.type != 'ARMATURE':
-        box.label(text="Select an armature")
-        return
-    try:
-        root = rig_info.root_name(s, obj)
-    except convert.RigError as e:
-        box.label(text=str(e), icon='ERROR')
-        return
-    row = box.row(align=True)
-    row.label(text="Root bone: %s (%s)" % (root, "set" if s.root_bone else "found"), icon='BONE_DATA')
-    active = context.active_bone
-    if s.root_bone:
-        row.operator(MOTIONFIELD_OT_set_root.bl_idname, text="Find", icon='LOOP_BACK').bone = ""
-    elif active is not None and active.name != root:
-        row.operator(MOTIONFIELD_OT_set_root.bl_idname, text="Use %s" % active.name, icon='EYEDROPPER').bone = \
-            active.name
-    model = None
-    try:
-        model = engine.model(bpy.path.abspath(s.model_path))
-    except Exception as e:  # no model: the map cannot be told
-        box.label(text="Model: %s" % e, icon='ERROR')
-        return
-    d, error = rig_info.describe(mf, obj, root, convert.metres_per_unit(context.scene, obj),
-                                 bpy.path.abspath(s.rig_map) if s.rig_map else "", model)
-    if error:
-        box.label(text="Rig map: %s" % error, icon='ERROR')
-    else:
-        box.label(text="Rig map: " + rig_info.summary(d), icon='CHECKMARK')
-
-
-class MOTIONFIELD_PT_panel(bpy.types.Panel):
-    bl_label = "motionfield"
-    bl_space_type = 'VIEW_3D'
-    bl_region_type = 'UI'
-    bl_category = "motionfield"
-
-    def draw(self, context):
-        layout = self.layout
-        s = context.scene.motionfield
-        try:
-            _mf()
-        except Exception as e:
-            layout.label(text=str(e), icon='ERROR')
-            return
-        obj = context.active_object
-        draw_rig(layout, context, _mf())
-        col = layout.column()
-        col.prop(s, "model_path")
-        col.prop(s, "rig_map")
-        if obj is not None and obj.type == 'ARMATURE':
-            col.prop_search(s, "root_bone", obj.data, "bones")
-        col.prop(s, "seed")
-        col.prop(s, "max_iterations")
-        box = layout.box()
-        box.prop(s, "method")
-        box.prop(s, "range_mode")
-        box.operator(MOTIONFIELD_OT_inbetween.bl_idname)
-        box.operator(MOTIONFIELD_OT_fill.bl_idname)
-        box.operator(MOTIONFIELD_OT_clear_generated.bl_idname)
-        box = layout.box()
-        box.prop(s, "resample_method")
-        box.prop(s, "source_fps")
-        box.operator(MOTIONFIELD_OT_resample.bl_idname)
-        box = layout.box()
-        box.prop(s, "path_method")
-        box.prop(s, "path_object")
-        box.operator(MOTIONFIELD_OT_follow_path.bl_idname)
-
-
 _classes = (MOTIONFIELD_AP_preferences, MotionfieldSettings, MOTIONFIELD_OT_set_root, MOTIONFIELD_OT_inbetween,
             MOTIONFIELD_OT_fill, MOTIONFIELD_OT_clear_generated, MOTIONFIELD_OT_import_motion,
-            MOTIONFIELD_OT_export_motion, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path, MOTIONFIELD_PT_panel)
+            MOTIONFIELD_OT_export_motion, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path) + panel.CLASSES
 
 
 def register():

@@ -129,21 +129,22 @@ class Job:
     """One task call, `run(progress=, cancel=)` -> Motion, on a thread or inline.
 
     progress: (iteration, max_iterations, window, window_count), updated by
-    the library's progress callback; cancel(): the cancel token.
+    the library's progress callback (motionfield.Progress); cancel(): the
+    cancel token.
     """
 
     def __init__(self, run):
         mf = load()
         self._run = run
         self.token = mf.CancelToken()
-        self.progress = (0, 0)
+        self.progress = (0, 0, 0, 0)
         self.result = None
         self.error = None
         self.done = False
         self._thread = None
 
     def _on_progress(self, p):
-        self.progress = (p.iteration, p.max_iterations)
+        self.progress = (p.iteration, p.max_iterations, p.window, p.window_count)
         return False
 
     def _call(self):

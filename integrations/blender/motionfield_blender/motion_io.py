@@ -16,6 +16,7 @@ from mathutils import Vector
 from . import animation, convert
 
 MIN_BONE = 0.02  # metres: a bone shorter than this points up instead
+FPS_PROP = "motionfield_fps"  # an imported action's frame rate (its file's)
 
 
 def _heads(motion):
@@ -79,6 +80,7 @@ def import_motion(context, mf, path, units="auto", rotation_mode='QUATERNION'):
     mats = convert.pose_matrices(rig, rotations, motion.root_positions)
     obj.animation_data_create()
     action = bpy.data.actions.new(name)
+    action[FPS_PROP] = float(motion.fps)
     obj.animation_data.action = action
     seqs = animation.motion_channels(obj, rig, mats, None)
     animation.write_channels(obj, action, seqs, context.scene.frame_start, 'BEZIER')

@@ -458,7 +458,7 @@ check(len(seen) >= 2, "progress reported")
 job = engine.Job(lambda progress, cancel: mf.inbetween(full, WALK_KEYS, method="nemf", progress=progress,
                                                         cancel=cancel))
 job.start()
-while job.progress == (0, 0) and not job.done:
+while job.progress[:2] == (0, 0) and not job.done:
     time.sleep(0.01)
 job.cancel()
 job.join()
@@ -503,7 +503,7 @@ def run_modal(press_esc):
     op._job.start()
     state, deadline = {'RUNNING_MODAL'}, time.time() + 60
     while state == {'RUNNING_MODAL'} and time.time() < deadline:
-        if press_esc and op._job.progress != (0, 0):
+        if press_esc and op._job.progress[:2] != (0, 0):
             op.modal(ctx, _Event('ESC'))
             press_esc = False
         state = op.modal(ctx, _Event('TIMER'))

@@ -193,6 +193,54 @@ with tempfile.TemporaryDirectory() as d:
     check(back.frame_count == want.frame_count and err < 1e-4, "export gives the joints back: %g m" % err)
 log("import and export")
 
+# ------------------------------------------------------------------ the panel an animator reads
+check(addon.progress_text("In-between", (180, 5030, 1, 3)) ==
+      "motionfield In-between: window 2 of 3, iteration 180 (at most 5030) (Esc cancels)", "progress text")
+check(addon.progress_text("Fill gap", (0, 0, 0, 0)) == "motionfield Fill gap: working (Esc cancels)", "no progress yet")
+check(addon.progress_fraction((180, 5030, 1, 3)) == 1 / 3 and addon.progress_fraction((5, 10, 0, 0)) == 0.5,
+      "the bar counts windows, else the budget")
+long_error = "motionfield: " + "cannot map this skeleton onto the model's humanoid " * 6
+check(all(len(line) <= 72 for line in addon.panel.wrap(long_error).split("\n")), "errors are wrapped")
+scene = bpy.context.scene
+obj, motion, keys = walk_session.setup(mf, fps=24, container=False)
+check(addon.source_fps(bpy.context, obj) == (30.0, 24.0), "the source rate is the imported file's")
+check(bpy.ops.motionfield.resample.poll(), "resample offered from 30 to 24 fps")
+scene.render.fps = 30
+check(not bpy.ops.motionfield.resample.poll(), "no resampling from 30 to 30 fps")
+s.source_fps = 60.0
+check(addon.source_fps(bpy.context, obj) == (60.0, 30.0) and bpy.ops.motionfield.resample.poll(), "a set source rate")
+s.source_fps = 0.0
+check(not bpy.ops.motionfield.follow_path.poll(), "follow path needs a curve")
+check(addon._method_items("complete")(s, bpy.context)[0][1] == "Default (%s)" % mf.default_method(),
+      "the default method is named")
+
+
+class Layout:
+    """Stands in for UILayout in background mode (no window to draw in):
+    records the labels and operators the panels draw."""
+
+    def __init__(self, out):
+        self.out = out
+
+    def __getattr__(self, name):
+        def call(*a, **kw):
+            if name in ("label", "operator"):
+                self.out.append((name, kw.get("text") or a[0]))
+            return Layout(self.out)
+        return call
+
+
+drawn = []
+for cls in addon.panel.CLASSES:
+    cls.draw(type("P", (), {"layout": Layout(drawn)})(), bpy.context)
+texts = [t for _, t in drawn]
+check(texts[:3] == ["motionfield.inbetween", "motionfield.fill", "motionfield.clear_generated"],
+      "the main buttons come first: %s" % texts[:3])
+check("Root bone: Hips (found)" in texts and any(t.startswith("Rig map: 21 of 21") for t in texts),
+      "the panel names the root and the rig map: %s" % texts)
+check("Resamples 30 fps to the scene's 30 fps" in texts, "the panel says the source rate")
+log("panel")
+
 addon.unregister()
 log("done,", len(FAILURES), "failures")
 if FAILURES:
