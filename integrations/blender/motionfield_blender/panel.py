@@ -11,7 +11,7 @@ import bpy
 
 from . import convert, engine, rig_info
 
-CHARS_PER_PIXEL = 1.0 / 7.0  # a rough width of the interface font's characters
+CHARS_PER_PIXEL = 1.0 / 8.0  # a rough width of the interface font's characters
 
 
 def wrap(text, width=72):
@@ -24,7 +24,8 @@ def wrapped_label(layout, context, text, icon='NONE'):
     width = 40
     region = getattr(context, "region", None)
     if region is not None and region.width > 0:
-        width = max(20, int(region.width * CHARS_PER_PIXEL / context.preferences.view.ui_scale) - 4)
+        # less the tabs, the margins and the icon
+        width = max(20, int((region.width - 60) * CHARS_PER_PIXEL / context.preferences.view.ui_scale))
     col = layout.column(align=True)
     for i, line in enumerate(wrap(text, width).split("\n")):
         col.label(text=line, icon=icon if i == 0 else 'BLANK1' if icon != 'NONE' else 'NONE')
@@ -114,10 +115,10 @@ class MOTIONFIELD_PT_resample(_Panel, bpy.types.Panel):
         from . import source_fps
         layout, s = self.layout, context.scene.motionfield
         field(layout, s, "resample_method", "Method")
-        field(layout, s, "source_fps", "Source frame rate (0: the action's)")
+        field(layout, s, "source_fps", "Source fps (0: the action's)")
         obj = context.active_object
         if obj is not None and obj.animation_data is not None and obj.animation_data.action is not None:
-            layout.label(text="Resamples %g fps to the scene's %g fps" % source_fps(context, obj))
+            layout.label(text="From %g fps to %g fps" % source_fps(context, obj))
         layout.operator("motionfield.resample", icon='TIME')
 
 
@@ -151,8 +152,8 @@ class MOTIONFIELD_PT_advanced(_Panel, bpy.types.Panel):
 
     def draw(self, context):
         layout, s = self.layout, context.scene.motionfield
-        field(layout, s, "model_path", "Model file (empty: the bundled one)")
-        field(layout, s, "rig_map", "Rig map file (empty: automatic)")
+        field(layout, s, "model_path", "Model (empty: bundled)")
+        field(layout, s, "rig_map", "Rig map (empty: automatic)")
         obj = context.active_object
         if obj is not None and obj.type == 'ARMATURE':
             col = layout.column(align=True)
