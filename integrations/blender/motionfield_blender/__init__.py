@@ -324,7 +324,7 @@ def _range(scene, s, obj, names):
 
 
 class MOTIONFIELD_OT_inbetween(_TaskOperator, bpy.types.Operator):
-    """Solve every frame between the animator's keys: generated keys (breakdowns) on the others, replacing earlier ones"""
+    """Solve the frames between the animator's keys as generated keys (breakdowns), replacing earlier generated ones"""
     bl_idname = "motionfield.inbetween"
     bl_label = "In-between"
 

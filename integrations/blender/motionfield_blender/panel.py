@@ -45,6 +45,12 @@ class _Panel:
     bl_category = "motionfield"
 
 
+class _SubPanel(_Panel):
+    """A folded panel under the main one."""
+    bl_parent_id = "MOTIONFIELD_PT_main"
+    bl_options = {'DEFAULT_CLOSED'}
+
+
 def package_or_error(layout, context):
     from . import _mf
     try:
@@ -107,9 +113,9 @@ def draw_rig(layout, context, mf):
         wrapped_label(box, context, "Rig map: " + rig_info.summary(d), 'CHECKMARK')
 
 
-class MOTIONFIELD_PT_resample(_Panel, bpy.types.Panel):
+class MOTIONFIELD_PT_resample(_SubPanel, bpy.types.Panel):
     bl_label = "Resample"
-    bl_parent_id = "MOTIONFIELD_PT_main"
+    bl_options = set()  # open: the second task an animator looks for
 
     def draw(self, context):
         from . import source_fps
@@ -122,10 +128,8 @@ class MOTIONFIELD_PT_resample(_Panel, bpy.types.Panel):
         layout.operator("motionfield.resample", icon='TIME')
 
 
-class MOTIONFIELD_PT_path(_Panel, bpy.types.Panel):
+class MOTIONFIELD_PT_path(_SubPanel, bpy.types.Panel):
     bl_label = "Follow path"
-    bl_parent_id = "MOTIONFIELD_PT_main"
-    bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
         layout, s = self.layout, context.scene.motionfield
@@ -134,10 +138,8 @@ class MOTIONFIELD_PT_path(_Panel, bpy.types.Panel):
         layout.operator("motionfield.follow_path", icon='CURVE_PATH')
 
 
-class MOTIONFIELD_PT_files(_Panel, bpy.types.Panel):
+class MOTIONFIELD_PT_files(_SubPanel, bpy.types.Panel):
     bl_label = "Import and export"
-    bl_parent_id = "MOTIONFIELD_PT_main"
-    bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
         col = self.layout.column(align=True)
@@ -145,10 +147,8 @@ class MOTIONFIELD_PT_files(_Panel, bpy.types.Panel):
         col.operator("motionfield.export_motion", text="Export action (.bvh)", icon='EXPORT')
 
 
-class MOTIONFIELD_PT_advanced(_Panel, bpy.types.Panel):
+class MOTIONFIELD_PT_advanced(_SubPanel, bpy.types.Panel):
     bl_label = "Advanced"
-    bl_parent_id = "MOTIONFIELD_PT_main"
-    bl_options = {'DEFAULT_CLOSED'}
 
     def draw(self, context):
         layout, s = self.layout, context.scene.motionfield

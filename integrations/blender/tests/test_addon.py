@@ -24,18 +24,11 @@ import time
 import bpy
 from mathutils import Quaternion, Vector
 
-sys.path.insert(0, os.environ["MF_BLENDER_ADDON_DIR"])
+sys.path[:0] = [os.path.dirname(os.path.abspath(__file__)), os.environ["MF_BLENDER_ADDON_DIR"]]
 import motionfield_blender as addon  # noqa: E402
+from checks import check, finish, log  # noqa: E402
 from motionfield_blender import convert, engine  # noqa: E402
 
-FAILURES = []
-T0 = time.time()
-
-
-def check(cond, what):
-    if not cond:
-        FAILURES.append(what)
-        print("FAIL:", what)
 
 
 def refresh():
@@ -43,10 +36,6 @@ def refresh():
     global scene, s
     scene = bpy.context.scene
     s = scene.motionfield
-
-
-def log(*a):
-    print("[%5.1fs]" % (time.time() - T0), *a, flush=True)
 
 
 mf = engine.load()
@@ -523,6 +512,4 @@ check(state == {'CANCELLED'} and any("cancelled" in r for r in reports), "Esc ca
 check(ctx.window_manager.windows[0].screen.areas[0].tagged, "a cancelled run redraws too")
 
 addon.unregister()
-log("done,", len(FAILURES), "failures")
-if FAILURES:
-    sys.exit(1)
+finish()

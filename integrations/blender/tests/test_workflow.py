@@ -9,7 +9,6 @@ import glob
 import os
 import sys
 import tempfile
-import time
 
 import bpy
 from mathutils import Quaternion
@@ -18,20 +17,9 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path[:0] = [HERE, os.environ.get("MF_BLENDER_ADDON_DIR", os.path.dirname(HERE))]
 import motionfield_blender as addon  # noqa: E402
 import walk_session  # noqa: E402
+from checks import check, finish, log  # noqa: E402
 from motionfield_blender import animation, engine, rig_info  # noqa: E402
 
-FAILURES = []
-T0 = time.time()
-
-
-def check(cond, what):
-    if not cond:
-        FAILURES.append(what)
-        print("FAIL:", what)
-
-
-def log(*a):
-    print("[%5.1fs]" % (time.time() - T0), *a, flush=True)
 
 
 def snapshot(action, bone):
@@ -181,7 +169,9 @@ def check_import(path, names):
 with tempfile.TemporaryDirectory() as d:
     samples = sorted(glob.glob(os.path.join(os.path.dirname(walk_session.SAMPLE), "*.bvh")))
     files = [(p, list(mf.Motion.load_bvh(p).joint_names)) for p in samples]
-    files += [(os.path.join(d, st + ".bvh"), styled_sample(st, os.path.join(d, st + ".bvh"))) for st in ("mixamo", "daz")]
+    for style in ("mixamo", "daz"):
+        path = os.path.join(d, style + ".bvh")
+        files.append((path, styled_sample(style, path)))
     for path, names in files:
         imported, want = check_import(path, names)
     out = os.path.join(d, "export.bvh")
@@ -242,6 +232,4 @@ check("From 30 fps to 30 fps" in texts, "the panel says the source rate")
 log("panel")
 
 addon.unregister()
-log("done,", len(FAILURES), "failures")
-if FAILURES:
-    sys.exit(1)
+finish()

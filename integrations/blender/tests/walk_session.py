@@ -46,14 +46,14 @@ def keep_keys(obj, frames):
         fc.update()
 
 
-def setup(mf, fps=24, every=20, container=True):
+def setup(mf, fps=24, every=20, container=True, rotation_mode='QUATERNION'):
     """The sample imported into an empty scene at `fps`, keys every `every`
     frames. Returns (armature, the full sample, the key frames)."""
     scene = bpy.context.scene
     for ob in list(bpy.data.objects):
         bpy.data.objects.remove(ob)
-    scene.render.fps, scene.render.fps_base = fps, 1.0
-    obj, motion = motion_io.import_motion(bpy.context, mf, SAMPLE)
+    scene.render.fps, scene.render.fps_base = int(fps), 1.0
+    obj, motion = motion_io.import_motion(bpy.context, mf, SAMPLE, rotation_mode=rotation_mode)
     scene.frame_start, scene.frame_end = 1, motion.frame_count
     if container:
         add_container_root(obj)
