@@ -85,13 +85,26 @@ def shoot(name):
 
 
 def run_inbetween():
+    """As from the button: on a thread, the status bar counting, Esc armed."""
     window, area = view3d()
     with bpy.context.temp_override(window=window, area=area):
-        bpy.ops.motionfield.inbetween('EXEC_DEFAULT')
+        bpy.ops.motionfield.inbetween('INVOKE_DEFAULT')
+
+
+def wait_for_keys(tries=[60]):
+    from motionfield_blender import animation
+    obj = bpy.context.view_layer.objects.active
+    if not animation.generated_frames(obj.animation_data.action):
+        tries[0] -= 1
+        if not tries[0]:
+            raise RuntimeError("In-between did not finish in a minute")
+        STEPS.insert(0, wait_for_keys)  # still running: look again in a second
+        return
     bpy.context.scene.frame_set(11)
 
 
-STEPS = [setup, show_tab, lambda: shoot("panel-before.png"), run_inbetween, lambda: shoot("panel-after.png")]
+STEPS = [setup, show_tab, lambda: shoot("panel-before.png"), run_inbetween, wait_for_keys,
+         lambda: shoot("panel-after.png")]
 
 
 def step():

@@ -106,6 +106,17 @@ check(left == set(keys), "clear generated leaves the animator's keys: %s" % sort
 check(not animation.generated_frames(action), "clear generated forgets the generated frames")
 log("generated keys")
 
+# ------------------------------------------------------------------ resample moves the found root with the pose
+obj, motion, keys = walk_session.setup(mf)
+s.resample_method = "interp"
+check(bpy.ops.motionfield.resample('EXEC_DEFAULT') == {'FINISHED'}, "resample finished")
+count = mf.resample_frame_count(61, 30.0, 24.0)[0]
+ends = {p: key_frames(obj, 'pose.bones["Hips"].%s' % p)[-1] for p in ("location", "rotation_quaternion")}
+check(ends == {"location": count, "rotation_quaternion": count},
+      "the travel ends with the pose at frame %d: %s" % (count, ends))
+s.resample_method = "DEFAULT"
+log("resample")
+
 # ------------------------------------------------------------------ only the methods that can run are offered
 with tempfile.TemporaryDirectory() as d:
     alone = os.path.join(d, "prior-alone.mfm")  # the prior without the transformer files next to it
