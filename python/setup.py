@@ -10,7 +10,7 @@ What it adds to pyproject.toml:
 - the bundle: when it finds a built libmotionfield.so.0 ($MOTIONFIELD_LIBRARY,
   else the source tree's build/capi/), it copies it into the package as
   ``motionfield/lib/libmotionfield.so.0`` and the source tree's models
-  (motionfield-prior.mfm, the transformers and the rig anatomy next to it) as
+  (motionfield-prior.mfm, every transformer next to it and the rig anatomy) as
   ``motionfield/share/motionfield/``: the package is then a small install
   prefix of its own, where the library finds its default model as it does in
   a CMake install tree (<prefix>/share/motionfield next to <prefix>/lib).
@@ -33,7 +33,8 @@ from setuptools.dist import Distribution
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-MODEL_FILES = ("motionfield-prior.mfm", "motionfield-twostage.mfm", "motionfield-citl.mfm", "motionfield-rig.json")
+MODEL_FILES = ("motionfield-prior.mfm", "motionfield-twostage.mfm", "motionfield-citl.mfm", "motionfield-keyframe.mfm",
+               "motionfield-rig.json")
 
 
 def project_version():

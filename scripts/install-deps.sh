@@ -18,6 +18,7 @@ packages=(
   python3-venv python3-pip python3-setuptools python3-wheel  # `pip install ./python` into a venv without network (README, capi_python_venv test)
   python3-distributed   # Dask: `python3 -m motionfield.dask` runs batch files on a cluster (python_dask_batch test)
   blender               # the Blender add-on's headless tests (capi_blender_addon*, integrations/blender); Debian's 3.4 runs on the system python3
+  xvfb xauth            # a virtual display (xvfb-run): the add-on's panels drawn in a real Blender window and screenshotted (capi_blender_panel)
   libtinygltf-dev       # tinygltf 2.7: glTF 2.0 output (prior/motion/motion_gltf.cc) and reading it back in the tests
   nodejs                # runs the Khronos glTF validator (npm gltf-validator) in the gltf_validator_* tests
 )

@@ -34,11 +34,19 @@ class Progress(NamedTuple):
         The most there will be.
     energy : float
         The solver's current energy (0 for methods without one).
+    window : int
+        The window being solved (0-based) of a long clip solved window by
+        window (`iteration` and `max_iterations` are summed over the windows).
+    window_count : int
+        The number of windows; 0 (and `window` 0) for methods that do not
+        work in windows.
     """
 
     iteration: int
     max_iterations: int
     energy: float
+    window: int = 0
+    window_count: int = 0
 
 
 class CancelToken(_Handle):
@@ -125,8 +133,9 @@ class _TaskCall:
         if progress is not None:
             def trampoline(_user_data: Any, p: Any) -> int:
                 try:
-                    return 1 if progress(Progress(p.contents.iteration, p.contents.max_iterations,
-                                                  p.contents.energy)) else 0
+                    c = p.contents
+                    return 1 if progress(Progress(c.iteration, c.max_iterations, c.energy, c.window,
+                                                  c.window_count)) else 0
                 except BaseException as e:  # noqa: B902 (re-raised after the call)
                     self.error = e
                     return 1

@@ -324,6 +324,16 @@ class ModelTest(unittest.TestCase):
             budgets[budget] = max(p.max_iterations for p in seen)
             self.assertLessEqual(max(p.iteration for p in seen), budgets[budget])
         self.assertLess(budgets[2], budgets[0])
+        # A clip longer than the model's window is solved window by window: progress says which.
+        frames = model.window + 40
+        long = mf.Motion.from_arrays(random_rotations(frames, model.joint_count, 6), np.zeros((frames, 3), np.float32),
+                                     30.0, model=model)
+        seen = []
+        mf.inbetween(long, [0, frames // 2, frames - 1], method="nemf", model=model, max_iterations=1,
+                     progress=seen.append)
+        windows = sorted({(p.window, p.window_count) for p in seen if p.window_count})
+        self.assertGreater(len(windows), 1)
+        self.assertEqual(windows, [(w, len(windows)) for w in range(len(windows))])
         with self.assertRaisesRegex(mf.InvalidArgumentError, "max_iterations"):
             mf.inbetween(m, [0, 29], method="nemf", model=model, max_iterations=-1)
 

@@ -28,10 +28,13 @@ bl_info = {
     "category": "Animation",
 }
 
-import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+import time
 
-from . import animation, convert, engine
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
+
+from . import animation, convert, engine, motion_io, panel, rig_info
 
 # ------------------------------------------------------------------ preferences
 
@@ -75,15 +78,30 @@ def _mf():
 _enum_keep = {}  # Blender needs the enum item strings kept alive
 
 
+def _default_label(kind, mf, model):
+    if kind == "complete":
+        return mf.default_method(model=model)
+    if kind == "resample":
+        return "prior" if model is not None else "cubic"
+    return "nemf"
+
+
 def _method_items(kind):
+    """The enum items of the methods for `kind` that can run with the settings'
+    model: a method whose transformer file is missing is not offered."""
     def items(self, context):
-        out = [("DEFAULT", "Default", "The library's default method for this task (mf_default_method)")]
+        out = []
         try:
-            for m in _mf().methods():
-                if (kind == "complete" and m.completes) or (kind == "resample" and m.resamples):
+            mf = _mf()
+            model = engine.model_or_none(bpy.path.abspath(self.model_path))
+            out.append(("DEFAULT", "Default (%s)" % _default_label(kind, mf, model),
+                        "The library's default method for this task with the model"))
+            for m in mf.methods():
+                if ((kind == "complete" and m.completes) or (kind == "resample" and m.resamples)) and \
+                        engine.can_run(m, model):
                     out.append((m.name, m.name, m.description))
         except Exception:  # the package is missing: the panel says so
-            pass
+            out = out or [("DEFAULT", "Default", "The library's default method for this task")]
         if kind == "renav":
             out += [("nemf", "nemf", "L-BFGS on the prior's latent codes"),
                     ("nemf-adam", "nemf-adam", "NeMF's Adam reference (slower)")]
@@ -109,7 +127,8 @@ class MotionfieldSettings(bpy.types.PropertyGroup):
                                         "automatic map (docs/RIGS.md); empty: automatic")
     root_bone: StringProperty(name="Root bone",
                               description="The bone whose translation moves the character; its tree is "
-                                          "converted. Empty: the armature's root bone")
+                                          "converted. Empty: found from the action (the first bone below "
+                                          "static container bones that moves)")
     seed: IntProperty(name="Seed", min=0, default=0)
     max_iterations: IntProperty(name="Iterations", min=0, default=0,
                                 description="Iteration budget of the solvers (per window of the full solve); "
@@ -119,8 +138,10 @@ class MotionfieldSettings(bpy.types.PropertyGroup):
         ('PREVIEW', "Preview", "Within the preview range (the scene range when off)"),
         ('SELECTED', "Selected keys", "Within the span of the selected keys"),
     ])
-    source_fps: FloatProperty(name="Source fps", default=60.0, min=1.0, max=1000.0,
-                              description="Frame rate the keyed frames were sampled at (one frame each)")
+    source_fps: FloatProperty(name="Source frame rate", default=0.0, min=0.0, max=1000.0,
+                              description="Frame rate the action's frames were sampled at (one frame each); "
+                                          "0: the action's own (its file's, when imported with motionfield), "
+                                          "else the scene's")
     path_object: PointerProperty(name="Path", type=bpy.types.Object, poll=_is_curve,
                                  description="Curve object whose ground path (first spline) to follow")
 
@@ -132,8 +153,57 @@ def _scene_fps(scene):
     return scene.render.fps / scene.render.fps_base
 
 
+def source_fps(context, obj):
+    """(the frame rate the action's frames are taken at, the scene's)."""
+    scene = context.scene
+    fps = scene.motionfield.source_fps or obj.animation_data.action.get(motion_io.FPS_PROP, 0.0)
+    return (fps or _scene_fps(scene)), _scene_fps(scene)
+
+
+def progress_text(label, progress):
+    """The status bar's line for (iteration, max_iterations, window, window_count):
+    the budget is an upper bound (the solvers stop when they converge)."""
+    i, n, w, count = progress
+    parts = ["window %d of %d" % (w + 1, count)] if count > 1 else []
+    if n:
+        parts.append("iteration %d (at most %d)" % (i, n))
+    return "motionfield %s: %s (Esc cancels)" % (label, ", ".join(parts) or "working")
+
+
+def progress_fraction(progress):
+    """0..1 for the progress bar: windows done when solved in windows, else the budget used."""
+    i, n, w, count = progress
+    if count > 1:
+        return w / count
+    return min(1.0, i / n) if n else 0.0
+
+
 def _method_arg(value):
     return None if value in ("", "DEFAULT") else value
+
+
+REDRAWN = {'VIEW_3D', 'DOPESHEET_EDITOR', 'GRAPH_EDITOR', 'NLA_EDITOR', 'TIMELINE'}
+
+
+def redraw(context):
+    """Tags the 3D views and the animation editors of every window for redraw:
+    new keys show at once, not at the next scrub."""
+    for window in context.window_manager.windows:
+        for area in window.screen.areas:
+            if area.type in REDRAWN:
+                area.tag_redraw()
+
+
+def has_action(cls, context):
+    """Whether the active object is an armature with an action; else says why
+    on the greyed button (poll_message_set)."""
+    obj = context.active_object
+    why = ("Select an armature" if obj is None or obj.type != 'ARMATURE' else
+           "The armature has no action: key a few poses first"
+           if obj.animation_data is None or obj.animation_data.action is None else None)
+    if why and hasattr(cls, "poll_message_set"):
+        cls.poll_message_set(why)
+    return why is None
 
 
 class _TaskOperator:
@@ -141,18 +211,19 @@ class _TaskOperator:
     inline (scripts, background mode), invoke() on a thread with Esc."""
 
     bl_options = {'REGISTER', 'UNDO'}
+    completes = False  # an in-betweening / gap-filling operator (its default method is mf_default_method's)
+    method_label = ""
 
     @classmethod
     def poll(cls, context):
-        obj = context.active_object
-        return (obj is not None and obj.type == 'ARMATURE' and obj.animation_data is not None
-                and obj.animation_data.action is not None)
+        return has_action(cls, context)
 
     def _setup(self, context):
         s = context.scene.motionfield
         self.mf = _mf()
         self.obj = context.active_object
-        self.rig = convert.Rig(self.obj, s.root_bone, convert.metres_per_unit(context.scene, self.obj))
+        self.rig = convert.Rig(self.obj, rig_info.root_name(s, self.obj),
+                               convert.metres_per_unit(context.scene, self.obj))
         self.keyed = animation.keyed_frames(self.obj, self.rig.names)
         if len(self.keyed) < 2:
             raise ValueError("the action has fewer than two keyed frames on the rig's bones")
@@ -163,6 +234,7 @@ class _TaskOperator:
         needs = m is None or any(x.name == m and x.needs_model for x in self.mf.methods())
         kw = {"method": m, "seed": s.seed, "max_iterations": s.max_iterations,
               "model": engine.model(bpy.path.abspath(s.model_path)) if needs else None}
+        self.method_label = m or (self.mf.default_method(model=kw["model"]) if self.completes else "the default method")
         if s.rig_map:
             kw["rig_map"] = bpy.path.abspath(s.rig_map)
         return kw
@@ -173,28 +245,33 @@ class _TaskOperator:
                                           offsets=self.rig.offsets)
 
     def _start(self, context):
+        self._t0 = time.time()
         try:
             self._setup(context)
             run, self._finish = self.prepare(context)
             self._job = engine.Job(run)
         except Exception as e:
-            self.report({'ERROR'}, "motionfield: %s" % e)
+            self.report({'ERROR'}, panel.wrap("motionfield: %s" % e))
             return False
         return True
 
     def _end(self, context):
         wm = context.window_manager
         wm.progress_end()
+        redraw(context)
         job = self._job
         if job.error is not None:
             cancelled = isinstance(job.error, self.mf.CancelledError)
             self.report({'WARNING'} if cancelled else {'ERROR'},
-                        "motionfield: cancelled, nothing changed" if cancelled else "motionfield: %s" % job.error)
+                        "motionfield: cancelled, nothing changed" if cancelled else
+                        panel.wrap("motionfield: %s" % job.error))
             return {'CANCELLED'}
         message = self._finish(context, job.result)
+        redraw(context)
         if job.result.warnings:
-            self.report({'WARNING'}, "motionfield: %s" % job.result.warnings)
-        self.report({'INFO'}, "motionfield: %s" % message)
+            self.report({'WARNING'}, panel.wrap("motionfield: %s" % job.result.warnings))
+        self.report({'INFO'}, "motionfield: %s with %s in %.1f s" % (message, self.method_label or "the default method",
+                                                                     time.time() - self._t0))
         return {'FINISHED'}
 
     def execute(self, context):
@@ -204,8 +281,7 @@ class _TaskOperator:
         wm.progress_begin(0, 100)
 
         def shown(progress):
-            i, n = progress
-            wm.progress_update(int(100 * i / n) if n else 0)
+            wm.progress_update(int(100 * progress_fraction(progress)))
             return False
         self._job.run_inline(shown)
         return self._end(context)
@@ -226,11 +302,8 @@ class _TaskOperator:
             job.cancel()
         if event.type != 'TIMER':
             return {'RUNNING_MODAL'} if not job.done else {'PASS_THROUGH'}
-        i, n = job.progress
-        context.window_manager.progress_update(int(100 * i / n) if n else 0)
-        context.workspace.status_text_set("motionfield %s: iteration %d of %d (Esc cancels)"
-                                          % (self.bl_label, i, n) if n else
-                                          "motionfield %s: working (Esc cancels)" % self.bl_label)
+        context.window_manager.progress_update(int(100 * progress_fraction(job.progress)))
+        context.workspace.status_text_set(progress_text(self.bl_label, job.progress))
         if not job.done:
             return {'RUNNING_MODAL'}
         job.join()
@@ -251,9 +324,11 @@ def _range(scene, s, obj, names):
 
 
 class MOTIONFIELD_OT_inbetween(_TaskOperator, bpy.types.Operator):
-    """Solve every frame between the keyed ones; keys only the frames that were not keyed"""
+    """Solve the frames between the animator's keys as generated keys (breakdowns), replacing earlier generated ones"""
     bl_idname = "motionfield.inbetween"
     bl_label = "In-between"
+
+    completes = True
 
     def prepare(self, context):
         scene, s = context.scene, context.scene.motionfield
@@ -305,6 +380,7 @@ class MOTIONFIELD_OT_fill(_TaskOperator, bpy.types.Operator):
     bl_label = "Fill gap"
 
     CONTEXT_FRAMES = 60
+    completes = True
 
     def prepare(self, context):
         scene, s = context.scene, context.scene.motionfield
@@ -326,7 +402,7 @@ class MOTIONFIELD_OT_fill(_TaskOperator, bpy.types.Operator):
             values = animation.channel_values(self.obj, self.rig, sampled, result.rotations,
                                               result.root_positions, new)
             animation.insert_keys(self.obj, self.rig, sampled, values, new, set(self.keyed))
-            return "filled frames %d..%d" % gap
+            return "keyed %d frames (%d..%d)" % (len(new), gap[0], gap[1])
         return run, finish
 
 
@@ -335,14 +411,24 @@ class MOTIONFIELD_OT_resample(_TaskOperator, bpy.types.Operator):
     bl_idname = "motionfield.resample"
     bl_label = "Resample"
 
+    @classmethod
+    def poll(cls, context):
+        if not has_action(cls, context):
+            return False
+        source, fps = source_fps(context, context.active_object)
+        if abs(source - fps) < 1e-6:
+            cls.poll_message_set("The source frame rate is the scene's (%g fps): set it under Resample" % fps)
+            return False
+        return True
+
     def prepare(self, context):
         scene, s = context.scene, context.scene.motionfield
-        fps = _scene_fps(scene)
-        if abs(s.source_fps - fps) < 1e-6:
+        source, fps = source_fps(context, self.obj)
+        if abs(source - fps) < 1e-6:
             raise ValueError("the source frame rate is the scene's (%g): nothing to resample" % fps)
         frames = list(range(self.keyed[0], self.keyed[-1] + 1))
         sampled = convert.read_frames(scene, self.obj, self.rig, frames)
-        motion = self.motion(sampled, s.source_fps)
+        motion = self.motion(sampled, source)
         kw = self.task_kwargs(context, s.resample_method)
 
         def run(progress, cancel):
@@ -377,6 +463,15 @@ class MOTIONFIELD_OT_follow_path(_TaskOperator, bpy.types.Operator):
     bl_idname = "motionfield.follow_path"
     bl_label = "Follow path"
 
+    @classmethod
+    def poll(cls, context):
+        if not has_action(cls, context):
+            return False
+        if context.scene.motionfield.path_object is None:
+            cls.poll_message_set("Choose a path curve first")
+            return False
+        return True
+
     def prepare(self, context):
         scene, s = context.scene, context.scene.motionfield
         if s.path_object is None:
@@ -400,57 +495,126 @@ class MOTIONFIELD_OT_follow_path(_TaskOperator, bpy.types.Operator):
         return run, finish
 
 
-# ------------------------------------------------------------------ panel
+class MOTIONFIELD_OT_clear_generated(bpy.types.Operator):
+    """Remove the keys In-between and Fill gap generated from the active armature's action (the animator's keys stay)"""
+    bl_idname = "motionfield.clear_generated"
+    bl_label = "Clear generated"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    @classmethod
+    def poll(cls, context):
+        return has_action(cls, context)
+
+    def execute(self, context):
+        n = animation.clear_generated(context.active_object)
+        redraw(context)
+        self.report({'INFO'}, "motionfield: removed the generated keys of %d frames" % n)
+        return {'FINISHED'}
 
 
-class MOTIONFIELD_PT_panel(bpy.types.Panel):
-    bl_label = "motionfield"
-    bl_space_type = 'VIEW_3D'
-    bl_region_type = 'UI'
-    bl_category = "motionfield"
+class MOTIONFIELD_OT_set_root(bpy.types.Operator):
+    """Use this bone as the root bone (empty: find the root from the action)"""
+    bl_idname = "motionfield.set_root"
+    bl_label = "Set root bone"
+    bl_options = {'REGISTER', 'UNDO'}
 
-    def draw(self, context):
-        layout = self.layout
-        s = context.scene.motionfield
+    bone: StringProperty(name="Bone")
+
+    def execute(self, context):
+        context.scene.motionfield.root_bone = self.bone
+        return {'FINISHED'}
+
+
+# ------------------------------------------------------------------ import and export
+
+UNIT_ITEMS = [("auto", "Automatic", "From the leg length (centimetres when no legs are found)"),
+              ("cm", "Centimetres", ""), ("m", "Metres", ""), ("mm", "Millimetres", ""), ("in", "Inches", "")]
+
+
+class MOTIONFIELD_OT_import_motion(bpy.types.Operator, ImportHelper):
+    """Import a BVH motion as an armature and its action with motionfield's reader (any Python version)"""
+    bl_idname = "motionfield.import_motion"
+    bl_label = "Import motion (motionfield)"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    filename_ext = ".bvh"
+    filter_glob: StringProperty(default="*.bvh", options={'HIDDEN'})
+    units: EnumProperty(name="File units", items=UNIT_ITEMS, default="auto")
+    rotation_mode: EnumProperty(name="Rotation", default='QUATERNION', items=[
+        ('QUATERNION', "Quaternion", "Bones rotate in quaternions"),
+        ('XYZ', "Euler XYZ", "Bones rotate in XYZ Euler angles")])
+    use_scene_fps: BoolProperty(name="Scene frame rate from the file", default=True,
+                                description="Set the scene's frame rate to the file's and its frame range to the "
+                                            "motion's (one key a frame either way)")
+
+    def execute(self, context):
         try:
-            _mf()
+            if context.object is not None and context.object.mode != 'OBJECT':
+                bpy.ops.object.mode_set(mode='OBJECT')
+            obj, motion = motion_io.import_motion(context, _mf(), self.filepath, self.units, self.rotation_mode)
         except Exception as e:
-            layout.label(text=str(e), icon='ERROR')
-            return
-        obj = context.active_object
-        col = layout.column()
-        col.prop(s, "model_path")
-        col.prop(s, "rig_map")
-        if obj is not None and obj.type == 'ARMATURE':
-            col.prop_search(s, "root_bone", obj.data, "bones")
-        col.prop(s, "seed")
-        col.prop(s, "max_iterations")
-        box = layout.box()
-        box.prop(s, "method")
-        box.prop(s, "range_mode")
-        box.operator(MOTIONFIELD_OT_inbetween.bl_idname)
-        box.operator(MOTIONFIELD_OT_fill.bl_idname)
-        box = layout.box()
-        box.prop(s, "resample_method")
-        box.prop(s, "source_fps")
-        box.operator(MOTIONFIELD_OT_resample.bl_idname)
-        box = layout.box()
-        box.prop(s, "path_method")
-        box.prop(s, "path_object")
-        box.operator(MOTIONFIELD_OT_follow_path.bl_idname)
+            self.report({'ERROR'}, panel.wrap("motionfield: %s" % e))
+            return {'CANCELLED'}
+        scene = context.scene
+        if self.use_scene_fps:
+            fps = max(1, round(motion.fps))
+            scene.render.fps, scene.render.fps_base = fps, fps / motion.fps
+            scene.frame_end = scene.frame_start + motion.frame_count - 1
+        redraw(context)
+        self.report({'INFO'}, "motionfield: imported %r: %d joints, %d frames at %g fps"
+                    % (obj.name, motion.joint_count, motion.frame_count, motion.fps))
+        return {'FINISHED'}
 
 
-_classes = (MOTIONFIELD_AP_preferences, MotionfieldSettings, MOTIONFIELD_OT_inbetween, MOTIONFIELD_OT_fill,
-            MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path, MOTIONFIELD_PT_panel)
+class MOTIONFIELD_OT_export_motion(bpy.types.Operator, ExportHelper):
+    """Export the active armature's action as BVH with motionfield's writer (metres, the armature's rest pose)"""
+    bl_idname = "motionfield.export_motion"
+    bl_label = "Export motion (motionfield)"
+
+    filename_ext = ".bvh"
+    filter_glob: StringProperty(default="*.bvh", options={'HIDDEN'})
+
+    @classmethod
+    def poll(cls, context):
+        return has_action(cls, context)
+
+    def execute(self, context):
+        obj, scene = context.active_object, context.scene
+        first, last = (int(round(f)) for f in obj.animation_data.action.frame_range)
+        try:
+            motion = motion_io.export_motion(context, _mf(), obj, rig_info.root_name(scene.motionfield, obj),
+                                             self.filepath, list(range(first, last + 1)), _scene_fps(scene))
+        except Exception as e:
+            self.report({'ERROR'}, panel.wrap("motionfield: %s" % e))
+            return {'CANCELLED'}
+        self.report({'INFO'}, "motionfield: wrote %d frames to %s" % (motion.frame_count, self.filepath))
+        return {'FINISHED'}
+
+
+def _menu_import(self, context):
+    self.layout.operator(MOTIONFIELD_OT_import_motion.bl_idname, text="Motion (motionfield) (.bvh)")
+
+
+def _menu_export(self, context):
+    self.layout.operator(MOTIONFIELD_OT_export_motion.bl_idname, text="Motion (motionfield) (.bvh)")
+
+
+_classes = (MOTIONFIELD_AP_preferences, MotionfieldSettings, MOTIONFIELD_OT_set_root, MOTIONFIELD_OT_inbetween,
+            MOTIONFIELD_OT_fill, MOTIONFIELD_OT_clear_generated, MOTIONFIELD_OT_import_motion,
+            MOTIONFIELD_OT_export_motion, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path) + panel.CLASSES
 
 
 def register():
     for c in _classes:
         bpy.utils.register_class(c)
     bpy.types.Scene.motionfield = PointerProperty(type=MotionfieldSettings)
+    bpy.types.TOPBAR_MT_file_import.append(_menu_import)
+    bpy.types.TOPBAR_MT_file_export.append(_menu_export)
 
 
 def unregister():
+    bpy.types.TOPBAR_MT_file_export.remove(_menu_export)
+    bpy.types.TOPBAR_MT_file_import.remove(_menu_import)
     del bpy.types.Scene.motionfield
     for c in reversed(_classes):
         bpy.utils.unregister_class(c)

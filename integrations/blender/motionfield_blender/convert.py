@@ -40,7 +40,8 @@ def metres_per_unit(scene, obj):
     return (scene.unit_settings.scale_length or 1.0) * (abs(s.x) + abs(s.y) + abs(s.z)) / 3.0
 
 
-def _default_root(arm):
+def default_root(arm):
+    """The root bone of the armature's biggest tree."""
     roots = [b for b in arm.bones if b.parent is None]
     if not roots:
         raise RigError("the armature has no bones")
@@ -65,7 +66,7 @@ class Rig:
             if root is None:
                 raise RigError("the armature has no bone named %r" % root_bone)
         else:
-            root = _default_root(arm)
+            root = default_root(arm)
         order = [root]
         i = 0
         while i < len(order):  # breadth first: every parent before its children
@@ -91,6 +92,59 @@ class Rig:
     def rest_relative(self, k):
         """Blender's relative rest matrix of bone k (k > 0): parent.rest^-1 @ rest."""
         return self.rest[self.parents[k]].inverted() @ self.rest[k]
+
+    def rest_frame_offsets(self):
+        """[J, 3] metres: the offsets in frames that are the identity at rest
+        (what a BVH file holds: each head relative to its parent's, Y up),
+        the root's its rest head."""
+        off = np.zeros((len(self.names), 3), dtype=np.float32)
+        heads = [r.translation for r in self.rest]
+        off[0] = C3 @ heads[0] * self.scale
+        for k in range(1, len(self.names)):
+            off[k] = C3 @ (heads[k] - heads[self.parents[k]]) * self.scale
+        return off
+
+
+def _rest_axes(rig):
+    """Per bone, its rest orientation in motion space (C @ bone.matrix_local)."""
+    return [C3 @ r.to_3x3().normalized() for r in rig.rest]
+
+
+def _globals(parents, local):
+    out = []
+    for k, p in enumerate(parents):
+        out.append(local[k] if p < 0 else out[p] @ local[k])
+    return out
+
+
+def _locals(parents, glob):
+    return [g if p < 0 else glob[p].transposed() @ g for g, p in zip(glob, parents)]
+
+
+def _requaternion(rotations, convert_globals):
+    out = np.empty_like(rotations)
+    for f in range(rotations.shape[0]):
+        local = [Quaternion([float(x) for x in q]).normalized().to_matrix() for q in rotations[f]]
+        glob = convert_globals(local)
+        for k, m in enumerate(glob):
+            out[f, k] = tuple(m.to_quaternion())
+    return out
+
+
+def to_rest_frames(rig, rotations):
+    """The rig's rotations (bone frames, as read_frames() reads them) as
+    rotations of frames that are the identity at rest (a BVH file's), with
+    rest_frame_offsets()."""
+    axes = _rest_axes(rig)
+    return _requaternion(rotations, lambda local: _locals(
+        rig.parents, [g @ a.transposed() for g, a in zip(_globals(rig.parents, local), axes)]))
+
+
+def from_rest_frames(rig, rotations):
+    """The inverse of to_rest_frames(): a BVH file's rotations on the rig's bones."""
+    axes = _rest_axes(rig)
+    return _requaternion(rotations, lambda local: _locals(
+        rig.parents, [g @ a for g, a in zip(_globals(rig.parents, local), axes)]))
 
 
 def rotation_channel(pose_bone):

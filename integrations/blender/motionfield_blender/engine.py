@@ -96,6 +96,31 @@ def model(path=""):
     return _models[key]
 
 
+# The transformer file each method family needs next to the model (the
+# library's inbetweener kinds, mf_model_has_inbetweener); "nemf-X" starts from X's.
+TRANSFORMER_KIND = {"context": "twostage", "detail": "twostage", "citl": "citl", "keyframe": "keyframe",
+                    "refine": "keyframe"}
+
+
+def can_run(method, model):
+    """Whether `method` (a motionfield.Method) can run with `model` (None: no model)."""
+    if not method.needs_model:
+        return True
+    if model is None:
+        return False
+    name = method.name[5:] if method.name.startswith("nemf-") else method.name
+    kind = TRANSFORMER_KIND.get(name)
+    return kind is None or model.has_inbetweener(kind)
+
+
+def model_or_none(path=""):
+    """model(path), or None when it cannot be loaded."""
+    try:
+        return model(path)
+    except Exception:  # no model: only the methods without one are offered
+        return None
+
+
 def default_model_path():
     return load().default_model_path() or ""
 
@@ -104,21 +129,22 @@ class Job:
     """One task call, `run(progress=, cancel=)` -> Motion, on a thread or inline.
 
     progress: (iteration, max_iterations, window, window_count), updated by
-    the library's progress callback; cancel(): the cancel token.
+    the library's progress callback (motionfield.Progress); cancel(): the
+    cancel token.
     """
 
     def __init__(self, run):
         mf = load()
         self._run = run
         self.token = mf.CancelToken()
-        self.progress = (0, 0)
+        self.progress = (0, 0, 0, 0)
         self.result = None
         self.error = None
         self.done = False
         self._thread = None
 
     def _on_progress(self, p):
-        self.progress = (p.iteration, p.max_iterations)
+        self.progress = (p.iteration, p.max_iterations, p.window, p.window_count)
         return False
 
     def _call(self):

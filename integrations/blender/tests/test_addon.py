@@ -16,6 +16,7 @@ at its child, rolled). A keyed cube stands beside them.
 import json
 import math
 import os
+import re
 import sys
 import tempfile
 import time
@@ -23,18 +24,11 @@ import time
 import bpy
 from mathutils import Quaternion, Vector
 
-sys.path.insert(0, os.environ["MF_BLENDER_ADDON_DIR"])
+sys.path[:0] = [os.path.dirname(os.path.abspath(__file__)), os.environ["MF_BLENDER_ADDON_DIR"]]
 import motionfield_blender as addon  # noqa: E402
+from checks import check, finish, log  # noqa: E402
 from motionfield_blender import convert, engine  # noqa: E402
 
-FAILURES = []
-T0 = time.time()
-
-
-def check(cond, what):
-    if not cond:
-        FAILURES.append(what)
-        print("FAIL:", what)
 
 
 def refresh():
@@ -42,10 +36,6 @@ def refresh():
     global scene, s
     scene = bpy.context.scene
     s = scene.motionfield
-
-
-def log(*a):
-    print("[%5.1fs]" % (time.time() - T0), *a, flush=True)
 
 
 mf = engine.load()
@@ -457,7 +447,7 @@ check(len(seen) >= 2, "progress reported")
 job = engine.Job(lambda progress, cancel: mf.inbetween(full, WALK_KEYS, method="nemf", progress=progress,
                                                         cancel=cancel))
 job.start()
-while job.progress == (0, 0) and not job.done:
+while job.progress[:2] == (0, 0) and not job.done:
     time.sleep(0.01)
 job.cancel()
 job.join()
@@ -474,6 +464,14 @@ class _Stub:
         return lambda *a: self.calls.append((name,) + a)
 
 
+class _Area:
+    def __init__(self, kind):
+        self.type, self.tagged = kind, 0
+
+    def tag_redraw(self):
+        self.tagged += 1
+
+
 class _Event:
     def __init__(self, kind):
         self.type = kind
@@ -482,15 +480,19 @@ class _Event:
 def run_modal(press_esc):
     op = type("Op", (addon._TaskOperator,), {"bl_label": "In-between"})()
     op.mf, op._timer, reports = mf, None, []
+    op.method_label, op._t0 = "nemf", time.time()  # what _start() and task_kwargs() set
     op.report = lambda kind, message: reports.append(message)
     op._finish = lambda context, result: "%d frames" % result.frame_count
     op._job = engine.Job(lambda progress, cancel: mf.inbetween(full, WALK_KEYS, method="nemf", progress=progress,
                                                                 cancel=cancel, max_iterations=BUDGET))
-    ctx = type("Ctx", (), {"window_manager": _Stub(), "workspace": _Stub()})()
+    wm = _Stub()
+    wm.windows = [type("Window", (), {"screen": type("Screen", (), {"areas": [_Area('DOPESHEET_EDITOR'),
+                                                                             _Area('PROPERTIES')]})()})()]
+    ctx = type("Ctx", (), {"window_manager": wm, "workspace": _Stub()})()
     op._job.start()
     state, deadline = {'RUNNING_MODAL'}, time.time() + 60
     while state == {'RUNNING_MODAL'} and time.time() < deadline:
-        if press_esc and op._job.progress != (0, 0):
+        if press_esc and op._job.progress[:2] != (0, 0):
             op.modal(ctx, _Event('ESC'))
             press_esc = False
         state = op.modal(ctx, _Event('TIMER'))
@@ -499,13 +501,15 @@ def run_modal(press_esc):
 
 
 state, reports, ctx = run_modal(press_esc=False)
-check(state == {'FINISHED'} and reports == ["motionfield: 61 frames"], "modal run: %s %s" % (state, reports))
+check(state == {'FINISHED'} and len(reports) == 1 and re.fullmatch(r"motionfield: 61 frames with nemf in [0-9.]+ s",
+                                                                    reports[0]), "modal run: %s %s" % (state, reports))
+areas = ctx.window_manager.windows[0].screen.areas
+check(areas[0].tagged and not areas[1].tagged, "modal run redraws the Dope Sheet (only the animation editors)")
 check(any(c[0] == "progress_update" for c in ctx.window_manager.calls), "modal run shows progress")
 check(("status_text_set", None) in ctx.workspace.calls, "modal run clears the status text")
 state, reports, ctx = run_modal(press_esc=True)
 check(state == {'CANCELLED'} and any("cancelled" in r for r in reports), "Esc cancels: %s %s" % (state, reports))
+check(ctx.window_manager.windows[0].screen.areas[0].tagged, "a cancelled run redraws too")
 
 addon.unregister()
-log("done,", len(FAILURES), "failures")
-if FAILURES:
-    sys.exit(1)
+finish()

@@ -26,6 +26,32 @@ bpy.context.scene.motionfield.method = "nemf-detail"  # the enum lists the libra
 if bpy.context.scene.motionfield.method != "nemf-detail":
     errors.append("method enum: %s" % bpy.context.scene.motionfield.method)
 engine.model()  # the default (bundled) model loads
+
+# Every method offered runs from the zip (a short budget: they run, not converge).
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import walk_session  # noqa: E402
+
+s = bpy.context.scene.motionfield
+offered = {kind: [i[0] for i in motionfield_blender._method_items(kind)(s, bpy.context)]
+           for kind in ("complete", "resample")}
+completes = [m.name for m in mf.methods() if m.completes]
+if offered["complete"] != ["DEFAULT"] + completes or len(completes) != 14:
+    errors.append("the zip does not offer every in-betweening method: %s" % offered["complete"])
+obj, motion, keys = walk_session.setup(mf, fps=30, container=False)
+action = obj.animation_data.action
+s.max_iterations = 2
+for kind, op in (("complete", bpy.ops.motionfield.inbetween), ("resample", bpy.ops.motionfield.resample)):
+    for name in offered[kind]:
+        setattr(s, "method" if kind == "complete" else "resample_method", name)
+        s.source_fps = 60.0
+        obj.animation_data.action = action
+        try:
+            if op('EXEC_DEFAULT') != {'FINISHED'}:
+                errors.append("%s with %s did not finish" % (op.idname_py(), name))
+        except RuntimeError as e:
+            errors.append("%s with %s: %s" % (op.idname_py(), name, e))
+        bpy.ops.motionfield.clear_generated('EXEC_DEFAULT')
+print("methods run from the zip:", offered)
 addon_utils.disable("motionfield_blender")
 if hasattr(bpy.types.Scene, "motionfield"):
     errors.append("disabling did not unregister")
