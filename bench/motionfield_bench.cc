@@ -74,6 +74,7 @@ struct Args {
   std::string dataset = "bandai";  // or "foreign": real capture on other rigs (bench/foreign_data.h)
   std::string foreign_source = mf::default_foreign_archive();
   std::string windows_csv;  // per-window scores and signals (bench/window_log.h)
+  bool no_fallback = false;  // the latent solvers keep their own result everywhere
 };
 
 void add_options(CLI::App& app, Args& args) {
@@ -124,6 +125,9 @@ void add_options(CLI::App& app, Args& args) {
                  "also write one CSV row per (task row, window, method) of the gap, sparse and resample tables: the "
                  "window's L2P and L2Q and the signals of bench/window_log.h (foreign: the windows of the content "
                  "groups)");
+  app.add_flag("--no-fallback", args.no_fallback,
+               "the latent solvers keep their own result where the prior cannot reach the keys (by default they fall "
+               "back to interpolation there: tasks/latent/fallback.h)");
   app.add_flag("--print-stats", args.print_stats,
                "add the table of training statistics (position mean / std, standing heights)");
 }
@@ -292,6 +296,7 @@ int run(Args& args, const std::string& command) {
 
   // The prior, loaded once, frozen, shared by every method and task.
   mf::TaskContext ctx;
+  ctx.interpolation_fallback = !args.no_fallback;
   std::shared_ptr<mf::NemfModel> model;
   if (!args.model.empty()) {
     std::cerr << "loading model " << args.model << "\n";

@@ -6,28 +6,13 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "tasks/latent/fallback.h"
+
 namespace mf::bench {
 namespace {
 
 std::string reference_key(const WindowRecord& r) {
   return r.clip + "\n" + r.task + "\n" + r.row + "\n" + std::to_string(r.start);
-}
-
-// The mean over maximal runs of unknown frames with a known frame either side
-// of the mean joint distance (cm) between those two known frames.
-double key_motion_cm(const Motion& truth, const std::vector<int>& known) {
-  const GlobalPose pose = forward_kinematics(truth);
-  double sum = 0.0;
-  int runs = 0;
-  for (size_t i = 0; i + 1 < known.size(); ++i) {
-    const int a = known[i], b = known[i + 1];
-    if (b - a < 2) continue;
-    double d = 0.0;
-    for (int j = 0; j < truth.num_joints(); ++j) d += (pose.position(b, j) - pose.position(a, j)).norm();
-    sum += 100.0 * d / truth.num_joints();
-    ++runs;
-  }
-  return runs == 0 ? 0.0 : sum / runs;
 }
 
 // Averages the entries of each name, keeping the order names first appear in.

@@ -92,14 +92,7 @@ Reachable reachable_problem(const NemfModel& model) {
   return r;
 }
 
-double max_abs_difference(const Motion& a, const Motion& b) {
-  double d = 0.0;
-  for (size_t i = 0; i < a.rotations.size(); ++i)
-    d = std::max(d, (a.rotations[i].coeffs() - b.rotations[i].coeffs()).cwiseAbs().maxCoeff());
-  for (size_t i = 0; i < a.root_positions.size(); ++i)
-    d = std::max(d, (a.root_positions[i] - b.root_positions[i]).cwiseAbs().maxCoeff());
-  return d;
-}
+using test::max_abs_difference;
 
 // A random motion with small rotations (a quarter of random_motion's angles)
 // and a root that sways in place: what a tiny random prior can come close to.

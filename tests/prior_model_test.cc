@@ -520,6 +520,25 @@ TEST(PriorTraining, AFewStepsRunCheckpointAndResume) {
   steer_resume.resume = true;
   steer_resume.max_epochs = 2;
   EXPECT_NO_THROW(train_prior(steer_resume));
+  // A VAE run from a model with a steering GMP (a shipped prior) drops it and
+  // continues with it as the GMP: it is the one trained with the VAE.
+  PriorTrainingOptions vae_from_steered = keep;
+  vae_from_steered.out_dir = dir + "/vae-from-steered";
+  vae_from_steered.gmp_only = false;
+  vae_from_steered.gmp_reconstructed = 0.0;
+  vae_from_steered.init_from = steer.out_dir + "/last.mfm";
+  vae_from_steered.max_steps = 0;
+  vae_from_steered.max_epochs = 1;
+  vae_from_steered.lr = vae_from_steered.lr_final = 0.0;
+  train_prior(vae_from_steered);
+  const NemfModel continued = load_nemf(vae_from_steered.out_dir + "/last.mfm");
+  EXPECT_FALSE(continued.has_steering_gmp());
+  std::map<std::string, at::Tensor> continued_params;
+  for (const auto& [name, value] : continued.named_parameters()) continued_params[name] = value;
+  for (const auto& [name, value] : init_params) {
+    if (name.rfind("gmp.", 0) != 0) continue;
+    EXPECT_TRUE(at::equal(continued_params.at(name), steered_params.at("steering_" + name))) << name;
+  }
   PriorTrainingOptions bad_steer = steer;
   bad_steer.out_dir = dir + "/gmp-steer-bad";
   bad_steer.config.gmp_width = 16;

@@ -2,6 +2,7 @@
 
 #include <ATen/ATen.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -17,6 +18,15 @@ Skeleton small_skeleton() {
   s.offsets = {{0, 0, 0},    {0, 0.2, 0},   {0, 0.4, 0}, {0.1, -0.05, 0},
                {0, -0.8, 0}, {-0.1, -0.05, 0}, {0, -0.8, 0}};
   return s;
+}
+
+double max_abs_difference(const Motion& a, const Motion& b) {
+  double d = 0.0;
+  for (size_t i = 0; i < a.rotations.size(); ++i)
+    d = std::max(d, (a.rotations[i].coeffs() - b.rotations[i].coeffs()).cwiseAbs().maxCoeff());
+  for (size_t i = 0; i < a.root_positions.size(); ++i)
+    d = std::max(d, (a.root_positions[i] - b.root_positions[i]).cwiseAbs().maxCoeff());
+  return d;
 }
 
 Motion random_motion(const Skeleton& skeleton, int frames, double fps, uint32_t seed) {

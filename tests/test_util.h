@@ -18,6 +18,10 @@ Skeleton small_skeleton();
 /// A motion with smooth random local rotations and root path, deterministic in `seed`.
 Motion random_motion(const Skeleton& skeleton, int frames, double fps, uint32_t seed);
 
+/// The largest absolute difference of any rotation coefficient or root
+/// position coordinate of two motions of the same size.
+double max_abs_difference(const Motion& a, const Motion& b);
+
 /// A tiny prior (32-frame window, 3x32 decoder, z_l 8, z_g 4) for fast tests.
 NemfConfig tiny_nemf_config();
 /// The rig of small_skeleton(), measured from one random motion.

@@ -246,7 +246,7 @@ TEST(TransformerMethods, MissingModelNamesTheFile) {
   }
   // The method itself checks too (callers that bypass jobs.h).
   for (const Method& method : transformer_methods()) {
-    EXPECT_THROW(method.complete(m, {0, 19}, no_transformers), InputError) << method.name;
+    EXPECT_THROW(method.complete(m, {0, 19}, no_transformers, nullptr), InputError) << method.name;
   }
   EXPECT_THROW(make_initializer("citl-encoder", no_transformers), InputError);
   EXPECT_THROW(make_initializer("nope", fx.ctx), InputError);

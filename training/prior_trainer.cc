@@ -282,7 +282,10 @@ bool is_steering_parameter(const std::string& name) { return name.rfind("steerin
 // A model of o.config with `init`'s VAE weights and statistics (called only
 // when o.config's GMP sizes or steering GMP differ from `init`'s). Its GMP is
 // `init`'s when the sizes are the same, else a fresh one; its steering GMP is
-// `init`'s steering GMP, or `init`'s GMP when `init` has none.
+// `init`'s steering GMP, or `init`'s GMP when `init` has none. A VAE run
+// (no --gmp-only) from a model with a steering GMP drops it and continues
+// with it as the GMP: the steering GMP is the one trained with the VAE, the
+// default one was fitted afterwards on the VAE's reconstructions.
 NemfModel with_new_gmp(const PriorTrainingOptions& o, const NemfModel& init) {
   auto without_gmp = [](const NemfConfig& c) {
     auto map = c.to_map();
@@ -307,7 +310,10 @@ NemfModel with_new_gmp(const PriorTrainingOptions& o, const NemfModel& init) {
   for (const auto& [name, value] : model.named_parameters()) {
     if (is_gmp_parameter(name) && !same_sizes) continue;
     const bool from_gmp = is_steering_parameter(name) && !init.has_steering_gmp();
-    const std::string from = from_gmp ? name.substr(std::string("steering_").size()) : name;
+    const bool from_steering = !o.gmp_only && is_gmp_parameter(name) && init.has_steering_gmp();
+    const std::string from = from_gmp ? name.substr(std::string("steering_").size())
+                             : from_steering ? "steering_" + name
+                                             : name;
     auto it = source.find(from);
     if (it == source.end() || !it->second.sizes().equals(value.sizes())) {
       throw InputError("train: --init " + o.init_from + " has no parameter " + from + " of this model's shape");
@@ -325,7 +331,9 @@ NemfModel load_or_make_model(const PriorTrainingOptions& o, const Dataset& data,
   if (!resuming && o.init_from.empty()) return NemfModel(o.config, training::measure_training_rig(data));
   const std::string what = resuming ? "--resume" : "--init " + o.init_from;
   NemfModel model = load_nemf(resuming ? files.last_model : o.init_from);
-  if (o.gmp_only && !resuming && model.config().to_map() != o.config.to_map()) model = with_new_gmp(o, model);
+  const bool drops_steering = !o.gmp_only && model.has_steering_gmp() && !o.config.steering_gmp;
+  if ((o.gmp_only || drops_steering) && !resuming && model.config().to_map() != o.config.to_map())
+    model = with_new_gmp(o, model);
   if (model.config().to_map() != o.config.to_map()) {
     throw InputError("train: " + what + " has other sizes than the options (" + model.config().describe() +
                      "; give the same sizes)");

@@ -97,11 +97,11 @@ int mf_inbetween(const mf_model* model, const mf_motion* input, const int32_t* k
                  const mf_task_options* options, mf_motion** out) {
   return mf::capi::run_task(model, input, options, out,
                             [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx,
-                                std::vector<std::string>*) {
+                                std::vector<std::string>* warnings) {
                               if (!keyframes && keyframe_count != 0)
                                 throw ApiError(MF_ERROR_INVALID_ARGUMENT, "keyframes is NULL");
                               const std::vector<int> keys(keyframes, keyframes + keyframe_count);
-                              return mf::run_inbetween(in, keys, method, ctx);
+                              return mf::run_inbetween(in, keys, method, ctx, warnings);
                             });
 }
 
@@ -109,8 +109,8 @@ int mf_fill(const mf_model* model, const mf_motion* input, int32_t gap_begin, in
             const mf_task_options* options, mf_motion** out) {
   return mf::capi::run_task(model, input, options, out,
                             [&](const mf::Motion& in, const std::string& method, const mf::TaskContext& ctx,
-                                std::vector<std::string>*) {
-                              return mf::run_fill(in, gap_begin, gap_end, method, ctx);
+                                std::vector<std::string>* warnings) {
+                              return mf::run_fill(in, gap_begin, gap_end, method, ctx, warnings);
                             });
 }
 

@@ -97,6 +97,10 @@ struct TaskContext : ModelSet {
   /// tasks/latent/latent_solver.h). Null: none are kept. Not thread-safe: one
   /// sink per concurrent call.
   std::vector<std::pair<std::string, double>>* diagnostics = nullptr;
+  /// The latent solvers' in-betweening and gap filling return interpolation
+  /// where the prior cannot reach the keys (tasks/latent/fallback.h); false
+  /// keeps their own result everywhere.
+  bool interpolation_fallback = true;
 
   /// Calls `progress` (with this context's window) and checks `cancel`;
   /// throws CancelledError when asked to stop.

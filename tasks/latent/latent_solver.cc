@@ -16,6 +16,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "prior/util/threads.h"
+#include "tasks/constraints/interpolation_fill.h"
 #include "tasks/constraints/residuals.h"
 #include "tasks/fixups/effector_ik.h"
 #include "tasks/fixups/foot_locking.h"
@@ -236,6 +237,9 @@ SolvedWindow solve_window(const NemfModel& model, const Motion& input, const Win
       solve_latents(model, problem, start, window_options, window_ctx, iteration_offset, iteration_total);
   rep->windows.push_back(sol.summary);
   rep->window_starts.push_back(w.start);
+  std::vector<int> keys;
+  for (const PoseKey& k : w.user.keys) keys.push_back(k.frame);
+  rep->trust.push_back(judge_window(options.fallback, sol.summary, src, keys));
   return {decode_window(model, problem, sol.z_l, sol.z_g), problem.transform, sol.summary.iterations};
 }
 
@@ -378,8 +382,18 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
   check_completion(model, input, constraints, options);
   const std::vector<WindowPlan> plan = plan_windows(model.config().window, input.num_frames(), constraints, options);
   CompletionReport rep;
-  WindowedSolution solved = solve_windows(model, input, constraints, plan, options, ctx, &rep);
+  LatentSolverOptions o = options;
+  o.fallback.enabled = options.fallback.enabled && options.start_noise == 0.0 && !constraints.beyond_full_poses();
+  WindowedSolution solved = solve_windows(model, input, constraints, plan, o, ctx, &rep);
+  const std::string note = fallback_note(rep.trust, o.fallback);
+  if (!note.empty()) {
+    const std::vector<WindowSpan> spans(plan.begin(), plan.end());
+    blend_toward_interpolation(fill_by_interpolation(input, constraints),
+                               interpolation_weights(spans, rep.trust, input.num_frames()), &solved.motion,
+                               &solved.contacts);
+  }
   make_known_values_exact(model.rig(), input, constraints, options, solved.contacts, &solved.motion, &rep);
+  if (!note.empty()) rep.warnings.push_back(note);
   rep.wall_ms = ms_since(t0);
   if (ctx.diagnostics) append_term_diagnostics(rep.windows, ctx.diagnostics);
   if (report) *report = std::move(rep);

@@ -73,6 +73,7 @@
 #include "tasks/fixups/foot_locking.h"
 #include "tasks/latent/energies.h"
 #include "tasks/latent/initializers.h"
+#include "tasks/latent/fallback.h"
 #include "tasks/latent/latent_optimizer.h"
 #include "tasks/latent/window_solver.h"
 
@@ -128,6 +129,11 @@ struct LatentSolverOptions : LatentOptimizerSettings {
   /// half the model's window is used).
   int overlap = 32;
 
+  /// Interpolation for the windows whose solution cannot reach the keys
+  /// (tasks/latent/fallback.h); off unless enabled. Only with whole-pose keys
+  /// and no start noise: other constraints are not interpolation's to meet.
+  InterpolationFallback fallback;
+
   /// Empty when valid, else what is wrong (Ceres' Options::IsValid style).
   std::string validate() const;
 };
@@ -174,7 +180,8 @@ struct CompletionReport {
   ConstraintError raw_known;           ///< raw solution vs keys, before the overwrite
   EffectorError raw_effectors;         ///< raw solution vs end-effector targets
   EffectorError effectors;             ///< output vs end-effector targets (after the blend)
-  std::vector<std::string> warnings;   ///< constraints that could not hold exactly (contact pins)
+  std::vector<WindowTrust> trust;      ///< per window, in solve order: the fallback rule's view
+  std::vector<std::string> warnings;   ///< constraints that could not hold exactly (contact pins), the fallback
   int iterations = 0;                  ///< summed over windows
   double wall_ms = 0.0;                ///< the whole call
 };

@@ -15,7 +15,7 @@ std::vector<Method> baseline_methods() {
   Method interp;
   interp.name = "interp";
   interp.description = "root LERP and rotation SLERP between known frames";
-  interp.complete = [](const Motion& in, const std::vector<int>& known, const TaskContext&) {
+  interp.complete = [](const Motion& in, const std::vector<int>& known, const TaskContext&, CompletionNotes*) {
     return interpolate_motion(in, known);
   };
   interp.complete_constrained = [](const Motion& in, const MotionConstraints& c, int variant, const TaskContext&,
@@ -32,7 +32,7 @@ std::vector<Method> baseline_methods() {
   Method zerovel;
   zerovel.name = "zerovel";
   zerovel.description = "hold the last known frame (zero velocity)";
-  zerovel.complete = [](const Motion& in, const std::vector<int>& known, const TaskContext&) {
+  zerovel.complete = [](const Motion& in, const std::vector<int>& known, const TaskContext&, CompletionNotes*) {
     return zero_velocity_motion(in, known);
   };
   zerovel.resample = [](const Motion& in, double fps, int frames, const TaskContext&) {

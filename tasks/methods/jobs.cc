@@ -49,13 +49,20 @@ void start(const TaskContext& ctx) { ctx.report(TaskProgress{}); }
 
 // Runs `complete` of `m` on validated input (the common end of
 // run_known_frames and run_fill): methods that need the model run on the
-// model's rig and rate (tasks/context/model_rig.h).
-Motion complete_with(const Method& m, const Motion& input, const std::vector<int>& known, const TaskContext& ctx) {
+// model's rig and rate (tasks/context/model_rig.h). A method that fell back to
+// interpolation everywhere gets the input rig's own interpolation, exactly.
+Motion complete_with(const Method& m, const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
+                     std::vector<std::string>* warnings) {
   start(ctx);
-  if (!m.needs_model) return m.complete(input, known, ctx);
-  return complete_on_model_rig(input, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
-    return m.complete(in, k, ctx);
-  });
+  CompletionNotes notes;
+  Motion out = !m.needs_model ? m.complete(input, known, ctx, &notes)
+                              : complete_on_model_rig(input, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
+                                  return m.complete(in, k, ctx, &notes);
+                                });
+  if (notes.interpolated) out = interpolate_motion(input, known);
+  if (warnings)
+    for (std::string& w : notes.warnings) warnings->push_back(std::move(w));
+  return out;
 }
 
 std::vector<int> key_frames(const MotionConstraints& c) {
@@ -215,21 +222,22 @@ int resampled_frame_count(int frames, double fps_in, double fps_out, bool* round
 }
 
 Motion run_known_frames(const Motion& input, const std::vector<int>& known, const std::string& method,
-                        const TaskContext& ctx) {
+                        const TaskContext& ctx, std::vector<std::string>* warnings) {
   const Method& m = checked_method(method, input, ctx, Ask::kComplete);
   validate_keyframes(known, input.num_frames());
-  return complete_with(m, input, known, ctx);
+  return complete_with(m, input, known, ctx, warnings);
 }
 
 Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method,
-                     const TaskContext& ctx) {
-  return run_known_frames(input, keyframes, method, ctx);
+                     const TaskContext& ctx, std::vector<std::string>* warnings) {
+  return run_known_frames(input, keyframes, method, ctx, warnings);
 }
 
-Motion run_fill(const Motion& input, int a, int b, const std::string& method, const TaskContext& ctx) {
+Motion run_fill(const Motion& input, int a, int b, const std::string& method, const TaskContext& ctx,
+                std::vector<std::string>* warnings) {
   const Method& m = checked_method(method, input, ctx, Ask::kComplete);
   // Sorted, unique, in range and at least two (frame 0 and the last): valid keyframes.
-  return complete_with(m, input, known_frames_outside_gap(input.num_frames(), a, b), ctx);
+  return complete_with(m, input, known_frames_outside_gap(input.num_frames(), a, b), ctx, warnings);
 }
 
 ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& constraints, const std::string& method,
@@ -240,7 +248,7 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
   ConstrainedResult result;
   const Eigen::Vector3d root_forward = ctx.model ? ctx.model->rig().root_forward : Eigen::Vector3d::UnitZ();
   if (!constraints.beyond_full_poses() && alternatives == 0) {
-    result.motions.push_back(run_known_frames(input, key_frames(constraints), method, ctx));
+    result.motions.push_back(run_known_frames(input, key_frames(constraints), method, ctx, &result.warnings));
     result.method = resolve_method(method, ctx).name;
   } else {
     const Method& m = resolve_method(method, ctx, !constraints.trajectory.empty());

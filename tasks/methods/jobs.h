@@ -74,13 +74,16 @@ int resampled_frame_count(int frames, double fps_in, double fps_out, bool* round
 
 /// Sparse-keyframe in-betweening: the output has the input's length and fps;
 /// known frames are `keyframes` (validated with validate_keyframes()), the
-/// others are never read. Known frames are copied exactly.
+/// others are never read. Known frames are copied exactly. What the method
+/// says about its path (for instance that it fell back to interpolation,
+/// tasks/latent/fallback.h) is appended to *warnings when given.
 Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method,
-                     const TaskContext& ctx = {});
+                     const TaskContext& ctx = {}, std::vector<std::string>* warnings = nullptr);
 
 /// Gap filling: frames a..b-1 unknown, all others known (as run_inbetween with
 /// known_frames_outside_gap()).
-Motion run_fill(const Motion& input, int a, int b, const std::string& method, const TaskContext& ctx = {});
+Motion run_fill(const Motion& input, int a, int b, const std::string& method, const TaskContext& ctx = {},
+                std::vector<std::string>* warnings = nullptr);
 
 /// Resampling to `fps`, keeping the time span; the output's fps is `fps` and
 /// its length resampled_frame_count(). If the frame count had to be rounded
@@ -91,7 +94,7 @@ Motion run_resample(const Motion& input, double fps, const std::string& method,
 /// Runs `complete` of a method on explicit known frames (validated like
 /// keyframes): the common path of run_inbetween and run_fill.
 Motion run_known_frames(const Motion& input, const std::vector<int>& known, const std::string& method,
-                        const TaskContext& ctx = {});
+                        const TaskContext& ctx = {}, std::vector<std::string>* warnings = nullptr);
 
 /// Most alternatives one request may ask for.
 inline constexpr int kMaxAlternatives = 16;

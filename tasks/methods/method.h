@@ -14,6 +14,17 @@
 
 namespace mf {
 
+/// What a method says about a completion besides its motion.
+struct CompletionNotes {
+  /// Sentences for the user (which path ran and why).
+  std::vector<std::string> warnings;
+  /// True when the method judged its own result implausible for the whole
+  /// input and returned interpolation of the known frames instead
+  /// (tasks/latent/fallback.h): the caller then returns the user rig's own
+  /// interpolation, exactly.
+  bool interpolated = false;
+};
+
 struct Method {
   std::string name;
   std::string description;
@@ -23,8 +34,11 @@ struct Method {
   std::string needs_inbetweener;
   /// Completes a motion from its known frames (sorted, unique, at least two,
   /// in range): every other frame is produced, known frames come out as given.
-  /// Unknown input frames must never be read. Null when unsupported.
-  std::function<Motion(const Motion& input, const std::vector<int>& known, const TaskContext& ctx)> complete;
+  /// Unknown input frames must never be read. `notes` (may be null) receives
+  /// what the method says about the path it took. Null when unsupported.
+  std::function<Motion(const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
+                       CompletionNotes* notes)>
+      complete;
   /// Completes a motion under any constraints (partial keys, end-effector
   /// targets, contact pins), validated by the caller. `variant` 0 is the
   /// method's answer; variant v > 0 the v-th alternative (another start, the

@@ -30,12 +30,21 @@ Method solver_method(const std::string& name, const std::string& description, La
   LatentSolverOptions options = default_solver_options(optimizer);
   if (!initializer.empty()) options.initializer = make_initializer(initializer);
   m.complete = [options, method_name = name, inbetweener](const Motion& input, const std::vector<int>& known,
-                                                   const TaskContext& ctx) {
+                                                   const TaskContext& ctx, CompletionNotes* notes) {
     const NemfModel& model = require_prior(ctx, "method '" + method_name + "'");
     if (!inbetweener.empty()) require_inbetweener(ctx, inbetweener, "method '" + method_name + "'");
     LatentSolverOptions o = options;
     if (ctx.max_iterations > 0) o.max_iterations = ctx.max_iterations;
-    return complete_motion(model, input, MotionConstraints::full_pose(known), o, ctx);
+    // Whole-pose keys: where the prior cannot reach them, interpolation (tasks/latent/fallback.h).
+    o.fallback.enabled = o.optimizer == LatentOptimizer::Lbfgs && ctx.interpolation_fallback;
+    CompletionReport report;
+    Motion out = complete_motion(model, input, MotionConstraints::full_pose(known), o, ctx, &report);
+    if (notes) {
+      notes->interpolated = !report.trust.empty();
+      for (const WindowTrust& t : report.trust) notes->interpolated = notes->interpolated && t.interpolated;
+      for (std::string& w : report.warnings) notes->warnings.push_back(std::move(w));
+    }
+    return out;
   };
   m.complete_constrained = [options, method_name = name, inbetweener](const Motion& input, const MotionConstraints& c,
                                                                int variant, const TaskContext& ctx,

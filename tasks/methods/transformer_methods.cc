@@ -15,7 +15,7 @@ Method transformer_method(const std::string& name, const std::string& descriptio
   m.needs_model = true;
   m.needs_inbetweener = kind;
   m.complete = [name, kind, stage, locks_feet](const Motion& input, const std::vector<int>& known,
-                                               const TaskContext& ctx) {
+                                               const TaskContext& ctx, CompletionNotes*) {
     const InbetweenModel& model = require_inbetweener(ctx, kind, "method '" + name + "'");
     return inbetweener_fill(model, stage, input, MotionConstraints::full_pose(known), LongGapPolicy::Throw,
                             locks_feet);
