@@ -19,6 +19,7 @@ packages=(
   python3-distributed   # Dask: `python3 -m motionfield.dask` runs batch files on a cluster (python_dask_batch test)
   blender               # the Blender add-on's headless tests (capi_blender_addon*, integrations/blender); Debian's 3.4 runs on the system python3
   libtinygltf-dev       # tinygltf 2.7: glTF 2.0 output (prior/motion/motion_gltf.cc) and reading it back in the tests
+  libassimp-dev         # assimp 5.2: FBX input (prior/motion/fbx_reader.cc), Debian's maintained FBX reader
   nodejs                # runs the Khronos glTF validator (npm gltf-validator) in the gltf_validator_* tests
 )
 # npm installs that validator (scripts/install-gltf-validator.sh). NodeSource's
