@@ -105,6 +105,13 @@ struct OptionPointerFields<mf_task_options> {
 };
 static_assert(sizeof(mf_task_options) == 72,
               "mf_task_options changed: list its pointer fields in OptionPointerFields");
+template <>
+struct OptionPointerFields<mf_motion_load_options> {
+  static constexpr size_t offsets[1] = {offsetof(mf_motion_load_options, animation)};
+  static constexpr size_t count = 1;
+};
+static_assert(sizeof(mf_motion_load_options) == 40,
+              "mf_motion_load_options changed: list its pointer fields in OptionPointerFields");
 
 /// Copies a caller's options struct of type T into a default-initialised T,
 /// reading only what fits in its struct_size; larger (newer) structs must have
