@@ -138,7 +138,11 @@ int command_version(const Settings& settings) {
 // The text form of mf_rig_describe's JSON (names from the file printable).
 void print_rig(const std::string& in, const nlohmann::ordered_json& d, const std::string& model_path, bool units_given) {
   const bool detected = d["unit_detected"].get<bool>();
-  const char* unit_how = units_given ? "given" : detected ? "detected from the leg length" : "no legs found: assumed";
+  const bool from_file = d["unit_from_file"].get<bool>();
+  const char* unit_how = from_file     ? "from the file"
+                         : units_given ? "given"
+                         : detected    ? "detected from the leg length"
+                                       : "no legs found: assumed";
   std::printf("%s: %d joints, unit %s (%s; %g m per file unit)\n", printable(in).c_str(), d["joints"].get<int>(),
               d["unit"].get<std::string>().c_str(), unit_how, d["length_scale"].get<double>());
   std::printf("mapped onto %s (%zu joints): user joint -> model joint, found by\n", printable(model_path).c_str(),

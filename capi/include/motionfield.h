@@ -681,7 +681,7 @@ MF_API int mf_length_unit_scale(const char *unit, double *out);
 /** How `motion`'s rig is read and mapped onto `model`'s, as JSON text (a
  *  string getter, UTF-8):
  *    {"unit": "cm", "length_scale": 0.01, "unit_detected": true,
- *     "joints": 65,
+ *     "unit_from_file": false, "joints": 65,
  *     "map": {"user joint": "model joint", ...},       (model joint order)
  *     "how": {"model joint": "name" | "shape" | "map file", ...},
  *     "unmapped_user_joints": ["user joint", ...],
@@ -690,7 +690,9 @@ MF_API int mf_length_unit_scale(const char *unit, double *out);
  *     "anatomy": "rest pose" | "known frames" | "model rig"}
  *  "unit" is the unit's name ("custom" for a length_scale that is none of
  *  mf_length_unit_scale's), "unit_detected" false when it was given or could
- *  not be detected (no humanoid legs found: centimetres), "joints" the
+ *  not be detected (no humanoid legs found: centimetres), "unit_from_file"
+ *  true when the file set it (glTF: metres, FBX: its UnitScaleFactor; added
+ *  in 0.3), "joints" the
  *  motion's joint count, "retargeting" whether the model has the rig anatomy
  *  that tasks on another rig need, "anatomy" where the user's anatomical
  *  joint frames come from: the rig's rest pose when it is a T or A pose,

@@ -39,6 +39,8 @@ struct mf_motion {
   /// from the skeleton (mf_bvh_options.length_scale 0 and humanoid legs found).
   std::string unit = "cm";
   bool unit_detected = false;
+  /// The unit was set by the file (glTF: metres; FBX: its UnitScaleFactor).
+  bool unit_from_file = false;
   /// Warnings of the task that made this motion, one per line ("" if none):
   /// mf_motion_get_warnings. Not passed on to motions derived from it.
   std::string warnings;

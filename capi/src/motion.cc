@@ -161,6 +161,7 @@ mf_motion* scene_motion(Motion motion, double metres_per_unit) {
   handle->motion = std::move(motion);
   handle->length_scale = metres_per_unit;
   handle->unit = unit_name(metres_per_unit);
+  handle->unit_from_file = true;
   return handle.release();
 }
 
@@ -208,6 +209,7 @@ mf_motion* derived_motion(Motion motion, const mf_motion& like) {
   handle->length_scale = like.length_scale;
   handle->unit = like.unit;
   handle->unit_detected = like.unit_detected;
+  handle->unit_from_file = like.unit_from_file;
   return handle.release();
 }
 
