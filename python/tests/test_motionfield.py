@@ -165,6 +165,26 @@ class MotionTest(unittest.TestCase):
                 m.save_gltf(os.path.join(d, "no", "e.glb"))
             self.assertEqual(sorted(os.listdir(d)), ["a.glb", "b.gltf", "c.bin"])
 
+    def test_load_any_format(self):
+        m = mf.Motion.load_bvh(SAMPLE)
+        self.assertEqual(mf.Motion.load(SAMPLE).frame_count, m.frame_count)
+        with tempfile.TemporaryDirectory() as d:
+            m.save_gltf(os.path.join(d, "a.glb"))
+            os.rename(os.path.join(d, "a.glb"), os.path.join(d, "a.data"))  # told by its content
+            g = mf.Motion.load(os.path.join(d, "a.data"))
+            self.assertEqual(g.joint_names, m.joint_names)
+            self.assertEqual(g.length_scale, 1.0)
+            np.testing.assert_allclose(g.global_positions, m.global_positions, atol=1e-5)
+            self.assertEqual(mf.Motion.load(os.path.join(d, "a.data"), fps=60, animation="motion").frame_count, 121)
+            with self.assertRaisesRegex(mf.InvalidArgumentError, "there is no animation 1"):
+                mf.Motion.load(os.path.join(d, "a.data"), animation=1)
+            with self.assertRaisesRegex(mf.InvalidArgumentError, "not a valid FBX file"):
+                mf.Motion.load(os.path.join(d, "a.data"), format="fbx")
+            with self.assertRaises(mf.InvalidArgumentError):
+                mf.Motion.load(os.path.join(d, "a.data"), format="obj")
+            with self.assertRaises(mf.InvalidArgumentError):
+                mf.Motion.load(os.path.join(d, "a.data"), animation=-1)
+
     def test_arrays_round_trip(self):
         names, parents, offsets = small_skeleton()
         rot = random_rotations(12, 7, 1)
