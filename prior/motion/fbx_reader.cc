@@ -10,8 +10,16 @@
 #include "prior/motion/errors.h"
 #include "prior/util/binary_io.h"
 
+namespace Assimp {
+void aiAssertViolation(const char* expression, const char* file, int line);  // assimp_assert.cc
+}  // namespace Assimp
+
 namespace mf {
 namespace {
+
+// A reference that links assimp_assert.cc's handler into every program that
+// links this reader from the static library.
+[[gnu::used]] void (*volatile const kAssertHandler)(const char*, const char*, int) = &Assimp::aiAssertViolation;
 
 // A number of the scene's metadata (FBX global settings), whatever its type.
 bool metadata_number(const aiScene* scene, const char* key, double* out) {
