@@ -184,6 +184,10 @@ class MotionTest(unittest.TestCase):
                 mf.Motion.load(os.path.join(d, "a.data"), format="obj")
             with self.assertRaises(mf.InvalidArgumentError):
                 mf.Motion.load(os.path.join(d, "a.data"), animation=-1)
+        # An FBX on which assimp's own check fails: an error, not an abort of this process.
+        bad = os.path.join(SOURCE, "fuzz", "corpus", "fuzz_fbx", "regression-assimp-assert-curve-without-keys.fbx")
+        with self.assertRaisesRegex(mf.InvalidArgumentError, "not a valid FBX file: assimp's check"):
+            mf.Motion.load(bad)
 
     def test_arrays_round_trip(self):
         names, parents, offsets = small_skeleton()
