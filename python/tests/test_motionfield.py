@@ -68,7 +68,8 @@ class LibraryTest(unittest.TestCase):
     def test_every_exported_function_is_declared(self):
         from motionfield import _capi
         with open(os.path.join(SOURCE, "tests", "capi", "exported_symbols.txt")) as f:
-            names = [line.strip() for line in f if line.strip() and not line.startswith("#")]
+            # The C functions (mf_*): not assimp's replaced assertion handler (prior/motion/assimp_assert.cc).
+            names = [line.strip() for line in f if line.startswith("mf_")]
         self.assertGreater(len(names), 50)
         for name in names:
             f = getattr(_capi, name, None)
