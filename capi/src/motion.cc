@@ -155,6 +155,18 @@ GltfFormat gltf_format_of(const mf_gltf_options* options, const std::string& pat
   return format;
 }
 
+// What a file is called in the messages of its reading ("cannot read BVH file
+// F: ...", as mf_motion_load_bvh says): by its name, BVH unless it is named
+// .glb, .gltf or .fbx.
+std::string file_kind(const std::string& path) {
+  MotionFormat format = MotionFormat::Bvh;
+  try {
+    format = detect_motion_format(path, nullptr, 0);
+  } catch (const InputError&) {
+  }
+  return std::string(to_string(format)) + " file";
+}
+
 // A motion read from a glTF or FBX file: no BVH layout, the unit it came in.
 mf_motion* scene_motion(Motion motion, double metres_per_unit) {
   auto handle = std::make_unique<mf_motion>();
@@ -303,7 +315,7 @@ int mf_motion_load(const char* path, const mf_motion_load_options* options, mf_m
     const mf_motion_load_options o = mf::capi::read_options(options, "mf_motion_load_options");
     // The BVH limit and the scene formats' are both 512 MiB.
     static_assert(mf::kMaxBvhFileBytes == mf::kMaxSceneFileBytes, "one read limit for every motion file");
-    const std::string bytes = mf::read_file_limited(path, "motion file", mf::kMaxSceneFileBytes);  // MF_ERROR_IO
+    const std::string bytes = mf::read_file_limited(path, mf::capi::file_kind(path), mf::kMaxSceneFileBytes);
     const std::string p(path);
     const size_t slash = p.rfind('/');
     const std::string dir = slash == std::string::npos ? "./" : p.substr(0, slash + 1);
