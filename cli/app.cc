@@ -137,6 +137,10 @@ void define_global_options(CLI::App& app, Settings& s, bool& version_flag) {
                  "the BVH length unit: auto (the default: detected from the\nleg length), cm, m, mm, in, ft, asf or "
                  "metres per unit\n(--length-scale 0.01 = --units cm)")
       ->type_name("U");
+  app.add_option("--animation", s.animation,
+                 "the animation of a glTF or FBX input to read, by name or\nindex (default: the first)")
+      ->type_name("NAME|INDEX")
+      ->check(kNonEmpty);
   app.add_flag("-v,--verbose", s.verbose, "print what runs and how long it takes (stderr)");
   app.add_flag("-q,--quiet", s.quiet, "no progress bar and no warnings (errors are still printed)");
   app.add_flag("--json", s.json,

@@ -23,6 +23,7 @@ struct Settings {
   std::vector<std::string> citl;      ///< --citl PATH (repeatable)
   std::string rig_map;                ///< --rig-map FILE, "" for the automatic map
   std::string units;                  ///< --units, "" = auto
+  std::string animation;              ///< --animation NAME|INDEX of glTF and FBX inputs, "" = the first
 
   /// The transformer files to add to the model, --twostage first.
   std::vector<std::string> transformers() const;

@@ -51,6 +51,12 @@ nlohmann::ordered_json number(double v) {
 
 // The job line of a task command (inbetween, fill, resample, renav, export)
 // from its options: the library runs it as a batch line.
+// --animation as a job line has it: an index (digits only) or a name.
+nlohmann::ordered_json animation_value(const std::string& text) {
+  if (!text.empty() && text.find_first_not_of("0123456789") == std::string::npos) return parse_int(text, "--animation");
+  return text;
+}
+
 std::string task_line(const std::string& command, const Arguments& a) {
   const JobOptions& job = a.job;
   nlohmann::ordered_json j{{"task", command}, {"in", job.in}, {"out", job.out}};
@@ -74,6 +80,7 @@ std::string task_line(const std::string& command, const Arguments& a) {
   if (!job.trajectory_file.empty()) j["trajectory"] = job.trajectory_file;
   if (job.alternatives != 0) j["alternatives"] = job.alternatives;
   if (!job.report_file.empty()) j["report"] = job.report_file;
+  if (!a.settings.animation.empty()) j["animation"] = animation_value(a.settings.animation);
   try {
     return j.dump();
   } catch (const nlohmann::json::exception&) {
@@ -131,7 +138,11 @@ int command_version(const Settings& settings) {
 // The text form of mf_rig_describe's JSON (names from the file printable).
 void print_rig(const std::string& in, const nlohmann::ordered_json& d, const std::string& model_path, bool units_given) {
   const bool detected = d["unit_detected"].get<bool>();
-  const char* unit_how = units_given ? "given" : detected ? "detected from the leg length" : "no legs found: assumed";
+  const bool from_file = d["unit_from_file"].get<bool>();
+  const char* unit_how = from_file     ? "from the file"
+                         : units_given ? "given"
+                         : detected    ? "detected from the leg length"
+                                       : "no legs found: assumed";
   std::printf("%s: %d joints, unit %s (%s; %g m per file unit)\n", printable(in).c_str(), d["joints"].get<int>(),
               d["unit"].get<std::string>().c_str(), unit_how, d["length_scale"].get<double>());
   std::printf("mapped onto %s (%zu joints): user joint -> model joint, found by\n", printable(model_path).c_str(),
@@ -166,7 +177,12 @@ int command_rig(const std::string& in, bool json, const Settings& settings) {
   const Model model = runner.load_model();
   if (!model) throw InputError("rig needs the model, and none is installed (name one with --model)");
   const double length_scale = units_scale(settings.units, "--units (--length-scale)");
-  const Motion motion = Motion::load_bvh(in, length_scale);
+  LoadOptions load;
+  load.length_scale = length_scale;
+  const nlohmann::ordered_json animation = animation_value(settings.animation);
+  if (animation.is_string()) load.animation = animation.get<std::string>();
+  else load.animation_index = animation.get<int>();
+  const Motion motion = Motion::load(in, load);
   std::string text;
   try {
     text = rig_describe(model, motion, map);

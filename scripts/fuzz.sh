@@ -15,7 +15,7 @@ SECONDS_PER_TARGET=${1:-60}
 shift || true
 BUILD=${FUZZ_BUILD:-build-fuzz}
 JOBS=${FUZZ_JOBS:-2}
-ALL_TARGETS=(fuzz_bvh fuzz_jsonl fuzz_path_csv fuzz_constraints fuzz_model_file fuzz_capi_motion fuzz_capi_inbetween)
+ALL_TARGETS=(fuzz_bvh fuzz_gltf fuzz_fbx fuzz_jsonl fuzz_path_csv fuzz_constraints fuzz_model_file fuzz_capi_motion fuzz_capi_inbetween)
 TARGETS=("${ALL_TARGETS[@]}")
 [ $# -gt 0 ] && TARGETS=("$@")
 
@@ -30,6 +30,7 @@ dict_of() {
   case "$1" in
     fuzz_bvh) echo fuzz/dict/bvh.dict ;;
     fuzz_jsonl | fuzz_constraints) echo fuzz/dict/json.dict ;;
+    fuzz_gltf) echo fuzz/dict/gltf.dict ;;
     fuzz_path_csv) echo fuzz/dict/csv.dict ;;
   esac
 }

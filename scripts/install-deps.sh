@@ -20,6 +20,7 @@ packages=(
   blender               # the Blender add-on's headless tests (capi_blender_addon*, integrations/blender); Debian's 3.4 runs on the system python3
   xvfb xauth            # a virtual display (xvfb-run): the add-on's panels drawn in a real Blender window and screenshotted (capi_blender_panel)
   libtinygltf-dev       # tinygltf 2.7: glTF 2.0 output (prior/motion/motion_gltf.cc) and reading it back in the tests
+  libassimp-dev         # assimp 5.2: FBX input (prior/motion/fbx_reader.cc), Debian's maintained FBX reader
   nodejs                # runs the Khronos glTF validator (npm gltf-validator) in the gltf_validator_* tests
 )
 # npm installs that validator (scripts/install-gltf-validator.sh). NodeSource's

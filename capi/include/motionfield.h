@@ -100,11 +100,11 @@ typedef struct mf_encoding mf_encoding;
 /* ================================================================ version */
 
 #define MF_VERSION_MAJOR 0
-#define MF_VERSION_MINOR 2
+#define MF_VERSION_MINOR 3
 #define MF_VERSION_PATCH 0
 /** MAJOR * 10000 + MINOR * 100 + PATCH */
 #define MF_VERSION_NUMBER (MF_VERSION_MAJOR * 10000 + MF_VERSION_MINOR * 100 + MF_VERSION_PATCH)
-#define MF_VERSION_STRING "0.2.0"
+#define MF_VERSION_STRING "0.3.0"
 /** The ABI major: the N of libmotionfield.so.N. */
 #define MF_ABI_VERSION 0
 
@@ -417,6 +417,58 @@ MF_API int mf_motion_save_gltf(const mf_motion *motion, const char *path, const 
 MF_API int mf_motion_save_gltf_to_memory(const mf_motion *motion, const mf_gltf_options *options, uint8_t *out,
                                          size_t capacity, size_t *needed);
 
+/* ================================================================ motion files */
+
+/** Motion file formats (mf_motion_load_options.format). */
+#define MF_FORMAT_AUTO 0 /**< from the content, then the name (see mf_motion_load) */
+#define MF_FORMAT_BVH 1
+#define MF_FORMAT_GLTF 2 /**< glTF 2.0: .glb or .gltf */
+#define MF_FORMAT_FBX 3  /**< FBX, binary or ASCII (read with assimp) */
+
+/** Options of mf_motion_load (appended in 0.3). */
+typedef struct mf_motion_load_options {
+  uint32_t struct_size;
+  /** MF_FORMAT_AUTO (0, the default) or the format to read the file as. */
+  int32_t format;
+  /** BVH: metres per file unit, as mf_bvh_options.length_scale (0: detected).
+   *  Ignored for glTF (metres) and FBX (the file's UnitScaleFactor). */
+  double length_scale;
+  /** glTF and FBX: the name of the animation to read; NULL or "": the one at
+   *  animation_index. */
+  const char *animation;
+  /** glTF and FBX: the index of the animation (0, the default: the first). */
+  int32_t animation_index;
+  /** glTF and FBX: the frame rate to sample the animation at (at most 1000);
+   *  0 (the default): the keys' rate (one over the smallest interval between
+   *  keys, e.g. 30 when keys are 1/30 s apart). */
+  double fps;
+} mf_motion_load_options;
+
+MF_API int mf_motion_load_options_init(mf_motion_load_options *options);
+/** Reads a motion file of any format motionfield reads: BVH (as
+ *  mf_motion_load_bvh), glTF 2.0 (.glb or .gltf: a skinned or skin-less
+ *  armature, the joints of its skin or the animated nodes) or FBX (binary or
+ *  ASCII; its unit and up axis from the file's settings). The format is
+ *  options->format, or (MF_FORMAT_AUTO) told from the content: "glTF" (GLB),
+ *  "Kaydara FBX Binary" or "; FBX" (FBX), "HIERARCHY" (BVH), "{" (glTF JSON);
+ *  else from the extension (.bvh, .glb, .gltf, .fbx). glTF and FBX
+ *  animations are sampled from their first key to their last; rotations are
+ *  made relative to the rest pose (whose rotations become identity, as in
+ *  BVH), so bone orientations do not show; the root is the armature's top
+ *  joint, or, as for BVH, the one child of a container joint whose
+ *  translation carries the motion (an armature object, a "joint_Root"); the
+ *  other joints keep their rest offsets. Such motions have no BVH layout: a
+ *  BVH is written with the default one, in metres (glTF) or the FBX file's
+ *  unit (mf_motion_get_length_scale). MF_ERROR_IO if the file cannot be
+ *  read; MF_ERROR_INVALID_ARGUMENT with "<path>: <problem>" for a malformed
+ *  file (truncated, no animation, no armature, two roots, NaN keys, counts
+ *  beyond the limits). */
+MF_API int mf_motion_load(const char *path, const mf_motion_load_options *options, mf_motion **out);
+/** The same from `size` bytes in memory (named "<memory>" in messages; a glTF
+ *  with external buffers cannot be read from memory). */
+MF_API int mf_motion_load_from_memory(const uint8_t *data, size_t size, const mf_motion_load_options *options,
+                                      mf_motion **out);
+
 /* ================================================================ tasks */
 
 /** Options of every task. Fields a task does not use are ignored. */
@@ -629,7 +681,7 @@ MF_API int mf_length_unit_scale(const char *unit, double *out);
 /** How `motion`'s rig is read and mapped onto `model`'s, as JSON text (a
  *  string getter, UTF-8):
  *    {"unit": "cm", "length_scale": 0.01, "unit_detected": true,
- *     "joints": 65,
+ *     "unit_from_file": false, "joints": 65,
  *     "map": {"user joint": "model joint", ...},       (model joint order)
  *     "how": {"model joint": "name" | "shape" | "map file", ...},
  *     "unmapped_user_joints": ["user joint", ...],
@@ -638,7 +690,9 @@ MF_API int mf_length_unit_scale(const char *unit, double *out);
  *     "anatomy": "rest pose" | "known frames" | "model rig"}
  *  "unit" is the unit's name ("custom" for a length_scale that is none of
  *  mf_length_unit_scale's), "unit_detected" false when it was given or could
- *  not be detected (no humanoid legs found: centimetres), "joints" the
+ *  not be detected (no humanoid legs found: centimetres), "unit_from_file"
+ *  true when the file set it (glTF: metres, FBX: its UnitScaleFactor; added
+ *  in 0.3), "joints" the
  *  motion's joint count, "retargeting" whether the model has the rig anatomy
  *  that tasks on another rig need, "anatomy" where the user's anatomical
  *  joint frames come from: the rig's rest pose when it is a T or A pose,

@@ -216,11 +216,34 @@ class Model : public detail::Handle<mf_model, mf_model_destroy> {
 /// mf_model_default_path: "" when no default model exists.
 inline std::string default_model_path() { return detail::read_string(mf_model_default_path); }
 
+/// mf_motion_load_options, as C++ values (every default is the C default).
+struct LoadOptions {
+  int32_t format = MF_FORMAT_AUTO;
+  double length_scale = 0.0;   ///< BVH: metres per file unit, 0 detects it
+  std::string animation;       ///< glTF, FBX: by name ("": by index)
+  int32_t animation_index = 0;
+  double fps = 0.0;            ///< glTF, FBX: the sampling rate, 0 = the keys' rate
+};
+
 /// A skeleton with per-frame local rotations and root positions (immutable).
 class Motion : public detail::Handle<mf_motion, mf_motion_destroy> {
  public:
   using Handle::Handle;
 
+  /// mf_motion_load: a BVH, glTF or FBX file, the format from its content or name.
+  static Motion load(const std::string& path, const LoadOptions& options = {}) {
+    const mf_motion_load_options o = load_options(options);
+    mf_motion* m = nullptr;
+    check(mf_motion_load(path.c_str(), &o, &m));
+    return Motion(m);
+  }
+  /// mf_motion_load_from_memory.
+  static Motion load_from_memory(const std::vector<uint8_t>& bytes, const LoadOptions& options = {}) {
+    const mf_motion_load_options o = load_options(options);
+    mf_motion* m = nullptr;
+    check(mf_motion_load_from_memory(bytes.data(), bytes.size(), &o, &m));
+    return Motion(m);
+  }
   /// mf_motion_load_bvh; length_scale 0 detects the unit (metres per file unit).
   static Motion load_bvh(const std::string& path, double length_scale = 0.0) {
     const mf_bvh_options o = bvh_options(length_scale);
@@ -300,6 +323,16 @@ class Motion : public detail::Handle<mf_motion, mf_motion_destroy> {
     mf_bvh_options o;
     check(mf_bvh_options_init(&o));
     o.length_scale = length_scale;
+    return o;
+  }
+  static mf_motion_load_options load_options(const LoadOptions& options) {
+    mf_motion_load_options o;
+    check(mf_motion_load_options_init(&o));
+    o.format = options.format;
+    o.length_scale = options.length_scale;
+    o.animation = options.animation.c_str();
+    o.animation_index = options.animation_index;
+    o.fps = options.fps;
     return o;
   }
   static mf_gltf_options gltf_options(int32_t format) {

@@ -39,6 +39,8 @@ struct mf_motion {
   /// from the skeleton (mf_bvh_options.length_scale 0 and humanoid legs found).
   std::string unit = "cm";
   bool unit_detected = false;
+  /// The unit was set by the file (glTF: metres; FBX: its UnitScaleFactor).
+  bool unit_from_file = false;
   /// Warnings of the task that made this motion, one per line ("" if none):
   /// mf_motion_get_warnings. Not passed on to motions derived from it.
   std::string warnings;
@@ -105,6 +107,13 @@ struct OptionPointerFields<mf_task_options> {
 };
 static_assert(sizeof(mf_task_options) == 72,
               "mf_task_options changed: list its pointer fields in OptionPointerFields");
+template <>
+struct OptionPointerFields<mf_motion_load_options> {
+  static constexpr size_t offsets[1] = {offsetof(mf_motion_load_options, animation)};
+  static constexpr size_t count = 1;
+};
+static_assert(sizeof(mf_motion_load_options) == 40,
+              "mf_motion_load_options changed: list its pointer fields in OptionPointerFields");
 
 /// Copies a caller's options struct of type T into a default-initialised T,
 /// reading only what fits in its struct_size; larger (newer) structs must have

@@ -1,6 +1,7 @@
 // mf_motion: creation from arrays and BVH, BVH output, queries.
 #include <algorithm>
 #include <cerrno>
+#include <cstring>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +12,9 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/motion_bvh.h"
+#include "prior/motion/fbx_reader.h"
+#include "prior/motion/gltf_reader.h"
+#include "prior/motion/motion_file.h"
 #include "prior/motion/motion_gltf.h"
 #include "prior/rig/units.h"
 #include "prior/util/binary_io.h"
@@ -151,6 +155,62 @@ GltfFormat gltf_format_of(const mf_gltf_options* options, const std::string& pat
   return format;
 }
 
+// What a file is called in the messages of its reading ("cannot read BVH file
+// F: ...", as mf_motion_load_bvh says): by its name, BVH unless it is named
+// .glb, .gltf or .fbx.
+std::string file_kind(const std::string& path) {
+  MotionFormat format = MotionFormat::Bvh;
+  try {
+    format = detect_motion_format(path, nullptr, 0);
+  } catch (const InputError&) {
+  }
+  return std::string(to_string(format)) + " file";
+}
+
+// A motion read from a glTF or FBX file: no BVH layout, the unit it came in.
+mf_motion* scene_motion(Motion motion, double metres_per_unit) {
+  auto handle = std::make_unique<mf_motion>();
+  handle->motion = std::move(motion);
+  handle->length_scale = metres_per_unit;
+  handle->unit = unit_name(metres_per_unit);
+  handle->unit_from_file = true;
+  return handle.release();
+}
+
+// mf_motion_load's reading of `size` bytes named `source`; `base_dir`: where
+// a glTF's external buffers are ("" from memory).
+mf_motion* load_motion(const uint8_t* data, size_t size, const mf_motion_load_options& o, const std::string& source,
+                       const std::string& base_dir) {
+  if (o.format < MF_FORMAT_AUTO || o.format > MF_FORMAT_FBX)
+    throw ApiError(MF_ERROR_INVALID_ARGUMENT, "mf_motion_load_options.format must be MF_FORMAT_AUTO, _BVH, _GLTF or "
+                                              "_FBX, not " + std::to_string(o.format));
+  mf_bvh_options bvh;
+  std::memset(&bvh, 0, sizeof bvh);
+  bvh.struct_size = sizeof bvh;
+  bvh.length_scale = o.length_scale;
+  length_scale_of(&bvh);
+  const MotionFormat format = o.format == MF_FORMAT_BVH    ? MotionFormat::Bvh
+                              : o.format == MF_FORMAT_GLTF ? MotionFormat::Gltf
+                              : o.format == MF_FORMAT_FBX  ? MotionFormat::Fbx
+                                                           : detect_motion_format(source, data, size);
+  if (format == MotionFormat::Bvh) {
+    const std::string text(reinterpret_cast<const char*>(data), size);
+    return motion_from_document(parse_bvh(text, source), &bvh, source);
+  }
+  SceneReadOptions scene;
+  scene.animation = o.animation ? o.animation : "";
+  scene.animation_index = o.animation_index;
+  scene.fps = o.fps;
+  try {
+    if (format == MotionFormat::Gltf) return scene_motion(read_gltf_motion(data, size, base_dir, scene), 1.0);
+    double unit = 1.0;
+    Motion m = read_fbx_motion(data, size, scene, &unit);
+    return scene_motion(std::move(m), unit);
+  } catch (const InputError& e) {
+    throw InputError(source + ": " + e.what());
+  }
+}
+
 }  // namespace
 
 mf_motion* derived_motion(Motion motion, const mf_motion& like) {
@@ -161,6 +221,7 @@ mf_motion* derived_motion(Motion motion, const mf_motion& like) {
   handle->length_scale = like.length_scale;
   handle->unit = like.unit;
   handle->unit_detected = like.unit_detected;
+  handle->unit_from_file = like.unit_from_file;
   return handle.release();
 }
 
@@ -244,6 +305,32 @@ int mf_motion_load_bvh_from_memory(const char* data, size_t size, const mf_bvh_o
     mf::capi::length_scale_of(options);
     const std::string text = data ? std::string(data, size) : std::string();
     *out = mf::capi::motion_from_document(mf::parse_bvh(text, "<memory>"), options, "<memory>");
+  });
+}
+
+int mf_motion_load(const char* path, const mf_motion_load_options* options, mf_motion** out) {
+  return guard([&] {
+    require(path, "path");
+    require(out, "out");
+    const mf_motion_load_options o = mf::capi::read_options(options, "mf_motion_load_options");
+    // The BVH limit and the scene formats' are both 512 MiB.
+    static_assert(mf::kMaxBvhFileBytes == mf::kMaxSceneFileBytes, "one read limit for every motion file");
+    const std::string bytes = mf::read_file_limited(path, mf::capi::file_kind(path), mf::kMaxSceneFileBytes);
+    const std::string p(path);
+    const size_t slash = p.rfind('/');
+    const std::string dir = slash == std::string::npos ? "./" : p.substr(0, slash + 1);
+    *out = mf::capi::load_motion(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), o, p, dir);
+  });
+}
+
+int mf_motion_load_from_memory(const uint8_t* data, size_t size, const mf_motion_load_options* options,
+                               mf_motion** out) {
+  return guard([&] {
+    if (!data && size != 0) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "data is NULL");
+    require(out, "out");
+    const mf_motion_load_options o = mf::capi::read_options(options, "mf_motion_load_options");
+    static const uint8_t kEmpty = 0;
+    *out = mf::capi::load_motion(data ? data : &kEmpty, size, o, "<memory>", "");
   });
 }
 

@@ -19,6 +19,7 @@ std::string describe_rig(const mf_model& model, const mf_motion& motion, const s
   out["unit"] = motion.unit;
   out["length_scale"] = motion.length_scale;
   out["unit_detected"] = motion.unit_detected;
+  out["unit_from_file"] = motion.unit_from_file;
   out["joints"] = user.num_joints();
   nlohmann::ordered_json mapped = nlohmann::ordered_json::object(), how = nlohmann::ordered_json::object();
   std::vector<bool> used(static_cast<size_t>(user.num_joints()), false);

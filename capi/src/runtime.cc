@@ -355,6 +355,14 @@ int mf_gltf_options_init(mf_gltf_options* options) {
   });
 }
 
+int mf_motion_load_options_init(mf_motion_load_options* options) {
+  return guard([&] {
+    require(options, "options");
+    std::memset(options, 0, sizeof *options);
+    options->struct_size = sizeof *options;
+  });
+}
+
 int mf_task_options_init(mf_task_options* options) {
   return guard([&] {
     require(options, "options");

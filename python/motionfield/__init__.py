@@ -17,6 +17,7 @@ Example::
     walk = mf.Motion.load_bvh("samples/walk_keyframes.bvh")
     filled = mf.inbetween(walk, [0, 15, 30, 45, 60])   # the CLI's default method
     mf.resample(filled, 60.0).save_bvh("walk60.bvh")
+    run = mf.Motion.load("character.glb", animation="Run")  # BVH, glTF or FBX
 
 Every task takes the motion first and everything else by keyword. Without
 ``model=`` a task uses the default model, exactly as the CLI does without

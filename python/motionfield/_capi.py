@@ -138,6 +138,17 @@ class MfGltfOptions(ctypes.Structure):
     ]
 
 
+class MfMotionLoadOptions(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("format", ctypes.c_int32),
+        ("length_scale", ctypes.c_double),
+        ("animation", ctypes.c_char_p),
+        ("animation_index", ctypes.c_int32),
+        ("fps", ctypes.c_double),
+    ]
+
+
 class MfTaskOptions(ctypes.Structure):
     _fields_ = [
         ("struct_size", ctypes.c_uint32),
@@ -339,6 +350,9 @@ _declare("mf_motion_get_rotations", _int, _motion, _P(_f32), _size, _P(_size))
 _declare("mf_motion_get_root_positions", _int, _motion, _P(_f32), _size, _P(_size))
 _declare("mf_motion_get_global_positions", _int, _motion, _P(_f32), _size, _P(_size))
 _declare("mf_gltf_options_init", _int, _P(MfGltfOptions))
+_declare("mf_motion_load_options_init", _int, _P(MfMotionLoadOptions))
+_declare("mf_motion_load", _int, _str, _P(MfMotionLoadOptions), _P(_motion))
+_declare("mf_motion_load_from_memory", _int, _P(ctypes.c_uint8), _size, _P(MfMotionLoadOptions), _P(_motion))
 _declare("mf_motion_save_gltf", _int, _motion, _str, _P(MfGltfOptions))
 _declare("mf_motion_save_gltf_to_memory", _int, _motion, _P(MfGltfOptions), _P(ctypes.c_uint8), _size, _P(_size))
 

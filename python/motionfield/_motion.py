@@ -24,6 +24,29 @@ def _bvh_options(length_scale: Optional[float]) -> Any:
     return o
 
 
+_LOAD_FORMATS = {None: 0, "auto": 0, "bvh": 1, "gltf": 2, "fbx": 3}  # MF_FORMAT_*
+
+
+def _load_options(format: Optional[str], length_scale: Optional[float], animation: Union[str, int, None],
+                  fps: Optional[float]) -> Any:
+    if format not in _LOAD_FORMATS:
+        raise InvalidArgumentError("format must be None, 'auto', 'bvh', 'gltf' or 'fbx', not %r" % (format,))
+    o = _c.MfMotionLoadOptions()
+    _check(_c.mf_motion_load_options_init(ctypes.byref(o)))
+    o.format = _LOAD_FORMATS[format]
+    if length_scale is not None:
+        o.length_scale = float(length_scale)
+    if isinstance(animation, str):
+        o.animation = animation.encode()
+    elif animation is not None:
+        if isinstance(animation, bool) or not isinstance(animation, int) or animation < 0:
+            raise InvalidArgumentError("animation must be a name or an index from 0, not %r" % (animation,))
+        o.animation_index = animation
+    if fps is not None:
+        o.fps = float(fps)
+    return o
+
+
 _GLTF_FORMATS = {None: 0, "auto": 0, "glb": 1, "gltf": 2}  # MF_GLTF_AUTO, MF_GLTF_BINARY, MF_GLTF_EMBEDDED
 
 
@@ -183,6 +206,47 @@ class Motion(_Skeletal):
                 raise InvalidArgumentError("offsets must have shape [%d, 3], not %s" % (joints, list(off.shape)))
             _check(_c.mf_motion_create(joints, names, par, _f32_ptr(off), frames, float(fps), _f32_ptr(rot),
                                        _f32_ptr(root), ctypes.byref(out)))
+        return cls._wrap(out)
+
+    @classmethod
+    def load(cls, path: PathLike, units: Union[str, float, None] = None, animation: Union[str, int, None] = None,
+             fps: Optional[float] = None, format: Optional[str] = None) -> "Motion":
+        """Reads a motion file: BVH, glTF 2.0 (.glb, .gltf) or FBX.
+
+        The format comes from the content, then the name (``format`` names
+        it instead: "bvh", "gltf" or "fbx"). glTF and FBX files give the
+        armature (the skin's joints, or the animated nodes) and one animation
+        sampled from its first key to its last, with rotations relative to the
+        rest pose (mf_motion_load in the C API documents the rules).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+        units : str or float, optional
+            BVH only, as for load_bvh. glTF is in metres, FBX in its file's unit.
+        animation : str or int, optional
+            glTF and FBX: the animation's name or index (default: the first).
+        fps : float, optional
+            glTF and FBX: the rate to sample at (default: the keys' rate).
+        format : str, optional
+            None or "auto", "bvh", "gltf", "fbx".
+
+        Returns
+        -------
+        Motion
+
+        Raises
+        ------
+        FileError
+            If the file cannot be read.
+        InvalidArgumentError
+            If it is malformed (the message names the problem: truncated, no
+            animation, no armature, two roots, NaN keys, ...).
+        """
+        out = ctypes.POINTER(_c.MfMotion)()
+        o = _load_options(format, _units_scale(units, None), animation, fps)
+        _check(_c.mf_motion_load(os.fspath(path).encode(), ctypes.byref(o), ctypes.byref(out)))
         return cls._wrap(out)
 
     @classmethod

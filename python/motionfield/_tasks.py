@@ -423,7 +423,7 @@ def describe_rig(motion: Motion, *, model: Optional[Model] = None, rig_map: Opti
     Returns
     -------
     dict
-        {"unit", "length_scale", "unit_detected", "joints", "map": {user joint:
+        {"unit", "length_scale", "unit_detected", "unit_from_file", "joints", "map": {user joint:
         model joint}, "how": {model joint: "name" | "shape" | "map file"},
         "unmapped_user_joints", "model_joints", "retargeting", "anatomy": "rest
         pose" | "known frames" | "model rig"} (where the user's joint frames

@@ -238,3 +238,57 @@ TEST(CApiGltf, TheWriterRefusesMotionsGltfCannotHold) {
 
 }  // namespace
 }  // namespace mf::capi_test
+
+namespace mf::capi_test {
+namespace {
+
+std::string last_error() { return mf_last_error_message(); }
+
+// mf_motion_load: the format from the content or the name, or as asked; a
+// glTF written by the library reads back (metres, no BVH layout).
+TEST(CApiMotionLoad, ReadsEveryFormatByContentNameOrOption) {
+  MotionPtr bvh;
+  {
+    mf_motion* m = nullptr;
+    ASSERT_EQ(mf_motion_load(sample_bvh().c_str(), nullptr, &m), MF_OK) << last_error();
+    bvh.reset(m);
+  }
+  EXPECT_EQ(frame_count(bvh.get()), 61);
+  mf_gltf_options go;
+  ASSERT_EQ(mf_gltf_options_init(&go), MF_OK);
+  size_t needed = 0;
+  ASSERT_EQ(mf_motion_save_gltf_to_memory(bvh.get(), &go, nullptr, 0, &needed), MF_OK);
+  std::vector<uint8_t> glb(needed);
+  ASSERT_EQ(mf_motion_save_gltf_to_memory(bvh.get(), &go, glb.data(), glb.size(), &needed), MF_OK);
+
+  mf_motion_load_options o;
+  ASSERT_EQ(mf_motion_load_options_init(&o), MF_OK);
+  mf_motion* m = nullptr;
+  ASSERT_EQ(mf_motion_load_from_memory(glb.data(), glb.size(), &o, &m), MF_OK) << last_error();
+  MotionPtr gltf(m);
+  double scale = 0;
+  ASSERT_EQ(mf_motion_get_length_scale(gltf.get(), &scale), MF_OK);
+  EXPECT_EQ(scale, 1.0);
+  const std::vector<float> a = global_positions(bvh.get()), b = global_positions(gltf.get());
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_NEAR(a[i], b[i], 1e-5);
+
+  // Named as FBX, it is refused by the FBX reader; a bad format value.
+  o.format = MF_FORMAT_FBX;
+  m = nullptr;
+  EXPECT_EQ(mf_motion_load_from_memory(glb.data(), glb.size(), &o, &m), MF_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(m, nullptr);
+  EXPECT_NE(last_error().find("<memory>: not a valid FBX file"), std::string::npos) << last_error();
+  o.format = 7;
+  EXPECT_EQ(mf_motion_load_from_memory(glb.data(), glb.size(), &o, &m), MF_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(last_error().find("mf_motion_load_options.format"), std::string::npos);
+  o.format = MF_FORMAT_AUTO;
+  const std::string garbage = "neither";
+  EXPECT_EQ(mf_motion_load_from_memory(reinterpret_cast<const uint8_t*>(garbage.data()), garbage.size(), &o, &m),
+            MF_ERROR_INVALID_ARGUMENT);
+  EXPECT_NE(last_error().find("cannot tell the format of <memory>"), std::string::npos) << last_error();
+  EXPECT_EQ(mf_motion_load("/nonexistent/walk.glb", &o, &m), MF_ERROR_IO);
+}
+
+}  // namespace
+}  // namespace mf::capi_test

@@ -94,6 +94,28 @@ TEST(CApiLayout, GltfOptions) {
   EXPECT_EQ(o.format, MF_GLTF_AUTO);
 }
 
+TEST(CApiLayout, MotionLoadOptions) {
+  EXPECT_EQ(sizeof(mf_motion_load_options), 40u);
+  EXPECT_EQ(offsetof(mf_motion_load_options, struct_size), 0u);
+  EXPECT_EQ(offsetof(mf_motion_load_options, format), 4u);
+  EXPECT_EQ(offsetof(mf_motion_load_options, length_scale), 8u);
+  EXPECT_EQ(offsetof(mf_motion_load_options, animation), 16u);
+  EXPECT_EQ(offsetof(mf_motion_load_options, animation_index), 24u);
+  EXPECT_EQ(offsetof(mf_motion_load_options, fps), 32u);
+  EXPECT_EQ(MF_FORMAT_AUTO, 0);
+  EXPECT_EQ(MF_FORMAT_BVH, 1);
+  EXPECT_EQ(MF_FORMAT_GLTF, 2);
+  EXPECT_EQ(MF_FORMAT_FBX, 3);
+  mf_motion_load_options o;
+  std::memset(&o, 0xff, sizeof o);
+  ASSERT_EQ(mf_motion_load_options_init(&o), MF_OK);
+  EXPECT_EQ(o.struct_size, sizeof o);
+  EXPECT_EQ(o.format, MF_FORMAT_AUTO);
+  EXPECT_EQ(o.animation, nullptr);
+  EXPECT_EQ(o.animation_index, 0);
+  EXPECT_EQ(o.fps, 0.0);
+}
+
 // The options' defaults are all zero (the rule that makes newer structs safe).
 TEST(CApiLayout, InitGivesZeroDefaults) {
   mf_task_options t;

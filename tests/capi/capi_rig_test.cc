@@ -215,6 +215,7 @@ TEST(CApiRig, DescribeShowsTheUnitAndTheMap) {
   EXPECT_EQ(d["unit"], "m");
   EXPECT_EQ(d["length_scale"], 1.0);
   EXPECT_EQ(d["unit_detected"], true);
+  EXPECT_EQ(d["unit_from_file"], false);
   EXPECT_EQ(d["joints"], 21);
   EXPECT_EQ(d["map"]["mixamorig:LeftArm"], "UpperArm_L");
   EXPECT_EQ(d["map"]["mixamorig:RightToeBase"], "Toes_R");

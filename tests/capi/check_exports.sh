@@ -19,7 +19,8 @@ else
   rm -f /tmp/mf-exports-diff.$$
   exit 1
 fi
-if echo "$actual" | grep -v '^mf_' >/dev/null; then
+# The one exception: assimp's assertion handler, replaced (prior/motion/fbx_reader.cc).
+if echo "$actual" | grep -v '^mf_' | grep -v '^_ZN6Assimp17aiAssertViolationEPKcS1_i$' >/dev/null; then
   echo "symbols without the mf_ prefix are exported"
   exit 1
 fi
@@ -29,7 +30,7 @@ case "$soname" in
   *) echo "unexpected SONAME '$soname'"; exit 1 ;;
 esac
 if [ -n "$reference" ]; then
-  missing=$(for s in $actual; do grep -q "\b$s(" "$reference" || echo "$s"; done)
+  missing=$(for s in $(echo "$actual" | grep '^mf_'); do grep -q "\b$s(" "$reference" || echo "$s"; done)
   if [ -n "$missing" ]; then
     echo "not described in $reference:"
     echo "$missing"

@@ -192,9 +192,12 @@ JobReport run_job(const BatchJob& job, OutputSet files, const JobSettings& setti
   if (load_warnings && job.method.empty() && !export_only) report.warnings = Models::load_warnings_of(model);
   // Standard input through its device file: the library reads pipes and
   // redirected files with its size limit, and refuses a terminal.
-  const Motion input = Motion::load_bvh(job.in == kStdio ? "/dev/stdin" : job.in,
-                                        units_scale(job.units.empty() ? settings.units : job.units,
-                                                    job.units.empty() ? "--units (--length-scale)" : "\"units\""));
+  LoadOptions load;
+  load.length_scale = units_scale(job.units.empty() ? settings.units : job.units,
+                                  job.units.empty() ? "--units (--length-scale)" : "\"units\"");
+  load.animation = job.animation;
+  load.animation_index = job.animation_index;
+  const Motion input = Motion::load(job.in == kStdio ? "/dev/stdin" : job.in, load);
   const auto t1 = Clock::now();
   const Solved solved = export_only ? Solved{} : solve(job, settings, model, input, progress);
   const Motion& result = export_only ? input : solved.motion;

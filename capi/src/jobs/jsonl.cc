@@ -448,6 +448,15 @@ BatchJob batch_job_from_json(const JsonValue& line, bool single) {
                      "\" (expected \"inbetween\", \"fill\", \"resample\" or \"renav\")");
   job.in = string_value(required(line, "in", job.task), "in", false);
   job.out = string_value(required(line, "out", job.task), "out", false);
+  if (const JsonValue* a = line.find("animation")) {
+    if (a->is_string()) {
+      job.animation = string_value(*a, "animation", false);
+    } else {
+      job.animation_index = int_value(*a, "\"animation\"");
+      if (job.animation_index < 0)
+        throw InputError("\"animation\" must be a name or an index from 0, not " + a->dump());
+    }
+  }
   if (export_only) return job;
   if (const JsonValue* m = line.find("method")) job.method = string_value(*m, "method", false);
   if (const JsonValue* n = line.find("max_iterations")) {

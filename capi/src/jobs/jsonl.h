@@ -93,7 +93,8 @@ const char* json_type_name(JsonValue::Type type);
 /// of x,z per output frame) and "polyline" (a CSV of vertices, with an
 /// optional "frames": N), and an optional "fps". Every task takes an optional
 /// "rig_map" (a JSON map file) and "units" (a unit name, "auto", or metres per
-/// unit as a number or a string). inbetween and fill also take "constraints"
+/// unit as a number or a string) and, for glTF and FBX inputs, "animation" (a
+/// name, or an index from 0). inbetween and fill also take "constraints"
 /// (a constraints file, or the same JSON inline as an object), "trajectory"
 /// (a trajectory CSV file, merged into the constraints), "alternatives"
 /// and "report" (a file for the constraint report). Only the keys the task needs
@@ -115,6 +116,8 @@ struct BatchJob {
   int frames = 0;                  ///< renav with a polyline: the output's frame count (0 = from the speed)
   std::string rig_map;             ///< a rig map file; empty: the command line's (--rig-map)
   std::string units;               ///< "auto", a unit name or metres per unit as text; empty: the command line's
+  std::string animation;           ///< glTF and FBX inputs: the animation's name; empty: by index
+  int animation_index = 0;         ///< glTF and FBX inputs: the animation's index (when no name)
   // inbetween and fill: constraints beyond whole-pose keys (docs/CONSTRAINTS.md)
   std::string constraints_file;    ///< a constraints file; empty: none
   std::string constraints_json;    ///< inline constraints (JSON text); empty: none
@@ -135,14 +138,15 @@ struct BatchJob {
 /// strings; "keyframes" an array of integers; "gap" an array of two integers;
 /// "fps" a number; "max_iterations" an integer in 0..100000; "method",
 /// "path", "polyline" and "rig_map" strings;
-/// "frames" an integer; "units" a string or a positive number; for inbetween
+/// "frames" an integer; "units" a string or a positive number; "animation" a
+/// string or an integer from 0; for inbetween
 /// and fill "constraints" a file name or an inline object, "trajectory" a file
 /// name, "alternatives" an
 /// integer in 0..16, "report" a file name; no string
 /// may contain a NUL, "\u0000", which would cut a file name). Range checks
 /// (keyframes within the clip, fps positive, ...) are the library's, once the
 /// input is read. `single` (a single command of the CLI): the task "export"
-/// ("in" and "out" only) is accepted too, and a resample's "fps" may be the
+/// ("in", "out" and "animation" only) is accepted too, and a resample's "fps" may be the
 /// text of a number ("nan", which JSON cannot hold, for the library's check).
 BatchJob batch_job_from_json(const JsonValue& line, bool single = false);
 
