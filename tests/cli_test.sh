@@ -394,7 +394,8 @@ if [ -n "$TINY" ]; then
   grep -q "iterations" "$TMP/tty.out" && fail "--quiet drew the progress bar" || pass
   expect_rc 0 "no progress bar when stderr is not a terminal" -- "$MF" --model "$TINY" --threads 1 inbetween --in "$SMALL" \
     --keyframes 0,39 --out "$TMP/notty.bvh" --method nemf
-  [ -s "$TMP/err" ] && fail "progress printed to a non-terminal stderr" || pass
+  # (A tiny random prior cannot reach the keys: the fallback's warning may be there, nothing else.)
+  grep -v "^motionfield: warning: interpolation was used" "$TMP/err" | grep -q . && fail "progress printed to a non-terminal stderr" || pass
 fi
 
 # ------------------------------------------------------------ bad input and faults (issue 18, docs/RELIABILITY.md)

@@ -532,14 +532,14 @@ UNIT_ITEMS = [("auto", "Automatic", "From the leg length (centimetres when no le
 
 
 class MOTIONFIELD_OT_import_motion(bpy.types.Operator, ImportHelper):
-    """Import a BVH motion as an armature and its action with motionfield's reader (any Python version)"""
+    """Import a motion (BVH, glTF 2.0 or FBX) as an armature and its action with motionfield's readers (any Python version)"""
     bl_idname = "motionfield.import_motion"
     bl_label = "Import motion (motionfield)"
     bl_options = {'REGISTER', 'UNDO'}
 
     filename_ext = ".bvh"
-    filter_glob: StringProperty(default="*.bvh", options={'HIDDEN'})
-    units: EnumProperty(name="File units", items=UNIT_ITEMS, default="auto")
+    filter_glob: StringProperty(default="*.bvh;*.glb;*.gltf;*.fbx", options={'HIDDEN'})
+    units: EnumProperty(name="File units (BVH)", items=UNIT_ITEMS, default="auto")
     rotation_mode: EnumProperty(name="Rotation", default='QUATERNION', items=[
         ('QUATERNION', "Quaternion", "Bones rotate in quaternions"),
         ('XYZ', "Euler XYZ", "Bones rotate in XYZ Euler angles")])
@@ -592,7 +592,7 @@ class MOTIONFIELD_OT_export_motion(bpy.types.Operator, ExportHelper):
 
 
 def _menu_import(self, context):
-    self.layout.operator(MOTIONFIELD_OT_import_motion.bl_idname, text="Motion (motionfield) (.bvh)")
+    self.layout.operator(MOTIONFIELD_OT_import_motion.bl_idname, text="Motion (motionfield) (.bvh, .glb, .fbx)")
 
 
 def _menu_export(self, context):

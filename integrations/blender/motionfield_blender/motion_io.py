@@ -66,10 +66,11 @@ def build_armature(context, motion, name):
 
 
 def import_motion(context, mf, path, units="auto", rotation_mode='QUATERNION'):
-    """Reads `path` with the library (`mf`: the motionfield package) and
-    builds an armature and its action, keyed from the scene's start frame.
-    Returns (armature object, motion)."""
-    motion = mf.Motion.load_bvh(path, units=units)
+    """Reads `path` (BVH, glTF 2.0 or FBX; `units` applies to BVH) with the
+    library (`mf`: the motionfield package) and builds an armature and its
+    action, keyed from the scene's start frame. Returns (armature object, motion)."""
+    is_bvh = os.path.splitext(path)[1].lower() == ".bvh"
+    motion = mf.Motion.load(path, units=units if is_bvh else None)
     name = os.path.splitext(os.path.basename(path))[0]
     obj = build_armature(context, motion, name)
     for pb in obj.pose.bones:

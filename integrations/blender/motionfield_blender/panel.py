@@ -143,7 +143,7 @@ class MOTIONFIELD_PT_files(_SubPanel, bpy.types.Panel):
 
     def draw(self, context):
         col = self.layout.column(align=True)
-        col.operator("motionfield.import_motion", text="Import motion (.bvh)", icon='IMPORT')
+        col.operator("motionfield.import_motion", text="Import motion (.bvh, .glb, .fbx)", icon='IMPORT')
         col.operator("motionfield.export_motion", text="Export action (.bvh)", icon='EXPORT')
 
 
