@@ -296,7 +296,9 @@ class ModelFile : public ::testing::Test {
  protected:
   void SetUp() override {
     at::manual_seed(0);
-    dir_ = test::scratch_dir("model_file");
+    // One folder per test: CTest runs this fixture's tests in parallel processes.
+    dir_ = test::scratch_dir(std::string("model_file-") +
+                             ::testing::UnitTest::GetInstance()->current_test_info()->name());
     path_ = dir_ + "/m.mfm";
     NemfModel model(tiny_nemf_config(), tiny_rig());
     save_nemf(model, path_);

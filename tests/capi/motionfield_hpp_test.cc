@@ -38,7 +38,7 @@ api::Error error_of(Call&& call) {
 api::Motion sample() { return api::Motion::load_bvh(sample_bvh()); }
 
 TEST(MotionfieldHpp, FailedCallsThrowErrorWithTheStatusAndTheMessage) {
-  const std::string missing = mf::test::scratch_dir("hpp") + "/missing.bvh";
+  const std::string missing = mf::test::scratch_dir("hpp-missing") + "/missing.bvh";
   const api::Error io = error_of([&] { api::Motion::load_bvh(missing); });
   EXPECT_EQ(io.status(), MF_ERROR_IO);
   EXPECT_STREQ(io.status_name(), "MF_ERROR_IO");
@@ -130,7 +130,7 @@ TEST(MotionfieldHpp, MotionsReadWriteAndReportWhatTheCApiDoes) {
   const api::Motion again = api::Motion::load_bvh_from_memory(text);
   EXPECT_EQ(again.joint_names(), names);
   EXPECT_EQ(again.frame_count(), 61);
-  const std::string path = mf::test::scratch_dir("hpp") + "/walk.bvh";
+  const std::string path = mf::test::scratch_dir("hpp-round-trip") + "/walk.bvh";
   walk.save_bvh(path, 1.0);  // written in metres
   const api::Motion metres = api::Motion::load_bvh(path, 1.0);
   EXPECT_NEAR(metres.offsets()[3 * 1 + 1], walk.offsets()[3 * 1 + 1], 1e-5);
