@@ -34,7 +34,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from . import animation, convert, engine, motion_io, panel, rig_info
+from . import alternatives, animation, convert, engine, motion_io, panel, rig_info
 
 # ------------------------------------------------------------------ preferences
 
@@ -129,6 +129,9 @@ class MotionfieldSettings(bpy.types.PropertyGroup):
                               description="The bone whose translation moves the character; its tree is "
                                           "converted. Empty: found from the action (the first bone below "
                                           "static container bones that moves)")
+    alternatives: IntProperty(name="Alternatives", min=0, max=8, default=0,
+                              description="More solutions of In-between and Fill gap from other starts, to cycle "
+                                          "through with Previous / Next (the latent solvers only: the nemf methods)")
     seed: IntProperty(name="Seed", min=0, default=0)
     max_iterations: IntProperty(name="Iterations", min=0, default=0,
                                 description="Iteration budget of the solvers (per window of the full solve); "
@@ -239,6 +242,30 @@ class _TaskOperator:
             kw["rig_map"] = bpy.path.abspath(s.rig_map)
         return kw
 
+    def completion(self, context, motion, known, sampled, new):
+        """(run, finish) of In-between and Fill gap: complete `motion` from its
+        frames `known` (indices into `sampled`), key the frames `new` as generated
+        keys; with alternatives, through motionfield.solve, keeping them to cycle."""
+        s = context.scene.motionfield
+        kw = self.task_kwargs(context, s.method)
+        count = s.alternatives
+
+        def run(progress, cancel):
+            if count:
+                return self.mf.solve(motion, known, alternatives=count, progress=progress, cancel=cancel, **kw)
+            return self.mf.inbetween(motion, known, progress=progress, cancel=cancel, **kw)
+
+        def key(result):
+            motions = result.motions if count else [result]
+            if count:
+                self.method_label = result.method
+            values = animation.channel_values(self.obj, self.rig, sampled, motions[0].rotations,
+                                              motions[0].root_positions, new)
+            animation.insert_keys(self.obj, self.rig, sampled, values, new, set(self.keyed))
+            alternatives.remember(self.obj, self.rig, sampled, new, self.keyed, motions)
+            return " (alternative 1 of %d)" % len(motions) if count else ""
+        return run, key
+
     def motion(self, sampled, fps):
         return self.mf.Motion.from_arrays(sampled.rotations, sampled.root_positions, fps,
                                           joint_names=self.rig.names, parents=self.rig.parents,
@@ -268,8 +295,10 @@ class _TaskOperator:
             return {'CANCELLED'}
         message = self._finish(context, job.result)
         redraw(context)
-        if job.result.warnings:
-            self.report({'WARNING'}, panel.wrap("motionfield: %s" % job.result.warnings))
+        warnings = job.result.warnings
+        if warnings:
+            text = warnings if isinstance(warnings, str) else " ".join(warnings)
+            self.report({'WARNING'}, panel.wrap("motionfield: %s" % text))
         self.report({'INFO'}, "motionfield: %s with %s in %.1f s" % (message, self.method_label or "the default method",
                                                                      time.time() - self._t0))
         return {'FINISHED'}
@@ -342,17 +371,11 @@ class MOTIONFIELD_OT_inbetween(_TaskOperator, bpy.types.Operator):
             raise ValueError("every frame in %d..%d is keyed already" % (keys[0], keys[-1]))
         sampled = convert.read_frames(scene, self.obj, self.rig, frames)
         motion = self.motion(sampled, _scene_fps(scene))
-        kw = self.task_kwargs(context, s.method)
-        index = [k - keys[0] for k in keys]
-
-        def run(progress, cancel):
-            return self.mf.inbetween(motion, index, progress=progress, cancel=cancel, **kw)
+        run, key = self.completion(context, motion, [k - keys[0] for k in keys], sampled, new)
 
         def finish(context, result):
-            values = animation.channel_values(self.obj, self.rig, sampled, result.rotations,
-                                              result.root_positions, new)
-            animation.insert_keys(self.obj, self.rig, sampled, values, new, set(self.keyed))
-            return "keyed %d frames between frames %d and %d" % (len(new), keys[0], keys[-1])
+            chosen = key(result)
+            return "keyed %d frames between frames %d and %d%s" % (len(new), keys[0], keys[-1], chosen)
         return run, finish
 
 
@@ -393,16 +416,11 @@ class MOTIONFIELD_OT_fill(_TaskOperator, bpy.types.Operator):
         new = set(range(gap[0], gap[1] + 1))
         sampled = convert.read_frames(scene, self.obj, self.rig, frames)
         motion = self.motion(sampled, _scene_fps(scene))
-        kw = self.task_kwargs(context, s.method)
-
-        def run(progress, cancel):
-            return self.mf.fill(motion, gap[0] - a, gap[1] + 1 - a, progress=progress, cancel=cancel, **kw)
+        known = [f - a for f in frames if f not in new]  # the gap filled from everything around it, as mf.fill does
+        run, key = self.completion(context, motion, known, sampled, new)
 
         def finish(context, result):
-            values = animation.channel_values(self.obj, self.rig, sampled, result.rotations,
-                                              result.root_positions, new)
-            animation.insert_keys(self.obj, self.rig, sampled, values, new, set(self.keyed))
-            return "keyed %d frames (%d..%d)" % (len(new), gap[0], gap[1])
+            return "keyed %d frames (%d..%d)%s" % (len(new), gap[0], gap[1], key(result))
         return run, finish
 
 
@@ -512,6 +530,35 @@ class MOTIONFIELD_OT_clear_generated(bpy.types.Operator):
         return {'FINISHED'}
 
 
+class MOTIONFIELD_OT_alternative(bpy.types.Operator):
+    """Key another of the last In-between's or Fill gap's alternative solutions on its generated frames"""
+    bl_idname = "motionfield.alternative"
+    bl_label = "Alternative"
+    bl_options = {'REGISTER', 'UNDO'}
+
+    step: IntProperty(name="Step", default=1, description="+1: the next alternative, -1: the previous one")
+
+    @classmethod
+    def poll(cls, context):
+        if not has_action(cls, context):
+            return False
+        if alternatives.current(context.active_object) is None:
+            cls.poll_message_set("Run In-between or Fill gap with Alternatives above 0 first (Advanced); "
+                                 "editing a key forgets them")
+            return False
+        return True
+
+    def execute(self, context):
+        try:
+            index, count = alternatives.step(context.active_object, self.step)
+        except ValueError as e:
+            self.report({'ERROR'}, panel.wrap("motionfield: %s" % e))
+            return {'CANCELLED'}
+        redraw(context)
+        self.report({'INFO'}, "motionfield: alternative %d of %d" % (index + 1, count))
+        return {'FINISHED'}
+
+
 class MOTIONFIELD_OT_set_root(bpy.types.Operator):
     """Use this bone as the root bone (empty: find the root from the action)"""
     bl_idname = "motionfield.set_root"
@@ -600,7 +647,7 @@ def _menu_export(self, context):
 
 
 _classes = (MOTIONFIELD_AP_preferences, MotionfieldSettings, MOTIONFIELD_OT_set_root, MOTIONFIELD_OT_inbetween,
-            MOTIONFIELD_OT_fill, MOTIONFIELD_OT_clear_generated, MOTIONFIELD_OT_import_motion,
+            MOTIONFIELD_OT_fill, MOTIONFIELD_OT_clear_generated, MOTIONFIELD_OT_alternative, MOTIONFIELD_OT_import_motion,
             MOTIONFIELD_OT_export_motion, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path) + panel.CLASSES
 
 

@@ -65,6 +65,20 @@ def keyed_frames(obj, bone_names):
     return sorted(frames)
 
 
+def animator_keys(obj, bone_names, first, last):
+    """{(data path, index): ((frame, value), ...)} of the animator's keys (not
+    the generated ones) of the bones' F-curves on frames first..last."""
+    names = set(bone_names)
+    generated, kind = generated_frames(obj.animation_data.action), _generated_type()
+    out = {}
+    for fc in fcurves_of(obj):
+        if bone_of(fc.data_path) in names:
+            out[(fc.data_path, fc.array_index)] = tuple(
+                (k.co[0], k.co[1]) for k in fc.keyframe_points
+                if first <= k.co[0] <= last and not is_generated(k, generated, kind))
+    return out
+
+
 def clear_generated(obj):
     """Removes the generated keys from the armature's action; returns how many
     frames had some."""

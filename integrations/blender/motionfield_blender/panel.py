@@ -9,7 +9,7 @@ import textwrap
 
 import bpy
 
-from . import convert, engine, rig_info
+from . import alternatives, convert, engine, rig_info
 
 CHARS_PER_PIXEL = 1.0 / 8.0  # a rough width of the interface font's characters
 
@@ -74,9 +74,22 @@ class MOTIONFIELD_PT_main(_Panel, bpy.types.Panel):
         row.operator("motionfield.inbetween", icon='IPO_BEZIER')
         row.operator("motionfield.fill", icon='SEQ_STRIP_DUPLICATE')
         layout.operator("motionfield.clear_generated", icon='TRASH')
+        draw_alternatives(layout, context)
         field(layout, s, "method", "Method")
         field(layout, s, "range_mode", "Frames")
+        field(layout, s, "alternatives", "Alternatives (0: one answer)")
         draw_rig(layout, context, mf)
+
+
+def draw_alternatives(layout, context):
+    """Previous / Next over the last run's alternatives, when it made some."""
+    state = alternatives.current(context.active_object)
+    if state is None:
+        return
+    row = layout.row(align=True)
+    row.operator("motionfield.alternative", text="", icon='TRIA_LEFT').step = -1
+    row.label(text="Alternative %d of %d" % (state[0] + 1, state[1]))
+    row.operator("motionfield.alternative", text="", icon='TRIA_RIGHT').step = 1
 
 
 def draw_rig(layout, context, mf):

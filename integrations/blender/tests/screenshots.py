@@ -63,6 +63,7 @@ def setup():
     with bpy.context.temp_override(window=window, area=area, region=main):
         bpy.ops.view3d.view_selected()
     bpy.context.scene.frame_set(11)
+    bpy.context.scene.motionfield.alternatives = 2  # the after picture shows the alternatives' row
 
 
 def show_tab():

@@ -106,6 +106,50 @@ check(left == set(keys), "clear generated leaves the animator's keys: %s" % sort
 check(not animation.generated_frames(action), "clear generated forgets the generated frames")
 log("generated keys")
 
+# ------------------------------------------------------------------ alternatives to cycle through
+from motionfield_blender import alternatives  # noqa: E402
+
+
+def generated_values(action, frames):
+    return {(fc.data_path, fc.array_index, int(round(k.co[0]))): k.co[1] for fc in action.fcurves
+            for k in fc.keyframe_points if int(round(k.co[0])) in frames}
+
+
+obj, motion, keys = walk_session.setup(mf)
+action = obj.animation_data.action
+s.alternatives, s.max_iterations = 2, 30
+check(alternatives.current(obj) is None, "no alternatives before a run")
+check(bpy.ops.motionfield.inbetween('EXEC_DEFAULT') == {'FINISHED'}, "in-between with alternatives finished")
+check(alternatives.current(obj) == (0, 3), "the method's answer and 2 alternatives: %s" % (alternatives.current(obj),))
+first, animator = generated_values(action, set(between)), generated_values(action, set(keys))
+check(bpy.ops.motionfield.alternative(step=1) == {'FINISHED'} and alternatives.current(obj) == (1, 3), "next")
+second = generated_values(action, set(between))
+check(second.keys() == first.keys(), "an alternative keys the same generated frames")
+check(max(abs(second[k] - first[k]) for k in first) > 1e-3, "the alternative is another motion")
+check(generated_values(action, set(keys)) == animator, "cycling keeps the animator's keys")
+check(all(k.type == kind for fc in action.fcurves for k in fc.keyframe_points if int(round(k.co[0])) in between),
+      "alternatives are generated keys too")
+bpy.ops.motionfield.alternative(step=1)
+bpy.ops.motionfield.alternative(step=1)
+back = generated_values(action, set(between))
+check(alternatives.current(obj) == (0, 3) and max(abs(back[k] - first[k]) for k in first) < 1e-6,
+      "three steps come back to the method's answer")
+bpy.ops.motionfield.alternative(step=-1)
+check(alternatives.current(obj) == (2, 3), "previous from the first is the last")
+scene.frame_set(21)
+arm = obj.pose.bones["UpperArm_L"]
+arm.rotation_quaternion = arm.rotation_quaternion @ Quaternion((0.0, 1.0, 0.0), 0.6)
+arm.keyframe_insert("rotation_quaternion", frame=21)  # a key edited by the animator ...
+try:
+    edited = bpy.ops.motionfield.alternative(step=1)
+except RuntimeError as e:  # the operator's error report
+    edited = str(e)
+check("keys changed" in str(edited) and alternatives.current(obj) is None, "... makes the alternatives out of date: %s"
+      % edited)
+check(not addon.MOTIONFIELD_OT_alternative.poll(bpy.context), "and the buttons greyed")
+s.alternatives, s.max_iterations = 0, 0
+log("alternatives")
+
 # ------------------------------------------------------------------ resample moves the found root with the pose
 obj, motion, keys = walk_session.setup(mf)
 s.resample_method = "interp"
