@@ -204,8 +204,11 @@ RigMap model_rig_map(const Skeleton& user, const TaskContext& ctx) {
   }
 }
 
-void check_model_rig(const Skeleton& input, const TaskContext& ctx) {
-  if (!ctx.model || input.same_as(ctx.model->rig().skeleton)) return;
+namespace {
+
+// Throws unless the context has the model's rig anatomy (another rig than the
+// model's needs it).
+void require_anatomy(const Skeleton& input, const TaskContext& ctx) {
   if (!ctx.model_anatomy) {
     const std::string what = "the motion has " + std::to_string(input.num_joints()) +
                              " joints on another rig than the model's (" +
@@ -215,15 +218,23 @@ void check_model_rig(const Skeleton& input, const TaskContext& ctx) {
     throw InputError(what + "the model has no rig anatomy to retarget with (" + kRigAnatomyFileName +
                      " next to the model file)");
   }
-  model_rig_map(input, ctx);
 }
 
-Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, const TaskContext& ctx) {
+}  // namespace
+
+std::optional<RigMap> check_model_rig(const Skeleton& input, const TaskContext& ctx) {
+  if (!ctx.model || input.same_as(ctx.model->rig().skeleton)) return std::nullopt;
+  require_anatomy(input, ctx);
+  return model_rig_map(input, ctx);
+}
+
+Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
+                            std::optional<RigMap> map) {
   const Skeleton& model = require_prior(ctx, "this method").rig().skeleton;
-  check_model_rig(input.skeleton, ctx);
-  RigMap map = model_rig_map(input.skeleton, ctx);
-  RigAnatomy user = user_rig_anatomy(input, map.user_parts, known);
-  return Retargeter(input.skeleton, model, std::move(map), std::move(user), *ctx.model_anatomy);
+  require_anatomy(input.skeleton, ctx);
+  if (!map) map = model_rig_map(input.skeleton, ctx);
+  RigAnatomy user = user_rig_anatomy(input, map->user_parts, known);
+  return Retargeter(input.skeleton, model, std::move(*map), std::move(user), *ctx.model_anatomy);
 }
 
 Motion match_known_frames(const Motion& out_in, const Motion& input, const std::vector<int>& known) {
@@ -235,7 +246,7 @@ Motion match_known_frames(const Motion& out_in, const Motion& input, const std::
 }
 
 Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
-                             const CompleteFn& complete) {
+                             const CompleteFn& complete, const std::optional<RigMap>& map) {
   if (!needs_model_rig(input, ctx)) return complete(input, known);
   const NemfModel& prior = require_prior(ctx, "this method");
   const double model_fps = prior.config().fps;
@@ -244,7 +255,7 @@ Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known,
   // (what joints the model lacks follow; reads only known frames).
   const Motion reference = interpolate_motion(input, known);
   std::optional<Retargeter> rig;
-  if (!native) rig.emplace(model_retargeter(input, known, ctx));
+  if (!native) rig.emplace(model_retargeter(input, known, ctx, map));
   Motion on_model = native ? reference : rig->to_model(reference);
   const std::vector<double> ground = model_ground(on_model, known, prior);
   shift_root_heights(&on_model, ground, -1.0);
@@ -269,7 +280,7 @@ Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known,
 
 Motion complete_constrained_on_model_rig(const Motion& input, const MotionConstraints& constraints,
                                          const TaskContext& ctx, const ConstrainedFn& complete,
-                                         std::vector<std::string>* warnings) {
+                                         std::vector<std::string>* warnings, const std::optional<RigMap>& map) {
   const NemfModel& prior = require_prior(ctx, "this method");
   const Skeleton& model = prior.rig().skeleton;
   const double model_fps = prior.config().fps;
@@ -282,7 +293,7 @@ Motion complete_constrained_on_model_rig(const Motion& input, const MotionConstr
                      "rotation): the joints no key gives have nothing to retarget from");
   const Motion reference = fill_by_interpolation(input, constraints);
   std::optional<Retargeter> rig;
-  if (!native) rig.emplace(model_retargeter(input, key_frames_of(constraints), ctx));
+  if (!native) rig.emplace(model_retargeter(input, key_frames_of(constraints), ctx, map));
   Motion on_model = native ? reference : rig->to_model(reference);
 
   ConstraintMapping mapping;
@@ -306,9 +317,9 @@ Motion complete_constrained_on_model_rig(const Motion& input, const MotionConstr
 }
 
 Motion resample_on_model_rig(const Motion& input, double fps, int frames, const TaskContext& ctx,
-                             const ResampleFn& resample) {
+                             const ResampleFn& resample, const std::optional<RigMap>& map) {
   if (!ctx.model || input.skeleton.same_as(ctx.model->rig().skeleton)) return resample(input, fps, frames);
-  const Retargeter rig = model_retargeter(input, {}, ctx);
+  const Retargeter rig = model_retargeter(input, {}, ctx, map);
   Motion on_model = rig.to_model(input);
   std::vector<int> all(static_cast<size_t>(input.num_frames()));
   for (int f = 0; f < input.num_frames(); ++f) all[f] = f;

@@ -11,6 +11,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,25 +45,31 @@ bool needs_model_rig(const Motion& input, const TaskContext& ctx);
 RigMap model_rig_map(const Skeleton& user, const TaskContext& ctx);
 
 /// Checks, before a model method runs, that a motion on `input` can be
-/// served: nothing for the prior's own skeleton (or without a prior); else
-/// the model needs its rig anatomy (ModelMissingError when the anatomy file
-/// next to the prior did not load, InputError when there is none) and the rig
-/// must map onto the prior's (model_rig_map's InputError).
-void check_model_rig(const Skeleton& input, const TaskContext& ctx);
+/// served, and returns its map onto the model's rig, which the adapters below
+/// take so that a request maps its rig once: nullopt for the prior's own
+/// skeleton (or without a prior); else the model needs its rig anatomy
+/// (ModelMissingError when the anatomy file next to the prior did not load,
+/// InputError when there is none) and the rig must map onto the prior's
+/// (model_rig_map's InputError).
+std::optional<RigMap> check_model_rig(const Skeleton& input, const TaskContext& ctx);
 
 /// A retargeter from `input`'s rig to the model's, its anatomy measured on the
-/// frames `known` of `input` (all when empty). Throws InputError when the rig
-/// cannot be mapped or the context has no model anatomy.
-Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, const TaskContext& ctx);
+/// frames `known` of `input` (all when empty), with `map` (check_model_rig's
+/// for this skeleton) or, without one, the map made here. Throws InputError
+/// when the rig cannot be mapped or the context has no model anatomy.
+Retargeter model_retargeter(const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
+                            std::optional<RigMap> map = std::nullopt);
 
 using CompleteFn = std::function<Motion(const Motion& input, const std::vector<int>& known)>;
 using ResampleFn = std::function<Motion(const Motion& input, double fps, int frames)>;
 using ConstrainedFn = std::function<Motion(const Motion& input, const MotionConstraints& constraints)>;
 
 /// Runs `complete` (a method on the model's rig and rate) for `input` with
-/// known frames `known` (validated by the caller).
+/// known frames `known` (validated by the caller). The adapters take the
+/// request's rig map (check_model_rig()) when the caller has it; without it
+/// they map the rig themselves.
 Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
-                             const CompleteFn& complete);
+                             const CompleteFn& complete, const std::optional<RigMap>& map = std::nullopt);
 
 /// Runs `complete` (a constrained method on the model's rig and rate) for
 /// `input` under `constraints` (validated against `input` by the caller).
@@ -84,11 +91,12 @@ Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known,
 /// one key must give every rotation.
 Motion complete_constrained_on_model_rig(const Motion& input, const MotionConstraints& constraints,
                                          const TaskContext& ctx, const ConstrainedFn& complete,
-                                         std::vector<std::string>* warnings);
+                                         std::vector<std::string>* warnings,
+                                         const std::optional<RigMap>& map = std::nullopt);
 
 /// Runs `resample` (a method on the model's rig; any input rate) for `input`.
 Motion resample_on_model_rig(const Motion& input, double fps, int frames, const TaskContext& ctx,
-                             const ResampleFn& resample);
+                             const ResampleFn& resample, const std::optional<RigMap>& map = std::nullopt);
 
 /// Corrects `out` so that its known frames equal `input`'s: the difference at
 /// each known frame (per joint rotation, root position) is interpolated

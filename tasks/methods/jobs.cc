@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "prior/inbetween/inbetweener.h"
@@ -30,17 +31,24 @@ void check_motion(const Motion& input) {
 // What a request asks of its method.
 enum class Ask { kComplete, kResample };
 
+// A request prepared once: its method, and the map of its motion's rig onto
+// the model's when the method needs the model and the rig is another (which
+// the model-rig adapter then takes instead of mapping again).
+struct Prepared {
+  const Method& method;
+  std::optional<RigMap> rig_map;
+};
+
 // The method of a request, checked once with the motion, in the order a user
 // thinks: the method exists and does the task, then the motion, then its rig
 // when the method needs the model (the frames come after, by the callers).
-const Method& checked_method(const std::string& method, const Motion& input, const TaskContext& ctx, Ask ask) {
+Prepared prepare(const std::string& method, const Motion& input, const TaskContext& ctx, Ask ask) {
   const Method& m = resolve_method(method, ctx);
   if (ask == Ask::kComplete && !m.complete)
     throw InputError("method '" + m.name + "' does not do in-betweening or gap filling");
   if (ask == Ask::kResample && !m.resample) throw InputError("method '" + m.name + "' does not do resampling");
   check_motion(input);
-  if (m.needs_model) check_model_rig(input.skeleton, ctx);
-  return m;
+  return {m, m.needs_model ? check_model_rig(input.skeleton, ctx) : std::nullopt};
 }
 
 // The first progress report of a validated request; it also honours a cancel
@@ -51,14 +59,14 @@ void start(const TaskContext& ctx) { ctx.report(TaskProgress{}); }
 // run_known_frames and run_fill): methods that need the model run on the
 // model's rig and rate (tasks/context/model_rig.h). A method that fell back to
 // interpolation everywhere gets the input rig's own interpolation, exactly.
-Motion complete_with(const Method& m, const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
-                     std::vector<std::string>* warnings) {
+Motion complete_with(const Prepared& request, const Motion& input, const std::vector<int>& known,
+                     const TaskContext& ctx, std::vector<std::string>* warnings) {
   start(ctx);
+  const Method& m = request.method;
   CompletionNotes notes;
+  auto complete = [&](const Motion& in, const std::vector<int>& k) { return m.complete(in, k, ctx, &notes); };
   Motion out = !m.needs_model ? m.complete(input, known, ctx, &notes)
-                              : complete_on_model_rig(input, known, ctx, [&](const Motion& in, const std::vector<int>& k) {
-                                  return m.complete(in, k, ctx, &notes);
-                                });
+                              : complete_on_model_rig(input, known, ctx, complete, request.rig_map);
   if (notes.interpolated) out = interpolate_motion(input, known);
   if (warnings)
     for (std::string& w : notes.warnings) warnings->push_back(std::move(w));
@@ -223,9 +231,9 @@ int resampled_frame_count(int frames, double fps_in, double fps_out, bool* round
 
 Motion run_known_frames(const Motion& input, const std::vector<int>& known, const std::string& method,
                         const TaskContext& ctx, std::vector<std::string>* warnings) {
-  const Method& m = checked_method(method, input, ctx, Ask::kComplete);
+  const Prepared request = prepare(method, input, ctx, Ask::kComplete);
   validate_keyframes(known, input.num_frames());
-  return complete_with(m, input, known, ctx, warnings);
+  return complete_with(request, input, known, ctx, warnings);
 }
 
 Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, const std::string& method,
@@ -235,9 +243,9 @@ Motion run_inbetween(const Motion& input, const std::vector<int>& keyframes, con
 
 Motion run_fill(const Motion& input, int a, int b, const std::string& method, const TaskContext& ctx,
                 std::vector<std::string>* warnings) {
-  const Method& m = checked_method(method, input, ctx, Ask::kComplete);
+  const Prepared request = prepare(method, input, ctx, Ask::kComplete);
   // Sorted, unique, in range and at least two (frame 0 and the last): valid keyframes.
-  return complete_with(m, input, known_frames_outside_gap(input.num_frames(), a, b), ctx, warnings);
+  return complete_with(request, input, known_frames_outside_gap(input.num_frames(), a, b), ctx, warnings);
 }
 
 ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& constraints, const std::string& method,
@@ -259,7 +267,8 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
       throw InputError("method '" + m.name +
                        "' takes whole-pose keys only: partial keys, end-effector targets, contacts and alternatives "
                        "need a latent solver (nemf, nemf-detail, ...) or 'interp' (without alternatives)");
-    if (m.needs_model) check_model_rig(input.skeleton, ctx);  // the rig before the frames
+    const std::optional<RigMap> rig_map =
+        m.needs_model ? check_model_rig(input.skeleton, ctx) : std::nullopt;  // the rig before the frames
     constraints.validate(input.num_frames(), input.num_joints());
     constraints.check_values(input);
     start(ctx);
@@ -268,7 +277,7 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
         return m.complete_constrained(in, c, v, ctx, &result.warnings);
       };
       result.motions.push_back(m.needs_model ? complete_constrained_on_model_rig(input, constraints, ctx, solve,
-                                                                                 &result.warnings)
+                                                                                 &result.warnings, rig_map)
                                              : solve(input, constraints));
     }
     warn_missed_targets(result.motions.front(), constraints, &result.warnings);
@@ -282,7 +291,9 @@ ConstrainedResult run_constrained(const Motion& input, const MotionConstraints& 
 
 Motion run_resample(const Motion& input, double fps, const std::string& method, std::vector<std::string>* warnings,
                     const TaskContext& ctx) {
-  const Method& m = checked_method(method.empty() ? default_resample_method(ctx) : method, input, ctx, Ask::kResample);
+  const Prepared request =
+      prepare(method.empty() ? default_resample_method(ctx) : method, input, ctx, Ask::kResample);
+  const Method& m = request.method;
   bool rounded = false;
   const int frames = resampled_frame_count(input.num_frames(), input.fps, fps, &rounded);
   if (rounded && warnings) {
@@ -296,9 +307,9 @@ Motion run_resample(const Motion& input, double fps, const std::string& method, 
   }
   start(ctx);
   if (!m.needs_model) return m.resample(input, fps, frames, ctx);
-  return resample_on_model_rig(input, fps, frames, ctx, [&](const Motion& in, double f, int n) {
-    return m.resample(in, f, n, ctx);
-  });
+  return resample_on_model_rig(
+      input, fps, frames, ctx, [&](const Motion& in, double f, int n) { return m.resample(in, f, n, ctx); },
+      request.rig_map);
 }
 
 }  // namespace mf

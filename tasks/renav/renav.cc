@@ -570,8 +570,9 @@ Motion hold_first_frame(const Motion& motion, int frames, double fps) {
 // size (it is in the reference's metres), and the result brought back onto
 // the reference's rig; joints the model lacks hold the reference's first pose.
 Motion renavigate_on_model_rig(const Motion& reference, const std::vector<Eigen::Vector2d>& path, double fps,
-                               const RenavOptions& options, const TaskContext& ctx, RenavReport* report) {
-  const Retargeter rig = model_retargeter(reference, {}, ctx);
+                               const RenavOptions& options, const TaskContext& ctx, std::optional<RigMap> map,
+                               RenavReport* report) {
+  const Retargeter rig = model_retargeter(reference, {}, ctx, std::move(map));
   std::vector<Eigen::Vector2d> scaled = path;
   for (Eigen::Vector2d& p : scaled) p *= rig.scale();
   const Motion result = renavigate(*ctx.model, rig.to_model(reference), scaled, fps, options, ctx, report);
@@ -601,7 +602,7 @@ Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& pa
     throw InputError("unknown re-navigation method '" + method + "' (available: " + list + ")");
   }
   const NemfModel& model = require_prior(ctx, "re-navigation");
-  check_model_rig(reference.skeleton, ctx);
+  std::optional<RigMap> rig_map = check_model_rig(reference.skeleton, ctx);
   if (reference.num_frames() < 2) throw InputError("the reference needs at least two frames");
   if (!(std::isfinite(reference.fps) && reference.fps > 0))
     throw InputError("the reference's fps must be finite and positive");
@@ -611,7 +612,7 @@ Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& pa
   if (ctx.max_iterations > 0) options.max_iterations = ctx.max_iterations;
   // renavigate() takes any frame rate itself; only another rig needs the adapter.
   if (!reference.skeleton.same_as(model.rig().skeleton))
-    return renavigate_on_model_rig(reference, path, fps, options, ctx, report);
+    return renavigate_on_model_rig(reference, path, fps, options, ctx, std::move(rig_map), report);
   return renavigate(model, reference, path, fps, options, ctx, report);
 }
 
