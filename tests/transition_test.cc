@@ -60,14 +60,6 @@ bool same_frames(const Motion& out, int out_begin, const Motion& in, int in_begi
   return true;
 }
 
-bool all_finite(const Motion& m) {
-  for (const auto& p : m.root_positions)
-    if (!p.allFinite()) return false;
-  for (const auto& q : m.rotations)
-    if (!q.coeffs().allFinite()) return false;
-  return true;
-}
-
 double facing(const Motion& m, int f) {
   const Eigen::Vector3d v = m.rotation(f, 0).normalized() * Eigen::Vector3d::UnitZ();
   return std::atan2(v.x(), v.z());
@@ -102,7 +94,7 @@ TEST(Transition, KeepReturnsBothPartsBitForBit) {
   ASSERT_EQ(out.num_frames(), I + 1 + 20 + b.num_frames() - 4);
   EXPECT_EQ(out.fps, a.fps);
   EXPECT_TRUE(out.skeleton.same_as(a.skeleton));
-  EXPECT_TRUE(all_finite(out));
+  EXPECT_TRUE(test::all_finite(out));
   EXPECT_TRUE(same_frames(out, 0, a, 0, I + 1));
   EXPECT_TRUE(same_frames(out, I + 21, b, 4, b.num_frames() - 4));
   EXPECT_TRUE(t.warnings.empty()) << t.warnings.front();
@@ -126,7 +118,7 @@ TEST(Transition, AutoPlacementContinuesAsEnd) {
   const int N = 20, I = a.num_frames() - 1;
   const TransitionResult t = run_transition(a, b, request(N), "interp", 0);
   const Motion& out = t.motions[0];
-  ASSERT_TRUE(all_finite(out));
+  ASSERT_TRUE(test::all_finite(out));
   EXPECT_TRUE(same_frames(out, 0, a, 0, I + 1));
   // B's part is B as placed, exactly.
   const Motion placed = place_transition_clip(a, b, I, 0, N);
@@ -318,7 +310,7 @@ TEST(Transition, DefaultMethodWithThePrior) {
   EXPECT_EQ(t.method, default_method(ctx));
   const Motion& out = t.motions[0];
   ASSERT_EQ(out.num_frames(), 20 + 8 + 25);
-  EXPECT_TRUE(all_finite(out));
+  EXPECT_TRUE(test::all_finite(out));
   EXPECT_TRUE(same_frames(out, 0, a, 0, 20));
   EXPECT_TRUE(same_frames(out, 28, place_transition_clip(a, b, 19, 0, 8), 0, 25));
 }
