@@ -1066,7 +1066,8 @@ MF_API int mf_job_result_get_json(const mf_job_result *result, char *out, size_t
  * of A's and B's parts. Optional constraints (partial keys, targets, pins, a
  * trajectory; mf_solve's) and alternatives work as for mf_solve; their frame
  * numbers refer to the whole output clip (the frame count of the transition
- * must then be given or read first).
+ * must then be given or read first), their joints to A's and their positions
+ * to A's world and unit.
  *
  * Automatic length (frames 0): the larger of the time the joints need to go
  * from A's pose at I to B's at J at 1.5 m/s (poses compared with the root at
