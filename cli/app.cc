@@ -89,7 +89,7 @@ void add_method(CLI::App* cmd, JobOptions& job,
       ->check(quiet(CLI::Range(0, 100000)));
 }
 
-// --constraints, --alternatives and --report of inbetween and fill.
+// --constraints, --alternatives and --report of inbetween, fill and transition.
 void add_constraints(CLI::App* cmd, JobOptions& job) {
   cmd->add_option("--constraints", job.constraints_file,
                   "a constraints file (JSON, docs/CONSTRAINTS.md): partial keys,\nend-effector targets, contacts")
@@ -227,6 +227,41 @@ void define_renav(CLI::App& app, HelpFormatter& help, Arguments& a) {
               kGlobalOptionsNote);
 }
 
+void define_transition(CLI::App& app, HelpFormatter& help, Arguments& a) {
+  CLI::App* cmd = add_command(
+      app, help, "transition", "generate the frames between the end of one clip and the start of another",
+      "motionfield transition A B -o OUT [--frames N] [--from-frame I] [--to-frame J]\n"
+      "                              [--place auto|keep] [--only-transition] [--method M]",
+      "One clip out of two: A's frames 0..I, N generated frames, B's frames J.. (on\n"
+      "A's rig, unit and frame rate; B may list the same joints in another order or\n"
+      "name them otherwise on the same hierarchy, and is resampled to A's rate).\n"
+      "--place auto moves and turns B on the ground so that it continues A's end\n"
+      "(facing alike, the root carried on at the mean of the two clips' speeds at the\n"
+      "seams); keep leaves B where it is. Without --frames, N is chosen from the change\n"
+      "of pose (and with keep the distance between the clips), 10..60 frames at 30\n"
+      "fps, and reported. Constraint frames (--constraints, --trajectory) are frames\n"
+      "of the whole output clip.");
+  cmd->add_option("a", a.job.in, "clip A (BVH, glTF or FBX): its end is kept")->required()->type_name("A");
+  cmd->add_option("b", a.to, "clip B: its start is kept")->required()->type_name("B");
+  cmd->add_option("-o,--out", a.job.out, "output: BVH, or glTF 2.0 for a name ending in .glb or .gltf;\n- writes BVH to standard output")
+      ->required()
+      ->type_name("PATH");
+  cmd->add_option("--frames", a.job.frames, "generated frames N (1..600; default: chosen)")
+      ->type_name("N")
+      ->check(quiet(CLI::Range(1, 600)));
+  cmd->add_option("--from-frame", a.from_frame, "A's last kept frame (default: its last; negative counts\nfrom the end)")
+      ->type_name("I");
+  cmd->add_option("--to-frame", a.to_frame, "B's first kept frame (default 0; negative counts from the\nend)")
+      ->type_name("J");
+  cmd->add_option("--place", a.place, "auto (default): B continues A's end; keep: B stays put")
+      ->type_name("auto|keep")
+      ->check(quiet(CLI::IsMember({"auto", "keep"})));
+  cmd->add_flag("--only-transition", a.only_transition, "write only the N generated frames");
+  add_method(cmd, a.job);
+  add_constraints(cmd, a.job);
+  cmd->footer([] { return method_list(MF_METHOD_COMPLETES) + "\n" + kGlobalOptionsNote; });
+}
+
 void define_export(CLI::App& app, HelpFormatter& help, Arguments& a) {
   CLI::App* cmd = add_command(app, help, "export", "write a BVH clip as glTF 2.0 (.glb or .gltf)",
                               "motionfield export IN.bvh OUT.glb|OUT.gltf [--units U]",
@@ -252,9 +287,12 @@ void define_batch(CLI::App& app, HelpFormatter& help, Arguments& a) {
       "  {\"task\": \"resample\", \"in\": \"a.bvh\", \"out\": \"d.bvh\", \"fps\": 60, \"method\": \"interp\"}\n"
       "  {\"task\": \"renav\", \"in\": \"a.bvh\", \"out\": \"e.bvh\", \"path\": \"path.csv\"}\n"
       "  {\"task\": \"renav\", \"in\": \"a.bvh\", \"out\": \"f.bvh\", \"polyline\": \"p.csv\", \"frames\": 90}\n"
+      "  {\"task\": \"transition\", \"in\": \"a.bvh\", \"to\": \"b.bvh\", \"out\": \"g.bvh\", \"frames\": 20}\n"
       "For fill, a \"keyframes\" list, if given, is authoritative over \"gap\". For\n"
       "renav, \"path\" or \"polyline\" and the optional \"fps\" and \"frames\" mean what\n"
-      "the flags of `motionfield renav` mean. inbetween and fill take \"constraints\"\n"
+      "the flags of `motionfield renav` mean. A transition takes \"to\" (clip B),\n"
+      "\"frames\", \"from_frame\", \"to_frame\", \"place\" and \"only_transition\" as the\n"
+      "arguments of `motionfield transition`. inbetween, fill and transition take \"constraints\"\n"
       "(a file or an inline object), \"trajectory\" (a CSV file), \"alternatives\" and\n"
       "\"report\" as the flags --constraints, --trajectory, --alternatives and --report.\n"
       "Every task takes \"max_iterations\" as the flag --max-iterations, and\n"
@@ -303,7 +341,7 @@ void define_command_line(CLI::App& app, Arguments& args) {
       &app,
       "motionfield [--threads N] [--model PATH] [--twostage PATH] [--citl PATH] [--verbose]\n"
       "                   [--quiet] [--json] [--rig-map FILE] [--units U] <command> [options]",
-      "motionfield " + version() + ": motion in-betweening, gap filling, resampling and re-navigation of BVH clips");
+      "motionfield " + version() + ": motion in-betweening, gap filling, transitions, resampling and re-navigation of BVH clips");
   // Global options may come anywhere, also after the command.
   app.fallthrough();
   define_global_options(app, args.settings, args.version);
@@ -311,6 +349,7 @@ void define_command_line(CLI::App& app, Arguments& args) {
   define_fill(app, *help, args);
   define_resample(app, *help, args);
   define_renav(app, *help, args);
+  define_transition(app, *help, args);
   define_export(app, *help, args);
   define_batch(app, *help, args);
   define_rig(app, *help, args);

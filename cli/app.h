@@ -16,8 +16,8 @@ struct JobOptions {
   std::string method;            ///< "" = the default method
   int max_iterations = 0;        ///< 0: each method's own
   double fps = 0.0;              ///< resample: the target fps; renav: the output's (0 = the reference's)
-  int frames = 0;                ///< renav --frames (0 = from the speed)
-  std::string constraints_file;  ///< inbetween and fill: --constraints
+  int frames = 0;                ///< renav --frames (0 = from the speed); transition --frames (0 = automatic)
+  std::string constraints_file;  ///< inbetween, fill and transition: --constraints
   std::string trajectory_file;   ///< --trajectory
   int alternatives = 0;          ///< --alternatives
   std::string report_file;       ///< --report
@@ -34,6 +34,12 @@ struct Arguments {
   std::string path;       ///< renav --path
   std::string polyline;   ///< renav --polyline
   std::string file;       ///< rig IN.bvh, batch JOBS.jsonl
+  // transition A B (A is job.in; --frames is job.frames)
+  std::string to;                ///< clip B
+  int from_frame = -1;           ///< --from-frame
+  int to_frame = 0;              ///< --to-frame
+  std::string place = "auto";    ///< --place
+  bool only_transition = false;  ///< --only-transition
   bool version = false;   ///< --version
 };
 

@@ -49,7 +49,7 @@ nlohmann::ordered_json number(double v) {
   return std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";
 }
 
-// The job line of a task command (inbetween, fill, resample, renav, export)
+// The job line of a task command (inbetween, fill, resample, renav, transition, export)
 // from its options: the library runs it as a batch line.
 // --animation as a job line has it: an index (digits only) or a name.
 nlohmann::ordered_json animation_value(const std::string& text) {
@@ -76,6 +76,14 @@ std::string task_line(const std::string& command, const Arguments& a) {
     if (job.fps != 0) j["fps"] = number(job.fps);
     if (job.frames != 0) j["frames"] = job.frames;
   }
+  if (command == "transition") {
+    j["to"] = a.to;
+    if (job.frames != 0) j["frames"] = job.frames;
+    j["from_frame"] = a.from_frame;
+    j["to_frame"] = a.to_frame;
+    j["place"] = a.place;
+    if (a.only_transition) j["only_transition"] = true;
+  }
   if (!job.constraints_file.empty()) j["constraints"] = job.constraints_file;
   if (!job.trajectory_file.empty()) j["trajectory"] = job.trajectory_file;
   if (job.alternatives != 0) j["alternatives"] = job.alternatives;
@@ -84,7 +92,7 @@ std::string task_line(const std::string& command, const Arguments& a) {
   try {
     return j.dump();
   } catch (const nlohmann::json::exception&) {
-    throw InputError("file names must be UTF-8 text: " + printable(job.in + " -> " + job.out));
+    throw InputError("file names must be UTF-8 text: " + printable(job.in + (a.to.empty() ? "" : " " + a.to) + " -> " + job.out));
   }
 }
 

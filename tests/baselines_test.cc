@@ -26,14 +26,6 @@ Motion poison_unknown(Motion m, const std::vector<int>& known) {
   return m;
 }
 
-bool all_finite(const Motion& m) {
-  for (const auto& p : m.root_positions)
-    if (!p.allFinite()) return false;
-  for (const auto& q : m.rotations)
-    if (!q.coeffs().allFinite()) return false;
-  return true;
-}
-
 // Exact (bitwise-equal values) copy of frame a of `x` in frame b of `y`.
 void expect_frame_equal(const Motion& x, int a, const Motion& y, int b) {
   EXPECT_EQ(x.root_positions[a], y.root_positions[b]) << "frames " << a << " / " << b;
@@ -69,7 +61,7 @@ TEST(BaselinesTest, InterpolateReadsOnlyKnownFramesAndCopiesThemExactly) {
   ASSERT_EQ(out.num_frames(), 31);
   ASSERT_EQ(out.num_joints(), truth.num_joints());
   EXPECT_DOUBLE_EQ(out.fps, 30.0);
-  EXPECT_TRUE(all_finite(out));
+  EXPECT_TRUE(test::all_finite(out));
   for (int k : known) expect_frame_equal(truth, k, out, k);
 }
 
@@ -78,7 +70,7 @@ TEST(BaselinesTest, ZeroVelocityReadsOnlyKnownFramesAndCopiesThemExactly) {
   const std::vector<int> known = {3, 11, 20};
   const Motion out = zero_velocity_motion(poison_unknown(truth, known), known);
   ASSERT_EQ(out.num_frames(), 25);
-  EXPECT_TRUE(all_finite(out));
+  EXPECT_TRUE(test::all_finite(out));
   for (int f = 0; f < 25; ++f) {
     const int source = f < 11 ? 3 : f < 20 ? 11 : 20;  // the last known frame before f, else the first
     expect_frame_equal(truth, source, out, f);

@@ -77,7 +77,7 @@ FT=$(frame_time_of "$SAMPLE")
 expect_rc 0 "--version" -- "$MF" --version
 grep -q "^motionfield [0-9]" "$TMP/out" && pass || fail "--version prints 'motionfield <version>'"
 expect_rc 0 "--help" -- "$MF" --help
-for cmd in inbetween fill resample renav batch rig; do
+for cmd in inbetween fill resample renav transition batch rig; do
   expect_rc 0 "$cmd --help" -- "$MF" "$cmd" --help
   grep -q "usage: motionfield $cmd" "$TMP/out" && pass || fail "$cmd --help prints its usage"
 done
@@ -127,6 +127,38 @@ for method in interp zerovel; do
 done
 expect_rc 0 "fill with the widest gap" -- "$MF" fill --in "$SAMPLE" --gap 1:60 --out "$TMP/fill-wide.bvh"
 expect_frames "$TMP/fill-wide.bvh" "$N"
+
+# ------------------------------------------------------------ transition
+# A's frames 0..30, 15 generated frames, B's frames 20..60 (both clips the sample).
+expect_rc 0 "transition --place keep" -- "$MF" --json transition "$SAMPLE" "$SAMPLE" -o "$TMP/tr.bvh" \
+  --frames 15 --from-frame 30 --to-frame 20 --place keep --method interp
+grep -q '"transition":{"frames":15,"first_frame":31}' "$TMP/out" && pass || fail "transition --json reports its frames"
+expect_frames "$TMP/tr.bvh" $((31 + 15 + 41))
+expect_frame_time "$TMP/tr.bvh" "$FT"
+expect_rc 0 "transition keeps A's part" -- "$DIFF" "$SAMPLE" "$TMP/tr.bvh" --frames "$(seq -s, 0 30)"
+expect_rc 0 "transition --only-transition" -- "$MF" transition "$SAMPLE" "$SAMPLE" -o "$TMP/tr-only.bvh" \
+  --frames 15 --from-frame 30 --to-frame 20 --only-transition --method interp
+expect_frames "$TMP/tr-only.bvh" 15
+expect_rc 0 "transition with the length chosen" -- "$MF" transition "$SAMPLE" "$SAMPLE" -o "$TMP/tr-auto.bvh" \
+  --to-frame 5 --method interp
+expect_stderr "the transition has [0-9]* frames (chosen" "the chosen length is reported"
+expect_rc 0 "transition --quiet" -- "$MF" --quiet transition "$SAMPLE" "$SAMPLE" -o "$TMP/tr-quiet.bvh" --method interp
+[ -s "$TMP/err" ] && fail "transition --quiet printed to stderr" || pass
+echo "{\"task\": \"transition\", \"in\": \"$SAMPLE\", \"to\": \"$SAMPLE\", \"out\": \"$TMP/tr-batch.bvh\", \"frames\": 15, \"from_frame\": 30, \"to_frame\": 20, \"place\": \"keep\", \"method\": \"interp\"}" >"$TMP/tr.jsonl"
+expect_rc 0 "transition as a batch line" -- "$MF" --json batch "$TMP/tr.jsonl"
+cmp -s "$TMP/tr.bvh" "$TMP/tr-batch.bvh" && pass || fail "the batch line gives the command's output"
+expect_rc 2 "transition --place elsewhere" -- "$MF" transition "$SAMPLE" "$SAMPLE" -o "$TMP/bad.bvh" --place here
+expect_absent "$TMP/bad.bvh"
+expect_rc 2 "transition --from-frame out of range" -- "$MF" transition "$SAMPLE" "$SAMPLE" -o "$TMP/bad.bvh" --from-frame 61 --method interp
+expect_stderr "from_frame 61 is out of range" "transition names the bad frame"
+expect_absent "$TMP/bad.bvh"
+echo "{\"task\": \"transition\", \"in\": \"$SAMPLE\", \"to\": \"$SAMPLE\", \"out\": \"$TMP/bad.bvh\", \"place\": \"here\"}" >"$TMP/tr-bad.jsonl"
+expect_rc 2 "transition with a bad batch key" -- "$MF" batch "$TMP/tr-bad.jsonl"
+expect_stderr '"place" must be "auto" or "keep"' "batch transition names the bad key"
+echo "{\"task\": \"transition\", \"in\": \"$SAMPLE\", \"out\": \"$TMP/bad.bvh\"}" >"$TMP/tr-bad.jsonl"
+expect_rc 2 "transition without clip B in a batch line" -- "$MF" batch "$TMP/tr-bad.jsonl"
+expect_stderr 'missing key "to"' "batch transition needs \"to\""
+expect_absent "$TMP/bad.bvh"
 
 # ------------------------------------------------------------ resample
 for method in interp zerovel; do

@@ -239,6 +239,35 @@ TEST(JsonlTest, RenavJobTakesAPathOrAPolyline) {
   EXPECT_TRUE(has(job_error(R"({"task": "renav", "in": "a", "out": "b", "path": "p", "fps": "30"})"), "a number"));
 }
 
+TEST(JsonlTest, TransitionJob) {
+  const BatchJob d = job(R"({"task": "transition", "in": "a.bvh", "to": "b.bvh", "out": "t.bvh"})");
+  EXPECT_EQ(d.to, "b.bvh");
+  EXPECT_EQ(d.frames, 0);
+  EXPECT_EQ(d.from_frame, -1);
+  EXPECT_EQ(d.to_frame, 0);
+  EXPECT_FALSE(d.place_keep);
+  EXPECT_FALSE(d.only_transition);
+  EXPECT_FALSE(d.constrained());
+  const BatchJob j = job(R"({"task": "transition", "in": "a.bvh", "to": "b.bvh", "out": "t.bvh", "frames": 20,
+                             "from_frame": -3, "to_frame": 4, "place": "keep", "only_transition": true,
+                             "constraints": {"targets": []}, "alternatives": 2})");
+  EXPECT_EQ(j.frames, 20);
+  EXPECT_EQ(j.from_frame, -3);
+  EXPECT_EQ(j.to_frame, 4);
+  EXPECT_TRUE(j.place_keep);
+  EXPECT_TRUE(j.only_transition);
+  EXPECT_EQ(j.alternatives, 2);
+  EXPECT_TRUE(j.constrained());
+  auto has = [](const std::string& m, const std::string& part) { return m.find(part) != std::string::npos; };
+  const std::string base = R"({"task": "transition", "in": "a", "out": "b", )";
+  EXPECT_TRUE(has(job_error(R"({"task": "transition", "in": "a", "out": "b"})"), "missing key \"to\""));
+  EXPECT_TRUE(has(job_error(base + R"("to": 3})"), "\"to\" must be a string"));
+  EXPECT_TRUE(has(job_error(base + R"("to": "c", "place": "here"})"), "\"place\" must be \"auto\" or \"keep\""));
+  EXPECT_TRUE(has(job_error(base + R"("to": "c", "frames": 1.5})"), "\"frames\" must be an integer"));
+  EXPECT_TRUE(has(job_error(base + R"("to": "c", "from_frame": "x"})"), "\"from_frame\" must be an integer"));
+  EXPECT_TRUE(has(job_error(base + R"("to": "c", "only_transition": 1})"), "\"only_transition\" must be true or false"));
+}
+
 TEST(JsonlTest, EveryJobTakesARigMapAndUnits) {
   const BatchJob a = job(R"({"task": "inbetween", "in": "a.bvh", "out": "b.bvh", "keyframes": [0, 9], "rig_map": "m.json", "units": "in"})");
   EXPECT_EQ(a.rig_map, "m.json");

@@ -20,6 +20,14 @@ Skeleton small_skeleton() {
   return s;
 }
 
+bool all_finite(const Motion& m) {
+  for (const auto& p : m.root_positions)
+    if (!p.allFinite()) return false;
+  for (const auto& q : m.rotations)
+    if (!q.coeffs().allFinite()) return false;
+  return true;
+}
+
 double max_abs_difference(const Motion& a, const Motion& b) {
   double d = 0.0;
   for (size_t i = 0; i < a.rotations.size(); ++i)

@@ -22,6 +22,9 @@ Motion random_motion(const Skeleton& skeleton, int frames, double fps, uint32_t 
 /// position coordinate of two motions of the same size.
 double max_abs_difference(const Motion& a, const Motion& b);
 
+/// True when every rotation coefficient and root position of `m` is finite.
+bool all_finite(const Motion& m);
+
 /// A tiny prior (32-frame window, 3x32 decoder, z_l 8, z_g 4) for fast tests.
 NemfConfig tiny_nemf_config();
 /// The rig of small_skeleton(), measured from one random motion.

@@ -100,11 +100,11 @@ typedef struct mf_encoding mf_encoding;
 /* ================================================================ version */
 
 #define MF_VERSION_MAJOR 0
-#define MF_VERSION_MINOR 3
+#define MF_VERSION_MINOR 4
 #define MF_VERSION_PATCH 0
 /** MAJOR * 10000 + MINOR * 100 + PATCH */
 #define MF_VERSION_NUMBER (MF_VERSION_MAJOR * 10000 + MF_VERSION_MINOR * 100 + MF_VERSION_PATCH)
-#define MF_VERSION_STRING "0.3.0"
+#define MF_VERSION_STRING "0.4.0"
 /** The ABI major: the N of libmotionfield.so.N. */
 #define MF_ABI_VERSION 0
 
@@ -923,7 +923,7 @@ MF_API int mf_model_get_load_warnings(const mf_model *model, char *out, size_t c
 
 /* ------------------------------------------------------------ batch jobs
  * Since 0.2.0. The JSON-lines jobs of `motionfield batch` (docs/CLI.md:
- * {"task": "inbetween" | "fill" | "resample" | "renav", "in": ..., "out": ...,
+ * {"task": "inbetween" | "fill" | "resample" | "renav" | "transition", "in": ..., "out": ...,
  * ...}) parsed, checked and run by the library, with the CLI's messages: the
  * one implementation the CLI, its single commands and the Python package's
  * batch runners use.
@@ -1040,6 +1040,84 @@ MF_API int mf_job_result_get_messages(const mf_job_result *result, char *out, si
  *  "frames_out", "timings_ms", "warnings", ...} or {..., "status": "error",
  *  "exit_code", "error"}: a string getter. */
 MF_API int mf_job_result_get_json(const mf_job_result *result, char *out, size_t capacity, size_t *needed);
+
+/* ------------------------------------------------------------ transitions
+ * Since 0.4.0. Two clips in, one transition out: the end of clip A (up to
+ * frame I) and the start of clip B (from frame J) with N generated frames
+ * between them, as one clip on A's rig, unit and frame rate:
+ *   A's frames 0..I | N generated frames (I + 1 .. I + N) | B's frames J..
+ * A's and B's parts come out exactly as given (B's after its placement).
+ *
+ * Clip B may be on A's rig with its joints in another order (matched by
+ * name) or under other names on the same hierarchy (matched in order, with a
+ * warning); anything else is MF_ERROR_INVALID_ARGUMENT "clip B's rig differs
+ * from A's: ..." naming the first difference. B at another frame rate is
+ * resampled to A's (the "cubic" spline), with a warning.
+ *
+ * Placement MF_PLACE_AUTO moves and turns B on the ground (about the vertical;
+ * heights untouched) so that its frame J continues A's frame I: B is turned
+ * by the yaw between the two root orientations so it starts facing the way A
+ * ends, and its root at J is put where A's root gets in the N + 1 frame steps
+ * at the mean of A's end ground velocity and B's start ground velocity (each
+ * over at most 5 frame steps at the seam). MF_PLACE_KEEP leaves B where it is.
+ *
+ * The generated frames are made by the method of the task options (default as
+ * mf_solve: every method that fills gaps) with whole-pose keys on every frame
+ * of A's and B's parts. Optional constraints (partial keys, targets, pins, a
+ * trajectory; mf_solve's) and alternatives work as for mf_solve; their frame
+ * numbers refer to the whole output clip (the frame count of the transition
+ * must then be given or read first), their joints to A's and their positions
+ * to A's world and unit.
+ *
+ * Automatic length (frames 0): the larger of the time the joints need to go
+ * from A's pose at I to B's at J at 1.5 m/s (poses compared with the root at
+ * the origin, facing alike) and, with MF_PLACE_KEEP, the time the root needs
+ * to cover the ground between the two seams at the mean of the two end speeds
+ * (at least 1 m/s); in frames at A's rate, clamped to 10..60 at 30 fps
+ * (scaled for other rates). The chosen count is in
+ * mf_solution_get_transition and, when automatic, in a warning. */
+
+/** mf_transition_options.place */
+#define MF_PLACE_AUTO 0
+#define MF_PLACE_KEEP 1
+
+typedef struct mf_transition_options {
+  uint32_t struct_size;
+  /** Generated frames N, 1..600; 0 (the default) = automatic. */
+  int32_t frames;
+  /** A's last kept frame I; negative counts from A's end; -1 (the default of
+   *  mf_transition_options_init) = A's last frame. A keeps at least two
+   *  frames: I in 1..frames(A) - 1. */
+  int32_t from_frame;
+  /** B's first kept frame J (default 0); negative counts from B's end. B
+   *  keeps at least two frames: J in 0..frames(B) - 2 (at A's rate). */
+  int32_t to_frame;
+  /** MF_PLACE_AUTO (default) or MF_PLACE_KEEP. */
+  int32_t place;
+  /** Non-zero: the motions hold only the N generated frames (not the seam
+   *  frames A[I] and B[J]); the reports are still measured on the whole
+   *  clip. */
+  int32_t only_transition;
+} mf_transition_options;
+
+MF_API int mf_transition_options_init(mf_transition_options *options);
+/** The transition of `a` into `b` (see above); `transition` NULL = the
+ *  defaults of mf_transition_options_init; `constraints` optional (NULL:
+ *  none); `alternatives` 0..16 more solutions; `options` as every task's (the
+ *  method, seed, progress, cancel, rig map, iterations). The result is an
+ *  mf_solution (mf_solution_get_motion, _get_report, _get_method, warnings
+ *  with each motion) whose motions are on A's skeleton, BVH layout and unit.
+ *  MF_ERROR_INVALID_ARGUMENT for a clip of fewer than two frames, I or J out
+ *  of range, frames out of 0..600, a place that is not MF_PLACE_*, rigs that
+ *  do not match, and what mf_solve refuses. */
+MF_API int mf_transition(const mf_model *model, const mf_motion *a, const mf_motion *b,
+                         const mf_transition_options *transition, const mf_constraints *constraints,
+                         int32_t alternatives, const mf_task_options *options, mf_solution **out);
+/** Where the transition of a solution made by mf_transition is: its frame
+ *  count N (as given or chosen) and its first frame in the whole clip
+ *  (I + 1; also with only_transition). Either pointer may be NULL.
+ *  MF_ERROR_INVALID_ARGUMENT for a solution of mf_solve. */
+MF_API int mf_solution_get_transition(const mf_solution *solution, int32_t *frames, int32_t *first_frame);
 
 #ifdef __cplusplus
 }

@@ -738,6 +738,19 @@ class Solution : public detail::Handle<mf_solution, mf_solution_destroy> {
       return mf_solution_get_report_json(get(), out, capacity, needed);
     });
   }
+  /// mf_solution_get_transition: the transition's frame count (a solution of
+  /// transition() only).
+  int32_t transition_frames() const {
+    int32_t frames = 0;
+    check(mf_solution_get_transition(get(), &frames, nullptr));
+    return frames;
+  }
+  /// mf_solution_get_transition: the transition's first frame in the whole clip.
+  int32_t transition_first_frame() const {
+    int32_t first = 0;
+    check(mf_solution_get_transition(get(), nullptr, &first));
+    return first;
+  }
 };
 
 /// mf_solve: `input` under `constraints`, plus `alternatives` more solutions.
@@ -746,6 +759,36 @@ inline Solution solve(const Model& model, const Motion& input, const Constraints
   detail::TaskCall call(options);
   mf_solution* out = nullptr;
   const int status = mf_solve(model.get(), input.get(), constraints.get(), alternatives, call.options(), &out);
+  return call.finish_handle(status, Solution(out));
+}
+
+// ---------------------------------------------------------------- transitions
+
+/// mf_transition_options in C++ types (the same defaults).
+struct TransitionOptions {
+  int32_t frames = 0;             ///< generated frames; 0 = automatic
+  int32_t from_frame = -1;        ///< A's last kept frame; negative from the end
+  int32_t to_frame = 0;           ///< B's first kept frame; negative from the end
+  int32_t place = MF_PLACE_AUTO;  ///< or MF_PLACE_KEEP
+  bool only_transition = false;   ///< only the generated frames
+};
+
+/// mf_transition: the end of `a` and the start of `b` with a transition
+/// between them; `constraints` may be an empty handle (Constraints()).
+inline Solution transition(const Model& model, const Motion& a, const Motion& b,
+                           const TransitionOptions& transition = {}, const Constraints& constraints = Constraints(),
+                           int32_t alternatives = 0, const TaskOptions& options = {}) {
+  mf_transition_options t;
+  check(mf_transition_options_init(&t));
+  t.frames = transition.frames;
+  t.from_frame = transition.from_frame;
+  t.to_frame = transition.to_frame;
+  t.place = transition.place;
+  t.only_transition = transition.only_transition ? 1 : 0;
+  detail::TaskCall call(options);
+  mf_solution* out = nullptr;
+  const int status =
+      mf_transition(model.get(), a.get(), b.get(), &t, constraints.get(), alternatives, call.options(), &out);
   return call.finish_handle(status, Solution(out));
 }
 

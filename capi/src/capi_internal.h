@@ -16,7 +16,10 @@
 #include "prior/motion/bvh.h"
 #include "prior/motion/motion.h"
 #include "prior/util/threads.h"
+#include "tasks/constraints/constraint_report.h"
+#include "tasks/constraints/constraint_spec.h"
 #include "tasks/context/task_context.h"
+#include "tasks/methods/jobs.h"
 
 
 /// The prior, the in-betweeners by kind and the rig anatomy loaded together
@@ -44,6 +47,25 @@ struct mf_motion {
   /// Warnings of the task that made this motion, one per line ("" if none):
   /// mf_motion_get_warnings. Not passed on to motions derived from it.
   std::string warnings;
+};
+
+/// A caller's constraints, by joint name (tasks/constraints/constraint_spec.h).
+struct mf_constraints {
+  mf::ConstraintSpec spec;
+};
+
+/// The result of mf_solve and mf_transition.
+struct mf_solution {
+  std::vector<std::unique_ptr<mf_motion>> motions;
+  std::vector<mf::ConstraintReport> reports;
+  std::vector<std::string> warnings;
+  double length_scale = 0.01;  ///< metres per input unit
+  std::string unit;
+  bool trajectory = false;  ///< the constraints had a trajectory (its report fields are written)
+  const char* method = "";  ///< the registered method's name (static storage)
+  /// mf_transition: the generated frames and the first one in the whole clip; 0: not a transition.
+  int32_t transition_frames = 0;
+  int32_t transition_first = 0;
 };
 
 struct mf_cancel_token {
@@ -192,6 +214,10 @@ std::unique_ptr<mf_model> load_model_set(const char* path, const char* const* in
 
 /// A new motion handle carrying `motion` and the BVH layout of `like` (if any).
 mf_motion* derived_motion(Motion motion, const mf_motion& like);
+
+/// The solution handle of a constrained result: its motions derived from
+/// `like` (layout, unit) with every warning, its reports, the method's name.
+std::unique_ptr<mf_solution> new_solution(ConstrainedResult&& result, const mf_motion& like, bool trajectory);
 
 /// The context of a task call from its options: models, seed, progress
 /// callback, cancel token and rig map (read from rig_map_path if given).

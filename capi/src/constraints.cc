@@ -1,5 +1,6 @@
 // Constraints beyond whole-pose keys (tasks/constraints/constraint_spec.h) and mf_solve
-// with its alternatives and reports (tasks/methods/jobs.h run_constrained).
+// with its alternatives and reports (tasks/methods/jobs.h run_constrained); the
+// solution handle mf_transition shares.
 #include <cmath>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -11,20 +12,6 @@
 #include "tasks/constraints/constraint_spec.h"
 #include "tasks/constraints/trajectory_csv.h"
 #include "tasks/methods/jobs.h"
-
-struct mf_constraints {
-  mf::ConstraintSpec spec;
-};
-
-struct mf_solution {
-  std::vector<std::unique_ptr<mf_motion>> motions;
-  std::vector<mf::ConstraintReport> reports;
-  std::vector<std::string> warnings;
-  double length_scale = 0.01;  ///< metres per input unit
-  std::string unit;
-  bool trajectory = false;  ///< the constraints had a trajectory (its report fields are written)
-  const char* method = "";  ///< the registered method's name (static storage)
-};
 
 namespace mf::capi {
 namespace {
@@ -70,6 +57,24 @@ nlohmann::json solution_report_json(const ConstraintReport& r, double cm_to_unit
 }
 
 }  // namespace
+
+std::unique_ptr<mf_solution> new_solution(ConstrainedResult&& r, const mf_motion& like, bool trajectory) {
+  auto s = std::make_unique<mf_solution>();
+  for (Motion& m : r.motions) {
+    std::unique_ptr<mf_motion> h(derived_motion(std::move(m), like));
+    for (const std::string& w : r.warnings) h->warnings += (h->warnings.empty() ? "" : "\n") + w;
+    s->motions.push_back(std::move(h));
+  }
+  s->reports = std::move(r.reports);
+  s->warnings = std::move(r.warnings);
+  s->length_scale = like.length_scale;
+  s->unit = like.unit;
+  s->trajectory = trajectory;
+  for (const Method& m : registered_methods())
+    if (m.name == r.method) s->method = m.name.c_str();
+  return s;
+}
+
 }  // namespace mf::capi
 
 using mf::capi::ApiError;
@@ -191,20 +196,7 @@ int mf_solve(const mf_model* model, const mf_motion* input, const mf_constraints
     const mf::MotionConstraints c = constraints->spec.resolve(input->motion.skeleton, input->length_scale);
     mf::ConstrainedResult r =
         mf::run_constrained(input->motion, c, o.method ? std::string(o.method) : std::string(), alternatives, ctx);
-    auto s = std::make_unique<mf_solution>();
-    for (mf::Motion& m : r.motions) {
-      std::unique_ptr<mf_motion> h(mf::capi::derived_motion(std::move(m), *input));
-      for (const std::string& w : r.warnings) h->warnings += (h->warnings.empty() ? "" : "\n") + w;
-      s->motions.push_back(std::move(h));
-    }
-    s->reports = std::move(r.reports);
-    s->warnings = std::move(r.warnings);
-    s->length_scale = input->length_scale;
-    s->unit = input->unit;
-    s->trajectory = !c.trajectory.empty();
-    for (const mf::Method& m : mf::registered_methods())
-      if (m.name == r.method) s->method = m.name.c_str();
-    *out = s.release();
+    *out = mf::capi::new_solution(std::move(r), *input, !c.trajectory.empty()).release();
   });
 }
 

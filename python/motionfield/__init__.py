@@ -1,5 +1,6 @@
 """motionfield from Python: a learned human-motion prior for keyframe
-in-betweening, gap filling, resampling and re-navigation along a new path.
+in-betweening, gap filling, transitions between two clips, resampling and
+re-navigation along a new path.
 
 A pure ctypes binding of libmotionfield.so's C API (no compiled extension):
 numpy arrays in and out, exceptions from the C status codes. Conventions are
@@ -59,6 +60,7 @@ from ._motion import Motion, length_unit_scale
 from ._outputs import OutputSet
 from ._tasks import (CancelToken, Progress, describe_rig, fill, inbetween, load_path_csv, renav, resample,
                      resample_frame_count)
+from ._transition import Transition, transition
 
 # The type aliases of the signatures.
 from ._args import FloatArray as FloatArray, PathLike as PathLike, RigMap as RigMap
@@ -106,7 +108,7 @@ __all__ = [
     "printable_text",
     "Model", "Motion", "CancelToken", "Progress", "Encoding", "OutputSet",
     "inbetween", "fill", "resample", "resample_frame_count", "encode",
-    "Constraints", "Solution", "solve",
+    "Constraints", "Solution", "solve", "Transition", "transition",
     "renav", "load_path_csv", "describe_rig", "length_unit_scale",
 ]
 

@@ -163,6 +163,21 @@ class MfTaskOptions(ctypes.Structure):
     ]
 
 
+PLACE_AUTO = 0
+PLACE_KEEP = 1
+
+
+class MfTransitionOptions(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("frames", ctypes.c_int32),
+        ("from_frame", ctypes.c_int32),
+        ("to_frame", ctypes.c_int32),
+        ("place", ctypes.c_int32),
+        ("only_transition", ctypes.c_int32),
+    ]
+
+
 class MfCodecOptions(ctypes.Structure):
     _fields_ = [
         ("struct_size", ctypes.c_uint32),
@@ -404,6 +419,10 @@ _declare("mf_solution_get_report_json", _int, _solution, ctypes.c_char_p, _size,
 _declare("mf_solution_get_method", _int, _solution, _P(_str))
 _declare("mf_constraints_add_trajectory", _int, _constraints, _P(_i32), _P(_f32), _size)
 _declare("mf_constraints_load_trajectory_csv", _int, _constraints, _str)
+_declare("mf_transition_options_init", _int, _P(MfTransitionOptions))
+_declare("mf_transition", _int, _model, _motion, _motion, _P(MfTransitionOptions), _constraints, _i32,
+         _P(MfTaskOptions), _P(_solution))
+_declare("mf_solution_get_transition", _int, _solution, _P(_i32), _P(_i32))
 
 _output_set = _P(MfOutputSet)
 _declare("mf_output_set_create", _int, _P(_output_set))

@@ -359,17 +359,7 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
     _instance_arg(motion, Motion, "motion")
     alternatives = _int_arg(alternatives, "alternatives", 0, 16)
     call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
-    if constraints is None:
-        c = Constraints()
-    elif isinstance(constraints, Constraints):
-        c = Constraints(constraints.to_dict())
-    elif isinstance(constraints, dict):
-        c = Constraints(constraints)
-    elif isinstance(constraints, (str, os.PathLike)):
-        c = Constraints.load(constraints)
-    else:
-        raise TypeError("constraints must be a Constraints, a dict or a file's path, not %s" %
-                        type(constraints).__name__)
+    c = _constraints_arg(constraints, trajectory)
     keys = _int_list(keyframes, "keyframes")
     if len(keys):
         c.add_keys(keys)
@@ -388,14 +378,36 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
             c.add_target(t[0], t[1], t[2], t[3] if len(t) > 3 else 1.0)  # type: ignore[misc]
     for joint, first, last in contacts:
         c.add_contact(joint, first, last)
+    handle = call.run(_c.mf_solve, _task_model(model, method), motion._live(), c._live(), alternatives,
+                      out_type=_c.MfSolution)
+    return _take_solution(handle)
+
+
+def _constraints_arg(constraints: Union[Constraints, str, Dict[str, Any], None],
+                     trajectory: Union[npt.ArrayLike, str, "os.PathLike[str]", None]) -> Constraints:
+    """A new Constraints from solve()'s `constraints` and `trajectory` arguments."""
+    if constraints is None:
+        c = Constraints()
+    elif isinstance(constraints, Constraints):
+        c = Constraints(constraints.to_dict())
+    elif isinstance(constraints, dict):
+        c = Constraints(constraints)
+    elif isinstance(constraints, (str, os.PathLike)):
+        c = Constraints.load(constraints)
+    else:
+        raise TypeError("constraints must be a Constraints, a dict or a file's path, not %s" %
+                        type(constraints).__name__)
     if isinstance(trajectory, (str, os.PathLike)):
         c.load_trajectory(trajectory)
     elif isinstance(trajectory, tuple) and len(trajectory) == 2:
         c.add_trajectory(trajectory[0], trajectory[1])
     elif trajectory is not None:
         c.add_trajectory(trajectory)
-    handle = call.run(_c.mf_solve, _task_model(model, method), motion._live(), c._live(), alternatives,
-                      out_type=_c.MfSolution)
+    return c
+
+
+def _take_solution(handle: Any) -> Solution:
+    """The Solution of an mf_solution handle, which it destroys."""
     try:
         n = ctypes.c_int32(0)
         _check(_c.mf_solution_get_count(handle, ctypes.byref(n)))

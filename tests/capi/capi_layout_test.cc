@@ -42,6 +42,16 @@ TEST(CApiLayout, TaskOptions) {
   EXPECT_EQ(offsetof(mf_task_options, max_iterations), 64u);
 }
 
+TEST(CApiLayout, TransitionOptions) {
+  EXPECT_EQ(sizeof(mf_transition_options), 24u);
+  EXPECT_EQ(offsetof(mf_transition_options, struct_size), 0u);
+  EXPECT_EQ(offsetof(mf_transition_options, frames), 4u);
+  EXPECT_EQ(offsetof(mf_transition_options, from_frame), 8u);
+  EXPECT_EQ(offsetof(mf_transition_options, to_frame), 12u);
+  EXPECT_EQ(offsetof(mf_transition_options, place), 16u);
+  EXPECT_EQ(offsetof(mf_transition_options, only_transition), 20u);
+}
+
 TEST(CApiLayout, CodecOptions) {
   EXPECT_EQ(sizeof(mf_constraint_report), 136u);
   EXPECT_EQ(offsetof(mf_constraint_report, struct_size), 0u);

@@ -369,6 +369,27 @@ TEST_F(CApiNull, ConstraintsAndSolutions) {
   mf_constraints_destroy(nullptr);
 }
 
+TEST_F(CApiNull, Transitions) {
+  mf_solution* s = kSolution;
+  mf_task_options interp;
+  mf_task_options_init(&interp);
+  interp.method = "interp";
+  EXPECT_REFUSES_NULL(mf_transition_options_init(nullptr));
+  EXPECT_REFUSES_NULL(mf_transition(nullptr, nullptr, motion_.get(), nullptr, nullptr, 0, &interp, &s));
+  EXPECT_REFUSES_NULL(mf_transition(nullptr, motion_.get(), nullptr, nullptr, nullptr, 0, &interp, &s));
+  EXPECT_REFUSES_NULL(mf_transition(nullptr, motion_.get(), motion_.get(), nullptr, nullptr, 0, &interp, nullptr));
+  EXPECT_EQ(s, kSolution);
+  // The transition options and the constraints are optional.
+  ASSERT_EQ(mf_transition(nullptr, motion_.get(), motion_.get(), nullptr, nullptr, 0, &interp, &s), MF_OK)
+      << describe(1);
+  int32_t frames = 0;
+  EXPECT_REFUSES_NULL(mf_solution_get_transition(nullptr, &frames, nullptr));
+  EXPECT_ACCEPTS(mf_solution_get_transition(s, nullptr, nullptr));
+  EXPECT_ACCEPTS(mf_solution_get_transition(s, &frames, nullptr));
+  EXPECT_GE(frames, 10);
+  mf_solution_destroy(s);
+}
+
 TEST_F(CApiNull, OutputSetsAndRigMapFiles) {
   const std::string dir = test::scratch_dir("capi-null-outputs-" + std::to_string(::getpid()));
   const std::string out = dir + "/o.bvh";

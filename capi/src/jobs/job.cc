@@ -31,17 +31,20 @@ void check_request(const BatchJob& job) {
     if (job.polyline && job.frames != 0 && job.frames < 2)
       throw InputError("renav: the frame count must be at least 2");
   }
+  if (job.task == "transition" && job.to == kStdio)
+    throw InputError("transition: clip B (\"to\") must be a file, not the standard input");
   if (job.out == kStdio && job.alternatives > 0)
     throw InputError("--alternatives writes OUT_1.bvh .. beside the output: name an output file, not -");
 }
 
 // The job's constraints: its file or inline JSON, plus the known frames of
-// the task as whole-pose keys.
+// the task as whole-pose keys (a transition's: none, mf_transition adds them).
 Constraints job_constraints(const BatchJob& job, const Motion& input) {
   Constraints c = !job.constraints_file.empty()   ? Constraints::load_json(job.constraints_file)
                   : !job.constraints_json.empty() ? Constraints::parse_json(job.constraints_json)
                                                   : Constraints::create();
   if (!job.trajectory_file.empty()) c.load_trajectory_csv(job.trajectory_file);
+  if (job.task == "transition") return c;  // the library keys the clips' frames
   if (job.task == "inbetween" || job.has_keyframes)
     return std::move(c.add_pose_keys(std::vector<int32_t>(job.keyframes.begin(), job.keyframes.end())));
   const int n = input.frame_count();
@@ -61,7 +64,33 @@ struct Solved {
   std::vector<Motion> alternatives;
   std::string report;
   std::string method;  ///< the method that ran, when the solve says (constrained jobs)
+  int transition_frames = 0, transition_first = 0;  ///< a transition's N and its first frame
 };
+
+// The solution's motion, its alternatives and (with constraints) its report.
+Solved solved_from(const BatchJob& job, const Solution& s) {
+  Solved out{s.motion(0), {}, job.constrained() ? s.report_json() : std::string(), s.method()};
+  for (int i = 1; i < s.count(); ++i) out.alternatives.push_back(s.motion(i));
+  return out;
+}
+
+// A transition from the job's input (clip A) into clip B.
+Solved solve_transition(const BatchJob& job, const Model& model, const Motion& a, const Motion& b,
+                        const TaskOptions& options) {
+  TransitionOptions t;
+  t.frames = job.frames;
+  t.from_frame = job.from_frame;
+  t.to_frame = job.to_frame;
+  t.place = job.place_keep ? MF_PLACE_KEEP : MF_PLACE_AUTO;
+  t.only_transition = job.only_transition;
+  const bool constrained = !job.constraints_file.empty() || !job.constraints_json.empty() || !job.trajectory_file.empty();
+  const Solution s = transition(model, a, b, t, constrained ? job_constraints(job, a) : Constraints(),
+                                job.alternatives, options);
+  Solved out = solved_from(job, s);
+  out.transition_frames = s.transition_frames();
+  out.transition_first = s.transition_first_frame();
+  return out;
+}
 
 // The plain tasks (whole-pose keys, a gap, resampling, re-navigation).
 Motion solve_task(const BatchJob& job, const Model& model, const Motion& input, const TaskOptions& options) {
@@ -80,17 +109,14 @@ Motion solve_task(const BatchJob& job, const Model& model, const Motion& input, 
 }
 
 Solved solve(const BatchJob& job, const JobSettings& settings, const Model& model, const Motion& input,
-             const ProgressFn& progress) {
+             const Motion& second, const ProgressFn& progress) {
   TaskOptions options(job.method);
   options.max_iterations = job.max_iterations;
   options.rig_map_path = job.rig_map.empty() ? settings.rig_map : job.rig_map;
   options.progress = progress;
-  if (job.constrained()) {
-    const Solution s = motionfield::solve(model, input, job_constraints(job, input), job.alternatives, options);
-    Solved out{s.motion(0), {}, s.report_json(), s.method()};
-    for (int i = 1; i < s.count(); ++i) out.alternatives.push_back(s.motion(i));
-    return out;
-  }
+  if (job.task == "transition") return solve_transition(job, model, input, second, options);
+  if (job.constrained())
+    return solved_from(job, motionfield::solve(model, input, job_constraints(job, input), job.alternatives, options));
   return {solve_task(job, model, input, options), {}, "", ""};
 }
 
@@ -168,6 +194,7 @@ OutputSet prepare_job(const BatchJob& job, const JobSettings& settings) {
   OutputSet files = OutputSet::create();
   const std::string& rig_map = job.rig_map.empty() ? settings.rig_map : job.rig_map;
   if (job.in != kStdio) files.add_input(job.in, "input");
+  files.add_input(job.to, "input");
   files.add_input(job.path_file, "path file");
   files.add_input(rig_map, "rig map file");
   files.add_input(job.constraints_file, "constraints file");
@@ -198,8 +225,9 @@ JobReport run_job(const BatchJob& job, OutputSet files, const JobSettings& setti
   load.animation = job.animation;
   load.animation_index = job.animation_index;
   const Motion input = Motion::load(job.in == kStdio ? "/dev/stdin" : job.in, load);
+  const Motion second = job.to.empty() ? Motion() : Motion::load(job.to, load);
   const auto t1 = Clock::now();
-  const Solved solved = export_only ? Solved{} : solve(job, settings, model, input, progress);
+  const Solved solved = export_only ? Solved{} : solve(job, settings, model, input, second, progress);
   const Motion& result = export_only ? input : solved.motion;
   const auto t2 = Clock::now();
   // Every output staged, standard output written, then all put in place at
@@ -217,6 +245,8 @@ JobReport run_job(const BatchJob& job, OutputSet files, const JobSettings& setti
   report.read_ms = ms(t1 - t0);
   report.solve_ms = ms(t2 - t1);
   report.write_ms = ms(t3 - t2);
+  report.transition_frames = solved.transition_frames;
+  report.transition_first = solved.transition_first;
   report.warnings += result.warnings();
   if (settings.verbose) report.verbose = verbose_line(job, report, settings.threads);
   return report;
@@ -247,6 +277,8 @@ std::string job_json(const BatchJob& job, const JobReport* report, const Failure
     std::istringstream lines(report->warnings);
     for (std::string w; std::getline(lines, w);) warnings.push_back(w);
     j["warnings"] = warnings;
+    if (report->transition_frames > 0)
+      j["transition"] = {{"frames", report->transition_frames}, {"first_frame", report->transition_first}};
     if (!report->constraints.empty()) {
       j["alternatives"] = report->alternatives;
       j["constraints"] = nlohmann::ordered_json::parse(report->constraints);

@@ -36,6 +36,8 @@ struct JobReport {
   std::string verbose;   ///< with JobSettings::verbose, the line of what ran (no "motionfield: ", no newline)
   std::string constraints;  ///< the constraint report (mf_solution_get_report_json), "" when not asked for
   std::vector<std::string> alternatives;  ///< files the alternatives were written to
+  int transition_frames = 0;  ///< a transition's generated frames (0: not a transition)
+  int transition_first = 0;   ///< a transition's first generated frame in the whole clip
 };
 
 /// Where alternative `index` (1..) of output `out` goes: OUT_1.bvh for OUT.bvh.
@@ -63,7 +65,8 @@ JobReport run_job(const BatchJob& job, OutputSet files, const JobSettings& setti
 /// The --json summary of one job: {"task", "in", "out", "status": "ok" |
 /// "error", "method", "model", "frames_in", "frames_out", "timings_ms":
 /// {"read", "solve", "write", "total"}, "warnings": [...], and with
-/// constraints "alternatives": [files] and "constraints": the report} when it ran, or
+/// constraints "alternatives": [files] and "constraints": the report, for a
+/// transition "transition": {"frames": N, "first_frame": I + 1}} when it ran, or
 /// {"task", "in", "out", "status": "error", "exit_code", "error"} when it
 /// failed; batch jobs add "line" and "id" (when given). One line of JSON.
 std::string job_json(const BatchJob& job, const JobReport* report, const Failure* failure, size_t line = 0);

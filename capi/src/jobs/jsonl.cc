@@ -365,11 +365,32 @@ void read_constraints(const JsonValue& line, BatchJob* job) {
   if (const JsonValue* r = line.find("report")) job->report_file = string_value(*r, "report", false);
 }
 
+// The keys of a transition: "to" (clip B), "frames", "from_frame", "to_frame", "place", "only_transition".
+void read_transition_keys(const JsonValue& line, BatchJob* job) {
+  job->to = string_value(required(line, "to", job->task), "to", false);
+  if (const JsonValue* n = line.find("frames")) job->frames = int_value(*n, "\"frames\"");
+  if (const JsonValue* i = line.find("from_frame")) job->from_frame = int_value(*i, "\"from_frame\"");
+  if (const JsonValue* j = line.find("to_frame")) job->to_frame = int_value(*j, "\"to_frame\"");
+  if (const JsonValue* p = line.find("place")) {
+    const std::string place = string_value(*p, "place", false);
+    if (place != "auto" && place != "keep")
+      throw InputError("\"place\" must be \"auto\" or \"keep\", not " + p->dump());
+    job->place_keep = place == "keep";
+  }
+  if (const JsonValue* o = line.find("only_transition")) {
+    if (!o->is_bool())
+      throw InputError(std::string("\"only_transition\" must be true or false, not ") + json_type_name(o->type()));
+    job->only_transition = o->as_bool();
+  }
+}
+
 // The keys of job->task: keyframes, gap, fps, the path of a re-navigation, constraints.
 void read_task_keys(const JsonValue& line, bool single, BatchJob* job_out) {
   BatchJob& job = *job_out;
-  if (job.task == "inbetween" || job.task == "fill") read_constraints(line, &job);
-  if (job.task == "inbetween") {
+  if (job.task == "inbetween" || job.task == "fill" || job.task == "transition") read_constraints(line, &job);
+  if (job.task == "transition") {
+    read_transition_keys(line, &job);
+  } else if (job.task == "inbetween") {
     job.keyframes = int_array(required(line, "keyframes", job.task), "keyframes");
     job.has_keyframes = true;
   } else if (job.task == "fill") {
@@ -443,9 +464,10 @@ BatchJob batch_job_from_json(const JsonValue& line, bool single) {
   if (const JsonValue* id = line.find("id")) job.id = id->is_string() ? id->as_string() : id->dump();
   job.task = string_value(required(line, "task", ""), "task", false);
   const bool export_only = single && job.task == "export";
-  if (job.task != "inbetween" && job.task != "fill" && job.task != "resample" && job.task != "renav" && !export_only)
+  if (job.task != "inbetween" && job.task != "fill" && job.task != "resample" && job.task != "renav" &&
+      job.task != "transition" && !export_only)
     throw InputError("unknown task \"" + job.task +
-                     "\" (expected \"inbetween\", \"fill\", \"resample\" or \"renav\")");
+                     "\" (expected \"inbetween\", \"fill\", \"resample\", \"renav\" or \"transition\")");
   job.in = string_value(required(line, "in", job.task), "in", false);
   job.out = string_value(required(line, "out", job.task), "out", false);
   if (const JsonValue* a = line.find("animation")) {

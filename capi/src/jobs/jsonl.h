@@ -88,7 +88,7 @@ JsonValue parse_json(const std::string& text);
 const char* json_type_name(JsonValue::Type type);
 
 /// One job of `motionfield batch`: {"task": "inbetween" | "fill" | "resample" |
-/// "renav", "in": path, "out": path, "keyframes": [int...], "gap": [A, B],
+/// "renav" | "transition", "in": path, "out": path, "keyframes": [int...], "gap": [A, B],
 /// "fps": F, "method": name}; re-navigation takes exactly one of "path" (a CSV
 /// of x,z per output frame) and "polyline" (a CSV of vertices, with an
 /// optional "frames": N), and an optional "fps". Every task takes an optional
@@ -97,11 +97,14 @@ const char* json_type_name(JsonValue::Type type);
 /// name, or an index from 0). inbetween and fill also take "constraints"
 /// (a constraints file, or the same JSON inline as an object), "trajectory"
 /// (a trajectory CSV file, merged into the constraints), "alternatives"
-/// and "report" (a file for the constraint report). Only the keys the task needs
+/// and "report" (a file for the constraint report). A transition takes "to"
+/// (clip B; "in" is clip A), optional "frames" (N; 0 = automatic),
+/// "from_frame", "to_frame", "place" ("auto" or "keep"), "only_transition"
+/// (a boolean) and the constraint keys of fill. Only the keys the task needs
 /// are read and type-checked; any other key ("id", a frame count, the input's
 /// fps, ...) is ignored, so callers can annotate jobs.
 struct BatchJob {
-  std::string task;    ///< "inbetween", "fill", "resample" or "renav"
+  std::string task;    ///< "inbetween", "fill", "resample", "renav" or "transition"
   std::string in, out; ///< paths as given (relative to the current directory)
   std::string method;  ///< empty: the default method
   int max_iterations = 0;  ///< iteration budget of iterative methods (mf_task_options); 0: each method's own
@@ -113,12 +116,18 @@ struct BatchJob {
   double fps = 0.0;                ///< resample: the target fps; renav: the output's (0 = the reference's)
   std::string path_file;           ///< renav: the CSV of the path or of the polyline's vertices
   bool polyline = false;           ///< renav: path_file holds a polyline's vertices
-  int frames = 0;                  ///< renav with a polyline: the output's frame count (0 = from the speed)
+  int frames = 0;                  ///< renav with a polyline: the output's frame count (0 = from the speed);
+                                   ///< transition: the generated frames (0 = automatic)
+  std::string to;                  ///< transition: clip B (the file); "in" is clip A
+  int from_frame = -1;             ///< transition: A's last kept frame (negative: from the end)
+  int to_frame = 0;                ///< transition: B's first kept frame (negative: from the end)
+  bool place_keep = false;         ///< transition: "place": "keep" (false: "auto")
+  bool only_transition = false;    ///< transition: only the generated frames
   std::string rig_map;             ///< a rig map file; empty: the command line's (--rig-map)
   std::string units;               ///< "auto", a unit name or metres per unit as text; empty: the command line's
   std::string animation;           ///< glTF and FBX inputs: the animation's name; empty: by index
   int animation_index = 0;         ///< glTF and FBX inputs: the animation's index (when no name)
-  // inbetween and fill: constraints beyond whole-pose keys (docs/CONSTRAINTS.md)
+  // inbetween, fill and transition: constraints beyond whole-pose keys (docs/CONSTRAINTS.md)
   std::string constraints_file;    ///< a constraints file; empty: none
   std::string constraints_json;    ///< inline constraints (JSON text); empty: none
   std::string trajectory_file;     ///< a trajectory CSV (merged into the constraints); empty: none
@@ -139,10 +148,12 @@ struct BatchJob {
 /// "fps" a number; "max_iterations" an integer in 0..100000; "method",
 /// "path", "polyline" and "rig_map" strings;
 /// "frames" an integer; "units" a string or a positive number; "animation" a
-/// string or an integer from 0; for inbetween
-/// and fill "constraints" a file name or an inline object, "trajectory" a file
+/// string or an integer from 0; for inbetween, fill
+/// and transition "constraints" a file name or an inline object, "trajectory" a file
 /// name, "alternatives" an
-/// integer in 0..16, "report" a file name; no string
+/// integer in 0..16, "report" a file name; for transition "to" a non-empty
+/// string, "from_frame" and "to_frame" integers, "place" "auto" or "keep",
+/// "only_transition" a boolean; no string
 /// may contain a NUL, "\u0000", which would cut a file name). Range checks
 /// (keyframes within the clip, fps positive, ...) are the library's, once the
 /// input is read. `single` (a single command of the CLI): the task "export"
