@@ -15,7 +15,9 @@ step, touching only the active armature's action:
 * Resample: the keyed span, taken at the given source frame rate, to the
   scene's frame rate, into a copy of the action;
 * Follow path: a new walk in the action's style along a curve object's
-  ground path, into a copy of the action.
+  ground path, into a copy of the action;
+* Transition: the end of the action into the start of a second action of
+  the armature, with generated frames between them, into a new action.
 """
 
 bl_info = {
@@ -147,6 +149,14 @@ class MotionfieldSettings(bpy.types.PropertyGroup):
                                           "else the scene's")
     path_object: PointerProperty(name="Path", type=bpy.types.Object, poll=_is_curve,
                                  description="Curve object whose ground path (first spline) to follow")
+    transition_action: PointerProperty(name="Into action", type=bpy.types.Action,
+                                       description="The action whose start the armature's action blends into")
+    transition_frames: IntProperty(name="Frames", min=0, max=600, default=0,
+                                   description="Generated frames between the two actions; 0: chosen from the change "
+                                               "of pose (10-60 at 30 fps, reported)")
+    transition_place: EnumProperty(name="Placement", default='AUTO', items=[
+        ('AUTO', "Continue", "Move and turn the second action on the ground so that it continues the first"),
+        ('KEEP', "Keep", "Leave the second action where it is")])
 
 
 # ------------------------------------------------------------------ operators
@@ -513,6 +523,68 @@ class MOTIONFIELD_OT_follow_path(_TaskOperator, bpy.types.Operator):
         return run, finish
 
 
+def read_action(context, obj, rig, action):
+    """The armature's pose over the keyed span of `action` (convert.read_frames),
+    played on it for the reading; its own action is back afterwards."""
+    own = obj.animation_data.action
+    obj.animation_data.action = action
+    try:
+        keyed = animation.keyed_frames(obj, rig.names)
+        if len(keyed) < 2:
+            raise ValueError("action %r has fewer than two keyed frames on the rig's bones" % action.name)
+        return convert.read_frames(context.scene, obj, rig, list(range(keyed[0], keyed[-1] + 1)))
+    finally:
+        obj.animation_data.action = own
+
+
+class MOTIONFIELD_OT_transition(_TaskOperator, bpy.types.Operator):
+    """Blend the end of the armature's action into the start of a second action, generated frames between them, into a new action"""
+    bl_idname = "motionfield.transition"
+    bl_label = "Transition"
+
+    completes = True
+
+    @classmethod
+    def poll(cls, context):
+        if not has_action(cls, context):
+            return False
+        into = context.scene.motionfield.transition_action
+        why = ("Choose the action to blend into" if into is None else
+               "Choose another action than the armature's own"
+               if into == context.active_object.animation_data.action else None)
+        if why:
+            cls.poll_message_set(why)
+        return why is None
+
+    def prepare(self, context):
+        scene, s = context.scene, context.scene.motionfield
+        first, into = self.obj.animation_data.action, s.transition_action
+        if into is None or into == first:
+            raise ValueError("choose a second action of the armature to blend into (Transition > Into action)")
+        frames = list(range(self.keyed[0], self.keyed[-1] + 1))
+        sampled = convert.read_frames(scene, self.obj, self.rig, frames)
+        second = read_action(context, self.obj, self.rig, into)
+        fps = _scene_fps(scene)
+        a, b = self.motion(sampled, fps), self.motion(second, fps)
+        kw = self.task_kwargs(context, s.method)
+        length = s.transition_frames or None
+
+        def run(progress, cancel):
+            return self.mf.transition(a, b, length, place=s.transition_place.lower(), progress=progress,
+                                      cancel=cancel, **kw)
+
+        def finish(context, result):
+            self.method_label = result.method
+            m = result.motion
+            act = animation.new_action_with(self.obj, self.rig, m.rotations, m.root_positions, frames[0],
+                                            "_to_" + into.name, sampled.parent_poses[0])
+            start = frames[0] + result.first_frame
+            animation.mark_generated(self.obj, act, range(start, start + result.frames))
+            return "%d frames between %r and %r (frames %d..%d) in action %r" % (
+                result.frames, first.name, into.name, start, start + result.frames - 1, act.name)
+        return run, finish
+
+
 class MOTIONFIELD_OT_clear_generated(bpy.types.Operator):
     """Remove the keys In-between and Fill gap generated from the active armature's action (the animator's keys stay)"""
     bl_idname = "motionfield.clear_generated"
@@ -648,7 +720,8 @@ def _menu_export(self, context):
 
 _classes = (MOTIONFIELD_AP_preferences, MotionfieldSettings, MOTIONFIELD_OT_set_root, MOTIONFIELD_OT_inbetween,
             MOTIONFIELD_OT_fill, MOTIONFIELD_OT_clear_generated, MOTIONFIELD_OT_alternative, MOTIONFIELD_OT_import_motion,
-            MOTIONFIELD_OT_export_motion, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path) + panel.CLASSES
+            MOTIONFIELD_OT_export_motion, MOTIONFIELD_OT_resample, MOTIONFIELD_OT_follow_path,
+            MOTIONFIELD_OT_transition) + panel.CLASSES
 
 
 def register():

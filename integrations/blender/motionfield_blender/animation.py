@@ -232,6 +232,20 @@ def new_action_with(obj, rig, motion_rot, motion_root, first_frame, suffix, pare
     return act
 
 
+def mark_generated(obj, action, frames):
+    """Makes the keys of the bones' F-curves of `action` on `frames` generated
+    keys: their key type, and the action's record of generated frames (which
+    then holds exactly `frames`)."""
+    frames, kind = set(frames), _generated_type()
+    for fc in fcurves_of(obj, action):
+        if bone_of(fc.data_path) is None:
+            continue
+        for k in fc.keyframe_points:
+            if int(round(k.co[0])) in frames:
+                k.type = kind
+    _set_generated_frames(action, frames)
+
+
 def moving_bones(obj):
     """Names of the bones whose keyed channels change over the action."""
     out = set()

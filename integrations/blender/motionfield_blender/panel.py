@@ -151,6 +151,19 @@ class MOTIONFIELD_PT_path(_SubPanel, bpy.types.Panel):
         layout.operator("motionfield.follow_path", icon='CURVE_PATH')
 
 
+class MOTIONFIELD_PT_transition(_SubPanel, bpy.types.Panel):
+    bl_label = "Transition"
+
+    def draw(self, context):
+        layout, s = self.layout, context.scene.motionfield
+        col = layout.column(align=True)
+        col.label(text="Into action")
+        col.prop_search(s, "transition_action", bpy.data, "actions", text="")
+        field(layout, s, "transition_frames", "Frames (0: chosen)")
+        field(layout, s, "transition_place", "Second action")
+        layout.operator("motionfield.transition", icon='NLA_PUSHDOWN')
+
+
 class MOTIONFIELD_PT_files(_SubPanel, bpy.types.Panel):
     bl_label = "Import and export"
 
@@ -176,5 +189,5 @@ class MOTIONFIELD_PT_advanced(_SubPanel, bpy.types.Panel):
         field(layout, s, "max_iterations", "Iterations (0: the method's)")
 
 
-CLASSES = (MOTIONFIELD_PT_main, MOTIONFIELD_PT_resample, MOTIONFIELD_PT_path, MOTIONFIELD_PT_files,
-           MOTIONFIELD_PT_advanced)
+CLASSES = (MOTIONFIELD_PT_main, MOTIONFIELD_PT_resample, MOTIONFIELD_PT_path, MOTIONFIELD_PT_transition,
+           MOTIONFIELD_PT_files, MOTIONFIELD_PT_advanced)

@@ -161,6 +161,42 @@ check(ends == {"location": count, "rotation_quaternion": count},
 s.resample_method = "DEFAULT"
 log("resample")
 
+# ------------------------------------------------------------------ a transition between two actions
+obj, motion, keys = walk_session.setup(mf, fps=30, every=1, container=False)
+walk = obj.animation_data.action
+into = walk.copy()
+into.name = "walk_b"
+check(not addon.MOTIONFIELD_OT_transition.poll(bpy.context), "no second action chosen: the button is greyed")
+s.transition_action, s.transition_frames, s.transition_place, s.method = into, 20, 'AUTO', "interp"
+check(bpy.ops.motionfield.transition('EXEC_DEFAULT') == {'FINISHED'}, "transition finished")
+act = obj.animation_data.action
+check(act.name == walk.name + "_to_walk_b" and walk.use_fake_user, "a new action, the old one kept: %s" % act.name)
+n = motion.frame_count
+check(tuple(int(f) for f in act.frame_range) == (1, 2 * n + 20), "the clip: A, 20 frames, B: %s" % (act.frame_range,))
+check(animation.generated_frames(act) == set(range(n + 1, n + 21)), "the 20 frames between are generated keys")
+arm = obj.pose.bones["UpperArm_L"]
+
+
+def arm_rotation(action, frame):
+    obj.animation_data.action = action
+    bpy.context.scene.frame_set(frame)
+    return arm.rotation_quaternion.copy()
+
+
+check(all((arm_rotation(act, f) - arm_rotation(walk, f)).magnitude < 1e-4 for f in (1, 30, n)), "A's part as it was")
+check(all((arm_rotation(act, n + 20 + f) - arm_rotation(into, f)).magnitude < 1e-4 for f in (1, 30, n)),
+      "B's part as it was (its pose; its place continues A)")
+obj.animation_data.action = act
+hips = {f: obj.pose.bones["Hips"].location.copy() for f in (n - 5, n, n + 21, n + 26) if not bpy.context.scene.frame_set(f)}
+ahead = (hips[n + 21] - hips[n]).length
+step = ((hips[n] - hips[n - 5]).length + (hips[n + 26] - hips[n + 21]).length) / 10  # A's end and B's start
+check(0.7 < ahead / (21 * step) < 1.3, "B's first frame continues A's walk: %.2f m ahead of A's last, %.3f m a frame"
+      % (ahead, step))
+s.transition_action = act
+check(not addon.MOTIONFIELD_OT_transition.poll(bpy.context), "blending an action into itself is greyed")
+s.transition_action, s.transition_frames, s.method = None, 0, "DEFAULT"
+log("transition")
+
 # ------------------------------------------------------------------ only the methods that can run are offered
 with tempfile.TemporaryDirectory() as d:
     alone = os.path.join(d, "prior-alone.mfm")  # the prior without the transformer files next to it
