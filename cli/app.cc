@@ -107,6 +107,9 @@ void add_constraints(CLI::App* cmd, JobOptions& job) {
                   "write how well each solution meets the constraints\n(JSON) to FILE")
       ->type_name("FILE")
       ->check(kNonEmpty);
+  cmd->add_flag("--no-fallback", job.no_fallback,
+                "keep the latent solvers' result where their fit to the keys\nis poor (by default such a window is "
+                "interpolated, with a\nwarning; docs/API.md, Never worse than interpolation)");
 }
 
 void define_global_options(CLI::App& app, Settings& s, bool& version_flag) {
@@ -294,7 +297,8 @@ void define_batch(CLI::App& app, HelpFormatter& help, Arguments& a) {
       "\"frames\", \"from_frame\", \"to_frame\", \"place\" and \"only_transition\" as the\n"
       "arguments of `motionfield transition`. inbetween, fill and transition take \"constraints\"\n"
       "(a file or an inline object), \"trajectory\" (a CSV file), \"alternatives\" and\n"
-      "\"report\" as the flags --constraints, --trajectory, --alternatives and --report.\n"
+      "\"report\" as the flags --constraints, --trajectory, --alternatives and --report,\n"
+      "and \"fallback\": false as the flag --no-fallback.\n"
       "Every task takes \"max_iterations\" as the flag --max-iterations, and\n"
       "\"rig_map\" (a file) and\n"
       "\"units\" (a name, auto, or metres per unit), which replace --rig-map and\n"

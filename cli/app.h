@@ -21,6 +21,7 @@ struct JobOptions {
   std::string trajectory_file;   ///< --trajectory
   int alternatives = 0;          ///< --alternatives
   std::string report_file;       ///< --report
+  bool no_fallback = false;      ///< --no-fallback
 };
 
 /// Everything the command line sets. The task commands (inbetween, fill,

@@ -88,6 +88,7 @@ std::string task_line(const std::string& command, const Arguments& a) {
   if (!job.trajectory_file.empty()) j["trajectory"] = job.trajectory_file;
   if (job.alternatives != 0) j["alternatives"] = job.alternatives;
   if (!job.report_file.empty()) j["report"] = job.report_file;
+  if (job.no_fallback) j["fallback"] = false;
   if (!a.settings.animation.empty()) j["animation"] = animation_value(a.settings.animation);
   try {
     return j.dump();

@@ -428,6 +428,15 @@ if [ -n "$TINY" ]; then
     --keyframes 0,39 --out "$TMP/notty.bvh" --method nemf
   # (A tiny random prior cannot reach the keys: the fallback's warning may be there, nothing else.)
   grep -v "^motionfield: warning: interpolation was used" "$TMP/err" | grep -q . && fail "progress printed to a non-terminal stderr" || pass
+  # --no-fallback keeps the solver's result where the fallback interpolates (and says so).
+  expect_rc 0 "fill with the fallback" -- "$MF" --model "$TINY" --threads 1 fill --in "$SMALL" --gap 5:35 \
+    --out "$TMP/fb.bvh" --method nemf
+  if grep -q "interpolation was used" "$TMP/err"; then
+    expect_rc 0 "fill --no-fallback" -- "$MF" --model "$TINY" --threads 1 fill --in "$SMALL" --gap 5:35 \
+      --out "$TMP/nofb.bvh" --method nemf --no-fallback
+    grep -q "interpolation was used" "$TMP/err" && fail "--no-fallback still fell back" || pass
+    cmp -s "$TMP/fb.bvh" "$TMP/nofb.bvh" && fail "--no-fallback gave the interpolated result" || pass
+  fi
 fi
 
 # ------------------------------------------------------------ bad input and faults (issue 18, docs/RELIABILITY.md)

@@ -268,6 +268,16 @@ TEST(JsonlTest, TransitionJob) {
   EXPECT_TRUE(has(job_error(base + R"("to": "c", "only_transition": 1})"), "\"only_transition\" must be true or false"));
 }
 
+TEST(JsonlTest, CompletionJobsTakeTheFallbackSwitch) {
+  EXPECT_TRUE(job(R"({"task": "fill", "in": "a", "out": "b", "gap": [1, 5]})").fallback);
+  EXPECT_FALSE(job(R"({"task": "fill", "in": "a", "out": "b", "gap": [1, 5], "fallback": false})").fallback);
+  EXPECT_FALSE(job(R"({"task": "inbetween", "in": "a", "out": "b", "keyframes": [0, 9], "fallback": false})").fallback);
+  EXPECT_FALSE(job(R"({"task": "transition", "in": "a", "to": "c", "out": "b", "fallback": false})").fallback);
+  EXPECT_TRUE(job(R"({"task": "resample", "in": "a", "out": "b", "fps": 60, "fallback": 3})").fallback);  // not read
+  const std::string m = job_error(R"({"task": "fill", "in": "a", "out": "b", "gap": [1, 5], "fallback": "no"})");
+  EXPECT_NE(m.find("\"fallback\" must be true or false"), std::string::npos) << m;
+}
+
 TEST(JsonlTest, EveryJobTakesARigMapAndUnits) {
   const BatchJob a = job(R"({"task": "inbetween", "in": "a.bvh", "out": "b.bvh", "keyframes": [0, 9], "rig_map": "m.json", "units": "in"})");
   EXPECT_EQ(a.rig_map, "m.json");

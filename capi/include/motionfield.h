@@ -497,6 +497,13 @@ typedef struct mf_task_options {
    *  most iterations of the full solve per window; 0 (the default) = each
    *  method's own. Must be >= 0; methods that do not iterate ignore it. */
   int32_t max_iterations;
+  /** Since 0.4 (appended): non-zero keeps what the latent solvers ("nemf",
+   *  "nemf-detail", ...) find even where their fit to the keys is poor. By
+   *  default (0) in-betweening, gap filling and transitions with whole-pose
+   *  keys take interpolation of the keys in such a window instead, and say so
+   *  in the result's warnings ("interpolation was used: the prior could not
+   *  reach the keys ..."; docs/API.md, "Never worse than interpolation"). */
+  int32_t no_fallback;
 } mf_task_options;
 
 MF_API int mf_task_options_init(mf_task_options *options);

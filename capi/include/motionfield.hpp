@@ -428,6 +428,7 @@ struct TaskOptions {
   std::string rig_map;            ///< JSON text; "" = automatic
   std::string rig_map_path;       ///< a JSON file; "" = none
   int32_t max_iterations = 0;     ///< iteration budget of iterative methods; 0 = each method's own
+  bool no_fallback = false;       ///< keep the latent solvers' result where it misses the keys (mf_task_options)
 };
 
 /// mf_renav_options in C++ types.
@@ -451,6 +452,7 @@ class TaskCall {
     c_.rig_map = options.rig_map.empty() ? nullptr : options.rig_map.c_str();
     c_.rig_map_path = options.rig_map_path.empty() ? nullptr : options.rig_map_path.c_str();
     c_.max_iterations = options.max_iterations;
+    c_.no_fallback = options.no_fallback ? 1 : 0;
     if (options.progress) {
       c_.progress = &TaskCall::on_progress;
       c_.user_data = this;

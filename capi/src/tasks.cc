@@ -40,6 +40,7 @@ TaskContext task_context(const mf_model* model, const mf_task_options& o) {
     throw ApiError(MF_ERROR_INVALID_ARGUMENT,
                    "mf_task_options.max_iterations is " + std::to_string(o.max_iterations) + ": must be >= 0");
   ctx.max_iterations = o.max_iterations;
+  ctx.interpolation_fallback = o.no_fallback == 0;
   if (o.progress) {
     const mf_progress_fn fn = o.progress;
     void* const user_data = o.user_data;

@@ -160,6 +160,7 @@ class MfTaskOptions(ctypes.Structure):
         ("rig_map", ctypes.c_char_p),
         ("rig_map_path", ctypes.c_char_p),
         ("max_iterations", ctypes.c_int32),
+        ("no_fallback", ctypes.c_int32),
     ]
 
 

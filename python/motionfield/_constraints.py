@@ -314,7 +314,7 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
           contacts: Sequence[Tuple[str, int, int]] = (), constraints: Union[Constraints, str, Dict[str, Any], None] = None,
           trajectory: Union[npt.ArrayLike, str, "os.PathLike[str]", None] = None, alternatives: int = 0, method: Optional[str] = None, model: Optional[Model] = None, seed: int = 0,
           progress: Optional[ProgressCallback] = None, cancel: Optional[CancelToken] = None,
-          rig_map: Optional[RigMap] = None, max_iterations: int = 0) -> Solution:
+          rig_map: Optional[RigMap] = None, max_iterations: int = 0, fallback: bool = True) -> Solution:
     """Completes a motion under any constraints, with alternative solutions.
 
     ``solve(motion, [0, 60], targets=[(30, "Hand_R", [20, 120, 40])])`` is
@@ -346,6 +346,7 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
     alternatives : int
         More solutions (0..16) from other starts, deterministic for `seed`.
     {task_parameters}
+    {fallback}
 
     Returns
     -------
@@ -358,7 +359,7 @@ def solve(motion: Motion, keyframes: Sequence[int] = (), *, partial_keys: Sequen
     """
     _instance_arg(motion, Motion, "motion")
     alternatives = _int_arg(alternatives, "alternatives", 0, 16)
-    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
+    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations, fallback)
     c = _constraints_arg(constraints, trajectory)
     keys = _int_list(keyframes, "keyframes")
     if len(keys):

@@ -113,10 +113,13 @@ class _TaskCall:
     alive for the call; exceptions it raises cancel the task and are re-raised)."""
 
     def __init__(self, method: Optional[str], seed: int, progress: Optional[ProgressCallback],
-                 cancel: Optional[CancelToken], rig_map: Optional[RigMap] = None, max_iterations: int = 0) -> None:
+                 cancel: Optional[CancelToken], rig_map: Optional[RigMap] = None, max_iterations: int = 0,
+                 fallback: bool = True) -> None:
         method = _str_arg(method, "method", optional=True)
         seed = _int_arg(seed, "seed", 0, 2**64 - 1)
         max_iterations = _int_arg(max_iterations, "max_iterations", 0, 100000)
+        if not isinstance(fallback, bool):
+            raise TypeError("fallback must be a bool, not %s" % type(fallback).__name__)
         if progress is not None and not callable(progress):
             raise TypeError("progress must be callable, not %s" % type(progress).__name__)
         _instance_arg(cancel, CancelToken, "cancel", optional=True)
@@ -129,6 +132,7 @@ class _TaskCall:
         self.options.rig_map, self.options.rig_map_path = self._rig_map
         self.options.seed = seed
         self.options.max_iterations = max_iterations
+        self.options.no_fallback = 0 if fallback else 1
         self.error: Optional[BaseException] = None
         if progress is not None:
             def trampoline(_user_data: Any, p: Any) -> int:
@@ -179,6 +183,11 @@ _TASK_PARAMETERS_DOC = """\
         "prior" resampling, re-navigation): the most iterations of the full
         solve per window; 0 (the default) = each method's own."""
 
+_FALLBACK_DOC = """    fallback : bool, optional
+        True (the default): where a latent solver ("nemf*") cannot reach the
+        keys, that window is interpolated instead and ``warnings`` say so;
+        False keeps the solver's result (mf_task_options.no_fallback)."""
+
 _TASK_RAISES_DOC = """\
     InvalidArgumentError
         If an argument is out of range or the method is unknown (the message says which).
@@ -193,7 +202,7 @@ _TASK_RAISES_DOC = """\
 
 def _task_doc(fn: _F) -> _F:
     fn.__doc__ = (fn.__doc__ or "").replace("    {task_parameters}", _TASK_PARAMETERS_DOC).replace(
-        "    {task_raises}", _TASK_RAISES_DOC)
+        "    {task_raises}", _TASK_RAISES_DOC).replace("    {fallback}", _FALLBACK_DOC)
     return fn
 
 
@@ -202,7 +211,7 @@ def _task_doc(fn: _F) -> _F:
 def inbetween(motion: Motion, keyframes: Sequence[int], *, method: Optional[str] = None,
               model: Optional[Model] = None, seed: int = 0, progress: Optional[ProgressCallback] = None,
               cancel: Optional[CancelToken] = None, rig_map: Optional[RigMap] = None,
-              max_iterations: int = 0) -> Motion:
+              max_iterations: int = 0, fallback: bool = True) -> Motion:
     """Keyframe in-betweening: the keyframes are kept, every other frame is produced.
 
     ``inbetween(motion, keys)`` gives what ``motionfield inbetween --in ...
@@ -215,6 +224,7 @@ def inbetween(motion: Motion, keyframes: Sequence[int], *, method: Optional[str]
     keyframes : sequence of int
         0-based frame indices, strictly increasing, at least two.
     {task_parameters}
+    {fallback}
 
     Returns
     -------
@@ -227,7 +237,7 @@ def inbetween(motion: Motion, keyframes: Sequence[int], *, method: Optional[str]
     """
     _instance_arg(motion, Motion, "motion")
     keys = _int_list(keyframes, "keyframes")
-    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
+    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations, fallback)
     return call.run(_c.mf_inbetween, _task_model(model, method), motion._live(),
                     keys.ctypes.data_as(ctypes.POINTER(ctypes.c_int32)), keys.size)
 
@@ -236,7 +246,8 @@ def inbetween(motion: Motion, keyframes: Sequence[int], *, method: Optional[str]
 @_keywords_after(*_TASK_OPTIONS)
 def fill(motion: Motion, gap_begin: int, gap_end: int, *, method: Optional[str] = None,
          model: Optional[Model] = None, seed: int = 0, progress: Optional[ProgressCallback] = None,
-         cancel: Optional[CancelToken] = None, rig_map: Optional[RigMap] = None, max_iterations: int = 0) -> Motion:
+         cancel: Optional[CancelToken] = None, rig_map: Optional[RigMap] = None, max_iterations: int = 0,
+         fallback: bool = True) -> Motion:
     """Gap filling: frames gap_begin..gap_end-1 are produced, the others kept.
 
     Parameters
@@ -246,6 +257,7 @@ def fill(motion: Motion, gap_begin: int, gap_end: int, *, method: Optional[str] 
     gap_begin, gap_end : int
         The unknown frames, 1 <= gap_begin < gap_end <= frames - 1.
     {task_parameters}
+    {fallback}
 
     Returns
     -------
@@ -258,7 +270,7 @@ def fill(motion: Motion, gap_begin: int, gap_end: int, *, method: Optional[str] 
     """
     _instance_arg(motion, Motion, "motion")
     begin, end = _int_arg(gap_begin, "gap_begin"), _int_arg(gap_end, "gap_end")
-    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
+    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations, fallback)
     return call.run(_c.mf_fill, _task_model(model, method), motion._live(), begin, end)
 
 

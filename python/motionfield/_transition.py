@@ -61,7 +61,7 @@ def transition(a: Motion, b: Motion, frames: Optional[int] = None, from_frame: O
                trajectory: Union[npt.ArrayLike, str, "os.PathLike[str]", None] = None, alternatives: int = 0,
                method: Optional[str] = None, model: Optional[Model] = None, seed: int = 0,
                progress: Optional[ProgressCallback] = None, cancel: Optional[CancelToken] = None,
-               rig_map: Optional[RigMap] = None, max_iterations: int = 0) -> Transition:
+               rig_map: Optional[RigMap] = None, max_iterations: int = 0, fallback: bool = True) -> Transition:
     """The end of clip `a` and the start of clip `b` with generated frames between them.
 
     ``transition(walk, run, 20).motion`` is ``motionfield transition walk.bvh
@@ -97,6 +97,7 @@ def transition(a: Motion, b: Motion, frames: Optional[int] = None, from_frame: O
     alternatives : int
         More transitions (0..16) from other starts, deterministic for `seed`.
     {task_parameters}
+    {fallback}
 
     Returns
     -------
@@ -128,7 +129,7 @@ def transition(a: Motion, b: Motion, frames: Optional[int] = None, from_frame: O
     alternatives = _int_arg(alternatives, "alternatives", 0, 16)
     given = constraints is not None or trajectory is not None
     c = _constraints_arg(constraints, trajectory) if given else None
-    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations)
+    call = _TaskCall(method, seed, progress, cancel, rig_map, max_iterations, fallback)
     handle = call.run(_c.mf_transition, _task_model(model, method), a._live(), b._live(), ctypes.byref(options),
                       c._live() if c is not None else None, alternatives, out_type=_c.MfSolution)
     n, first = ctypes.c_int32(0), ctypes.c_int32(0)

@@ -338,6 +338,22 @@ class ModelTest(unittest.TestCase):
         same_code = code.with_latents(code.local_latents, code.global_latents)
         np.testing.assert_array_equal(same_code.decode(60.0).rotations, dec.rotations)
 
+    def test_fallback_to_interpolation_can_be_switched_off(self):
+        model = mf.Model(os.environ["MF_TEST_MODEL"])  # a tiny random prior cannot reach random keys
+        m = mf.Motion.from_arrays(random_rotations(26, model.joint_count, 9), np.zeros((26, 3), np.float32), 30.0,
+                                  model=model)
+        interp = mf.fill(m, 5, 20, method="interp")
+        out = mf.fill(m, 5, 20, method="nemf", model=model)
+        self.assertIn("interpolation was used", out.warnings)
+        np.testing.assert_array_equal(out.rotations, interp.rotations)
+        own = mf.fill(m, 5, 20, method="nemf", model=model, fallback=False)
+        self.assertNotIn("interpolation was used", own.warnings)
+        self.assertGreater(float(np.abs(own.rotations - interp.rotations).max()), 1e-3)
+        solved = mf.solve(m, [f for f in range(26) if not 5 <= f < 20], method="nemf", model=model, fallback=False)
+        np.testing.assert_array_equal(solved.motion.rotations, own.rotations)
+        with self.assertRaises(TypeError):
+            mf.fill(m, 5, 20, method="nemf", model=model, fallback="no")
+
     def test_max_iterations_budgets_the_solver(self):
         model = mf.Model(os.environ["MF_TEST_MODEL"])
         m = mf.Motion.from_arrays(random_rotations(30, model.joint_count, 5), np.zeros((30, 3), np.float32), 30.0,

@@ -30,7 +30,7 @@ TEST(CApiLayout, BvhOptions) {
 }
 
 TEST(CApiLayout, TaskOptions) {
-  EXPECT_EQ(sizeof(mf_task_options), 72u);  // max_iterations appended
+  EXPECT_EQ(sizeof(mf_task_options), 72u);  // max_iterations, then no_fallback in the tail padding, appended
   EXPECT_EQ(offsetof(mf_task_options, struct_size), 0u);
   EXPECT_EQ(offsetof(mf_task_options, method), 8u);
   EXPECT_EQ(offsetof(mf_task_options, seed), 16u);
@@ -40,6 +40,7 @@ TEST(CApiLayout, TaskOptions) {
   EXPECT_EQ(offsetof(mf_task_options, rig_map), 48u);
   EXPECT_EQ(offsetof(mf_task_options, rig_map_path), 56u);
   EXPECT_EQ(offsetof(mf_task_options, max_iterations), 64u);
+  EXPECT_EQ(offsetof(mf_task_options, no_fallback), 68u);
 }
 
 TEST(CApiLayout, TransitionOptions) {
@@ -143,6 +144,7 @@ TEST(CApiLayout, InitGivesZeroDefaults) {
   EXPECT_EQ(t.rig_map, nullptr);
   EXPECT_EQ(t.rig_map_path, nullptr);
   EXPECT_EQ(t.max_iterations, 0);
+  EXPECT_EQ(t.no_fallback, 0);
   EXPECT_EQ(b.struct_size, sizeof b);
   EXPECT_EQ(b.length_scale, 0.0);
   EXPECT_EQ(c.struct_size, sizeof c);

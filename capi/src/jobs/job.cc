@@ -112,6 +112,7 @@ Solved solve(const BatchJob& job, const JobSettings& settings, const Model& mode
              const Motion& second, const ProgressFn& progress) {
   TaskOptions options(job.method);
   options.max_iterations = job.max_iterations;
+  options.no_fallback = !job.fallback;
   options.rig_map_path = job.rig_map.empty() ? settings.rig_map : job.rig_map;
   options.progress = progress;
   if (job.task == "transition") return solve_transition(job, model, input, second, options);

@@ -365,6 +365,12 @@ void read_constraints(const JsonValue& line, BatchJob* job) {
   if (const JsonValue* r = line.find("report")) job->report_file = string_value(*r, "report", false);
 }
 
+// A boolean value of `key`.
+bool bool_value(const JsonValue& v, const char* key) {
+  if (!v.is_bool()) throw InputError(std::string("\"") + key + "\" must be true or false, not " + json_type_name(v.type()));
+  return v.as_bool();
+}
+
 // The keys of a transition: "to" (clip B), "frames", "from_frame", "to_frame", "place", "only_transition".
 void read_transition_keys(const JsonValue& line, BatchJob* job) {
   job->to = string_value(required(line, "to", job->task), "to", false);
@@ -377,17 +383,16 @@ void read_transition_keys(const JsonValue& line, BatchJob* job) {
       throw InputError("\"place\" must be \"auto\" or \"keep\", not " + p->dump());
     job->place_keep = place == "keep";
   }
-  if (const JsonValue* o = line.find("only_transition")) {
-    if (!o->is_bool())
-      throw InputError(std::string("\"only_transition\" must be true or false, not ") + json_type_name(o->type()));
-    job->only_transition = o->as_bool();
-  }
+  if (const JsonValue* o = line.find("only_transition")) job->only_transition = bool_value(*o, "only_transition");
 }
 
 // The keys of job->task: keyframes, gap, fps, the path of a re-navigation, constraints.
 void read_task_keys(const JsonValue& line, bool single, BatchJob* job_out) {
   BatchJob& job = *job_out;
-  if (job.task == "inbetween" || job.task == "fill" || job.task == "transition") read_constraints(line, &job);
+  if (job.task == "inbetween" || job.task == "fill" || job.task == "transition") {
+    read_constraints(line, &job);
+    if (const JsonValue* f = line.find("fallback")) job.fallback = bool_value(*f, "fallback");
+  }
   if (job.task == "transition") {
     read_transition_keys(line, &job);
   } else if (job.task == "inbetween") {

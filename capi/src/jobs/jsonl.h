@@ -100,7 +100,9 @@ const char* json_type_name(JsonValue::Type type);
 /// and "report" (a file for the constraint report). A transition takes "to"
 /// (clip B; "in" is clip A), optional "frames" (N; 0 = automatic),
 /// "from_frame", "to_frame", "place" ("auto" or "keep"), "only_transition"
-/// (a boolean) and the constraint keys of fill. Only the keys the task needs
+/// (a boolean) and the constraint keys of fill. inbetween, fill and
+/// transition take "fallback" (a boolean; false: mf_task_options.no_fallback).
+/// Only the keys the task needs
 /// are read and type-checked; any other key ("id", a frame count, the input's
 /// fps, ...) is ignored, so callers can annotate jobs.
 struct BatchJob {
@@ -108,6 +110,7 @@ struct BatchJob {
   std::string in, out; ///< paths as given (relative to the current directory)
   std::string method;  ///< empty: the default method
   int max_iterations = 0;  ///< iteration budget of iterative methods (mf_task_options); 0: each method's own
+  bool fallback = true;    ///< "fallback": false keeps the latent solvers' result where it misses the keys
   std::string id;      ///< the job's "id" for messages (JSON text; strings unquoted), empty if none
   bool has_keyframes = false;
   std::vector<int> keyframes;  ///< inbetween: required; fill: optional and then authoritative
@@ -153,7 +156,7 @@ struct BatchJob {
 /// name, "alternatives" an
 /// integer in 0..16, "report" a file name; for transition "to" a non-empty
 /// string, "from_frame" and "to_frame" integers, "place" "auto" or "keep",
-/// "only_transition" a boolean; no string
+/// "only_transition" a boolean; "fallback" a boolean; no string
 /// may contain a NUL, "\u0000", which would cut a file name). Range checks
 /// (keyframes within the clip, fps positive, ...) are the library's, once the
 /// input is read. `single` (a single command of the CLI): the task "export"
