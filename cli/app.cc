@@ -109,7 +109,7 @@ void add_constraints(CLI::App* cmd, JobOptions& job) {
       ->check(kNonEmpty);
   cmd->add_flag("--no-fallback", job.no_fallback,
                 "keep the latent solvers' result where their fit to the keys\nis poor (by default such a window is "
-                "interpolated, with a\nwarning; docs/API.md, Never worse than interpolation)");
+                "interpolated, with a\nwarning; docs/API.md, When the prior cannot reach the keys)");
 }
 
 void define_global_options(CLI::App& app, Settings& s, bool& version_flag) {

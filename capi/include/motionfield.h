@@ -502,7 +502,7 @@ typedef struct mf_task_options {
    *  default (0) in-betweening, gap filling and transitions with whole-pose
    *  keys take interpolation of the keys in such a window instead, and say so
    *  in the result's warnings ("interpolation was used: the prior could not
-   *  reach the keys ..."; docs/API.md, "Never worse than interpolation"). */
+   *  reach the keys ..."; docs/API.md, "When the prior cannot reach the keys"). */
   int32_t no_fallback;
 } mf_task_options;
 

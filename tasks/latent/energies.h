@@ -121,8 +121,8 @@ WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int 
 enum class Penalty { Squared, Absolute };
 
 /// Weights of the energy terms (see the top of this file for each term's
-/// definition and unit). Defaults were chosen by measurement (docs/BENCHMARKS.md,
-/// "Energy weights").
+/// definition and unit). Defaults were chosen by measurement
+/// (docs/experiments/2026-12-07-solver-defaults.md, "Energy weights").
 struct EnergyWeights {
   double rotation = 5.0;
   double position = 10.0;

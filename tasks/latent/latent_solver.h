@@ -149,7 +149,7 @@ struct WindowCaps {
 /// targets or with 40 or more frames in a row without a key (long gaps) gets a
 /// single stage of 60 iterations; any other window 30 keys-only iterations,
 /// then 20 on the whole energy (without a keys-only stage: 40). Measured in
-/// docs/BENCHMARKS.md ("Iteration caps", "A keys-only first stage"): the
+/// docs/BENCHMARKS.md ("Iteration caps") and docs/experiments/2026-12-07-solver-defaults.md: the
 /// keys-only stage costs a fraction of a dense iteration and leaves the full
 /// stage less to do on short gaps and sparse keys, while long gaps keep
 /// improving up to 60 full iterations. `key_frames` are the window's key
