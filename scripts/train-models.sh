@@ -4,8 +4,8 @@
 # produced the shipped files (docs/MODEL_CARD.md, "How the models were trained").
 #
 #   scripts/train-models.sh [--build DIR] [--out DIR] [--checkpoints DIR] [--data PATH]
-#                           [--foreign PATH] [--cache-dir DIR] [--threads N] [--jobs 1|2] [--smoke]
-#                           [--fresh] [--replace-shipped] [--dry-run]
+#                           [--cache-dir DIR] [--threads N] [--jobs 1|2] [--smoke] [--fresh]
+#                           [--replace-shipped] [--dry-run]
 #
 # Stages run one after another (--jobs 2: the prior's chain and the in-betweeners'
 # chain side by side, one core each). Each stage trains into DIR/<stage>/ of the
@@ -15,9 +15,6 @@
 # --resume; its --max-minutes budget counts the earlier part). At the end the
 # five model files are copied into the output folder (default out/models/). The
 # output folder is never models/ unless --replace-shipped is given.
-#
-# --data is the Bandai Namco archive; --foreign the foreign capture (its training
-# part, on the model's rig, joins the prior's last two stages: see "mixed_data").
 #
 # --smoke runs every stage for a few steps on a slice of the data (the 17
 # "normal"-style clips of dataset 1 from the archive, or a folder's first 30
@@ -36,7 +33,6 @@ BUILD=$ROOT/build
 OUT=""
 CK=""
 DATA=$ROOT/../shared/data/bandai-namco/train.tar.xz
-FOREIGN=$ROOT/../shared/data/foreign/foreign.tar.xz
 CACHE=""
 THREADS=1
 JOBS=1
@@ -54,7 +50,6 @@ while (($#)); do
     --out) OUT=${2:?}; shift ;;
     --checkpoints) CK=${2:?}; shift ;;
     --data) DATA=${2:?}; shift ;;
-    --foreign) FOREIGN=${2:?}; shift ;;
     --cache-dir) CACHE=${2:?}; shift ;;
     --threads) THREADS=${2:?}; shift ;;
     --jobs) JOBS=${2:?}; shift ;;
@@ -84,7 +79,6 @@ if [[ ! -e $DATA ]]; then
   exit 77
 fi
 ((DRY)) || [[ -x $TRAIN ]] || die "no trainer at $TRAIN: build it first (make build, or --build DIR)"
-[[ -e $FOREIGN ]] || die "no foreign capture at $FOREIGN (../shared/data/foreign, or --foreign PATH)"
 
 OUT=$(realpath -m "$OUT")
 if [[ $OUT == "$(realpath -m "$ROOT/models")" ]] && ((!REPLACE)); then
@@ -136,9 +130,7 @@ stage() {
     return 0
   fi
   [[ $name == twostage-1b ]] && steps=6
-  local data=("${DATA_ARGS[@]}")
-  [[ -n ${STAGE_DATA:-} ]] && data=(--data "$STAGE_DATA" --cache-dir "$CK/cache-mixed")
-  local cmd=("$TRAIN" "$kind" --out "$dir" "${data[@]}" --threads "$THREADS" --resume "$@")
+  local cmd=("$TRAIN" "$kind" --out "$dir" "${DATA_ARGS[@]}" --threads "$THREADS" --resume "$@")
   local extra
   mapfile -t extra < <(smoke_args "$kind" "$steps")
   cmd+=("${extra[@]}")
@@ -152,69 +144,11 @@ stage() {
 
 init() { echo "$CK/$1/best.mfm"; }
 
-# The rig anatomy of the model's rig, measured on the data (the in-betweeners
-# do not need it; the prior's foreign stages retarget with it).
-rig_stage() {
-  if [[ -f $CK/rig.done ]]; then
-    echo "train-models: rig: done earlier"
-    return 0
-  fi
-  local cmd=("$TRAIN" rig --out "$CK/rig/motionfield-rig.json" "${DATA_ARGS[@]}")
-  echo "train-models: rig: ${cmd[*]}"
-  ((DRY)) && return 0
-  mkdir -p "$CK/rig"
-  "${cmd[@]}"
-  touch "$CK/rig.done"
-}
-
-# The data of the prior's last stages, made once in CK/mixed: the Bandai clips
-# and the foreign capture's training part (never its validation part) on the
-# model's rig, written by bench/foreign-training-set with prior-9 and the rig
-# anatomy: the 16 CMU clips three times each (copy2-, copy3-) and the ReActIdle
-# acted clips 003, 007, 008 and 009; about 374k Bandai frames and 40k foreign.
-# Smoke mode: the slice and two CMU clips.
-mixed_data() {
-  local dir=$CK/mixed
-  [[ -d $dir ]] && return 0
-  echo "train-models: mixed data: $dir"
-  ((DRY)) && return 0
-  rm -rf "$dir.tmp" && mkdir -p "$dir.tmp/bandai" "$dir.tmp/foreign" "$CK/rig-model"
-  cp "$(init prior-9)" "$CK/rig-model/motionfield-prior.mfm"
-  cp "$CK/rig/motionfield-rig.json" "$CK/rig-model/"
-  "$BUILD/bench/foreign-training-set" --model "$CK/rig-model/motionfield-prior.mfm" --source "$FOREIGN" \
-    --cache-dir "$CK/cache-foreign" --out "$dir.tmp/all"
-  local f name
-  for f in "$dir.tmp/all"/foreign-cmu-cgspeed-*.bvh; do
-    name=$(basename "$f")
-    cp "$f" "$dir.tmp/foreign/$name"
-    ((SMOKE)) || cp "$f" "$dir.tmp/foreign/copy2-$name"
-    ((SMOKE)) || cp "$f" "$dir.tmp/foreign/copy3-$name"
-  done
-  if ((SMOKE)); then
-    mapfile -t keep < <(find "$dir.tmp/foreign" -name '*.bvh' | LC_ALL=C sort | tail -n +3)
-    rm -f "${keep[@]}"
-  else
-    for f in 003 007 008 009; do cp "$dir.tmp/all/foreign-reactidle-${f}_acted.bvh" "$dir.tmp/foreign/"; done
-  fi
-  rm -rf "$dir.tmp/all"
-  if ((SMOKE)); then
-    cp -r "$SLICE/." "$dir.tmp/bandai/"
-  elif [[ -d $DATA ]]; then
-    cp -r "$DATA/." "$dir.tmp/bandai/"
-  else
-    tar -xJf "$DATA" -C "$dir.tmp/bandai"
-  fi
-  mv "$dir.tmp" "$dir"
-}
-
 # The prior: 750 minutes for the VAE (9 runs, each continuing the last one's
 # weights with a lower cosine schedule, the last two with time warp and
 # mirroring), then 35 minutes for the default GMP on the VAE's reconstructions,
-# the 750-minute GMP kept as the steering GMP (prior-9). Then 150 minutes of the
-# VAE on the Bandai clips with the foreign training part (prior-10) and its
-# default GMP refitted on them (prior-11).
+# the 750-minute GMP kept as the steering GMP.
 prior_chain() {
-  rig_stage
   local common=(--lr-final 1e-5 --kl-warmup 0)
   stage prior-1 prior-1 prior --width 256 --layers 6 --zl 256 --zg 64 --max-minutes 95 --seed 1
   stage prior-2 prior-2 prior --init "$(init prior-1)" --lr 3e-4 "${common[@]}" --max-minutes 105 --seed 2
@@ -228,16 +162,11 @@ prior_chain() {
     --mirror --speeds 0.8,1.25
   stage prior-9 prior-9 prior --init "$(init prior-8)" --gmp-only --steering-gmp --gmp-width 128 \
     --gmp-reconstructed 1 --mirror --speeds 0.8,1.25 --lr 3e-4 "${common[@]}" --max-minutes 35 --seed 301
-  mixed_data
-  STAGE_DATA=$CK/mixed stage prior-10 prior-10 prior --init "$(init prior-9)" --lr 8e-5 "${common[@]}" \
-    --mirror --speeds 0.8,1.25 --max-minutes 150 --seed 21
-  STAGE_DATA=$CK/mixed stage prior-11 prior-11 prior --init "$(init prior-10)" --gmp-only --steering-gmp \
-    --gmp-width 128 --gmp-reconstructed 1 --mirror --speeds 0.8,1.25 --lr 3e-4 "${common[@]}" --max-minutes 35 \
-    --seed 302
 }
 
 # The in-betweeners: the two-stage model (750 minutes over 8 runs, the last two
-# with mirroring), CITL (100 minutes), KeyframeNet + RefineNet (120 minutes).
+# with mirroring), CITL (100 minutes), KeyframeNet + RefineNet (120 minutes);
+# then the rig anatomy, measured on the data.
 inbetweener_chain() {
   local small=(--hp width=64 --hp layers=2 --hp heads=4)
   stage twostage-1a twostage-1 twostage "${small[@]}" --hp ffn=128 --max-minutes 55 --seed 1
@@ -254,6 +183,17 @@ inbetweener_chain() {
   stage citl citl citl "${small[@]}" --hp ffn=256 --max-minutes 100 --seed 1
   stage keyframe keyframe keyframe --hp width=96 --hp layers=3 --hp heads=4 --hp ffn=192 --max-minutes 120 --seed 1 \
     --validation-windows 128 --validate-minutes 5
+  if [[ -f $CK/rig.done ]]; then
+    echo "train-models: rig: done earlier"
+  else
+    local cmd=("$TRAIN" rig --out "$CK/rig/motionfield-rig.json" "${DATA_ARGS[@]}")
+    echo "train-models: rig: ${cmd[*]}"
+    if ((!DRY)); then
+      mkdir -p "$CK/rig"
+      "${cmd[@]}"
+      touch "$CK/rig.done"
+    fi
+  fi
 }
 
 START=$SECONDS
@@ -277,7 +217,7 @@ install_model() {  # FROM NAME
   mv "$OUT/.$2.tmp" "$OUT/$2"
   echo "train-models: $OUT/$2"
 }
-install_model "$CK/prior-11/best.mfm" motionfield-prior.mfm
+install_model "$CK/prior-9/best.mfm" motionfield-prior.mfm
 install_model "$CK/twostage-8/best.mfm" motionfield-twostage.mfm
 install_model "$CK/citl/best.mfm" motionfield-citl.mfm
 install_model "$CK/keyframe/best.mfm" motionfield-keyframe.mfm
