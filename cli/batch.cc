@@ -72,23 +72,16 @@ std::vector<Outcome> check_lines(const std::vector<std::string>& lines, const st
 }
 
 // Prints the batch's last line (on failures, with --verbose, or after a
-// progress line) and returns its exit code: 1 if a job hit an internal error,
-// else 2 if one had bad input, else 0.
+// progress line) and returns its exit code (mf_job_batch_summary).
 int summary(const std::string& path, const std::vector<Outcome>& outcomes, const Settings& settings,
             bool progress_shown) {
-  const int total = static_cast<int>(outcomes.size());
-  int bad = 0, internal = 0;
-  for (const Outcome& o : outcomes)
-    if (o.result.exit_code != kExitOk) ++(o.result.exit_code == kExitBadInput ? bad : internal);
-  const int failed = bad + internal;
-  if (failed > 0 || settings.verbose || (progress_shown && !settings.quiet))
-    std::fprintf(stderr, "motionfield: %s\n",
-                 printable("batch " + path + ": " + std::to_string(total) + " jobs, " + std::to_string(total - failed) +
-                           " ok, " + std::to_string(failed) + " failed")
-                     .c_str());
-  if (internal > 0) return kExitInternal;
-  if (bad > 0) return kExitBadInput;
-  return kExitOk;
+  std::vector<int32_t> codes;
+  for (const Outcome& o : outcomes) codes.push_back(o.result.exit_code);
+  const uint32_t flags = (settings.verbose ? MF_JOB_VERBOSE : 0u) | (settings.quiet ? MF_JOB_QUIET : 0u) |
+                         (progress_shown ? MF_JOB_PROGRESS_SHOWN : 0u);
+  const BatchSummary s = batch_summary(path, codes, flags);
+  std::fputs(s.line.c_str(), stderr);
+  return s.exit_code;
 }
 
 }  // namespace

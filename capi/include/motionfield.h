@@ -1048,6 +1048,19 @@ MF_API int mf_job_result_get_messages(const mf_job_result *result, char *out, si
  *  "exit_code", "error"}: a string getter. */
 MF_API int mf_job_result_get_json(const mf_job_result *result, char *out, size_t capacity, size_t *needed);
 
+/** mf_job_batch_summary's flags: a progress line was drawn during the batch. */
+#define MF_JOB_PROGRESS_SHOWN 8u
+/** Since 0.4.0. The end of a batch as `motionfield batch` ends it, from its
+ *  jobs' exit codes (mf_job_result_get_exit_code, `count` of them, any order;
+ *  `exit_codes` may be NULL when `count` is 0): *exit_code (optional) 1 when a
+ *  job hit an internal error, else 2 when one had bad input, else 0; and, a
+ *  string getter, its last standard-error line "motionfield: batch PATH: N
+ *  jobs, K ok, F failed\n" (PATH printable) when a job failed, with
+ *  MF_JOB_VERBOSE in `flags`, or with MF_JOB_PROGRESS_SHOWN unless
+ *  MF_JOB_QUIET; "" otherwise. */
+MF_API int mf_job_batch_summary(const char *batch_path, const int32_t *exit_codes, size_t count, uint32_t flags,
+                                int32_t *exit_code, char *out, size_t capacity, size_t *needed);
+
 /* ------------------------------------------------------------ transitions
  * Since 0.4.0. Two clips in, one transition out: the end of clip A (up to
  * frame I) and the start of clip B (from frame J) with N generated frames

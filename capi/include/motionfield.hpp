@@ -1042,6 +1042,27 @@ class JobRunner : public detail::Handle<mf_job_runner, mf_job_runner_destroy> {
   }
 };
 
+/// The end of a batch (mf_job_batch_summary): its exit code and its last
+/// standard-error line ("" when the batch prints none).
+struct BatchSummary {
+  int exit_code = kExitOk;
+  std::string line;
+};
+
+/// mf_job_batch_summary of the jobs' exit codes; `flags`: MF_JOB_VERBOSE,
+/// MF_JOB_QUIET, MF_JOB_PROGRESS_SHOWN.
+inline BatchSummary batch_summary(const std::string& batch_path, const std::vector<int32_t>& exit_codes,
+                                  uint32_t flags) {
+  int32_t code = kExitOk;
+  BatchSummary s;
+  s.line = detail::read_string([&](char* out, size_t capacity, size_t* needed) {
+    return mf_job_batch_summary(batch_path.c_str(), exit_codes.data(), exit_codes.size(), flags, &code, out, capacity,
+                                needed);
+  });
+  s.exit_code = code;
+  return s;
+}
+
 }  // namespace motionfield
 
 #endif  // MOTIONFIELD_HPP

@@ -201,6 +201,7 @@ JOB_QUIET = 2
 JOB_PRELOAD_MODEL = 4
 JOB_SINGLE = 1
 JOB_LOAD_WARNINGS = 2
+JOB_PROGRESS_SHOWN = 8
 
 
 class MfJobRunnerOptions(ctypes.Structure):
@@ -462,3 +463,5 @@ _declare("mf_job_result_destroy", None, _result)
 _declare("mf_job_result_get_exit_code", _int, _result, _P(_i32))
 _declare("mf_job_result_get_messages", _int, _result, ctypes.c_char_p, _size, _P(_size))
 _declare("mf_job_result_get_json", _int, _result, ctypes.c_char_p, _size, _P(_size))
+_declare("mf_job_batch_summary", _int, ctypes.c_char_p, _P(_i32), _size, ctypes.c_uint32, _P(_i32), ctypes.c_char_p,
+         _size, _P(_size))

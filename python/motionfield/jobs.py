@@ -21,6 +21,7 @@ from typing import Iterable, List, Optional, Sequence, Tuple
 
 from . import _capi as _c
 from . import _check, printable_text
+from ._handles import _read_string
 
 EXIT_OK = 0
 EXIT_INTERNAL = 1
@@ -232,16 +233,14 @@ def printable(text: str) -> str:
 
 def summary(path: str, exit_codes: Iterable[int], verbose: bool, quiet: bool,
             progress_shown: bool) -> Tuple[str, int]:
-    """The batch's last stderr line (when the CLI prints one) and its exit code."""
-    codes = list(exit_codes)
-    bad = sum(1 for c in codes if c == EXIT_BAD_INPUT)
-    internal = sum(1 for c in codes if c not in (EXIT_OK, EXIT_BAD_INPUT))
-    failed, total = bad + internal, len(codes)
-    line = ""
-    if failed > 0 or verbose or (progress_shown and not quiet):
-        line = "motionfield: %s\n" % printable("batch %s: %d jobs, %d ok, %d failed" % (path, total, total - failed,
-                                                                                       failed))
-    return line, (EXIT_INTERNAL if internal else EXIT_BAD_INPUT if bad else EXIT_OK)
+    """The batch's last stderr line (when the CLI prints one) and its exit code (mf_job_batch_summary)."""
+    listed = [int(c) for c in exit_codes]
+    codes = (ctypes.c_int32 * len(listed))(*listed)
+    flags = (_c.JOB_VERBOSE if verbose else 0) | (_c.JOB_QUIET if quiet else 0) | \
+        (_c.JOB_PROGRESS_SHOWN if progress_shown else 0)
+    code = ctypes.c_int32(0)
+    line = _read_string(_c.mf_job_batch_summary, _path(path), codes, len(listed), flags, ctypes.byref(code))
+    return line, code.value
 
 
 def failure_line(message: str, exit_code: int = EXIT_BAD_INPUT, prefix: str = "") -> str:

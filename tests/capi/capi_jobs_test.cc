@@ -118,6 +118,28 @@ TEST(CApiJobs, TheFunctionsCheckTheirArguments) {
   mf_job_result_destroy(nullptr);
 }
 
+TEST(CApiJobs, TheEndOfABatchIsItsWorstExitCodeAndTheClisLastLine) {
+  const motionfield::BatchSummary failed = motionfield::batch_summary("b.jsonl", {0, 2, 0}, 0);
+  EXPECT_EQ(failed.exit_code, 2);
+  EXPECT_EQ(failed.line, "motionfield: batch b.jsonl: 3 jobs, 2 ok, 1 failed\n");
+  EXPECT_EQ(motionfield::batch_summary("b.jsonl", {2, 1, 0}, MF_JOB_QUIET).exit_code, 1);  // an internal error wins
+  const motionfield::BatchSummary ok = motionfield::batch_summary("b.jsonl", {0, 0}, 0);
+  EXPECT_EQ(ok.exit_code, 0);
+  EXPECT_EQ(ok.line, "");
+  EXPECT_EQ(motionfield::batch_summary("b.jsonl", {0, 0}, MF_JOB_VERBOSE).line, "motionfield: batch b.jsonl: 2 jobs, 2 ok, 0 failed\n");
+  EXPECT_EQ(motionfield::batch_summary("b.jsonl", {0}, MF_JOB_PROGRESS_SHOWN).line, "motionfield: batch b.jsonl: 1 jobs, 1 ok, 0 failed\n");
+  EXPECT_EQ(motionfield::batch_summary("b.jsonl", {0}, MF_JOB_PROGRESS_SHOWN | MF_JOB_QUIET).line, "");
+  EXPECT_EQ(motionfield::batch_summary("a\x01b", {1}, 0).line,
+            "motionfield: " + motionfield::printable("batch a\x01b: 1 jobs, 0 ok, 1 failed") + "\n");
+  int32_t code = -1;
+  size_t needed = 0;
+  EXPECT_EQ(mf_job_batch_summary("b", nullptr, 0, 0, &code, nullptr, 0, &needed), MF_OK);  // no jobs
+  EXPECT_EQ(code, 0);
+  EXPECT_EQ(needed, 1u);
+  EXPECT_EQ(mf_job_batch_summary(nullptr, nullptr, 0, 0, &code, nullptr, 0, &needed), MF_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(mf_job_batch_summary("b", nullptr, 2, 0, &code, nullptr, 0, &needed), MF_ERROR_INVALID_ARGUMENT);
+}
+
 TEST(CApiJobs, AModelSetTakesTheInbetweenersGivenAndSaysWhatDidNotLoad) {
   mf_model* model = nullptr;
   const char* missing[] = {"/nonexistent/twostage.mfm"};

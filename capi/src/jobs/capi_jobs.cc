@@ -210,4 +210,16 @@ int mf_job_result_get_json(const mf_job_result* result, char* out, size_t capaci
   return job_guard([&] { mf::capi::write_string(mf::capi::get(result).json, out, capacity, needed); });
 }
 
+int mf_job_batch_summary(const char* batch_path, const int32_t* exit_codes, size_t count, uint32_t flags,
+                         int32_t* exit_code, char* out, size_t capacity, size_t* needed) {
+  return job_guard([&] {
+    require(batch_path, "batch_path");
+    if (count > 0) require(exit_codes, "exit_codes");
+    const motionfield::BatchSummary s =
+        motionfield::jobs::batch_summary(batch_path, std::vector<int>(exit_codes, exit_codes + count), flags);
+    if (exit_code) *exit_code = s.exit_code;
+    mf::capi::write_string(s.line, out, capacity, needed);
+  });
+}
+
 }  // extern "C"

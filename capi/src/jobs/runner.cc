@@ -102,4 +102,21 @@ JobResult JobRunner::outcome(const CheckedJob& c, const JobReport* report, const
   return r;
 }
 
+BatchSummary batch_summary(const std::string& batch_path, const std::vector<int>& exit_codes, uint32_t flags) {
+  const int total = static_cast<int>(exit_codes.size());
+  int bad = 0, internal = 0;
+  for (int code : exit_codes)
+    if (code != kExitOk) ++(code == kExitBadInput ? bad : internal);
+  const int failed = bad + internal;
+  BatchSummary s;
+  s.exit_code = internal > 0 ? kExitInternal : bad > 0 ? kExitBadInput : kExitOk;
+  const bool progress = (flags & MF_JOB_PROGRESS_SHOWN) && !(flags & MF_JOB_QUIET);
+  if (failed > 0 || (flags & MF_JOB_VERBOSE) || progress)
+    s.line = "motionfield: " +
+             printable("batch " + batch_path + ": " + std::to_string(total) + " jobs, " +
+                       std::to_string(total - failed) + " ok, " + std::to_string(failed) + " failed") +
+             "\n";
+  return s;
+}
+
 }  // namespace motionfield::jobs

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <mutex>
 #include <string>
+#include <vector>
 
 #include "capi/src/jobs/job.h"
 
@@ -29,6 +30,10 @@ struct CheckedJob {
   Failure failure;             ///< why it is not runnable
   bool load_warnings = false;  ///< the model's load warnings go with this job's
 };
+
+/// The end of a batch (mf_job_batch_summary). `flags`: MF_JOB_VERBOSE,
+/// MF_JOB_QUIET, MF_JOB_PROGRESS_SHOWN.
+BatchSummary batch_summary(const std::string& batch_path, const std::vector<int>& exit_codes, uint32_t flags);
 
 class JobRunner {
  public:
