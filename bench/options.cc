@@ -66,6 +66,14 @@ void add_threads_option(CLI::App& app, int& threads) {
   app.add_option("--threads", threads, "torch intra-op threads")->check(mf::cli::at_least(1));
 }
 
+void add_model_bench_options(CLI::App& app, ModelBenchOptions& options) {
+  app.add_option("--model", options.model, "the prior (default: the default model)");
+  add_data_options(app, options.data);
+  add_split_options(app, options.split);
+  add_transformer_options(app, options.transformers);
+  add_threads_option(app, options.threads);
+}
+
 void add_number_options(CLI::App& app, std::map<std::string, double>& numbers, const NamedHelp& options,
                         const std::string& group) {
   for (const auto& [name, help] : options) {

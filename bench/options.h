@@ -60,6 +60,18 @@ void add_split_options(CLI::App& app, SplitChoice& choice);
 /// --threads N (N >= 1): torch's intra-op threads; `threads` holds the default.
 void add_threads_option(CLI::App& app, int& threads);
 
+/// What every benchmark on the protocol's clips with the learned models takes:
+/// --model (the prior; "" = the default model), the data, the split, the
+/// transformer files and --threads.
+struct ModelBenchOptions {
+  std::string model;
+  DataSource data;
+  SplitChoice split;
+  TransformerFiles transformers;
+  int threads = 1;
+};
+void add_model_bench_options(CLI::App& app, ModelBenchOptions& options);
+
 /// A comma-separated list, e.g. "--methods interp,nemf" or "--lengths 5,15":
 /// one argument per occurrence, split at the commas and converted to T.
 template <class T>

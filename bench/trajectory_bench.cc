@@ -50,12 +50,7 @@ namespace {
 
 using mf::bench::fixed;
 
-struct Args {
-  std::string model;
-  mf::bench::DataSource data;
-  mf::bench::SplitChoice split;
-  mf::bench::TransformerFiles transformers;
-  int threads = 1;
+struct Args : mf::bench::ModelBenchOptions {
   std::vector<int> gaps{30, 60};
   std::vector<std::string> starts{"interp-encoder", "detail-encoder"};
   std::vector<double> weights{mf::EnergyWeights{}.trajectory};
@@ -66,11 +61,7 @@ struct Args {
 };
 
 void add_options(CLI::App& app, Args& a) {
-  app.add_option("--model", a.model, "the prior (default: the default model)");
-  mf::bench::add_data_options(app, a.data);
-  mf::bench::add_split_options(app, a.split);
-  mf::bench::add_transformer_options(app, a.transformers);
-  mf::bench::add_threads_option(app, a.threads);
+  mf::bench::add_model_bench_options(app, a);
   mf::bench::add_list_option(app, "--gaps", a.gaps, "gap lengths (default 30,60)");
   app.add_option("--starts", a.starts, "the solver's starts, make_initializer() names (default interp-encoder,detail-encoder)")
       ->delimiter(',');

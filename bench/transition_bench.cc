@@ -48,12 +48,7 @@ namespace {
 
 using mf::bench::fixed;
 
-struct Args {
-  std::string model;
-  mf::bench::DataSource data;
-  mf::bench::SplitChoice split;
-  mf::bench::TransformerFiles transformers;
-  int threads = 1;
+struct Args : mf::bench::ModelBenchOptions {
   std::vector<int> lengths{10, 20, 30, 60};
   int context = 30;
   std::vector<std::string> methods{"interp", "nemf-detail"};
@@ -61,11 +56,7 @@ struct Args {
 };
 
 void add_options(CLI::App& app, Args& a) {
-  app.add_option("--model", a.model, "the prior (default: the default model)");
-  mf::bench::add_data_options(app, a.data);
-  mf::bench::add_split_options(app, a.split);
-  mf::bench::add_transformer_options(app, a.transformers);
-  mf::bench::add_threads_option(app, a.threads);
+  mf::bench::add_model_bench_options(app, a);
   mf::bench::add_list_option(app, "--lengths", a.lengths, "transition lengths N (default 10,20,30,60)");
   app.add_option("--context", a.context, "frames kept of A and of B (default 30)")->check(CLI::Range(2, 1000));
   app.add_option("--methods", a.methods, "methods (default interp nemf-detail)");
