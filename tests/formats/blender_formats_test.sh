@@ -2,7 +2,7 @@
 # glTF and FBX files exported by Blender (Debian's 3.4) from the sample BVH
 # read back to the BVH's motion (compare_motion.py: 1e-4 of the BVH's unit,
 # 1e-3 degrees), through every client: the CLI's commands (rig, inbetween,
-# export, batch) on a Mixamo-style rig ("mixamorig:" names), Python, and the
+# export, transition, batch) on a Mixamo-style rig ("mixamorig:" names), Python, and the
 # outputs checked by the Khronos glTF validator. Skipped (77) without Blender.
 #   usage: blender_formats_test.sh MOTIONFIELD SOURCE_DIR TOOLS_PREFIX WORK_DIR
 set -euo pipefail
@@ -40,6 +40,9 @@ for f in blender.fbx blender.glb; do
   "$MF" --quiet --model "$MODEL" fill --in "$WORK/mixamo/$f" --gap 20:40 --method interp -o "$WORK/fill-$f.bvh"
   grep -q "mixamorig:Hips" "$WORK/fill-$f.bvh" || fail "the BVH written from $f lost the joint names"
 done
+# A transition from Blender's FBX into Blender's glTF of the same rig.
+"$MF" --quiet --model "$MODEL" transition "$WORK/mixamo/blender.fbx" "$WORK/mixamo/blender.glb" --frames 10 \
+  --method interp -o "$WORK/transition.glb" || fail "transition from FBX into glTF"
 # The batch, with the animation named by index; an animation that is not there.
 printf '{"task": "resample", "in": "%s", "out": "%s", "fps": 60, "method": "interp", "animation": 0}\n' \
   "$WORK/mixamo/blender_zup.fbx" "$WORK/batch.glb" > "$WORK/jobs.jsonl"
@@ -76,7 +79,7 @@ except mf.InvalidArgumentError as e:
 PY
 
 if [ -f "$TOOLS/node_modules/gltf-validator/package.json" ]; then
-  node "$ROOT/scripts/gltf-validate.js" "$TOOLS" "$WORK"/inbetween-*.glb "$WORK/batch.glb"
+  node "$ROOT/scripts/gltf-validate.js" "$TOOLS" "$WORK"/inbetween-*.glb "$WORK/batch.glb" "$WORK/transition.glb"
 else
   fail "the glTF validator is not installed in $TOOLS (the gltf_validator_install test installs it)"
 fi
