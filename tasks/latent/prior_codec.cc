@@ -122,8 +122,9 @@ EncodedMotion encode_motion(const NemfModel& model, const Motion& motion, const 
   const Motion* src = &motion;
   if (!same_frame_rate(motion.fps, c.fps)) {
     const double span = (motion.num_frames() - 1) * c.fps / motion.fps;
+    // Checked before the cast: a tiny input fps makes the span overflow an int.
+    if (!(span < 10000000.0)) throw InputError("motion too long to encode");
     const int n = static_cast<int>(std::ceil(span - 1e-5)) + 1;
-    if (n > 10000000) throw InputError("motion too long to encode");
     seq = resample_interpolate(motion, c.fps, std::max(2, n));
     src = &seq;
   }

@@ -5,6 +5,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "tasks/constraints/interpolation_fill.h"
+#include "tasks/context/model_rig.h"
 #include "tasks/latent/latent_solver.h"
 #include "tasks/latent/prior_codec.h"
 #include "tasks/methods/method.h"
@@ -33,7 +34,11 @@ bool upsample_by_solving(const Motion& in, double fps, int frames, const TaskCon
   const double ratio = model_fps / in.fps;
   const long r = std::lround(ratio);
   if (r < 2 || std::abs(ratio - static_cast<double>(r)) > 1e-5 * ratio || in.num_frames() < 2) return false;
-  const int n = (in.num_frames() - 1) * static_cast<int>(r) + 1;
+  const double frames_at_rate = static_cast<double>(in.num_frames() - 1) * static_cast<double>(r) + 1.0;
+  if (frames_at_rate > kMaxResampledFrames)
+    throw InputError("the motion would span more than " + std::to_string(static_cast<long>(kMaxResampledFrames)) +
+                     " frames at the model's frame rate");
+  const int n = static_cast<int>(frames_at_rate);
   const Motion spline = resample_cubic(in, model_fps, n);
   const double prior_weight = std::clamp((std::log2(static_cast<double>(r)) - 1.0) / 2.0, 0.0, 1.0);
   Motion dense = spline;
