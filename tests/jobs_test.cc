@@ -46,7 +46,7 @@ TEST(JobsTest, Methods) {
   EXPECT_NE(std::find(methods.begin(), methods.end(), "interp"), methods.end());
   EXPECT_NE(std::find(methods.begin(), methods.end(), "zerovel"), methods.end());
   EXPECT_EQ(default_method(), "interp");  // without a model
-  EXPECT_EQ(default_resample_method(), "cubic");
+  EXPECT_EQ(default_resample_method(), "quintic");
 }
 
 TEST(JobsTest, ValidateKeyframesAcceptsSortedUniqueInRange) {

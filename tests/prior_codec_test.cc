@@ -254,10 +254,10 @@ TEST(PriorCodec, ResidualMakesTheReconstructionExactAtInputFrames) {
   EXPECT_LT(fixed_err, 0.01);  // times ~3e-3 frames off, residual interpolated
 }
 
-// Method "prior" at ratios that are not whole: dense input takes the spline
-// (the codec lost to it at every input up to 6 times sparser than the model's
+// Method "prior" at ratios that are not whole: dense input takes the quintic
+// (the codec lost to the spline at every input up to 6 times sparser than the model's
 // rate), very sparse input the codec with its residual.
-TEST(PriorCodec, PriorResamplingTakesTheSplineOrTheCodecByTheRatio) {
+TEST(PriorCodec, PriorResamplingTakesTheQuinticOrTheCodecByTheRatio) {
   auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   ASSERT_DOUBLE_EQ(model->config().fps, 30.0);
   TaskContext ctx;
@@ -266,28 +266,59 @@ TEST(PriorCodec, PriorResamplingTakesTheSplineOrTheCodecByTheRatio) {
   for (const auto& [in_fps, out_fps] : dense) {
     const Motion m = test::random_motion(model->rig().skeleton, 25, in_fps, 3);
     const Motion prior = run_resample(m, out_fps, "prior", nullptr, ctx);
-    const Motion cubic = run_resample(m, out_fps, "cubic", nullptr, ctx);
-    ASSERT_EQ(prior.num_frames(), cubic.num_frames()) << in_fps << " -> " << out_fps;
+    const Motion quintic = run_resample(m, out_fps, "quintic", nullptr, ctx);
+    ASSERT_EQ(prior.num_frames(), quintic.num_frames()) << in_fps << " -> " << out_fps;
     for (int f = 0; f < prior.num_frames(); ++f) {
-      EXPECT_TRUE(prior.root_positions[f] == cubic.root_positions[f]) << f;
-      for (int j = 0; j < prior.num_joints(); ++j) EXPECT_TRUE(prior.rotation(f, j).coeffs() == cubic.rotation(f, j).coeffs());
+      EXPECT_TRUE(prior.root_positions[f] == quintic.root_positions[f]) << f;
+      for (int j = 0; j < prior.num_joints(); ++j) EXPECT_TRUE(prior.rotation(f, j).coeffs() == quintic.rotation(f, j).coeffs());
     }
   }
   // 4 fps -> 30 (7.5 times sparser): the codec, through every input frame.
   const Motion m = test::random_motion(model->rig().skeleton, 9, 4.0, 4);
   const Motion prior = run_resample(m, 30.0, "prior", nullptr, ctx);
-  const Motion cubic = run_resample(m, 30.0, "cubic", nullptr, ctx);
+  const Motion quintic = run_resample(m, 30.0, "quintic", nullptr, ctx);
   ASSERT_EQ(prior.num_frames(), 61);
   double differs = 0.0;
   for (int f = 0; f < prior.num_frames(); ++f) {
     for (int j = 0; j < prior.num_joints(); ++j)
-      differs = std::max(differs, geodesic_angle(prior.rotation(f, j), cubic.rotation(f, j)));
+      differs = std::max(differs, geodesic_angle(prior.rotation(f, j), quintic.rotation(f, j)));
   }
   EXPECT_GT(differs, 1e-3);
   for (int k = 0; k < m.num_frames(); k += 2) {  // input frame k is output frame 7.5 k
     for (int j = 0; j < m.num_joints(); ++j)
       EXPECT_LT(geodesic_angle(prior.rotation(15 * k / 2, j), m.rotation(k, j)), 1e-5) << k << " " << j;
   }
+}
+
+// Method "prior" at a whole ratio (7.5 -> 30 fps: the quintic blended with a
+// latent solve): where the solve cannot fit the input frames (an untrained
+// prior here) the quintic is kept and a warning says why; without the
+// fallback the solve's blend is returned.
+TEST(PriorCodec, PriorResamplingKeepsTheQuinticWhereTheSolveMissesTheInput) {
+  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
+  TaskContext ctx;
+  ctx.model = model;
+  const Motion m = test::random_motion(model->rig().skeleton, 9, 7.5, 5);
+  std::vector<std::string> warnings;
+  const Motion kept = run_resample(m, 30.0, "prior", &warnings, ctx);
+  const Motion quintic = run_resample(m, 30.0, "quintic", nullptr, ctx);
+  ASSERT_EQ(kept.num_frames(), quintic.num_frames());
+  double kept_diff = 0.0;
+  for (int f = 0; f < kept.num_frames(); ++f) {
+    for (int j = 0; j < kept.num_joints(); ++j)
+      kept_diff = std::max(kept_diff, geodesic_angle(kept.rotation(f, j), quintic.rotation(f, j)));
+  }
+  EXPECT_LT(kept_diff, 1e-5);
+  ASSERT_FALSE(warnings.empty());
+  EXPECT_NE(warnings.back().find("the prior could not reach the keys"), std::string::npos) << warnings.back();
+  ctx.interpolation_fallback = false;
+  const Motion solved = run_resample(m, 30.0, "prior", nullptr, ctx);
+  double solved_diff = 0.0;
+  for (int f = 0; f < solved.num_frames(); ++f) {
+    for (int j = 0; j < solved.num_joints(); ++j)
+      solved_diff = std::max(solved_diff, geodesic_angle(solved.rotation(f, j), quintic.rotation(f, j)));
+  }
+  EXPECT_GT(solved_diff, 1e-3);
 }
 
 TEST(PriorCodec, RejectsBadInput) {

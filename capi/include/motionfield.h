@@ -240,7 +240,7 @@ MF_API int mf_method_find(const char *name, int32_t *index);
  *  be NULL: then a method that does not need one): "nemf-detail" when the
  *  model has the two-stage transformer, "nemf" with the prior alone, "interp"
  *  without a model. Resampling without a method uses "prior" with a model and
- *  "cubic" (a Catmull-Rom spline) without. mf_solve with constraints that carry a trajectory uses
+ *  "quintic" (local quintic interpolation) without. mf_solve with constraints that carry a trajectory uses
  *  "nemf-refine" instead when the model has the keyframe transformer
  *  (mf_solution_get_method says which ran). The string is static. */
 MF_API int mf_default_method(const mf_model *model, const char **name);

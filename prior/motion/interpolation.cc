@@ -49,23 +49,22 @@ void blend_frames(const Motion& from, int a, int b, double t, Motion& to, int f_
   for (int j = 0; j < J; ++j) to.rotation(f_to, j) = slerp(from.rotation(a, j), from.rotation(b, j), t);
 }
 
-// Frame f_to of `to` = uniform Catmull-Rom spline through frames a - 1, a,
-// a + 1, a + 2 of `from` (clamped to the clip) at t in (0, 1): root positions
-// per coordinate; rotations per quaternion component, the four brought into
-// the hemisphere of frame a's, then normalised.
-void cubic_frame(const Motion& from, int a, double t, Motion& to, int f_to) {
+// Frame f_to of `to` = sum_k w[k] * frame (a + first + k) of `from`, the
+// indices clamped to the clip (the end frames repeated as missing neighbours):
+// root positions per coordinate; rotations per quaternion component, all
+// brought into the hemisphere of frame a's, then normalised.
+template <int n>
+void stencil_frame(const Motion& from, int a, int first, const double (&w)[n], Motion& to, int f_to) {
   const int last = from.num_frames() - 1;
-  const int idx[4] = {std::max(a - 1, 0), a, std::min(a + 1, last), std::min(a + 2, last)};
-  const double t2 = t * t, t3 = t2 * t;
-  const double w[4] = {0.5 * (-t3 + 2 * t2 - t), 0.5 * (3 * t3 - 5 * t2 + 2), 0.5 * (-3 * t3 + 4 * t2 + t),
-                       0.5 * (t3 - t2)};
+  int idx[n];
+  for (int k = 0; k < n; ++k) idx[k] = std::clamp(a + first + k, 0, last);
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
-  for (int k = 0; k < 4; ++k) p += w[k] * from.root_positions[idx[k]];
+  for (int k = 0; k < n; ++k) p += w[k] * from.root_positions[idx[k]];
   to.root_positions[f_to] = p;
   for (int j = 0; j < from.num_joints(); ++j) {
     const Eigen::Vector4d ref = from.rotation(a, j).coeffs();
     Eigen::Vector4d q = Eigen::Vector4d::Zero();
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < n; ++k) {
       const Eigen::Vector4d c = from.rotation(idx[k], j).coeffs();
       q += w[k] * (c.dot(ref) < 0 ? -c : c);
     }
@@ -73,6 +72,26 @@ void cubic_frame(const Motion& from, int a, double t, Motion& to, int f_to) {
     r.coeffs() = q.norm() > 1e-12 ? Eigen::Vector4d(q.normalized()) : ref;
     to.rotation(f_to, j) = r;
   }
+}
+
+// Uniform Catmull-Rom spline through frames a - 1 .. a + 2 at t in (0, 1).
+void cubic_frame(const Motion& from, int a, double t, Motion& to, int f_to) {
+  const double t2 = t * t, t3 = t2 * t;
+  const double w[4] = {0.5 * (-t3 + 2 * t2 - t), 0.5 * (3 * t3 - 5 * t2 + 2), 0.5 * (-3 * t3 + 4 * t2 + t),
+                       0.5 * (t3 - t2)};
+  stencil_frame(from, a, -1, w, to, f_to);
+}
+
+// The Lagrange polynomial of degree 5 through frames a - 2 .. a + 3 at t in (0, 1).
+void quintic_frame(const Motion& from, int a, double t, Motion& to, int f_to) {
+  double w[6];
+  for (int k = 0; k < 6; ++k) {
+    w[k] = 1.0;
+    for (int m = 0; m < 6; ++m) {
+      if (m != k) w[k] *= (t + 2 - m) / static_cast<double>(k - m);
+    }
+  }
+  stencil_frame(from, a, -2, w, to, f_to);
 }
 
 // Input frame position (in input frames, possibly fractional) of output
@@ -160,6 +179,11 @@ Motion resample_interpolate(const Motion& input, double new_fps, int frames) {
 Motion resample_cubic(const Motion& input, double new_fps, int frames) {
   return resample_at_times(input, new_fps, frames,
                            [&](int a, double t, Motion& out, int i) { cubic_frame(input, a, t, out, i); });
+}
+
+Motion resample_quintic(const Motion& input, double new_fps, int frames) {
+  return resample_at_times(input, new_fps, frames,
+                           [&](int a, double t, Motion& out, int i) { quintic_frame(input, a, t, out, i); });
 }
 
 Motion resample_zero_velocity(const Motion& input, double new_fps, int frames) {

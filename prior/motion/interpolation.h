@@ -58,6 +58,14 @@ Motion resample_interpolate(const Motion& input, double new_fps, int frames);
 /// into one hemisphere, the result normalised).
 Motion resample_cubic(const Motion& input, double new_fps, int frames);
 
+/// Resampling by local quintic interpolation: between input frames a and a + 1
+/// the Lagrange polynomial of degree 5 through frames a - 2 .. a + 3 (ends
+/// repeated like resample_cubic()'s), per root coordinate and quaternion
+/// component like resample_cubic(). C0 only, but its error on captured motion
+/// sampled at 15 fps and below is 10-20 % under the spline's
+/// (docs/BENCHMARKS.md, "Resampling").
+Motion resample_quintic(const Motion& input, double new_fps, int frames);
+
 /// `motion` played `speed` times as fast at its own frame rate (frame i of the
 /// result is the motion at frame position i * speed; resample_cubic() between
 /// frames); the result covers the whole motion. Throws InputError unless speed

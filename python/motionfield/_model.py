@@ -238,7 +238,7 @@ def default_method(*, model: Optional["Model"] = None) -> str:
     The best measured method that can run with the model (mf_default_method):
     "nemf-detail" when it has the two-stage transformer, "nemf" with the
     prior alone, "interp" without a model. Resampling without a method uses
-    "prior" with a model and "cubic" without; re-navigation uses "nemf".
+    "prior" with a model and "quintic" without; re-navigation uses "nemf".
     solve() with a trajectory uses "nemf-refine" instead when the model has the
     keyframe transformer (Solution.method says which ran).
 

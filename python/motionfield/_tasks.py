@@ -282,7 +282,7 @@ def resample(motion: Motion, fps: float, *, method: Optional[str] = None, model:
     """Resampling to another frame rate, keeping the time span.
 
     Without a method: "prior" with a model (the default one unless given),
-    "cubic" (a Catmull-Rom spline) without, as the CLI does.
+    "quintic" (local quintic interpolation) without, as the CLI does.
 
     Parameters
     ----------

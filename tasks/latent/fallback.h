@@ -32,6 +32,10 @@ struct InterpolationFallback {
   double always_above = 0.15;
   double max_data_terms = 0.035;
   double max_data_terms_per_cm = 0.01;
+  /// Blend toward the input as given (its unknown frames already hold a
+  /// start, as resampling's quintic) instead of toward interpolation between
+  /// the known frames.
+  bool toward_input = false;
 };
 
 /// What the rule saw in one window, and what it chose.

@@ -388,7 +388,7 @@ Motion complete_motion(const NemfModel& model, const Motion& input, const Motion
   const std::string note = fallback_note(rep.trust, o.fallback);
   if (!note.empty()) {
     const std::vector<WindowSpan> spans(plan.begin(), plan.end());
-    blend_toward_interpolation(fill_by_interpolation(input, constraints),
+    blend_toward_interpolation(o.fallback.toward_input ? input : fill_by_interpolation(input, constraints),
                                interpolation_weights(spans, rep.trust, input.num_frames()), &solved.motion,
                                &solved.contacts);
   }

@@ -26,7 +26,7 @@ std::vector<Method> baseline_methods() {
     for (std::string& w : pin_contacts(c, kDefaultContactRamp, &out)) warnings->push_back(std::move(w));
     return out;
   };
-  interp.resample = [](const Motion& in, double fps, int frames, const TaskContext&) {
+  interp.resample = [](const Motion& in, double fps, int frames, const TaskContext&, std::vector<std::string>*) {
     return resample_interpolate(in, fps, frames);
   };
   Method zerovel;
@@ -35,16 +35,22 @@ std::vector<Method> baseline_methods() {
   zerovel.complete = [](const Motion& in, const std::vector<int>& known, const TaskContext&, CompletionNotes*) {
     return zero_velocity_motion(in, known);
   };
-  zerovel.resample = [](const Motion& in, double fps, int frames, const TaskContext&) {
+  zerovel.resample = [](const Motion& in, double fps, int frames, const TaskContext&, std::vector<std::string>*) {
     return resample_zero_velocity(in, fps, frames);
   };
   Method cubic;
   cubic.name = "cubic";
   cubic.description = "Catmull-Rom spline through the input frames (resampling)";
-  cubic.resample = [](const Motion& in, double fps, int frames, const TaskContext&) {
+  cubic.resample = [](const Motion& in, double fps, int frames, const TaskContext&, std::vector<std::string>*) {
     return resample_cubic(in, fps, frames);
   };
-  return {interp, zerovel, cubic};
+  Method quintic;
+  quintic.name = "quintic";
+  quintic.description = "local quintic interpolation through the six nearest input frames (resampling)";
+  quintic.resample = [](const Motion& in, double fps, int frames, const TaskContext&, std::vector<std::string>*) {
+    return resample_quintic(in, fps, frames);
+  };
+  return {interp, zerovel, cubic, quintic};
 }
 
 }  // namespace mf

@@ -165,7 +165,7 @@ std::string default_method(const TaskContext& ctx, bool trajectory) {
   return ctx.model ? "nemf" : "interp";
 }
 
-std::string default_resample_method(const TaskContext& ctx) { return ctx.model ? "prior" : "cubic"; }
+std::string default_resample_method(const TaskContext& ctx) { return ctx.model ? "prior" : "quintic"; }
 
 const Method& resolve_method(const std::string& method, const TaskContext& ctx, bool trajectory) {
   const std::string m = method.empty() ? default_method(ctx, trajectory) : method;
@@ -306,10 +306,14 @@ Motion run_resample(const Motion& input, double fps, const std::string& method, 
     warnings->push_back(msg.str());
   }
   start(ctx);
-  if (!m.needs_model) return m.resample(input, fps, frames, ctx);
-  return resample_on_model_rig(
-      input, fps, frames, ctx, [&](const Motion& in, double f, int n) { return m.resample(in, f, n, ctx); },
-      request.rig_map);
+  std::vector<std::string> notes;
+  Motion out = m.needs_model ? resample_on_model_rig(
+                                   input, fps, frames, ctx,
+                                   [&](const Motion& in, double f, int n) { return m.resample(in, f, n, ctx, &notes); },
+                                   request.rig_map)
+                             : m.resample(input, fps, frames, ctx, &notes);
+  if (warnings) warnings->insert(warnings->end(), notes.begin(), notes.end());
+  return out;
 }
 
 }  // namespace mf

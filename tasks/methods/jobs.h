@@ -36,7 +36,7 @@ std::vector<std::string> available_methods();
 /// without a model). With `trajectory` (constraints that carry one) and the
 /// keyframe transformer: "nemf-refine".
 std::string default_method(const TaskContext& ctx = {}, bool trajectory = false);
-/// The same for resampling: "prior" with a model, "cubic" without one.
+/// The same for resampling: "prior" with a model, "quintic" without one.
 std::string default_resample_method(const TaskContext& ctx = {});
 
 /// The method `method` names (empty: default_method(ctx)), checked against

@@ -52,9 +52,12 @@ struct Method {
   /// run_constrained() refuses a trajectory for the other methods (naming
   /// the ones that can) rather than ignoring it.
   bool follows_trajectory = false;
-  /// Resamples to `fps` with exactly `frames` output frames at times i / fps.
-  /// Null when unsupported.
-  std::function<Motion(const Motion& input, double fps, int frames, const TaskContext& ctx)> resample;
+  /// Resamples to `fps` with exactly `frames` output frames at times i / fps,
+  /// appending what the user should know to *warnings (never null). Null when
+  /// unsupported.
+  std::function<Motion(const Motion& input, double fps, int frames, const TaskContext& ctx,
+                       std::vector<std::string>* warnings)>
+      resample;
 };
 
 /// The method families, each defined beside its implementation.

@@ -124,7 +124,7 @@ Solved solve(const BatchJob& job, const JobSettings& settings, const Model& mode
 // The method that ran.
 std::string method_name(const BatchJob& job, const Model& model) {
   if (!job.method.empty() || job.task == "export") return job.method;
-  if (job.task == "resample") return model ? "prior" : "cubic";
+  if (job.task == "resample") return model ? "prior" : "quintic";
   if (job.task == "renav") return "nemf";
   return default_method(model);
 }
