@@ -75,6 +75,7 @@ struct Args {
   std::string foreign_source = mf::default_foreign_archive();
   std::string windows_csv;  // per-window scores and signals (bench/window_log.h)
   bool no_fallback = false;  // the latent solvers keep their own result everywhere
+  std::string features;  // the feature extractor of the distribution metrics (bench/motion_features.h)
 };
 
 void add_options(CLI::App& app, Args& args) {
@@ -125,6 +126,10 @@ void add_options(CLI::App& app, Args& args) {
                  "also write one CSV row per (task row, window, method) of the gap, sparse and resample tables: the "
                  "window's L2P and L2Q and the signals of bench/window_log.h (foreign: the windows of the content "
                  "groups)");
+  app.add_option("--features", args.features,
+                 "the motion feature extractor (models/evaluation/motion-features.mfm): adds NeMF's FID and diversity "
+                 "per task row and method, and of the prior's samples with the sample task (bench/motion_features.h)")
+      ->check(CLI::ExistingFile);
   app.add_flag("--no-fallback", args.no_fallback,
                "the latent solvers keep their own result where the prior cannot reach the keys (by default they fall "
                "back to interpolation there: tasks/latent/fallback.h)");
@@ -203,6 +208,19 @@ std::vector<ForeignGroup> foreign_groups(const std::vector<mf::bench::ForeignCli
   return groups;
 }
 
+// Real windows of `length` frames (every 40 frames, at most max_windows),
+// canonical at their first frame as the prior's samples are, as the real side
+// of `set`.
+void add_real_windows(const mf::bench::MotionFeatures& extractor, const std::vector<mf::Clip>& clips, int length,
+                      int max_windows, const Eigen::Vector3d& root_forward, const std::string& set,
+                      mf::bench::FeatureSets* sets) {
+  for (const mf::Window& w :
+       mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, 40), max_windows)) {
+    const mf::Motion raw = clips[w.clip].motion.slice(w.start, w.start + length);
+    sets->add_truth(set, extractor.features(mf::bench::canonicalise(raw, 0, root_forward)));
+  }
+}
+
 // The foreign capture's tables: per task row, L2P of each method and its
 // ratio to interpolation's, per group of clips (all, per rig convention, per
 // content).
@@ -240,7 +258,9 @@ void run_foreign(const Args& args, const mf::TaskContext& ctx, const mf::bench::
         mf::bench::ProtocolOptions o = options;
         o.clip_to_model = groups[g].to_model;
         // The content groups partition the clips: each window is logged once.
-        o.window_log = groups[g].name.rfind("content: ", 0) == 0 ? log : nullptr;
+        const bool content = groups[g].name.rfind("content: ", 0) == 0;
+        o.window_log = content ? log : nullptr;
+        if (!content) o.feature_sets = nullptr;
         results[g].push_back(mf::bench::run_task(task, groups[g].clips, stats, method, o, ctx));
         if (o.window_log) o.window_log->write_csv(args.windows_csv);  // so far, in case the run is stopped
       }
@@ -363,6 +383,13 @@ int run(Args& args, const std::string& command) {
   if (!args.rig.empty()) emit("- rig: " + args.rig + " (bench/synthetic_rigs.h)\n\n");
   mf::bench::WindowLog window_log(args.dataset, {args.rig.empty() ? "native" : args.rig, ""});
   if (!args.windows_csv.empty()) options.window_log = &window_log;
+  std::unique_ptr<mf::bench::MotionFeatures> extractor;
+  mf::bench::FeatureSets feature_sets;
+  if (!args.features.empty()) {
+    extractor = std::make_unique<mf::bench::MotionFeatures>(args.features);
+    options.features = extractor.get();
+    options.feature_sets = &feature_sets;
+  }
   if (args.dataset == "foreign") {
     run_foreign(args, ctx, stats, options, emit, options.window_log);
     args.tasks.clear();
@@ -424,10 +451,21 @@ int run(Args& args, const std::string& command) {
       table = mf::bench::format_seams(mf::bench::run_seams(*model, clips, prior_options),
                                       prior_options.seam_radius);
     } else {
+      if (extractor) {
+        add_real_windows(*extractor, clips, model->config().window, prior_options.max_windows,
+                         model->rig().root_forward, "prior samples", &feature_sets);
+        prior_options.on_sample = [&](const mf::Motion& m) {
+          feature_sets.add_generated("prior samples", extractor->features(m));
+        };
+      }
       table = mf::bench::format_sample(
           mf::bench::run_sample(*model, clips, data.train, stats, prior_options));
     }
     emit(table + "\nTask wall time: " + fixed(seconds_since(t0), 1) + " s.\n\n");
+  }
+  if (extractor) {
+    emit("### Distribution metrics (NeMF's FID and diversity; features: " + args.features +
+         ")\n\n" + feature_sets.table() + "\n");
   }
   emit("Total wall time: " + fixed(seconds_since(run_start), 1) + " s.\n");
 

@@ -383,6 +383,7 @@ SampleResult run_sample(const NemfModel& model, const std::vector<Clip>& clips, 
         const double* e = p + (static_cast<size_t>(b) * W + f) * 3;
         m.root_positions[f] = Eigen::Vector3d(e[0], e[1], e[2]);
       }
+      if (options.on_sample) options.on_sample(m);
       const SkatingTerms s = foot_skating(forward_kinematics(m), all_frames, stats.feet, stats.standing_height);
       skate.sum_cm += s.sum_cm, skate.count += s.count;
       count_limit_exceedances(m, limits, &exceed, &frames);

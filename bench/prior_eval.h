@@ -21,6 +21,7 @@
 // Forward kinematics uses each motion's own skeleton.
 #pragma once
 
+#include <functional>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -89,6 +90,8 @@ struct PriorEvalOptions {
   int seam_radius = 5;                          ///< frames from a window boundary that count as "near"
   int samples = 256;                            ///< windows drawn for the sample task
   uint64_t seed = 1;
+  /// When set, the sample task hands it every decoded sample window.
+  std::function<void(const Motion&)> on_sample;
 };
 
 struct ReconResult {

@@ -100,9 +100,12 @@ TaskContext logging_context(const TaskContext& ctx, const ProtocolOptions& optio
   return c;
 }
 
-// Records a scored window in options.window_log, when set.
+// Records a scored window in options.window_log and options.feature_sets, when set.
 void log_window(const ProtocolOptions& options, const EvalStats& stats, const Clip& clip, Task task,
                 const std::string& row, const Window& w, const std::string& method, ScoredWindow scored) {
+  if (options.features && options.feature_sets)
+    options.feature_sets->add(std::string(task_name(task)) + " " + row + " / " + method,
+                              options.features->features(*scored.truth), options.features->features(*scored.pred));
   if (!options.window_log) return;
   WindowRecord r;
   r.clip = clip.name;

@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/motion_features.h"
 #include "bench/window_log.h"
 #include "prior/data/dataset.h"
 #include "prior/rig/retarget.h"
@@ -107,6 +108,11 @@ struct ProtocolOptions {
   /// When set, every scored window is also recorded there (bench/window_log.h),
   /// with the method's diagnostics (TaskContext::diagnostics). Not owned.
   WindowLog* window_log = nullptr;
+  /// When both are set, every scored window's truth and prediction also go
+  /// through the feature extractor into `feature_sets` (bench/motion_features.h)
+  /// as the set "TASK ROW / METHOD". Not owned.
+  const MotionFeatures* features = nullptr;
+  FeatureSets* feature_sets = nullptr;
 };
 
 /// The ground truth's trajectory rows (trajectory_features(), frames a..b-1)
