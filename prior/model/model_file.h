@@ -1,73 +1,30 @@
-// The model file: one self-describing binary file per trained model.
-//
-// Layout (little-endian):
-//   "MFMODEL\0"                 8-byte magic
-//   u32 format version          kModelFormatVersion
-//   str kind                    "nemf" (the transformer issue adds its kinds)
-//   u64 payload size
-//   payload:
-//     hyperparameters           u32 n, then n x (str name, f64 value)
-//     rig                       skeleton (names, parents, offsets in metres),
-//                               root forward axis, feet (joint, standing height,
-//                               threshold), contact speed
-//     tensors                   u32 n, then n x (str name, u32 rank, i64 dims...,
-//                               float32 data): normalisation stats ("stats.*")
-//                               and weights
-//   u64 checksum                FNV-1a 64 of the payload
-// Strings are u32 length + bytes. Loading validates every part and throws
-// mf::InputError saying precisely what is wrong (not a model file, truncated,
-// corrupted, wrong version, wrong kind, missing or misshapen weights).
+// The NeMF prior's model file, libtorch side: a NemfModel's tensors written
+// to and read from the container of model_container.h (its layout, parsing and
+// validation, torch-free), which this header includes.
 #pragma once
 
+#include <ATen/core/Tensor.h>
 #include <cstdint>
 #include <map>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "prior/model/model_container.h"
 #include "prior/model/nemf.h"
 
 namespace mf {
 
-constexpr uint32_t kModelFormatVersion = 1;
-constexpr char kNemfKind[] = "nemf";
-
-/// A tensor as a model file stores it: its shape and its float32 values,
-/// which stay in the file's bytes (no copy; not necessarily aligned), so
-/// they are valid only while the bytes given to parse_model_file live.
-struct StoredTensor {
-  std::vector<int64_t> shape;
-  const uint8_t* data = nullptr;
-  int64_t numel() const;
-};
-
-/// The generic container, shared by every model kind (the NeMF prior here,
-/// the in-betweeners in prior/inbetween/inbetweener.cc).
-struct ModelFileContents {
-  std::string kind;
-  std::map<std::string, double> hyperparameters;
-  RigInfo rig;                                   ///< skeleton validated
-  std::map<std::string, StoredTensor> tensors;   ///< finite values; views of the parsed bytes
-};
-
-/// The bytes of a model file of `kind` (layout above); tensors are written in
-/// the given order.
+/// The bytes of a model file of `kind` (model_container.h's layout); tensors
+/// (any dtype, converted to float32) are written in the given order.
 std::vector<uint8_t> serialize_model_file(const std::string& kind, const std::map<std::string, double>& hyperparameters,
                                           const RigInfo& rig,
                                           const std::vector<std::pair<std::string, at::Tensor>>& tensors);
-/// Parses and validates a model file (magic, version, size, checksum, rig,
-/// tensors). `expected_kinds` (non-empty) lists the kinds the caller accepts;
-/// any other throws "wrong kind of model". `source` names the file in errors.
-ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::string& source,
-                                   const std::vector<std::string>& expected_kinds);
 /// Copies tensor `name` of `tensors` into `target` (same shape required; a
 /// new tensor when `target` is undefined) and removes it from the map;
 /// throws InputError when missing or misshapen.
 void take_model_tensor(std::map<std::string, StoredTensor>& tensors, const std::string& name, at::Tensor& target,
                        const std::string& source);
-/// Throws InputError naming the first tensor left in `tensors` (one the
-/// architecture does not have), if any.
-void check_no_extra_tensors(const std::map<std::string, StoredTensor>& tensors, const std::string& source);
 
 std::vector<uint8_t> serialize_nemf(const NemfModel& model);
 /// The prior stored by serialize_nemf(), frozen (set_requires_grad(false)): the
@@ -76,9 +33,5 @@ NemfModel deserialize_nemf(const uint8_t* data, size_t size, const std::string& 
 
 void save_nemf(const NemfModel& model, const std::string& path);
 NemfModel load_nemf(const std::string& path);
-
-/// The default model shipped in models/: MF_MODEL if set, else the installed or
-/// source-tree models/motionfield-prior.mfm, else "" when none exists.
-std::string default_model_path();
 
 }  // namespace mf

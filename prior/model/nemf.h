@@ -33,37 +33,10 @@
 #include <string>
 #include <vector>
 
+#include "prior/model/nemf_config.h"
 #include "prior/model/representation.h"
 
 namespace mf {
-
-struct NemfConfig {
-  int window = 128;          ///< frames per window
-  double fps = 30.0;         ///< frame rate of the training data
-  int pe_frequencies = 7;    ///< positional-encoding octaves (NeMF: 7)
-  int decoder_width = 256;
-  int decoder_layers = 6;
-  int zl = 256;              ///< local latent size
-  int zg = 64;               ///< global (root orientation) latent size
-  int zg_layers = 3;         ///< the last layers that also take z_g
-  int encoder_channels = 12; ///< per-joint channels of the first skeleton conv (then doubled once)
-  int gmp_width = 128;
-  int gmp_kernel = 7;
-  int gmp_blocks = 3;
-  /// 1: a second GMP of the same sizes, sharing the GMP statistics, for the
-  /// tasks that steer the root along a path (GmpUse::Steering). A GMP reading
-  /// the VAE's reconstructions in-betweens better; one trained on captured
-  /// motion follows a path better. Files without it load with 0.
-  int steering_gmp = 0;
-
-  /// Empty when valid, else what is wrong.
-  std::string validate() const;
-  /// "decoder 6x256, z_l 256, z_g 64, ..." for logs and the model card.
-  std::string describe() const;
-  /// Named numeric fields, for the model file.
-  std::map<std::string, double> to_map() const;
-  static NemfConfig from_map(const std::map<std::string, double>& values);
-};
 
 /// Normalisation statistics (z-scores), measured on the training split.
 struct NemfStats {
@@ -88,10 +61,6 @@ struct GmpOutput {
 /// (and run through the GMP) in two halves on two threads when the calling
 /// thread has two or more; shorter windows gain nothing from a second thread.
 inline constexpr int kNemfParallelFrames = 64;
-
-/// Which GMP a task asks for: the default one, or the steering GMP where the
-/// model has one (NemfConfig::steering_gmp; else the default).
-enum class GmpUse { Default, Steering };
 
 class NemfModel {
  public:
@@ -118,6 +87,12 @@ class NemfModel {
   /// local rotations [B, S, J, 3, 3], joint 0 being the root orientation in
   /// the canonical frame. z_l [B, zl], z_g [B, zg].
   at::Tensor decode(const at::Tensor& frames, const at::Tensor& z_l, const at::Tensor& z_g) const;
+
+  /// The decoder's own output, before decode() turns it into rotation
+  /// matrices: [B, S, J, 6], per joint the 6D of its rotation (the two first
+  /// columns, not yet orthonormalised). For the Eigen runtime's equivalence
+  /// tests (prior/runtime/), which compare it unnormalised.
+  at::Tensor decode_sixd(const at::Tensor& frames, const at::Tensor& z_l, const at::Tensor& z_g) const;
 
   /// The GMP on a dense sequence of frames at the model's fps, [B, T, J, 3, 3] -> outputs.
   GmpOutput predict_global(const at::Tensor& local_rotations, GmpUse use = GmpUse::Default) const;

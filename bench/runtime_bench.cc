@@ -1,0 +1,159 @@
+// The decoder of the prior through the Eigen runtime (prior/runtime/) and
+// through libtorch (NemfModel::decode, autograd on the latents), at one
+// thread: forward and forward + VJP times for a gap window (30 frames) and a
+// full window (128), the decoder's matrix-product FLOPs per evaluation, the
+// machine's single-thread SGEMM rate (Eigen's kernels and the system BLAS,
+// 512 x 512 x 512, and the BLAS at the decoder's own hidden-layer shape), and
+// the runtime's forward + VJP time against the floor FLOPs / rate (issue 56:
+// within 1.5x). Prints a markdown table; median of --reps evaluations, in
+// the calling thread's CPU time unless --wall-clock.
+#include <ATen/ATen.h>
+
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "prior/model/model_file.h"
+#include "prior/runtime/nemf_runtime.h"
+#include "prior/util/command_line.h"
+#include "prior/util/threads.h"
+
+namespace {
+
+using mf::runtime::MatrixRXf;
+
+// The calling thread's CPU time (the default) or the wall clock, in ms. At
+// one thread every product runs on the calling thread (OpenBLAS's pool is
+// kept at 1), so its CPU time is the work done, which a machine shared with
+// other jobs stretches less than the wall clock.
+bool g_wall_clock = false;
+
+double now_ms() {
+  if (g_wall_clock) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  }
+  timespec t;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
+
+template <class F>
+double median_ms(int reps, F&& f) {
+  std::vector<double> t;
+  for (int i = 0; i < 3; ++i) f();  // warm-up: workspaces sized, caches filled
+  for (int i = 0; i < reps; ++i) {
+    const double a = now_ms();
+    f();
+    t.push_back(now_ms() - a);
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+MatrixRXf random_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937& rng) {
+  std::normal_distribution<float> n;
+  MatrixRXf m(rows, cols);
+  for (Eigen::Index i = 0; i < m.size(); ++i) m.data()[i] = n(rng);
+  return m;
+}
+
+// GFLOP/s of c = a * b^T ([m, k] x [k, n]) through the runtime's gemm on `backend`.
+double gemm_rate(mf::runtime::GemmBackend backend, int m, int k, int n, int reps) {
+  std::mt19937 rng(1);
+  const MatrixRXf a = random_matrix(m, k, rng), b = random_matrix(n, k, rng);
+  MatrixRXf c(m, n);
+  mf::runtime::set_gemm_backend(backend);
+  const double ms = median_ms(reps, [&] { mf::runtime::gemm(a, false, b, true, c, 0.0f); });
+  mf::runtime::set_gemm_backend(mf::runtime::GemmBackend::Blas);
+  return 2.0 * m * k * n / (ms * 1e6);
+}
+
+struct DecoderTimes {
+  double forward_ms, forward_vjp_ms;
+};
+
+DecoderTimes runtime_times(const mf::runtime::NemfRuntime& rt, int S, int reps) {
+  std::mt19937 rng(S);
+  const Eigen::VectorXd frames = Eigen::VectorXd::LinSpaced(S, 0.0, rt.config().window - 1.0);
+  const MatrixRXf z_l = random_matrix(rt.config().zl, 1, rng), z_g = random_matrix(rt.config().zg, 1, rng);
+  const MatrixRXf g = random_matrix(S, rt.rig().num_joints() * 6, rng);
+  mf::runtime::DecoderWorkspace ws;
+  MatrixRXf out;
+  Eigen::VectorXf g_zl, g_zg;
+  DecoderTimes t;
+  t.forward_ms = median_ms(reps, [&] { rt.decode(frames, z_l, z_g, &ws, &out); });
+  t.forward_vjp_ms = median_ms(reps, [&] {
+    rt.decode(frames, z_l, z_g, &ws, &out);
+    rt.decode_vjp(&ws, g, &g_zl, &g_zg);
+  });
+  return t;
+}
+
+DecoderTimes torch_times(const mf::NemfModel& model, int S, int reps) {
+  const mf::NemfConfig& c = model.config();
+  const at::Tensor frames = at::linspace(0.0, c.window - 1.0, S, at::kDouble);
+  const at::Tensor z_l = at::randn({1, c.zl}), z_g = at::randn({1, c.zg});
+  const at::Tensor g = at::randn({1, S, model.rig().num_joints(), 3, 3});
+  DecoderTimes t;
+  t.forward_ms = median_ms(reps, [&] {
+    at::NoGradGuard no_grad;
+    model.decode(frames, z_l, z_g);
+  });
+  t.forward_vjp_ms = median_ms(reps, [&] {
+    const at::Tensor zl = z_l.clone().requires_grad_(true), zg = z_g.clone().requires_grad_(true);
+    (model.decode(frames, zl, zg) * g).sum().backward();
+  });
+  return t;
+}
+
+int run(const std::string& model_path, int reps) {
+  mf::set_compute_threads(1);
+  const mf::NemfModel model = mf::load_nemf(model_path);
+  const mf::runtime::NemfRuntime rt = mf::runtime::NemfRuntime::load(model_path);
+  using mf::runtime::GemmBackend;
+  const int W = rt.config().decoder_width;
+  const double eigen_rate = gemm_rate(GemmBackend::Eigen, 512, 512, 512, 20);
+  const double blas_rate = gemm_rate(GemmBackend::Blas, 512, 512, 512, 20);
+  std::printf("1 thread; BLAS: %s; model %s (%s); times: median %s\n\n", mf::describe_blas().c_str(),
+              model_path.c_str(), rt.config().describe().c_str(),
+              g_wall_clock ? "wall clock" : "CPU time of the calling thread");
+  std::printf("SGEMM 512 x 512 x 512: Eigen %.1f GFLOP/s, BLAS %.1f GFLOP/s\n\n", eigen_rate, blas_rate);
+  std::printf("| S | GEMM MFLOP fwd + VJP | BLAS GFLOP/s at [S, %d] x [%d, %d] | runtime fwd (ms) | runtime fwd + VJP (ms) "
+              "| runtime on Eigen's kernels fwd + VJP (ms) | libtorch fwd (ms) | libtorch fwd + bwd (ms) "
+              "| floor at 512^3 rate (ms) | runtime / floor | floor at own-shape rate (ms) | runtime / that floor |\n"
+              "|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+              W, W, W);
+  for (int S : {30, 128}) {
+    const double flops = static_cast<double>(rt.decoder().forward_flops(S) + rt.decoder().vjp_flops(S));
+    const double shape_rate = gemm_rate(GemmBackend::Blas, S, W, W, 200);
+    const DecoderTimes r = runtime_times(rt, S, reps);
+    mf::runtime::set_gemm_backend(GemmBackend::Eigen);
+    const DecoderTimes e = runtime_times(rt, S, reps);
+    mf::runtime::set_gemm_backend(GemmBackend::Blas);
+    const DecoderTimes t = torch_times(model, S, reps);
+    const double floor_ms = flops / (blas_rate * 1e6), shape_floor_ms = flops / (shape_rate * 1e6);
+    std::printf("| %d | %.2f | %.1f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.2f | %.3f | %.2f |\n", S, flops * 1e-6,
+                shape_rate, r.forward_ms, r.forward_vjp_ms, e.forward_vjp_ms, t.forward_ms, t.forward_vjp_ms, floor_ms,
+                r.forward_vjp_ms / floor_ms, shape_floor_ms, r.forward_vjp_ms / shape_floor_ms);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string model_path = mf::default_model_path();
+  int reps = 200;
+  CLI::App app{"Times the prior's decoder through the Eigen runtime and through libtorch at one thread, against "
+               "its matrix-product floor (FLOPs / measured SGEMM rate).",
+               "runtime-bench"};
+  mf::cli::use_tool_defaults(app);
+  app.add_option("--model", model_path, "the prior's model file (default: the shipped one)");
+  app.add_flag("--wall-clock", g_wall_clock, "time by the wall clock instead of the thread's CPU time");
+  app.add_option("--reps", reps, "timed evaluations per figure (the median is printed)")->check(mf::cli::at_least(1));
+  return mf::cli::run(app, argc, argv, [&] { return run(model_path, reps); });
+}

@@ -1,0 +1,127 @@
+// The Eigen runtime on its own: built and linked against mf_runtime only (no
+// libtorch; the runtime_links_no_torch test checks this binary), it loads the
+// shipped prior and evaluates it. tests/runtime_equivalence_test.cc compares
+// it with libtorch and its gradients with finite differences.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <string>
+
+#include "prior/motion/errors.h"
+#include "prior/runtime/nemf_runtime.h"
+
+namespace mf::runtime {
+namespace {
+
+const NemfRuntime& shipped() {
+  static const NemfRuntime model = NemfRuntime::load(std::string(MF_SOURCE_DIR) + "/models/motionfield-prior.mfm");
+  return model;
+}
+
+MatrixRXf normal_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937& rng, float scale = 1.0f) {
+  std::normal_distribution<float> n(0.0f, scale);
+  MatrixRXf m(rows, cols);
+  for (Eigen::Index i = 0; i < m.size(); ++i) m.data()[i] = n(rng);
+  return m;
+}
+
+Eigen::VectorXf normal_vector(Eigen::Index n, std::mt19937& rng) {
+  const MatrixRXf m = normal_matrix(n, 1, rng);
+  return Eigen::Map<const Eigen::VectorXf>(m.data(), n);
+}
+
+// The decoder's VJP is linear in the output gradient, and a reused workspace
+// gives the results of a fresh one (fractional frames across the window).
+TEST(RuntimeStandalone, DecoderVjpIsLinearAndWorkspacesAreReusable) {
+  const NemfRuntime& m = shipped();
+  std::mt19937 rng(7);
+  const int S = 30, J6 = m.rig().num_joints() * 6;
+  Eigen::VectorXd frames(S);
+  for (int s = 0; s < S; ++s) frames[s] = 3.0 + 4.1 * s;
+  const Eigen::VectorXf z_l = normal_vector(m.config().zl, rng), z_g = normal_vector(m.config().zg, rng);
+  const MatrixRXf g1 = normal_matrix(S, J6, rng), g2 = normal_matrix(S, J6, rng);
+  DecoderWorkspace ws;
+  MatrixRXf out, again;
+  Eigen::VectorXf l1, g1_zg, l2, g2_zg, l12, g12_zg;
+  m.decode(frames, z_l, z_g, &ws, &out);
+  ASSERT_EQ(out.rows(), S);
+  ASSERT_EQ(out.cols(), J6);
+  m.decode_vjp(&ws, g1, &l1, &g1_zg);
+  m.decode_vjp(&ws, g2, &l2, &g2_zg);
+  m.decode_vjp(&ws, 2.0f * g1 - g2, &l12, &g12_zg);
+  EXPECT_LT((l12 - (2.0f * l1 - l2)).cwiseAbs().maxCoeff(), 1e-4f * l12.cwiseAbs().maxCoeff());
+  EXPECT_LT((g12_zg - (2.0f * g1_zg - g2_zg)).cwiseAbs().maxCoeff(), 1e-4f * g12_zg.cwiseAbs().maxCoeff());
+  DecoderWorkspace fresh;
+  m.decode(frames.head(7), z_l * 0.5f, z_g, &ws, &again);  // another size in between
+  m.decode(frames, z_l, z_g, &ws, &again);
+  EXPECT_EQ(again, out);
+  m.decode(frames, z_l, z_g, &fresh, &again);
+  EXPECT_EQ(again, out);
+}
+
+// The GMPs give finite outputs of the documented shape on inputs around their
+// statistics, and the steering GMP is another network than the default one.
+TEST(RuntimeStandalone, GmpsHaveTheirShapes) {
+  const NemfRuntime& m = shipped();
+  ASSERT_TRUE(m.has_steering_gmp());
+  std::mt19937 rng(11);
+  const int T = 40, C = m.rig().num_joints() * 3 + 6, outputs = 4 + m.rig().num_feet();
+  MatrixRXf x = normal_matrix(T, C, rng, 0.5f);
+  x = ((x.array().rowwise() * m.stats().gmp_in_std.array()).rowwise() + m.stats().gmp_in_mean.array()).matrix();
+  GmpWorkspace ws;
+  MatrixRXf def, steer, g_x;
+  m.predict_global(x, GmpUse::Default, &ws, &def);
+  m.predict_global(x, GmpUse::Steering, &ws, &steer);
+  ASSERT_EQ(def.rows(), T);
+  ASSERT_EQ(def.cols(), outputs);
+  EXPECT_TRUE(def.allFinite());
+  EXPECT_GT((def - steer).cwiseAbs().maxCoeff(), 1e-3f);
+  m.predict_global_vjp(&ws, GmpUse::Steering, normal_matrix(T, outputs, rng), &g_x);
+  EXPECT_EQ(g_x.rows(), T);
+  EXPECT_EQ(g_x.cols(), C);
+  EXPECT_TRUE(g_x.allFinite());
+}
+
+// Both matrix-product backends (the system BLAS, Eigen's kernels) give the
+// same products, transposed operands and strided blocks included.
+TEST(RuntimeStandalone, GemmBackendsAgree) {
+  std::mt19937 rng(3);
+  const MatrixRXf a = normal_matrix(37, 53, rng), b = normal_matrix(29, 53, rng);
+  const MatrixRXf c0 = normal_matrix(37, 29, rng);
+  MatrixRXf blas = c0, eigen = c0;
+  set_gemm_backend(GemmBackend::Blas);
+  gemm(a, false, b, true, blas, 0.5f);
+  set_gemm_backend(GemmBackend::Eigen);
+  gemm(a, false, b, true, eigen, 0.5f);
+  set_gemm_backend(GemmBackend::Blas);
+  const MatrixRXf expected = 0.5f * c0 + a * b.transpose();
+  EXPECT_LT((blas - expected).cwiseAbs().maxCoeff(), 1e-4f);
+  EXPECT_LT((eigen - expected).cwiseAbs().maxCoeff(), 1e-4f);
+  MatrixRXf block_result(10, 29);
+  gemm(a.block(2, 3, 10, 50).transpose(), true, b.middleCols(3, 50), true, block_result, 0.0f);
+  EXPECT_LT((block_result - a.block(2, 3, 10, 50) * b.middleCols(3, 50).transpose()).cwiseAbs().maxCoeff(), 1e-4f);
+}
+
+TEST(RuntimeStandalone, RejectsWrongShapes) {
+  const NemfRuntime& m = shipped();
+  DecoderWorkspace ws;
+  MatrixRXf out;
+  Eigen::VectorXd frames = Eigen::VectorXd::LinSpaced(5, 0.0, 4.0);
+  EXPECT_THROW(m.decode(frames, Eigen::VectorXf::Zero(3), Eigen::VectorXf::Zero(m.config().zg), &ws, &out),
+               InputError);
+  GmpWorkspace gw;
+  EXPECT_THROW(m.predict_global(MatrixRXf::Zero(10, 5), GmpUse::Default, &gw, &out), InputError);
+  const int J = m.rig().num_joints();
+  EXPECT_THROW(m.encode_features(MatrixRXf::Zero(m.config().window + 1, J * 15), MatrixRXf::Zero(m.config().window + 1, 6),
+                                 Eigen::VectorXf::Ones(m.config().window + 1)),
+               InputError);
+}
+
+TEST(RuntimeStandalone, RefusesAFileWithoutItsWeights) {
+  const std::string bytes = "MFMODEL";
+  EXPECT_THROW(NemfRuntime::from_bytes(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), "x.mfm"),
+               InputError);
+}
+
+}  // namespace
+}  // namespace mf::runtime
