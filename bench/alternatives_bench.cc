@@ -20,7 +20,6 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
-#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -29,12 +28,6 @@
 #include "bench/options.h"
 #include "bench/protocol.h"
 #include "bench/text.h"
-#include "prior/model/model_file.h"
-#include "prior/model/nemf.h"
-#include "prior/motion/errors.h"
-#include "prior/util/command_line.h"
-#include "prior/util/threads.h"
-#include "tasks/context/model_rig.h"
 #include "tasks/methods/jobs.h"
 
 namespace {
@@ -173,28 +166,20 @@ std::string run_gap(const Args& args, int T, const std::vector<mf::Clip>& clips,
 }
 
 int run(Args& args, const std::string& command) {
-  if (args.model.empty()) args.model = mf::default_model_path();
-  if (args.model.empty()) throw mf::InputError("no default model: pass --model FILE");
-  mf::set_compute_threads(args.threads);
-  mf::TaskContext ctx;
-  auto model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));  // frozen
-  ctx.model = model;
-  ctx.seed = args.seed;
-  mf::bench::load_transformers(args.transformers, args.model, &ctx, false);
-  const mf::Dataset data = mf::bench::load_data(args.data, false);
-  const std::vector<mf::Clip>& clips = args.split.clips(data);
-  const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);
+  mf::bench::BenchContext bench = mf::bench::load_bench_context(args);
+  bench.ctx.seed = args.seed;
+  const std::vector<mf::Clip>& clips = args.split.clips(bench.data);
 
   std::ostringstream md;
-  md << "## alternatives-bench\n\n- command: `" << command << "`\n- model: " << args.model << "\n- method: "
+  md << "## alternatives-bench\n\n- command: `" << command << "`\n- model: " << bench.model_path << "\n- method: "
      << args.method << ", " << args.alternatives << " alternatives, seed " << args.seed
      << (args.with_targets ? ", with targets (both hands at the gap's middle) and a foot pin where the ground truth's foot is planted" : "")
      << "\n- " << args.split.split << " split, torch threads: " << at::get_num_threads() << "\n\n"
      << "| gap | windows | solution | L2P | L2Q | NPSS | skating (cm) | diversity (cm) | alternatives within 10 % "
         "of the method's L2P | constraints (largest error of any solution), time |\n"
      << "|---:|---:|---|---:|---:|---:|---:|---:|---:|---|\n";
-  mf::bench::stream_gap_table(md.str(), args.gaps, [&](int T) { return run_gap(args, T, clips, stats, ctx); },
-                              args.out);
+  mf::bench::stream_gap_table(
+      md.str(), args.gaps, [&](int T) { return run_gap(args, T, clips, bench.stats, bench.ctx); }, args.out);
   return 0;
 }
 

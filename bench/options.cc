@@ -1,10 +1,16 @@
 #include "bench/options.h"
 
 #include <iostream>
+#include <memory>
 
 #include "prior/inbetween/inbetweener.h"
+#include "prior/model/model_file.h"
+#include "prior/model/nemf.h"
+#include "prior/motion/errors.h"
 #include "prior/rig/mirror.h"
 #include "prior/util/command_line.h"
+#include "prior/util/threads.h"
+#include "tasks/context/model_rig.h"
 #include "tasks/transformer/inbetweener_files.h"
 
 namespace mf::bench {
@@ -72,6 +78,20 @@ void add_model_bench_options(CLI::App& app, ModelBenchOptions& options) {
   add_split_options(app, options.split);
   add_transformer_options(app, options.transformers);
   add_threads_option(app, options.threads);
+}
+
+BenchContext load_bench_context(const ModelBenchOptions& options) {
+  BenchContext b;
+  b.model_path = options.model.empty() ? default_model_path() : options.model;
+  if (b.model_path.empty()) throw InputError("no default model: pass --model FILE");
+  set_compute_threads(options.threads);
+  auto model = std::make_shared<NemfModel>(load_nemf(b.model_path));  // frozen
+  b.ctx.model = model;
+  load_transformers(options.transformers, b.model_path, &b.ctx, false);
+  b.ctx.model_anatomy = load_rig_anatomy_next_to(b.model_path, model->rig().skeleton);
+  b.data = load_data(options.data, false);
+  b.stats = compute_eval_stats(b.data.train);
+  return b;
 }
 
 void add_number_options(CLI::App& app, std::map<std::string, double>& numbers, const NamedHelp& options,

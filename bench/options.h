@@ -2,7 +2,8 @@
 // (prior/util/command_line.h runs them with the tools' exit codes): the
 // transformer files, the data set and its split, the thread count, lists and
 // numeric overrides of solver settings. Each group adds its options to a
-// CLI::App and fills a small struct whose defaults are the documented ones.
+// CLI::App and fills a small struct whose defaults are the documented ones;
+// load_bench_context() loads what the benchmarks on the learned models start from.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -12,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "bench/metrics.h"
 #include "prior/data/dataset.h"
 #include "prior/util/command_line.h"
 #include "tasks/context/task_context.h"
@@ -71,6 +73,24 @@ struct ModelBenchOptions {
   int threads = 1;
 };
 void add_model_bench_options(CLI::App& app, ModelBenchOptions& options);
+
+/// What a benchmark of ModelBenchOptions runs with (load_bench_context()).
+struct BenchContext {
+  std::string model_path;  ///< --model, or the default model
+  /// The prior (frozen), its rig anatomy (kRigAnatomyFileName next to it, as
+  /// mf_model_load loads it: clips on another rig than the model's are
+  /// retargeted) and the in-betweeners.
+  TaskContext ctx;
+  Dataset data;
+  EvalStats stats;  ///< of data.train, for the metrics
+};
+
+/// The start of every such benchmark: the model path (the default model when
+/// --model is not given; InputError "no default model: pass --model FILE"
+/// when there is none), torch's threads (options.threads), the models (the
+/// in-betweeners strictly, quietly: load_transformers()), the data (quietly)
+/// and the statistics. The split's clips are options.split.clips(data).
+BenchContext load_bench_context(const ModelBenchOptions& options);
 
 /// A comma-separated list, e.g. "--methods interp,nemf" or "--lengths 5,15":
 /// one argument per occurrence, split at the commas and converted to T.

@@ -26,7 +26,6 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
-#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -35,14 +34,10 @@
 #include "bench/options.h"
 #include "bench/protocol.h"
 #include "bench/text.h"
-#include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
-#include "prior/util/command_line.h"
-#include "prior/util/threads.h"
 #include "tasks/constraints/constraint_report.h"
 #include "tasks/constraints/interpolation_fill.h"
-#include "tasks/context/model_rig.h"
 #include "tasks/latent/latent_solver.h"
 #include "tasks/methods/jobs.h"
 
@@ -278,39 +273,29 @@ std::string run_paths(const Args& args, int T, const std::vector<mf::Clip>& clip
 }
 
 int run(Args& args, const std::string& command) {
-  if (args.model.empty()) args.model = mf::default_model_path();
-  if (args.model.empty()) throw mf::InputError("no default model: pass --model FILE");
-  mf::set_compute_threads(args.threads);
-  mf::TaskContext ctx;
-  auto model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));
-  model->set_requires_grad(false);
-  ctx.model = model;
-  mf::bench::load_transformers(args.transformers, args.model, &ctx, false);
-  ctx.model_anatomy = mf::load_rig_anatomy_next_to(args.model, model->rig().skeleton);  // clips of other root offsets
-  const mf::Dataset data = mf::bench::load_data(args.data, false);
-  const std::vector<mf::Clip>& clips = args.split.clips(data);
-  const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);
+  const mf::bench::BenchContext bench = mf::bench::load_bench_context(args);
+  const std::vector<mf::Clip>& clips = args.split.clips(bench.data);
 
+  // With --paths the tables of the test paths, else those of the ground truth's trajectory.
+  const bool paths = !args.paths.empty();
   std::ostringstream md;
-  if (!args.paths.empty()) {
-    md << "## trajectory-bench: test paths\n\n- command: `" << command << "`\n- model: " << args.model << "\n- "
-       << args.split.split << " split, torch threads: " << at::get_num_threads()
-       << "\n- skating: of the result and of the ground truth on the same frames\n\n"
+  md << "## trajectory-bench" << (paths ? ": test paths" : "") << "\n\n- command: `" << command
+     << "`\n- model: " << bench.model_path << "\n- " << args.split.split
+     << " split, torch threads: " << at::get_num_threads();
+  if (paths) {
+    md << "\n- skating: of the result and of the ground truth on the same frames\n\n"
        << "| gap | path | method | windows | failed | ground distance mean / max (cm) | facing mean / max (deg) | "
           "skating (cm) | ground truth's skating (cm) | s / window |\n"
        << "|---:|---|---|---:|---:|---:|---:|---:|---:|---:|\n";
-    mf::bench::stream_gap_table(md.str(), args.gaps, [&](int T) { return run_paths(args, T, clips, stats, ctx); },
-                                args.out);
-    return 0;
+  } else {
+    md << "\n- trajectory rows: the ground truth's on every gap frame; weights: trajectory / trajectory_facing\n\n"
+       << "| gap | windows | solution | L2P | L2Q | NPSS | skating (cm) | ground distance mean / max (cm) | "
+          "facing mean / max (deg) | s / window |\n"
+       << "|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
   }
-  md << "## trajectory-bench\n\n- command: `" << command << "`\n- model: " << args.model << "\n- "
-     << args.split.split << " split, torch threads: " << at::get_num_threads()
-     << "\n- trajectory rows: the ground truth's on every gap frame; weights: trajectory / trajectory_facing\n\n"
-     << "| gap | windows | solution | L2P | L2Q | NPSS | skating (cm) | ground distance mean / max (cm) | "
-        "facing mean / max (deg) | s / window |\n"
-     << "|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|\n";
-  mf::bench::stream_gap_table(md.str(), args.gaps, [&](int T) { return run_gap(args, T, clips, stats, ctx); },
-                              args.out);
+  mf::bench::stream_gap_table(md.str(), args.gaps, [&](int T) {
+    return paths ? run_paths(args, T, clips, bench.stats, bench.ctx) : run_gap(args, T, clips, bench.stats, bench.ctx);
+  }, args.out);
   return 0;
 }
 

@@ -27,7 +27,6 @@
 #include <chrono>
 #include <cmath>
 #include <iostream>
-#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -36,12 +35,7 @@
 #include "bench/options.h"
 #include "bench/protocol.h"
 #include "bench/text.h"
-#include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
-#include "prior/motion/errors.h"
-#include "prior/util/command_line.h"
-#include "prior/util/threads.h"
-#include "tasks/context/model_rig.h"
 #include "tasks/transition/transition.h"
 
 namespace {
@@ -200,33 +194,26 @@ std::string two_takes(const Args& args, int N, const std::vector<mf::Clip>& clip
 }
 
 int run(Args& args, const std::string& command) {
-  if (args.model.empty()) args.model = mf::default_model_path();
-  if (args.model.empty()) throw mf::InputError("no default model: pass --model FILE");
-  mf::set_compute_threads(args.threads);
-  mf::TaskContext ctx;
-  auto model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));
-  ctx.model = model;
-  ctx.model_anatomy = mf::load_rig_anatomy_next_to(args.model, model->rig().skeleton);  // as the CLI loads a model
-  mf::bench::load_transformers(args.transformers, args.model, &ctx, false);
-  const mf::Dataset data = mf::bench::load_data(args.data, false);
-  const std::vector<mf::Clip>& clips = args.split.clips(data);
-  const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);
+  const mf::bench::BenchContext bench = mf::bench::load_bench_context(args);
+  const std::vector<mf::Clip>& clips = args.split.clips(bench.data);
 
   std::ostringstream head;
-  head << "## transition-bench\n\n- command: `" << command << "`\n- model: " << args.model << "\n- "
+  head << "## transition-bench\n\n- command: `" << command << "`\n- model: " << bench.model_path << "\n- "
        << args.split.split << " split, " << args.context << " frames kept of A and of B, torch threads: "
        << at::get_num_threads() << "\n\n### One take (ground truth between A and B)\n\n"
        << "| N | windows | method | placement | L2P | ratio to interp (keep) | check / placement error | s per "
           "transition |\n|---:|---:|---|---|---:|---:|---|---:|\n";
   std::vector<double> interp_l2p;
-  mf::bench::stream_gap_table(head.str(), args.lengths,
-                              [&](int N) { return one_take(args, N, clips, stats, ctx, &interp_l2p); }, args.out);
+  mf::bench::stream_gap_table(
+      head.str(), args.lengths, [&](int N) { return one_take(args, N, clips, bench.stats, bench.ctx, &interp_l2p); },
+      args.out);
   std::ostringstream head2;
   head2 << "\n### Two takes (A and B from different clips)\n\n"
         << "| N | pairs | method | placement | foot skating (cm) | root velocity change at the seams (cm/frame^2) | "
            "the same within A and B | s per transition |\n|---:|---:|---|---|---:|---:|---:|---:|\n";
-  mf::bench::stream_gap_table(head2.str(), args.lengths, [&](int N) { return two_takes(args, N, clips, stats, ctx); },
-                              args.out.empty() ? "" : args.out + ".two-takes.md");
+  mf::bench::stream_gap_table(
+      head2.str(), args.lengths, [&](int N) { return two_takes(args, N, clips, bench.stats, bench.ctx); },
+      args.out.empty() ? "" : args.out + ".two-takes.md");
   return 0;
 }
 

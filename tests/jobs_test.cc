@@ -9,6 +9,7 @@
 
 #include "prior/motion/errors.h"
 #include "tasks/constraints/interpolation_fill.h"
+#include "tasks/constraints/motion_constraints.h"
 #include "tests/test_util.h"
 
 namespace mf {
@@ -66,6 +67,14 @@ TEST(JobsTest, ValidateKeyframesRejectsWithClearMessages) {
   m = input_error([] { validate_keyframes({0, 5, 3}, 10); });
   EXPECT_TRUE(contains(m, "increasing order")) << m;
   m = input_error([] { validate_keyframes({0, 5, 5, 9}, 10); });
+  EXPECT_TRUE(contains(m, "keyframe 5 is given twice")) << m;
+}
+
+// The keys of constraints are checked in order by the same function, with the same words.
+TEST(JobsTest, ConstraintKeysOutOfOrderSayWhatKeyframesSay) {
+  std::string m = input_error([] { MotionConstraints::full_pose({0, 5, 3}).validate(10, 7); });
+  EXPECT_TRUE(contains(m, "keyframes must be in increasing order (5 is followed by 3)")) << m;
+  m = input_error([] { MotionConstraints::full_pose({0, 5, 5, 9}).validate(10, 7); });
   EXPECT_TRUE(contains(m, "keyframe 5 is given twice")) << m;
 }
 

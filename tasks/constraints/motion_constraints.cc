@@ -52,6 +52,13 @@ bool MotionConstraints::beyond_full_poses() const {
   return false;
 }
 
+void check_keyframe_order(int previous, int frame) {
+  if (frame == previous) throw InputError("keyframe " + std::to_string(frame) + " is given twice");
+  if (frame < previous)
+    throw InputError("keyframes must be in increasing order (" + std::to_string(previous) + " is followed by " +
+                     std::to_string(frame) + ")");
+}
+
 void MotionConstraints::validate(int frames, int joints) const {
   auto range = [&](int f) { return "(the motion has " + std::to_string(frames) + " frames)"; };
   bool anchor = false;
@@ -59,9 +66,7 @@ void MotionConstraints::validate(int frames, int joints) const {
     const PoseKey& key = keys[k];
     if (key.frame < 0 || key.frame >= frames)
       throw InputError("key frame " + std::to_string(key.frame) + " is out of range " + range(key.frame));
-    if (k > 0 && key.frame <= keys[k - 1].frame)
-      throw InputError("key frames must be strictly increasing (" + std::to_string(keys[k - 1].frame) +
-                       " is followed by " + std::to_string(key.frame) + ")");
+    if (k > 0) check_keyframe_order(keys[k - 1].frame, key.frame);
     if (!key.rotations && !key.joints.empty())
       throw InputError("key at frame " + std::to_string(key.frame) + ": joints listed on a key without rotations");
     if (!key.rotations && !key.root_position)

@@ -56,6 +56,13 @@ struct TrajectoryPoint {
   double forward_x = 0, forward_z = 1;
 };
 
+/// The one order check of keyframes, whether a task's list
+/// (tasks/methods/jobs.h validate_keyframes) or the keys of MotionConstraints:
+/// throws mf::InputError unless `frame` comes after `previous`, the keyframe
+/// before it ("keyframe F is given twice", "keyframes must be in increasing
+/// order (P is followed by F)").
+void check_keyframe_order(int previous, int frame);
+
 /// Everything known about a motion to complete.
 struct MotionConstraints {
   std::vector<PoseKey> keys;              ///< strictly increasing frames
@@ -66,9 +73,10 @@ struct MotionConstraints {
   /// Full-pose keys (every joint and the root position) at `frames`.
   static MotionConstraints full_pose(const std::vector<int>& frames);
 
-  /// Throws mf::InputError unless: keys are in range and strictly increasing,
-  /// key joints are in range, increasing and unique, effector frames and joints
-  /// are in range with finite positions and non-negative finite weights,
+  /// Throws mf::InputError unless: keys are in range and strictly increasing
+  /// (check_keyframe_order()), key joints are in range, increasing and unique,
+  /// effector frames and joints are in range with finite positions and
+  /// non-negative finite weights,
   /// trajectory rows are in range, strictly increasing, finite, with a facing
   /// direction of non-zero length (|(forward_x, forward_z)| >= 1e-6), and at
   /// least one key fixes the root (rotation of joint 0 and root position), which

@@ -4,6 +4,7 @@
 #include <ATen/CPUGeneratorImpl.h>
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -83,12 +84,16 @@ void overwrite_known(const Motion& input, const MotionConstraints& c, Motion* ou
 // ---------------------------------------------------------------------------
 // complete_motion() in steps
 
+void check_solver_options(const LatentSolverOptions& options) {
+  const std::string bad = options.validate();
+  if (!bad.empty()) throw InputError("invalid solver options: " + bad);
+}
+
 // Throws InputError unless the call can run: valid options, the model's
 // skeleton, a well-formed motion and constraints, finite known values.
 void check_completion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
                       const LatentSolverOptions& options) {
-  const std::string bad = options.validate();
-  if (!bad.empty()) throw InputError("invalid solver options: " + bad);
+  check_solver_options(options);
   const int N = input.num_frames(), J = input.num_joints();
   check_model_skeleton(model.rig(), input.skeleton, "motion");
   if (N < 2) throw InputError("the motion needs at least two frames");
@@ -208,6 +213,38 @@ InitialGuess perturbed(InitialGuess g, const LatentSolverOptions& o, int window)
   return g;
 }
 
+// solve_latents() on options the caller validated: complete_motion() checks
+// them once per call, not once per window.
+LatentSolution solve_window_latents(const NemfModel& model, const WindowProblem& problem, const InitialGuess& start,
+                                    const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset,
+                                    int iteration_total) {
+  assert(options.validate().empty());
+  const int zl = model.config().zl, zg = model.config().zg;
+  if (!start.z_l.defined() || !start.z_g.defined() || start.z_l.numel() != zl || start.z_g.numel() != zg)
+    throw InputError("initial codes must have " + std::to_string(zl) + " + " + std::to_string(zg) + " values");
+  const auto t0 = Clock::now();
+  const FlatLatentEnergy energy(window_energy(model, problem, options.weights), zl, zg);
+  const at::Tensor x0 = energy.join(start.z_l, start.z_g);
+  const WindowCaps caps =
+      window_caps(options, key_frames_of(problem),
+                  problem.num_effectors() > 0 || problem.num_pin_steps() > 0 || problem.num_trajectory() > 0, problem.length);
+  const int total = iteration_total > 0 ? iteration_total : caps.keyed + caps.full;
+
+  FirstStage first;
+  EnergyWeights keyed = options.weights;
+  keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
+  keyed.trajectory = keyed.trajectory_facing = 0.0;
+  const FlatLatentEnergy cheap(window_energy(model, problem, keyed), zl, zg);
+  if (caps.keyed > 0) first = {&cheap, caps.keyed};
+  LatentSolution out;
+  const at::Tensor x = minimize_window(energy, x0, options.capped(caps.full), ctx, iteration_offset, total,
+                                       &out.summary, first);
+  out.z_l = energy.z_l(x);
+  out.z_g = energy.z_g(x);
+  out.summary.wall_ms = ms_since(t0);
+  return out;
+}
+
 // Solves window `w` of `input` from its initial codes (`whole`: the
 // initialiser's fill of the whole input, when there is one) given the
 // solution so far, and records its summary.
@@ -234,7 +271,7 @@ SolvedWindow solve_window(const NemfModel& model, const Motion& input, const Win
   window_options.keyed_iterations = w.caps.keyed;
   window_options.max_iterations = w.caps.full;
   const LatentSolution sol =
-      solve_latents(model, problem, start, window_options, window_ctx, iteration_offset, iteration_total);
+      solve_window_latents(model, problem, start, window_options, window_ctx, iteration_offset, iteration_total);
   rep->windows.push_back(sol.summary);
   rep->window_starts.push_back(w.start);
   std::vector<int> keys;
@@ -348,32 +385,8 @@ LatentSolverOptions default_solver_options(LatentOptimizer optimizer) {
 LatentSolution solve_latents(const NemfModel& model, const WindowProblem& problem, const InitialGuess& start,
                              const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset,
                              int iteration_total) {
-  const std::string bad = options.validate();
-  if (!bad.empty()) throw InputError("invalid solver options: " + bad);
-  const int zl = model.config().zl, zg = model.config().zg;
-  if (!start.z_l.defined() || !start.z_g.defined() || start.z_l.numel() != zl || start.z_g.numel() != zg)
-    throw InputError("initial codes must have " + std::to_string(zl) + " + " + std::to_string(zg) + " values");
-  const auto t0 = Clock::now();
-  const FlatLatentEnergy energy(window_energy(model, problem, options.weights), zl, zg);
-  const at::Tensor x0 = energy.join(start.z_l, start.z_g);
-  const WindowCaps caps =
-      window_caps(options, key_frames_of(problem),
-                  problem.num_effectors() > 0 || problem.num_pin_steps() > 0 || problem.num_trajectory() > 0, problem.length);
-  const int total = iteration_total > 0 ? iteration_total : caps.keyed + caps.full;
-
-  FirstStage first;
-  EnergyWeights keyed = options.weights;
-  keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
-  keyed.trajectory = keyed.trajectory_facing = 0.0;
-  const FlatLatentEnergy cheap(window_energy(model, problem, keyed), zl, zg);
-  if (caps.keyed > 0) first = {&cheap, caps.keyed};
-  LatentSolution out;
-  const at::Tensor x = minimize_window(energy, x0, options.capped(caps.full), ctx, iteration_offset, total,
-                                       &out.summary, first);
-  out.z_l = energy.z_l(x);
-  out.z_g = energy.z_g(x);
-  out.summary.wall_ms = ms_since(t0);
-  return out;
+  check_solver_options(options);
+  return solve_window_latents(model, problem, start, options, ctx, iteration_offset, iteration_total);
 }
 
 Motion complete_motion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,

@@ -169,7 +169,10 @@ struct LatentSolution {
 /// Optimises the codes of one window from `start`. `iteration_offset` and
 /// `iteration_total` only shape the progress reports (iteration =
 /// offset + this window's iteration, max_iterations = total; 0 = this window's
-/// cap). Throws CancelledError when the context asks to stop.
+/// cap). Throws InputError on invalid `options` (checked here, once per call;
+/// complete_motion() checks its options once per request and solves its
+/// windows without checking them again), CancelledError when the context asks
+/// to stop.
 LatentSolution solve_latents(const NemfModel& model, const WindowProblem& problem, const InitialGuess& start,
                              const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset = 0,
                              int iteration_total = 0);

@@ -9,6 +9,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "tasks/constraints/interpolation_fill.h"
+#include "tasks/constraints/motion_constraints.h"
 #include "tasks/context/model_rig.h"
 #include "tasks/transformer/inbetweener_files.h"
 
@@ -186,10 +187,7 @@ void validate_keyframes(const std::vector<int>& keyframes, int frames) {
     if (k < 0 || k >= frames)
       throw InputError("keyframe " + std::to_string(k) + " is out of range: the input has " + std::to_string(frames) +
                        " frames (0.." + std::to_string(frames - 1) + ")");
-    if (i > 0 && k == keyframes[i - 1]) throw InputError("keyframe " + std::to_string(k) + " is given twice");
-    if (i > 0 && k < keyframes[i - 1])
-      throw InputError("keyframes must be in increasing order (" + std::to_string(keyframes[i - 1]) + " is followed by " +
-                       std::to_string(k) + ")");
+    if (i > 0) check_keyframe_order(keyframes[i - 1], k);
   }
 }
 
