@@ -97,7 +97,8 @@ TEST(InbetweenTraining, LossDecreasesCheckpointAndResume) {
   ASSERT_EQ(a.size(), b.size());
   for (size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(at::allclose(a[i], b[i], 0.0, 1e-9)) << "parameter " << i;
   EXPECT_TRUE(at::equal(from->stats().pose_std, tuned->stats().pose_std));
-  // Another kind or other hyperparameters than the file's are refused.
+  // Another kind or other hyperparameters than the file's are refused, unless
+  // they only add parameters (RealKindsTrainAFewSteps: the two-stage gate).
   InbetweenTrainingOptions other = f;
   other.out_dir = data + "/finetune-other";
   other.hyperparameters = {{"window", 32}};
@@ -125,6 +126,22 @@ TEST(InbetweenTraining, RealKindsTrainAFewSteps) {
     EXPECT_EQ(m->kind(), kind);
     EXPECT_EQ(m->window(), 32);
     EXPECT_EQ(test::log_column(o.out_dir + "/log.csv", "val_score").size(), 2u) << kind;
+    if (kind != kTwoStageKind) continue;
+    // --init with --hp interp_input=1 keeps every trained parameter and adds the gate.
+    InbetweenTrainingOptions g = o;
+    g.out_dir = data + "/grown-twostage";
+    g.init_from = r.best_path;
+    g.hyperparameters["interp_input"] = 1;
+    g.lr = 1e-12;
+    g.max_epochs = 1;
+    train_inbetweener(g);
+    auto grown = load_inbetweener(g.out_dir + "/last.mfm");
+    EXPECT_EQ(grown->hyperparameters().at("interp_input"), 1.0);
+    std::map<std::string, at::Tensor> after;
+    for (auto& [name, t] : grown->named_parameters()) after[name] = t;
+    EXPECT_EQ(after.size(), m->named_parameters().size() + 1);
+    for (auto& [name, t] : m->named_parameters()) EXPECT_TRUE(at::allclose(after.at(name), t, 0.0, 1e-9)) << name;
+    EXPECT_TRUE(at::equal(grown->stats().pose_std, m->stats().pose_std));
   }
 }
 

@@ -383,6 +383,68 @@ TEST_P(TransformerKind, OverfitsOneBatch) {
 INSTANTIATE_TEST_SUITE_P(Kinds, TransformerKind, ::testing::Values(two_stage_kind(), citl_kind(), keyframe_kind()));
 
 // CITL alone keeps the known values of valid frames exactly, partial keys included.
+// Per window, joint and channel: the linear interpolation of `pose` between
+// the nearest valid frames where that joint (or, for the root position, the
+// root) is known, held before the first and after the last.
+at::Tensor interpolated_per_joint(const InbetweenBatch& b, int64_t J) {
+  at::Tensor out = b.pose.clone();
+  for (int64_t w = 0; w < b.pose.size(0); ++w) {
+    const int64_t T = b.valid[w].sum().item<int64_t>();
+    for (int64_t j = 0; j <= J; ++j) {
+      const int64_t c0 = 6 * j, width = j < J ? 6 : 3;
+      std::vector<int64_t> keys;
+      for (int64_t t = 0; t < T; ++t)
+        if (b.known[w][t][j].item<float>() > 0.5f) keys.push_back(t);
+      for (int64_t t = 0; t < T && !keys.empty(); ++t) {
+        auto next = std::lower_bound(keys.begin(), keys.end(), t);
+        const int64_t after = next == keys.end() ? keys.back() : *next;
+        const int64_t before = next == keys.end() ? keys.back() : (*next == t ? t : (next == keys.begin() ? after : *(next - 1)));
+        const double a = after == before ? 0.0 : static_cast<double>(t - before) / static_cast<double>(after - before);
+        out[w][t].narrow(0, c0, width).copy_(b.pose[w][before].narrow(0, c0, width) * (1 - a) +
+                                             b.pose[w][after].narrow(0, c0, width) * a);
+      }
+    }
+  }
+  return out;
+}
+
+// "interp_input" 1: the Context Transformer corrects each joint's own
+// interpolation between the frames it is known at, through a gate that starts
+// closed, so a new model's context stage is that interpolation.
+TEST(TwoStage, InterpolatedInputStartsAtEachJointsInterpolation) {
+  std::map<std::string, double> hp = two_stage_kind().tiny;
+  hp["interp_input"] = 1;
+  at::manual_seed(3);
+  auto model = make_two_stage(hp, test::tiny_rig());
+  const int64_t J = model->rig().num_joints(), D = model->pose_size();
+  model->stats().pose_mean = at::randn({D}) * 0.1;
+  model->stats().pose_std = at::rand({D}) + 0.5;
+  InbetweenBatch b = two_windows(*model);
+  at::Tensor expected = interpolated_per_joint(b, J);
+  at::Tensor context = model->forward(b).stages[0];
+  for (int64_t w = 0; w < 2; ++w) {
+    const int64_t T = b.valid[w].sum().item<int64_t>();
+    EXPECT_TRUE(at::allclose(context[w].narrow(0, 0, T), expected[w].narrow(0, 0, T), 1e-4, 1e-5)) << "window " << w;
+  }
+  // The partial key at frame 3 of window 1 bends its two joints' lines only.
+  EXPECT_GT((expected[1][2].narrow(0, 6, 12) - (b.pose[1][0].narrow(0, 6, 12) * 7 + b.pose[1][9].narrow(0, 6, 12) * 2) / 9)
+                .abs().max().item<float>(), 1e-3f);
+
+  // Opened, the gate lets the correction through.
+  {
+    torch::NoGradGuard no_grad;
+    for (auto& [name, t] : model->named_parameters())
+      if (name == "context.gate") t.fill_(0.5);
+  }
+  EXPECT_FALSE(at::allclose(model->forward(b).stages[0][0], expected[0], 1e-3, 1e-3));
+
+  EXPECT_EQ(model->hyperparameters().at("interp_input"), 1.0);
+  EXPECT_NE(model->describe().find("on interpolated input"), std::string::npos);
+  EXPECT_EQ(two_stage_parameter_count(hp, model->rig()), model->num_parameters());
+  // Models of the original design do not name the key (their files stay as they were).
+  EXPECT_EQ(tiny(two_stage_kind(), 0)->hyperparameters().count("interp_input"), 0u);
+}
+
 TEST(Citl, KnownValuesComeBackExactly) {
   auto model = tiny(citl_kind(), 0);
   InbetweenBatch b = two_windows(*model);

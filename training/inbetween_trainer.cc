@@ -14,6 +14,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
+#include <map>
 #include <memory>
 #include <random>
 
@@ -299,6 +301,36 @@ void check_options(const InbetweenTrainingOptions& o) {
   }
 }
 
+// A model of `from`'s kind with the hyperparameters `hp` that holds every
+// parameter of `from` under the same name and shape, its statistics too, and
+// the parameters only `hp` has freshly initialised (a part added to a trained
+// model, e.g. the two-stage "interp_input" gate). Anything else is refused.
+std::unique_ptr<InbetweenModel> grown_model(const InbetweenModel& from, const std::map<std::string, double>& hp,
+                                            const std::string& what) {
+  std::unique_ptr<InbetweenModel> model = make_inbetweener(from.kind(), hp, from.rig());
+  std::map<std::string, at::Tensor> target;
+  for (auto& [name, t] : model->named_parameters()) target[name] = t;
+  torch::NoGradGuard no_grad;
+  for (const auto& [name, t] : from.named_parameters()) {
+    auto it = target.find(name);
+    if (it == target.end() || !it->second.sizes().equals(t.sizes())) {
+      throw InputError("train: " + what + " with other hyperparameters: its parameter " + name +
+                       " has no counterpart of the same shape in " + model->describe());
+    }
+    it->second.copy_(t);
+    target.erase(it);
+  }
+  if (target.empty()) {
+    throw InputError("train: " + what + " with other hyperparameters than the file's (" + from.describe() +
+                     ") that add no parameter");
+  }
+  model->stats() = from.stats();
+  std::cerr << "train: " << what << ": every parameter taken, " << target.size() << " new (";
+  for (auto it = target.begin(); it != target.end(); ++it) std::cerr << (it == target.begin() ? "" : ", ") << it->first;
+  std::cerr << ")\n";
+  return model;
+}
+
 // A new model of o.kind, the checkpoint's when resuming, or o.init_from's
 // (checked against the options).
 std::unique_ptr<InbetweenModel> load_or_make_model(const InbetweenTrainingOptions& o, const Dataset& data,
@@ -312,14 +344,16 @@ std::unique_ptr<InbetweenModel> load_or_make_model(const InbetweenTrainingOption
   if (model->kind() != o.kind) {
     throw InputError("train: " + what + ": the file holds a '" + model->kind() + "' model, not '" + o.kind + "'");
   }
-  const auto hp = model->hyperparameters();
+  auto hp = model->hyperparameters();
+  bool same = true;
   for (const auto& [k, v] : o.hyperparameters) {
     auto it = hp.find(k);
-    if (it == hp.end() || it->second != v) {
-      throw InputError("train: " + what + " with other hyperparameters than the file's (" + model->describe() + ")");
-    }
+    if (it == hp.end() || it->second != v) same = false;
+    hp[k] = v;
   }
-  return model;
+  if (same) return model;
+  if (resuming) throw InputError("train: --resume with other hyperparameters than the file's (" + model->describe() + ")");
+  return grown_model(*model, hp, what);
 }
 
 // The training clips' frame rate and skeleton must be the model's.

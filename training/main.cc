@@ -94,7 +94,8 @@ void add_run_options(CLI::App& cmd, Options& o, RunArgs& run) {
       ->delimiter(',');
   cmd.add_flag("--resume", o.resume, "continue from DIR/last.* if present");
   cmd.add_option("--init", o.init_from,
-                 "start a new run from this model's weights and statistics (same sizes and skeleton), not random ones");
+                 "start a new run from this model's weights and statistics (same sizes and skeleton), not random ones; "
+                 "an in-betweener's --hp may add parameters to it (twostage: --hp interp_input=1)");
   cmd.add_option("--export", run.export_path, "copy the best checkpoint to PATH at the end");
   cmd.add_flag("--quiet", run.quiet, "no progress lines on stderr");
   add_distributed_options(cmd, o.distributed);

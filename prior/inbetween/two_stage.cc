@@ -24,9 +24,13 @@ struct TwoStageConfig {
   int ffn = 128;
   int window = 128;
   double fps = 30.0;
+  int interp_input = 0;
 
   std::map<std::string, double> to_map() const {
-    return {{"width", width}, {"layers", layers}, {"heads", heads}, {"ffn", ffn}, {"window", window}, {"fps", fps}};
+    std::map<std::string, double> m{{"width", width}, {"layers", layers}, {"heads", heads},
+                                    {"ffn", ffn},     {"window", window}, {"fps", fps}};
+    if (interp_input) m["interp_input"] = interp_input;  // absent in files of the original design
+    return m;
   }
   blocks::TrunkSize trunk() const { return {width, layers, heads, ffn, window}; }
 };
@@ -40,6 +44,7 @@ TwoStageConfig parse_config(const std::map<std::string, double>& values) {
   r.integer("ffn", 1, 16384, &c.ffn);
   r.integer("window", 2, 4096, &c.window);
   r.positive("fps", 1000, &c.fps);
+  r.integer("interp_input", 0, 1, &c.interp_input);
   r.check(c.width % c.heads == 0,
           "heads (" + std::to_string(c.heads) + ") must divide width (" + std::to_string(c.width) + ")");
   r.finish();
@@ -55,6 +60,7 @@ struct TwoStageNetImpl : torch::nn::Module {
     torch::NoGradGuard no_grad;
     detail->output->fc2->weight.mul_(0.1);  // the detail stage starts close to the identity
     detail->output->fc2->bias.zero_();
+    if (c.interp_input) gate = context->register_parameter("gate", torch::zeros({1}));
   }
 
   // pose [B, T, D] raw; known [B, T, J + 1]; valid [B, T]; mean/std [D].
@@ -64,8 +70,10 @@ struct TwoStageNetImpl : torch::nn::Module {
     at::Tensor known = known_in * valid.unsqueeze(-1);
     at::Tensor channel_known = known_channel_mask(known, joints) > 0.5;  // [B, T, D]
     at::Tensor normalised = (pose - mean) / scale;
-    at::Tensor rotations = at::where(channel_known.narrow(-1, 0, 6 * J), normalised.narrow(-1, 0, 6 * J),
-                                     at::zeros({1}, pose.options()));
+    at::Tensor rotations = config.interp_input
+                               ? interpolated_rotations(normalised.narrow(-1, 0, 6 * J), known)
+                               : at::where(channel_known.narrow(-1, 0, 6 * J), normalised.narrow(-1, 0, 6 * J),
+                                           at::zeros({1}, pose.options()));
     at::Tensor root_known = known.select(-1, J) > 0.5;
     at::Tensor root_in = blocks::interpolate_known(pose.narrow(-1, 6 * J, 3), root_known);
     at::Tensor root = (root_in - mean.narrow(0, 6 * J, 3)) / scale.narrow(0, 6 * J, 3);
@@ -78,6 +86,7 @@ struct TwoStageNetImpl : torch::nn::Module {
 
     at::Tensor key_encoding = blocks::key_features(key, config.window);
     at::Tensor context_out = context->forward(at::cat({x, known}, -1), key_encoding, key_mask, positions);  // normalised
+    if (config.interp_input) context_out = x + kGateScale * gate * context_out;
     at::Tensor mixed = at::where(channel_known, x, context_out);
     at::Tensor detail_out = detail->forward(at::cat({mixed, known}, -1), at::Tensor(), valid_mask, positions);
 
@@ -88,9 +97,23 @@ struct TwoStageNetImpl : torch::nn::Module {
     return out;
   }
 
+  // Each joint's normalised 6D channels [B, T, J * 6], at frames where that
+  // joint is unknown linearly interpolated between its nearest known frames.
+  at::Tensor interpolated_rotations(const at::Tensor& rotations, const at::Tensor& known) const {
+    const int64_t B = rotations.size(0), T = rotations.size(1), J = joints;
+    at::Tensor per_joint = rotations.reshape({B, T, J, 6}).permute({0, 2, 1, 3}).reshape({B * J, T, 6});
+    at::Tensor joint_known = known.narrow(-1, 0, J).permute({0, 2, 1}).reshape({B * J, T}) > 0.5;
+    at::Tensor filled = blocks::interpolate_known(per_joint, joint_known);
+    return filled.reshape({B, J, T, 6}).permute({0, 2, 1, 3}).reshape({B, T, J * 6});
+  }
+
   TwoStageConfig config;
   int joints, feet, pose_size;
   Stage context{nullptr}, detail{nullptr};
+  at::Tensor gate;  // interp_input: the context stage's correction scale / kGateScale, 0 at the start
+  // Adam moves a parameter by about the learning rate per step; the scale lets
+  // the gate open within a few hundred steps.
+  static constexpr double kGateScale = 10.0;
 };
 TORCH_MODULE(TwoStageNet);
 
@@ -106,6 +129,7 @@ class TwoStageModel final : public NetworkModel<TwoStageConfig, TwoStageNet> {
     s << "twostage: context " << config_.layers << "x" << config_.width << ", detail " << config_.layers << "x"
       << config_.width << ", " << config_.heads << " heads, ffn " << config_.ffn << ", window " << config_.window
       << " frames at " << config_.fps << " fps";
+    if (config_.interp_input) s << ", on interpolated input";
     return s.str();
   }
 
@@ -128,7 +152,7 @@ int64_t two_stage_parameter_count(const std::map<std::string, double>& hyperpara
   const TwoStageConfig c = parse_config(hyperparameters);
   const int pose_size = rig.num_joints() * 6 + 3, inputs = pose_size + rig.num_joints() + 1;
   return blocks::stage_parameter_count(c.trunk(), inputs, pose_size, true) +
-         blocks::stage_parameter_count(c.trunk(), inputs, pose_size + rig.num_feet(), false);
+         blocks::stage_parameter_count(c.trunk(), inputs, pose_size + rig.num_feet(), false) + c.interp_input;
 }
 
 InbetweenerKind two_stage_kind() {

@@ -28,6 +28,14 @@
 //     written over it, concatenated with the known mask. Output: a correction
 //     added to that input (stage 1) and foot contact logits [B, T, F] for
 //     rig().foot_joints.
+// With "interp_input" 1 (a design after SILK and the Delta-interpolator,
+// ../shared/docs/REFERENCE.md section 8), the rotation channels of unknown
+// frames are not zero but, per joint, the linear interpolation of its 6D
+// between its nearest known frames (as the root's), and the Context
+// Transformer's output is a correction added to that input, scaled by a
+// learned gate (10 x the parameter "context.gate", which starts at 0): a new model starts at
+// interpolation refined by the detail stage. Files without the key are of the
+// original design.
 // Neither stage copies known values into its output (callers overwrite known
 // frames if they want them exact). Padding frames (valid = 0) never influence
 // valid frames, unless a window has no known value at all (every attention row
@@ -39,7 +47,7 @@
 // Hyperparameters (defaults: the size the pilots chose for two hours of training
 // at 1 CPU thread, docs/MODEL_CARD.md; a few milliseconds per 128-frame window):
 //   "width" 64 (d_model), "layers" 2 (per stage), "heads" 4 (must divide
-//   width), "ffn" 128, "window" 128 (maximum frames), "fps" 30.
+//   width), "ffn" 128, "window" 128 (maximum frames), "fps" 30, "interp_input" 0.
 #pragma once
 
 #include <map>
