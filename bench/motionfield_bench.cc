@@ -5,7 +5,9 @@
 // seams, sample), and prints markdown tables.
 #include <ATen/Parallel.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -73,6 +75,7 @@ struct Args {
   bool l2t = false;
   std::string dataset = "bandai";  // or "foreign": real capture on other rigs (bench/foreign_data.h)
   std::string foreign_source = mf::default_foreign_archive();
+  double foreign_fps = 0;  // the foreign clips captured at this rate only, at it (0: every clip at the model's rate)
   std::string windows_csv;  // per-window scores and signals (bench/window_log.h)
   bool no_fallback = false;  // the latent solvers keep their own result everywhere
   std::string features;  // the feature extractor of the distribution metrics (bench/motion_features.h)
@@ -122,6 +125,11 @@ void add_options(CLI::App& app, Args& args) {
                  "gets it, scored on the model's rig, with tables per rig convention and content")
       ->check(CLI::IsMember({"bandai", "foreign"}));
   app.add_option("--foreign-source", args.foreign_source, "the foreign capture (folder or archive)");
+  app.add_option("--foreign-fps", args.foreign_fps,
+                 "only the foreign clips captured at this frame rate, at their own rate (e.g. 120 with "
+                 "--resample-factors 4: real 120 fps capture given at 30 fps, its new frames scored against the real "
+                 "ones); default: every clip, resampled to the model's rate")
+      ->check(CLI::PositiveNumber);
   app.add_option("--windows-csv", args.windows_csv,
                  "also write one CSV row per (task row, window, method) of the gap, sparse and resample tables: the "
                  "window's L2P and L2Q and the signals of bench/window_log.h (foreign: the windows of the content "
@@ -174,6 +182,8 @@ void resolve(Args& args) {
     if (!args.prior_tasks.empty() && args.tasks_given)
       throw mf::InputError("--dataset foreign runs the gap, sparse and resample tasks only");
     args.prior_tasks.clear();
+  } else if (args.foreign_fps > 0) {
+    throw mf::InputError("--foreign-fps needs --dataset foreign");
   }
 }
 
@@ -227,10 +237,18 @@ void add_real_windows(const mf::bench::MotionFeatures& extractor, const std::vec
 void run_foreign(const Args& args, const mf::TaskContext& ctx, const mf::bench::EvalStats& stats,
                  mf::bench::ProtocolOptions options, const std::function<void(const std::string&)>& emit,
                  mf::bench::WindowLog* log) {
-  const mf::bench::ForeignData data =
-      mf::bench::load_foreign_data(args.foreign_source, args.data.cache_dir, ctx.model->config().fps, true);
-  const std::vector<mf::bench::ForeignClip>& clips = args.split.split == "train" ? data.train : data.validation;
-  if (clips.empty()) throw mf::InputError("no foreign clip in the " + args.split.split + " split");
+  const double fps = args.foreign_fps > 0 ? args.foreign_fps : ctx.model->config().fps;
+  const mf::bench::ForeignData data = mf::bench::load_foreign_data(args.foreign_source, args.data.cache_dir, fps, true);
+  std::vector<mf::bench::ForeignClip> clips = args.split.split == "train" ? data.train : data.validation;
+  if (args.foreign_fps > 0) {
+    clips.erase(std::remove_if(clips.begin(), clips.end(),
+                               [&](const mf::bench::ForeignClip& c) { return std::abs(c.source_fps - fps) > 1e-3; }),
+                clips.end());
+  }
+  if (clips.empty()) {
+    throw mf::InputError("no foreign clip in the " + args.split.split + " split" +
+                         (args.foreign_fps > 0 ? " captured at " + fixed(args.foreign_fps, 0) + " fps" : ""));
+  }
   std::ostringstream head;
   head << "### Foreign capture (" << args.split.split << " split: " << clips.size() << " clips)\n\n";
   for (const mf::bench::ForeignClip& c : clips)
