@@ -5,8 +5,13 @@
 // machine's single-thread SGEMM rate (Eigen's kernels and the system BLAS,
 // 512 x 512 x 512, and the BLAS at the decoder's own hidden-layer shape), and
 // the runtime's forward + VJP time against the floor FLOPs / rate (issue 56:
-// within 1.5x). Prints a markdown table; median of --reps evaluations, in
-// the calling thread's CPU time unless --wall-clock.
+// within 1.5x). Then the default solve's whole energy with its gradient with
+// respect to the latents, libtorch's evaluate_energy() + backward against the
+// Eigen runtime's (tasks/latent/runtime_energy.h), on a gap window (10 known
+// frames, a 30-frame gap, the frame after it) and a 128-frame window with
+// keys every 15 frames, cut from a motion the prior decodes from zero codes.
+// Prints markdown tables; median of --reps evaluations, in the calling
+// thread's CPU time unless --wall-clock.
 #include <ATen/ATen.h>
 
 #include <algorithm>
@@ -18,9 +23,13 @@
 #include <vector>
 
 #include "prior/model/model_file.h"
+#include "prior/model/representation.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
+#include "tasks/latent/energies.h"
+#include "tasks/latent/runtime_energy.h"
+#include "tasks/latent/runtime_problem.h"
 
 namespace {
 
@@ -110,6 +119,67 @@ DecoderTimes torch_times(const mf::NemfModel& model, int S, int reps) {
   return t;
 }
 
+// The motion the prior decodes from zero codes over its whole window, its
+// root path from the GMP: a source of windows as long as the model's.
+mf::Motion decoded_motion(const mf::NemfModel& model) {
+  at::NoGradGuard no_grad;
+  const int W = model.config().window;
+  const at::Tensor z_l = at::zeros({1, model.config().zl}), z_g = at::zeros({1, model.config().zg});
+  const at::Tensor rotations = model.decode(at::arange(W, at::kFloat), z_l, z_g);
+  const at::Tensor root = model.root_positions(rotations, model.predict_global(rotations));
+  mf::Motion m = mf::Motion::identity(model.rig().skeleton, W, model.config().fps);
+  mf::write_window(rotations, root, mf::GroundTransform{}, &m, 0);
+  return m;
+}
+
+struct EnergyTimes {
+  double torch_ms, runtime_ms;
+};
+
+// The default energy + its gradient at random codes on frames [0, length) of
+// `motion` with full-pose keys at `keys`.
+EnergyTimes energy_times(const mf::NemfModel& model, const mf::runtime::NemfRuntime& rt, const mf::Motion& motion,
+                         const std::vector<int>& keys, int length, int reps) {
+  const mf::WindowProblem problem =
+      mf::make_window_problem(model.rig(), motion, 0, length, mf::MotionConstraints::full_pose(keys), keys.front());
+  const mf::RuntimeWindowProblem rp = mf::to_runtime_problem(problem, rt.rig().num_joints());
+  const mf::EnergyWeights weights;
+  std::mt19937 rng(length);
+  const MatrixRXf z_l = random_matrix(rt.config().zl, 1, rng), z_g = random_matrix(rt.config().zg, 1, rng);
+  const at::Tensor t_zl = at::from_blob(const_cast<float*>(z_l.data()), {1, z_l.rows()}, at::kFloat).clone();
+  const at::Tensor t_zg = at::from_blob(const_cast<float*>(z_g.data()), {1, z_g.rows()}, at::kFloat).clone();
+  EnergyTimes t;
+  t.torch_ms = median_ms(reps, [&] {
+    const at::Tensor zl = t_zl.clone().requires_grad_(true), zg = t_zg.clone().requires_grad_(true);
+    mf::evaluate_energy(model, problem, weights, zl, zg).total.backward();
+  });
+  mf::RuntimeEnergy energy(rt);
+  const Eigen::VectorXf zl = z_l.col(0), zg = z_g.col(0);
+  Eigen::VectorXf g_zl, g_zg;
+  t.runtime_ms = median_ms(reps, [&] { energy.evaluate(rp, weights, zl, zg, &g_zl, &g_zg); });
+  return t;
+}
+
+void print_energy_times(const mf::NemfModel& model, const mf::runtime::NemfRuntime& rt, int reps) {
+  const mf::Motion motion = decoded_motion(model);
+  std::vector<int> every_15;
+  for (int f = 0; f < 128; f += 15) every_15.push_back(f);
+  every_15.push_back(127);
+  const struct {
+    const char* name;
+    std::vector<int> keys;
+    int length;
+  } windows[] = {{"gap 30 (41 frames)", {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 40}, 41},
+                 {"keys every 15 (128 frames)", every_15, 128}};
+  std::printf("\nThe default energy + gradient (rotation, position, root_orientation, root_translation; squared)\n\n"
+              "| window | libtorch evaluate_energy + backward (ms) | Eigen runtime (ms) | speed-up |\n"
+              "|---|---|---|---|\n");
+  for (const auto& w : windows) {
+    const EnergyTimes t = energy_times(model, rt, motion, w.keys, w.length, reps);
+    std::printf("| %s | %.3f | %.3f | %.1fx |\n", w.name, t.torch_ms, t.runtime_ms, t.torch_ms / t.runtime_ms);
+  }
+}
+
 int run(const std::string& model_path, int reps) {
   mf::set_compute_threads(1);
   const mf::NemfModel model = mf::load_nemf(model_path);
@@ -140,6 +210,7 @@ int run(const std::string& model_path, int reps) {
                 shape_rate, r.forward_ms, r.forward_vjp_ms, e.forward_vjp_ms, t.forward_ms, t.forward_vjp_ms, floor_ms,
                 r.forward_vjp_ms / floor_ms, shape_floor_ms, r.forward_vjp_ms / shape_floor_ms);
   }
+  print_energy_times(model, rt, reps);
   return 0;
 }
 
@@ -149,7 +220,8 @@ int main(int argc, char** argv) {
   std::string model_path = mf::default_model_path();
   int reps = 200;
   CLI::App app{"Times the prior's decoder through the Eigen runtime and through libtorch at one thread, against "
-               "its matrix-product floor (FLOPs / measured SGEMM rate).",
+               "its matrix-product floor (FLOPs / measured SGEMM rate), and the default solve's energy + gradient both "
+               "ways.",
                "runtime-bench"};
   mf::cli::use_tool_defaults(app);
   app.add_option("--model", model_path, "the prior's model file (default: the shipped one)");

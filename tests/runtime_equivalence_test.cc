@@ -17,112 +17,45 @@
 
 #include "prior/model/model_file.h"
 #include "prior/model/representation.h"
-#include "prior/motion/motion_bvh.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/util/threads.h"
-#include "tasks/context/model_rig.h"
-#include "tasks/context/task_context.h"
+#include "tests/runtime_test_util.h"
 
 namespace mf {
 namespace {
 
-using runtime::MatrixRXf;
+using test::float64_model;
+using test::MatrixRXf;
+using test::normal_matrix;
+using test::relative_difference;
+using test::relative_vector_difference;
+using test::to_matrix;
+using test::to_tensor;
+using test::to_vector;
 
-constexpr double kOutputTolerance = 1e-5;
-constexpr double kGradientTolerance = 1e-4;
+using test::kGradientTolerance;
+using test::kOutputTolerance;
 
-const std::string& model_path() {
-  static const std::string path = std::string(MF_SOURCE_DIR) + "/models/motionfield-prior.mfm";
-  return path;
-}
-
-struct BothModels {
-  NemfModel frozen = load_nemf(model_path());  // as the solvers use it: the hand-written backward nodes
-  runtime::NemfRuntime runtime = runtime::NemfRuntime::load(model_path());
-};
-
-const BothModels& models() {
-  static const BothModels m;
-  return m;
-}
+const test::BothModels& models() { return test::shipped_models(); }
 
 // The shipped prior with its weights unfrozen: decode and the GMP take the
 // module path, whose gradients are libtorch's own autograd.
 const NemfModel& autograd_model() {
   static const NemfModel m = [] {
-    NemfModel model = load_nemf(model_path());
+    NemfModel model = load_nemf(test::shipped_model_path());
     model.set_requires_grad(true);
     return model;
   }();
   return m;
 }
 
-// The shipped prior in float64 (parameters and statistics converted in
-// place; it runs the module path, the frozen nodes being float32 only):
-// central differences of it resolve derivatives far below float32 rounding
-// and, with steps of 1e-5, cross almost none of the ReLU kinks, which
-// made float32 differences disagree by 1e-3 to 1e-1 (steps 1e-3 to 1e-1).
-const NemfModel& float64_model() {
-  static const NemfModel m = [] {
-    NemfModel model = load_nemf(model_path());
-    at::NoGradGuard no_grad;
-    for (auto& named : model.named_parameters()) named.second.set_data(named.second.to(at::kDouble));
-    NemfStats& s = model.stats();
-    for (at::Tensor* t : {&s.feature_mean, &s.feature_std, &s.root_mean, &s.root_std, &s.gmp_in_mean, &s.gmp_in_std,
-                          &s.gmp_out_mean, &s.gmp_out_std})
-      *t = t->to(at::kDouble);
-    return model;
-  }();
-  return m;
-}
+using test::kDifferenceStep;
 
-constexpr double kDifferenceStep = 1e-5;
-
-at::Tensor to_tensor(const Eigen::Ref<const MatrixRXf>& m) {
-  const MatrixRXf copy = m;
-  return at::from_blob(const_cast<float*>(copy.data()), {copy.rows(), copy.cols()}, at::kFloat).clone();
-}
-
-MatrixRXf to_matrix(const at::Tensor& t) {
-  const at::Tensor c = t.detach().to(at::kFloat).contiguous().reshape({t.size(0), -1});
-  return Eigen::Map<const MatrixRXf>(c.data_ptr<float>(), c.size(0), c.size(1));
-}
-
-Eigen::VectorXf to_vector(const at::Tensor& t) {
-  const at::Tensor c = t.detach().to(at::kFloat).contiguous().reshape({-1});
-  return Eigen::Map<const Eigen::VectorXf>(c.data_ptr<float>(), c.numel());
-}
-
-// max |a - b| / max |b|
-double relative_difference(const Eigen::Ref<const MatrixRXf>& a, const Eigen::Ref<const MatrixRXf>& b) {
-  EXPECT_EQ(a.rows(), b.rows());
-  EXPECT_EQ(a.cols(), b.cols());
-  if (a.rows() != b.rows() || a.cols() != b.cols()) return 1.0;
-  return (a - b).cwiseAbs().maxCoeff() / b.cwiseAbs().maxCoeff();
-}
-
-double relative_vector_difference(const Eigen::VectorXf& a, const Eigen::VectorXf& b) {
-  return relative_difference(MatrixRXf(a.transpose()), MatrixRXf(b.transpose()));
-}
-
-MatrixRXf normal_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937& rng) {
-  std::normal_distribution<float> n;
-  MatrixRXf m(rows, cols);
-  for (Eigen::Index i = 0; i < m.size(); ++i) m.data()[i] = n(rng);
-  return m;
-}
-
-// The sample walk on the model's rig (retargeted as the tasks do) as one
-// canonical window of its 61 frames.
+// The sample walk on the model's rig as one canonical window of its 61 frames.
 const WindowTensors& real_window() {
   static const WindowTensors w = [] {
-    const Motion walk = read_motion(std::string(MF_SOURCE_DIR) + "/samples/walk_keyframes.bvh");
-    TaskContext ctx;
-    auto model = std::make_shared<const NemfModel>(load_nemf(model_path()));
-    ctx.model = model;
-    ctx.model_anatomy = load_rig_anatomy_next_to(model_path(), model->rig().skeleton);
-    const Motion on_model = model_retargeter(walk, {}, ctx).to_model(walk);
-    return window_tensors(on_model, 0, on_model.num_frames(), model->rig(), 0);
+    const Motion& on_model = test::walk_on_model_rig();
+    return window_tensors(on_model, 0, on_model.num_frames(), models().frozen.rig(), 0);
   }();
   return w;
 }
@@ -133,7 +66,7 @@ const WindowTensors& real_window() {
 void expect_decoders_agree(const Eigen::VectorXd& frames, const Eigen::VectorXf& z_l, const Eigen::VectorXf& z_g,
                            uint32_t seed) {
   ScopedComputeThreads one_thread(1);
-  const BothModels& m = models();
+  const test::BothModels& m = models();
   const int64_t S = frames.size(), J6 = m.runtime.rig().num_joints() * 6;
   runtime::DecoderWorkspace ws;
   MatrixRXf out;
@@ -223,7 +156,7 @@ TEST(RuntimeEquivalence, DecoderOnRandomLatentsAndTimes) {
 
 TEST(RuntimeEquivalence, EncodersAndDecoderOnARealWindow) {
   ScopedComputeThreads one_thread(1);
-  const BothModels& m = models();
+  const test::BothModels& m = models();
   const WindowTensors& w = real_window();
   const int64_t T = w.local_rotations.size(1);
   at::Tensor root6d;
@@ -250,7 +183,7 @@ TEST(RuntimeEquivalence, EncodersAndDecoderOnARealWindow) {
 // <g, outputs> for a random g against the frozen node's and autograd's.
 void expect_gmps_agree(const MatrixRXf& inputs, uint32_t seed) {
   ScopedComputeThreads one_thread(1);
-  const BothModels& m = models();
+  const test::BothModels& m = models();
   const int64_t T = inputs.rows(), outputs = 4 + m.runtime.rig().num_feet();
   std::mt19937 rng(seed);
   const MatrixRXf g = normal_matrix(T, outputs, rng);

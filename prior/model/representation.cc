@@ -11,6 +11,7 @@
 
 #include "prior/motion/errors.h"
 #include "prior/motion/kinematics_torch.h"
+#include "prior/motion/rotation_kernels.h"
 #include "prior/motion/rotations_torch.h"
 
 namespace mf {
@@ -60,16 +61,10 @@ at::Tensor time_derivative(const at::Tensor& x, double fps) {
   return (next - prev) * fps / span.view(shape);
 }
 
-// The heading R_y(yaw) of each root rotation as one autograd node (as tensor
-// operations it was ~17 operators forward and as many backward, paid twice in
-// every evaluation of a dense energy: the GMP's inputs and the root path).
-// f = R forward, n = sqrt(fx^2 + fz^2 + eps), (s, c) = (fx, fz) / n,
-// H = [[c, 0, s], [0, 1, 0], [-s, 0, c]]. Backward: g_s = G02 - G20,
-// g_c = G00 + G22; g_fx = (g_s (fz^2 + eps) - g_c fx fz) / n^3,
-// g_fz = (g_c (fx^2 + eps) - g_s fx fz) / n^3; dL/dR row 0 = g_fx forward^T,
-// row 2 = g_fz forward^T, row 1 = 0.
-constexpr double kHeadingEps = 1e-12;
-
+// The heading R_y(yaw) of each root rotation as one autograd node
+// (kernels::heading_rotation and its VJP; as tensor operations it was ~17
+// operators forward and as many backward, paid twice in every evaluation of a
+// dense energy: the GMP's inputs and the root path).
 class HeadingFunction : public torch::autograd::Function<HeadingFunction> {
  public:
   // root [N, 3, 3] contiguous float or double -> [N, 3, 3].
@@ -82,17 +77,7 @@ class HeadingFunction : public torch::autograd::Function<HeadingFunction> {
       scalar_t* H = out.data_ptr<scalar_t>();
       const scalar_t w[3] = {scalar_t(forward.x()), scalar_t(forward.y()), scalar_t(forward.z())};
       at::parallel_for(0, N, 2048, [&](int64_t n0, int64_t n1) {
-        for (int64_t n = n0; n < n1; ++n) {
-          const scalar_t* r = R + n * 9;
-          const scalar_t fx = r[0] * w[0] + r[1] * w[1] + r[2] * w[2];
-          const scalar_t fz = r[6] * w[0] + r[7] * w[1] + r[8] * w[2];
-          const scalar_t inv = scalar_t(1) / std::sqrt(fx * fx + fz * fz + scalar_t(kHeadingEps));
-          const scalar_t s = fx * inv, c = fz * inv;
-          scalar_t* h = H + n * 9;
-          h[0] = c, h[1] = 0, h[2] = s;
-          h[3] = 0, h[4] = 1, h[5] = 0;
-          h[6] = -s, h[7] = 0, h[8] = c;
-        }
+        for (int64_t n = n0; n < n1; ++n) kernels::heading_rotation(R + n * 9, w, H + n * 9);
       });
     });
     ctx->save_for_backward({root});
@@ -111,21 +96,8 @@ class HeadingFunction : public torch::autograd::Function<HeadingFunction> {
       const scalar_t *R = root.data_ptr<scalar_t>(), *G = g.data_ptr<scalar_t>();
       scalar_t* out = groot.data_ptr<scalar_t>();
       const scalar_t w[3] = {scalar_t(forward[0]), scalar_t(forward[1]), scalar_t(forward[2])};
-      const scalar_t eps = scalar_t(kHeadingEps);
       at::parallel_for(0, N, 2048, [&](int64_t n0, int64_t n1) {
-        for (int64_t n = n0; n < n1; ++n) {
-          const scalar_t* r = R + n * 9;
-          const scalar_t* gh = G + n * 9;
-          const scalar_t fx = r[0] * w[0] + r[1] * w[1] + r[2] * w[2];
-          const scalar_t fz = r[6] * w[0] + r[7] * w[1] + r[8] * w[2];
-          const scalar_t n2 = fx * fx + fz * fz + eps;
-          const scalar_t inv3 = scalar_t(1) / (n2 * std::sqrt(n2));
-          const scalar_t gs = gh[2] - gh[6], gc = gh[0] + gh[8];
-          const scalar_t gfx = (gs * (fz * fz + eps) - gc * fx * fz) * inv3;
-          const scalar_t gfz = (gc * (fx * fx + eps) - gs * fx * fz) * inv3;
-          scalar_t* o = out + n * 9;
-          for (int k = 0; k < 3; ++k) o[k] = gfx * w[k], o[3 + k] = 0, o[6 + k] = gfz * w[k];
-        }
+        for (int64_t n = n0; n < n1; ++n) kernels::heading_rotation_vjp(R + n * 9, w, G + n * 9, out + n * 9);
       });
     });
     return {groot, at::Tensor()};

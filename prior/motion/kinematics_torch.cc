@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "prior/motion/errors.h"
+#include "prior/motion/kinematics_kernels.h"
 #include "prior/motion/skeleton.h"
 
 namespace mf {
@@ -22,73 +23,13 @@ std::string shape_string(const at::Tensor& t) {
   return s + "]";
 }
 
-// The kinematic chain as one autograd node with a hand-written backward over
-// plain arrays. FK runs in every energy evaluation of the latent solvers, where
-// a batched formulation (a few tensor operations per tree level) cost about
-// 2 ms per forward + backward over 128 frames, nearly all of it per-operation
-// framework overhead; the arithmetic is ~100 flops per joint and frame
-// (bench/fk_cost.cc compares it with a joint-by-joint autograd reference).
-//   R_0 = L_0, p_0 = root;  R_j = R_par L_j, p_j = p_par + R_par o_j.
-// Backward, children before parents (parents[j] < j):
-//   gp_par += gp_j;  gR_par += gp_j o_j^T + gR_j L_j^T;
-//   go_j = R_par^T gp_j (summed over frames);  gL_j = R_par^T gR_j;  gL_0 = gR_0;  g_root = gp_0.
-template <typename T>
-void fk_forward(const T* L, const T* root, const T* o, const int* parents, int64_t J, int64_t n0, int64_t n1, T* P,
-                T* R) {
-  for (int64_t n = n0; n < n1; ++n) {
-    const T* l = L + n * J * 9;
-    T* r = R + n * J * 9;
-    T* p = P + n * J * 3;
-    std::copy(l, l + 9, r);
-    std::copy(root + n * 3, root + n * 3 + 3, p);
-    for (int64_t j = 1; j < J; ++j) {
-      const T* a = r + parents[j] * 9;
-      const T* b = l + j * 9;
-      const T* oj = o + j * 3;
-      const T* pp = p + parents[j] * 3;
-      T* c = r + j * 9;
-      for (int i = 0; i < 3; ++i) {
-        for (int k = 0; k < 3; ++k) c[i * 3 + k] = a[i * 3] * b[k] + a[i * 3 + 1] * b[3 + k] + a[i * 3 + 2] * b[6 + k];
-        p[j * 3 + i] = pp[i] + a[i * 3] * oj[0] + a[i * 3 + 1] * oj[1] + a[i * 3 + 2] * oj[2];
-      }
-    }
-  }
-}
-
-template <typename T>
-void fk_backward(const T* L, const T* o, const T* R, const T* gP, const T* gR, const int* parents, int64_t J,
-                 int64_t n0, int64_t n1, T* gL, T* gRoot, T* gO, std::vector<T>& gp, std::vector<T>& gr) {
-  for (int64_t n = n0; n < n1; ++n) {
-    const T* l = L + n * J * 9;
-    const T* r = R + n * J * 9;
-    std::copy(gP + n * J * 3, gP + (n + 1) * J * 3, gp.begin());
-    std::copy(gR + n * J * 9, gR + (n + 1) * J * 9, gr.begin());
-    T* gl = gL + n * J * 9;
-    T* go = gO + n * J * 3;
-    std::fill(go, go + 3, T(0));
-    for (int64_t j = J - 1; j >= 1; --j) {
-      const int64_t q = parents[j];
-      const T* a = r + q * 9;   // R_par
-      const T* b = l + j * 9;   // L_j
-      const T* oj = o + j * 3;
-      const T* gpj = &gp[j * 3];
-      const T* grj = &gr[j * 9];
-      T* grq = &gr[q * 9];
-      for (int i = 0; i < 3; ++i) {
-        gp[q * 3 + i] += gpj[i];
-        go[j * 3 + i] = a[i] * gpj[0] + a[3 + i] * gpj[1] + a[6 + i] * gpj[2];
-        for (int k = 0; k < 3; ++k) {
-          grq[i * 3 + k] += gpj[i] * oj[k] + grj[i * 3] * b[k * 3] + grj[i * 3 + 1] * b[k * 3 + 1] +
-                            grj[i * 3 + 2] * b[k * 3 + 2];
-          gl[j * 9 + i * 3 + k] = a[i] * grj[k] + a[3 + i] * grj[3 + k] + a[6 + i] * grj[6 + k];
-        }
-      }
-    }
-    std::copy(gr.begin(), gr.begin() + 9, gl);
-    std::copy(gp.begin(), gp.begin() + 3, gRoot + n * 3);
-  }
-}
-
+// The kinematic chain as one autograd node with the hand-written backward of
+// kinematics_kernels.h (shared with the Eigen runtime). FK runs in every
+// energy evaluation of the latent solvers, where a batched formulation (a few
+// tensor operations per tree level) cost about 2 ms per forward + backward
+// over 128 frames, nearly all of it per-operation framework overhead; the
+// arithmetic is ~100 flops per joint and frame (bench/fk_cost.cc compares it
+// with a joint-by-joint autograd reference).
 // Frames per parallel task: a humanoid's FK costs about a microsecond per frame.
 constexpr int64_t kGrain = 64;
 
@@ -103,7 +44,8 @@ class FkFunction : public torch::autograd::Function<FkFunction> {
     AT_DISPATCH_FLOATING_TYPES(local.scalar_type(), "forward_kinematics", [&] {
       const scalar_t *l = local.data_ptr<scalar_t>(), *rt = root.data_ptr<scalar_t>(), *o = offsets.data_ptr<scalar_t>();
       scalar_t *p = P.data_ptr<scalar_t>(), *r = R.data_ptr<scalar_t>();
-      at::parallel_for(0, N, kGrain, [&](int64_t n0, int64_t n1) { fk_forward(l, rt, o, parents.data(), J, n0, n1, p, r); });
+      at::parallel_for(0, N, kGrain,
+                       [&](int64_t n0, int64_t n1) { kernels::fk_forward(l, rt, o, parents.data(), J, n0, n1, p, r); });
     });
     ctx->save_for_backward({local, offsets, R});
     ctx->saved_data["parents"] = c10::List<int64_t>(std::vector<int64_t>(parents.begin(), parents.end()));
@@ -127,7 +69,7 @@ class FkFunction : public torch::autograd::Function<FkFunction> {
       scalar_t *gl = gL.data_ptr<scalar_t>(), *groot = gRoot.data_ptr<scalar_t>(), *go = gO.data_ptr<scalar_t>();
       at::parallel_for(0, N, kGrain, [&](int64_t n0, int64_t n1) {
         std::vector<scalar_t> acc_p(static_cast<size_t>(J) * 3), acc_r(static_cast<size_t>(J) * 9);
-        fk_backward(l, o, r, gp, gr, parents.data(), J, n0, n1, gl, groot, go, acc_p, acc_r);
+        kernels::fk_backward(l, o, r, gp, gr, parents.data(), J, n0, n1, gl, groot, go, acc_p, acc_r);
       });
     });
     return {gL, gRoot, gO.sum(0), at::Tensor()};

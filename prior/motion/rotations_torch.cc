@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "prior/motion/errors.h"
+#include "prior/motion/rotation_kernels.h"
 
 namespace mf::torch_rot {
 namespace {
@@ -62,50 +63,11 @@ at::Tensor sqrt_positive(const at::Tensor& x) {
 }
 
 // Gram-Schmidt of the 6D representation as one autograd node with a
-// hand-written backward: as tensor operations it was ~25 operators forward and
-// as many backward nodes in every decode (per-operation overhead, not
-// arithmetic, is what a latent solver's evaluation pays; see FK). Same clamp as
-// normalize_last. Per 6-vector (a1, a2):
-//   b1 = a1 r1, r1 = 1/|a1|;  u = a2 - (b1.a2) b1;  b2 = u r2, r2 = 1/|u|;  b3 = b1 x b2.
-// Backward: g1 += b2 x g3, g2 += g3 x b1;  gu = r2 (g2 - (g2.b2) b2);
-//   ga2 = gu - (gu.b1) b1;  g1 += -(b1.a2) gu - (gu.b1) a2;  ga1 = r1 (g1 - (g1.b1) b1)
-// (a clamped norm passes g r unprojected, as clamp_min's zero gradient does).
-constexpr double kNormFloor = 1e-24;
-
-template <typename T>
-struct SixdFrame {
-  T a1[3], a2[3], b1[3], b2[3], b3[3], u[3], r1, r2, d;
-  bool clamp1, clamp2;
-  explicit SixdFrame(const T* x) {
-    for (int i = 0; i < 3; ++i) a1[i] = x[i], a2[i] = x[3 + i];
-    const T n1 = a1[0] * a1[0] + a1[1] * a1[1] + a1[2] * a1[2];
-    clamp1 = n1 < T(kNormFloor);
-    r1 = T(1) / std::sqrt(clamp1 ? T(kNormFloor) : n1);
-    for (int i = 0; i < 3; ++i) b1[i] = a1[i] * r1;
-    d = b1[0] * a2[0] + b1[1] * a2[1] + b1[2] * a2[2];
-    for (int i = 0; i < 3; ++i) u[i] = a2[i] - d * b1[i];
-    const T n2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-    clamp2 = n2 < T(kNormFloor);
-    r2 = T(1) / std::sqrt(clamp2 ? T(kNormFloor) : n2);
-    for (int i = 0; i < 3; ++i) b2[i] = u[i] * r2;
-    b3[0] = b1[1] * b2[2] - b1[2] * b2[1];
-    b3[1] = b1[2] * b2[0] - b1[0] * b2[2];
-    b3[2] = b1[0] * b2[1] - b1[1] * b2[0];
-  }
-};
-
-template <typename T>
-T dot3(const T* a, const T* b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-template <typename T>
-void cross_add(const T* a, const T* b, T* out) {
-  out[0] += a[1] * b[2] - a[2] * b[1];
-  out[1] += a[2] * b[0] - a[0] * b[2];
-  out[2] += a[0] * b[1] - a[1] * b[0];
-}
-
+// hand-written backward (kernels::sixd_to_matrix and its VJP, shared with the
+// Eigen runtime): as tensor operations it was ~25 operators forward and as
+// many backward nodes in every decode (per-operation overhead, not
+// arithmetic, is what a latent solver's evaluation pays; see FK). Same clamp
+// as normalize_last.
 class SixdFunction : public torch::autograd::Function<SixdFunction> {
  public:
   // d6 [N, 6] contiguous float or double -> [N, 3, 3] (columns b1, b2, b3).
@@ -116,11 +78,7 @@ class SixdFunction : public torch::autograd::Function<SixdFunction> {
       const scalar_t* x = d6.data_ptr<scalar_t>();
       scalar_t* out = m.data_ptr<scalar_t>();
       at::parallel_for(0, N, 1024, [&](int64_t n0, int64_t n1) {
-        for (int64_t n = n0; n < n1; ++n) {
-          const SixdFrame<scalar_t> f(x + n * 6);
-          scalar_t* o = out + n * 9;
-          for (int i = 0; i < 3; ++i) o[i * 3] = f.b1[i], o[i * 3 + 1] = f.b2[i], o[i * 3 + 2] = f.b3[i];
-        }
+        for (int64_t n = n0; n < n1; ++n) kernels::sixd_to_matrix(x + n * 6, out + n * 9);
       });
     });
     ctx->save_for_backward({d6});
@@ -137,54 +95,19 @@ class SixdFunction : public torch::autograd::Function<SixdFunction> {
       const scalar_t *x = d6.data_ptr<scalar_t>(), *gm = g.data_ptr<scalar_t>();
       scalar_t* out = gd.data_ptr<scalar_t>();
       at::parallel_for(0, N, 1024, [&](int64_t n0, int64_t n1) {
-        for (int64_t n = n0; n < n1; ++n) {
-          const SixdFrame<scalar_t> f(x + n * 6);
-          const scalar_t* G = gm + n * 9;
-          scalar_t g1[3], g2[3], g3[3], gu[3];
-          for (int i = 0; i < 3; ++i) g1[i] = G[i * 3], g2[i] = G[i * 3 + 1], g3[i] = G[i * 3 + 2];
-          cross_add(f.b2, g3, g1);
-          cross_add(g3, f.b1, g2);
-          const scalar_t p2 = f.clamp2 ? scalar_t(0) : dot3(g2, f.b2);
-          for (int i = 0; i < 3; ++i) gu[i] = f.r2 * (g2[i] - p2 * f.b2[i]);
-          const scalar_t ub = dot3(gu, f.b1);
-          scalar_t* o = out + n * 6;
-          for (int i = 0; i < 3; ++i) {
-            o[3 + i] = gu[i] - ub * f.b1[i];
-            g1[i] += -f.d * gu[i] - ub * f.a2[i];
-          }
-          const scalar_t p1 = f.clamp1 ? scalar_t(0) : dot3(g1, f.b1);
-          for (int i = 0; i < 3; ++i) o[i] = f.r1 * (g1[i] - p1 * f.b1[i]);
-        }
+        for (int64_t n = n0; n < n1; ++n) kernels::sixd_to_matrix_vjp(x + n * 6, gm + n * 9, out + n * 6);
       });
     });
     return {gd};
   }
 };
 
-// The angle of the relative rotation R = m0^T m1 as one autograd node (it was
-// ~60 operators forward and as many backward through matrix_to_quat, in every
-// evaluation of the key terms). For a rotation, with the skew part
-// v = (R21 - R12, R02 - R20, R10 - R01) / 2 = sin(angle) axis and
-// c = (trace R - 1) / 2 = cos(angle): angle = atan2(|v|, c), which keeps float
-// precision near 0 and pi (the same value as 2 atan2(|xyz|, |w|) of the
-// quaternion; the gradients agree along rotations, which is all a 6D decode
-// can move). Backward: with d = |v|^2 + c^2, g_s = g c / d, g_c = -g |v| / d,
-// G = dL/dR = (g_c / 2) I plus (g_s / 2) v/|v| scattered to the skew entries
-// (zero where |v| = 0: a subgradient); dL/dm0 = m1 G^T, dL/dm1 = m0 G.
-template <typename T>
-struct GeodesicPair {
-  T R[9], v[3], s, c;
-  GeodesicPair(const T* A, const T* B) {
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) R[i * 3 + j] = A[i] * B[j] + A[3 + i] * B[3 + j] + A[6 + i] * B[6 + j];
-    v[0] = T(0.5) * (R[7] - R[5]);
-    v[1] = T(0.5) * (R[2] - R[6]);
-    v[2] = T(0.5) * (R[3] - R[1]);
-    s = std::sqrt(dot3(v, v));
-    c = T(0.5) * (R[0] + R[4] + R[8] - T(1));
-  }
-};
-
+// The angle of the relative rotation m0^T m1 as one autograd node
+// (kernels::geodesic_angle and its VJP; it was ~60 operators forward and as
+// many backward through matrix_to_quat, in every evaluation of the key
+// terms). atan2(|skew part|, (trace - 1) / 2) is the same value as
+// 2 atan2(|xyz|, |w|) of the quaternion; the gradients agree along
+// rotations, which is all a 6D decode can move.
 class GeodesicFunction : public torch::autograd::Function<GeodesicFunction> {
  public:
   // m0, m1 [N, 3, 3] contiguous, same floating type -> [N].
@@ -196,10 +119,7 @@ class GeodesicFunction : public torch::autograd::Function<GeodesicFunction> {
       const scalar_t *A = m0.data_ptr<scalar_t>(), *B = m1.data_ptr<scalar_t>();
       scalar_t* out = angle.data_ptr<scalar_t>();
       at::parallel_for(0, N, 2048, [&](int64_t n0, int64_t n1) {
-        for (int64_t n = n0; n < n1; ++n) {
-          const GeodesicPair<scalar_t> p(A + n * 9, B + n * 9);
-          out[n] = std::atan2(p.s, p.c);
-        }
+        for (int64_t n = n0; n < n1; ++n) out[n] = kernels::geodesic_angle(A + n * 9, B + n * 9);
       });
     });
     ctx->save_for_backward({m0, m1});
@@ -221,28 +141,8 @@ class GeodesicFunction : public torch::autograd::Function<GeodesicFunction> {
       scalar_t* out1 = want1 ? g1.data_ptr<scalar_t>() : nullptr;
       at::parallel_for(0, N, 2048, [&](int64_t n0, int64_t n1) {
         for (int64_t n = n0; n < n1; ++n) {
-          const scalar_t* a = A + n * 9;
-          const scalar_t* b = B + n * 9;
-          const GeodesicPair<scalar_t> p(a, b);
-          const scalar_t d = p.s * p.s + p.c * p.c;
-          const scalar_t gs = d > 0 ? gn[n] * p.c / d : scalar_t(0);
-          const scalar_t gc = d > 0 ? -gn[n] * p.s / d : scalar_t(0);
-          const scalar_t k = p.s > 0 ? scalar_t(0.5) * gs / p.s : scalar_t(0);
-          const scalar_t h = scalar_t(0.5) * gc;
-          const scalar_t x = k * p.v[0], y = k * p.v[1], z = k * p.v[2];
-          const scalar_t G[9] = {h, -z, y, z, h, -x, -y, x, h};
-          if (out0) {  // m1 G^T
-            scalar_t* o = out0 + n * 9;
-            for (int i = 0; i < 3; ++i)
-              for (int j = 0; j < 3; ++j)
-                o[i * 3 + j] = b[i * 3] * G[j * 3] + b[i * 3 + 1] * G[j * 3 + 1] + b[i * 3 + 2] * G[j * 3 + 2];
-          }
-          if (out1) {  // m0 G
-            scalar_t* o = out1 + n * 9;
-            for (int i = 0; i < 3; ++i)
-              for (int j = 0; j < 3; ++j)
-                o[i * 3 + j] = a[i * 3] * G[j] + a[i * 3 + 1] * G[3 + j] + a[i * 3 + 2] * G[6 + j];
-          }
+          kernels::geodesic_angle_vjp(A + n * 9, B + n * 9, gn[n], out0 ? out0 + n * 9 : nullptr,
+                                      out1 ? out1 + n * 9 : nullptr);
         }
       });
     });

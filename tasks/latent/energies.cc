@@ -306,38 +306,22 @@ void blend_residuals(const WindowProblem& p, const at::Tensor& rotations, const 
 
 namespace {
 
-// Which terms are active (a positive weight and something to measure) and
-// how many items each averages over.
-struct ActiveTerms {
-  double n_rot = 0, n_root_rot = 0, n_pos = 0, n_root = 0;
-  bool rot = false, root_rot = false, pos = false, root = false, eff = false, pin = false, skate = false, smooth = false;
-  bool traj = false, facing = false;
-  bool dense = false;  // a term that needs the whole window decoded
-  bool keyed = false;  // a term that needs the key frames decoded
-};
-
+// The items of each term in `problem` (TermCounts).
 ActiveTerms active_terms(const RigInfo& rig, const WindowProblem& problem, const EnergyWeights& w) {
-  const int J = rig.num_joints(), T = problem.length;
-  ActiveTerms a;
+  const int J = rig.num_joints();
+  TermCounts c;
   if (problem.num_keys() > 0) {
-    a.n_rot = problem.key_rotation_mask.narrow(1, 1, J - 1).sum().item<double>();
-    a.n_root_rot = problem.key_rotation_mask.select(1, 0).sum().item<double>();
-    a.n_pos = problem.key_position_mask.sum().item<double>();
-    a.n_root = problem.key_root_mask.sum().item<double>();
+    c.rotations = problem.key_rotation_mask.narrow(1, 1, J - 1).sum().item<double>();
+    c.root_rotations = problem.key_rotation_mask.select(1, 0).sum().item<double>();
+    c.positions = problem.key_position_mask.sum().item<double>();
+    c.root_positions = problem.key_root_mask.sum().item<double>();
   }
-  a.rot = w.rotation > 0 && a.n_rot > 0;
-  a.root_rot = w.root_orientation > 0 && a.n_root_rot > 0;
-  a.pos = w.position > 0 && a.n_pos > 0;
-  a.root = w.root_translation > 0 && a.n_root > 0;
-  a.eff = w.effector > 0 && problem.num_effectors() > 0;
-  a.pin = w.contact > 0 && problem.num_pin_steps() > 0;
-  a.skate = w.foot_skating > 0 && rig.num_feet() > 0 && T >= 2;
-  a.smooth = w.smoothness > 0 && T >= 3;
-  a.traj = w.trajectory > 0 && problem.num_trajectory() > 0;
-  a.facing = w.trajectory_facing > 0 && problem.num_trajectory() > 0;
-  a.dense = a.root || a.eff || a.pin || a.traj || a.facing || a.skate || a.smooth;
-  a.keyed = a.rot || a.root_rot || a.pos;
-  return a;
+  c.effectors = problem.num_effectors();
+  c.pin_steps = problem.num_pin_steps();
+  c.trajectory_rows = problem.num_trajectory();
+  c.feet = rig.num_feet();
+  c.length = problem.length;
+  return active_terms(c, w);
 }
 
 void add_term(EnergyTerms* out, const char* name, double weight, const at::Tensor& value) {

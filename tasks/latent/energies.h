@@ -64,6 +64,7 @@
 #include "prior/model/representation.h"
 #include "prior/motion/motion.h"
 #include "tasks/constraints/motion_constraints.h"
+#include "tasks/latent/energy_weights.h"
 #include "tasks/latent/latent_energy.h"
 #include "tasks/latent/window_solver.h"
 
@@ -116,35 +117,6 @@ struct WindowProblem {
 /// match the rig, a bad range or a bad anchor.
 WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int begin, int length,
                                   const MotionConstraints& constraints, int anchor);
-
-/// How residuals are penalised (see the top of this file).
-enum class Penalty { Squared, Absolute };
-
-/// Weights of the energy terms (see the top of this file for each term's
-/// definition and unit). Defaults were chosen by measurement
-/// (docs/experiments/2026-12-07-solver-defaults.md, "Energy weights").
-struct EnergyWeights {
-  double rotation = 5.0;
-  double position = 10.0;
-  double root_orientation = 1.0;
-  double root_translation = 10.0;
-  double effector = 100.0;
-  double contact = 10.0;
-  /// The trajectory terms' weights: docs/CONSTRAINTS.md ("Trajectory") has
-  /// their measurement (trajectory-bench).
-  double trajectory = 100.0;
-  double trajectory_facing = 30.0;
-  double latent_prior = 0.0;
-  double foot_skating = 0.0;
-  double smoothness = 0.0;
-  Penalty penalty = Penalty::Squared;
-  /// The dense output terms (effector, contact, trajectory, foot_skating,
-  /// smoothness) see the
-  /// motion as complete_motion() returns it: after the overwrite of the known
-  /// values, whose residuals are blended into the frames between keys (see
-  /// tasks/latent/latent_solver.h); otherwise the raw decoded motion.
-  bool on_output = true;
-};
 
 /// Evaluates the energy of (z_l [1, zl], z_g [1, zg]) on `problem`: the
 /// active terms, weighted, in the order above (EnergyTerms, tasks/latent/latent_energy.h).

@@ -8,7 +8,10 @@
 #include <string>
 
 #include "prior/motion/errors.h"
+#include "prior/runtime/kinematics.h"
 #include "prior/runtime/nemf_runtime.h"
+#include "prior/runtime/rotations.h"
+#include "tasks/latent/runtime_energy.h"
 
 namespace mf::runtime {
 namespace {
@@ -100,6 +103,44 @@ TEST(RuntimeStandalone, GemmBackendsAgree) {
   MatrixRXf block_result(10, 29);
   gemm(a.block(2, 3, 10, 50).transpose(), true, b.middleCols(3, 50), true, block_result, 0.0f);
   EXPECT_LT((block_result - a.block(2, 3, 10, 50) * b.middleCols(3, 50).transpose()).cwiseAbs().maxCoeff(), 1e-4f);
+}
+
+// The latent energy without libtorch: full keys at what z0 decodes to give a
+// near-zero energy and gradient at z0 and a larger energy away from it; the
+// latent prior is 0.5 |z|^2 weighted; an active term it does not implement
+// is refused.
+TEST(RuntimeStandalone, LatentEnergyVanishesAtAPerfectFit) {
+  const NemfRuntime& m = shipped();
+  const int J = m.rig().num_joints();
+  std::mt19937 rng(5);
+  const Eigen::VectorXf z_l = normal_vector(m.config().zl, rng), z_g = normal_vector(m.config().zg, rng);
+  RuntimeWindowProblem p;
+  p.length = 31;
+  p.key_frames = {0, 12, 30};
+  DecoderWorkspace ws;
+  MatrixRXf sixd, positions, globals;
+  m.decode(Eigen::Vector3d(0.0, 12.0, 30.0), z_l, z_g, &ws, &sixd);
+  sixd_to_matrix(sixd, &p.key_rotations);
+  Kinematics(m.rig().skeleton).forward(p.key_rotations, MatrixRXf::Zero(3, 3), &positions, &globals);
+  p.key_positions = positions;
+  p.key_rotation_mask = p.key_position_mask = MatrixRXf::Ones(3, J);
+  p.key_position_mask.col(0).setZero();
+  p.key_root = MatrixRXf::Zero(3, 3);
+  p.key_root_mask = Eigen::VectorXf::Zero(3);
+  RuntimeEnergy energy(m);
+  EnergyWeights w;
+  Eigen::VectorXf g_zl, g_zg, far_zl, far_zg;
+  const RuntimeEnergyTerms at_fit = energy.evaluate(p, w, z_l, z_g, &g_zl, &g_zg);
+  ASSERT_EQ(at_fit.terms.size(), 3u);  // rotation, root_orientation, position
+  const RuntimeEnergyTerms away = energy.evaluate(p, w, z_l * 0.5f, z_g, &far_zl, &far_zg);
+  EXPECT_LT(at_fit.total, 1e-6);
+  EXPECT_GT(away.total, 1e-2);
+  EXPECT_LT(g_zl.norm() + g_zg.norm(), 1e-3f * (far_zl.norm() + far_zg.norm()));
+  w.latent_prior = 2.0;
+  const double with_prior = energy.evaluate(p, w, z_l, z_g, nullptr, nullptr).total;
+  EXPECT_NEAR(with_prior - at_fit.total, z_l.squaredNorm() + z_g.squaredNorm(), 1e-3);
+  w.smoothness = 1.0;
+  EXPECT_THROW(energy.evaluate(p, w, z_l, z_g, nullptr, nullptr), InputError);
 }
 
 TEST(RuntimeStandalone, RejectsWrongShapes) {

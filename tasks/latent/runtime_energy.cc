@@ -1,0 +1,299 @@
+#include "tasks/latent/runtime_energy.h"
+
+#include <cmath>
+#include <string>
+
+#include "prior/motion/errors.h"
+#include "prior/motion/rotation_kernels.h"
+#include "prior/runtime/rotations.h"
+
+namespace mf {
+namespace {
+
+using runtime::MatrixRXf;
+using Matrix3 = Eigen::Matrix<float, 3, 3, Eigen::RowMajor>;
+using Map3 = Eigen::Map<Matrix3>;
+using ConstMap3 = Eigen::Map<const Matrix3>;
+
+TermCounts term_counts(const RuntimeWindowProblem& p, int J, int feet) {
+  TermCounts c;
+  if (p.num_keys() > 0) {
+    c.rotations = p.key_rotation_mask.rightCols(J - 1).sum();
+    c.root_rotations = p.key_rotation_mask.col(0).sum();
+    c.positions = p.key_position_mask.sum();
+    c.root_positions = p.key_root_mask.sum();
+  }
+  c.effectors = p.num_effectors;
+  c.pin_steps = p.num_pin_steps;
+  c.trajectory_rows = p.num_trajectory;
+  c.feet = feet;
+  c.length = p.length;
+  return c;
+}
+
+void refuse_unported(const ActiveTerms& a) {
+  const std::pair<bool, const char*> unported[] = {{a.eff, "effector"},       {a.pin, "contact"},
+                                                   {a.traj, "trajectory"},    {a.facing, "trajectory_facing"},
+                                                   {a.skate, "foot_skating"}, {a.smooth, "smoothness"}};
+  for (const auto& u : unported) {
+    if (u.first) {
+      throw InputError(std::string("the Eigen runtime's energy does not implement the ") + u.second +
+                       " term: give it a zero weight or use the libtorch energy (tasks/latent/energies.h)");
+    }
+  }
+}
+
+void check_problem(const RuntimeWindowProblem& p, int J, int window) {
+  const Eigen::Index K = p.num_keys();
+  if (p.length < 2 || p.length > window || p.anchor < 0 || p.anchor >= p.length)
+    throw InputError("runtime energy: a window of 2 to " + std::to_string(window) +
+                     " frames with its anchor inside it is required");
+  for (int f : p.key_frames) {
+    if (f < 0 || f >= p.length) throw InputError("runtime energy: a key lies outside its window");
+  }
+  if (p.key_rotations.rows() != K || p.key_rotations.cols() != J * 9 || p.key_rotation_mask.rows() != K ||
+      p.key_rotation_mask.cols() != J || p.key_positions.rows() != K || p.key_positions.cols() != J * 3 ||
+      p.key_position_mask.rows() != K || p.key_position_mask.cols() != J || p.key_root.rows() != K ||
+      p.key_root.cols() != 3 || p.key_root_mask.size() != K)
+    throw InputError("runtime energy: the keys' targets do not match " + std::to_string(K) + " keys of " +
+                     std::to_string(J) + " joints");
+}
+
+// A penalised residual and its derivative with respect to the residual.
+struct Penalised {
+  float value, slope;
+};
+
+// The penalty of an angle (rad).
+Penalised angle_penalty(float angle, Penalty p) {
+  return p == Penalty::Squared ? Penalised{angle * angle, 2 * angle} : Penalised{angle, 1.0f};
+}
+
+// The penalty of a distance given as its square d2, and its derivative with
+// respect to d2 (the 1e-12 of energies.cc smooths the absolute penalty at 0).
+Penalised squared_penalty(float d2, Penalty p) {
+  if (p == Penalty::Squared) return {d2, 1.0f};
+  const float s = std::sqrt(d2 + 1e-12f);
+  return {s, 0.5f / s};
+}
+
+}  // namespace
+
+RuntimeEnergy::RuntimeEnergy(const runtime::NemfRuntime& model)
+    : model_(&model), kinematics_(model.rig().skeleton), root_forward_(model.rig().root_forward.cast<float>()) {}
+
+RuntimeEnergyTerms RuntimeEnergy::evaluate(const RuntimeWindowProblem& problem, const EnergyWeights& w,
+                                           const Eigen::Ref<const Eigen::VectorXf>& z_l,
+                                           const Eigen::Ref<const Eigen::VectorXf>& z_g, Eigen::VectorXf* g_zl,
+                                           Eigen::VectorXf* g_zg) {
+  const RigInfo& rig = model_->rig();
+  const NemfConfig& config = model_->config();
+  check_problem(problem, rig.num_joints(), config.window);
+  if (z_l.size() != config.zl || z_g.size() != config.zg)
+    throw InputError("runtime energy: expected z_l [" + std::to_string(config.zl) + "] and z_g [" +
+                     std::to_string(config.zg) + "]");
+  const ActiveTerms a = active_terms(term_counts(problem, rig.num_joints(), rig.num_feet()), w);
+  refuse_unported(a);
+  gradient_ = g_zl != nullptr && g_zg != nullptr;
+  RuntimeEnergyTerms out;
+  const bool decoded = a.keyed || a.dense;
+  if (decoded) decode(problem, a, z_l, z_g);
+  if (a.keyed) add_key_terms(problem, w, a, &out);
+  if (a.dense) add_root_translation(problem, w, a, &out);
+  if (w.latent_prior > 0)
+    out.terms.emplace_back("latent_prior", w.latent_prior * 0.5 * (z_l.squaredNorm() + z_g.squaredNorm()));
+  for (const auto& t : out.terms) out.total += t.second;
+  if (!gradient_) return out;
+  if (decoded) {
+    backward(a, g_zl, g_zg);
+  } else {
+    g_zl->setZero(config.zl);
+    g_zg->setZero(config.zg);
+  }
+  if (w.latent_prior > 0) {
+    *g_zl += static_cast<float>(w.latent_prior) * z_l;
+    *g_zg += static_cast<float>(w.latent_prior) * z_g;
+  }
+  return out;
+}
+
+// Decodes the whole window when a dense term is active, else the key frames,
+// and runs FK (root at the origin) when a term reads positions.
+void RuntimeEnergy::decode(const RuntimeWindowProblem& problem, const ActiveTerms& a,
+                           const Eigen::Ref<const Eigen::VectorXf>& z_l, const Eigen::Ref<const Eigen::VectorXf>& z_g) {
+  const int S = a.dense ? problem.length : problem.num_keys(), J = kinematics_.joints();
+  frames_.resize(S);
+  for (int s = 0; s < S; ++s) frames_[s] = a.dense ? s : problem.key_frames[s];
+  model_->decode(frames_, z_l, z_g, &decoder_ws_, &sixd_);
+  runtime::sixd_to_matrix(sixd_, &rotations_);
+  if (a.dense || a.pos) {
+    zero_root_.setZero(S, 3);
+    kinematics_.forward(rotations_, zero_root_, &positions_, &globals_);
+  }
+  if (gradient_) {
+    g_rotations_.setZero(S, J * 9);
+    g_positions_.setZero(S, J * 3);
+  }
+}
+
+// rotation, root_orientation and position at the keys: means over the
+// constrained items, as add_key_terms in energies.cc.
+void RuntimeEnergy::add_key_terms(const RuntimeWindowProblem& p, const EnergyWeights& w, const ActiveTerms& a,
+                                  RuntimeEnergyTerms* out) {
+  const int J = kinematics_.joints();
+  double sum_rot = 0, sum_root = 0, sum_pos = 0;
+  for (int k = 0; k < p.num_keys(); ++k) {
+    const int row = a.dense ? p.key_frames[k] : k;
+    for (int j = 0; j < J && (a.rot || a.root_rot); ++j) {
+      const float mask = p.key_rotation_mask(k, j);
+      if (mask == 0 || !(j == 0 ? a.root_rot : a.rot)) continue;
+      const float* decoded = &rotations_(row, j * 9);
+      const Penalised pen = angle_penalty(kernels::geodesic_angle(decoded, &p.key_rotations(k, j * 9)), w.penalty);
+      (j == 0 ? sum_root : sum_rot) += mask * pen.value;
+      if (!gradient_) continue;
+      const double scale = j == 0 ? w.root_orientation / a.n_root_rot : w.rotation / a.n_rot;
+      float g[9];
+      kernels::geodesic_angle_vjp(decoded, &p.key_rotations(k, j * 9), static_cast<float>(scale * mask * pen.slope), g,
+                                  static_cast<float*>(nullptr));
+      g_rotations_.row(row).segment<9>(j * 9) += Eigen::Map<const Eigen::Matrix<float, 1, 9>>(g);
+    }
+    for (int j = 0; j < J && a.pos; ++j) {
+      const float mask = p.key_position_mask(k, j);
+      if (mask == 0) continue;
+      const Eigen::Matrix<float, 1, 3> d =
+          positions_.row(row).segment<3>(j * 3) - p.key_positions.row(k).segment<3>(j * 3);
+      const Penalised pen = squared_penalty(d.squaredNorm(), w.penalty);
+      sum_pos += mask * pen.value;
+      if (gradient_) {
+        g_positions_.row(row).segment<3>(j * 3) += static_cast<float>(w.position / a.n_pos * mask * pen.slope * 2) * d;
+      }
+    }
+  }
+  if (a.rot) out->terms.emplace_back("rotation", w.rotation * sum_rot / a.n_rot);
+  if (a.root_rot) out->terms.emplace_back("root_orientation", w.root_orientation * sum_root / a.n_root_rot);
+  if (a.pos) out->terms.emplace_back("position", w.position * sum_pos / a.n_pos);
+}
+
+// root_translation: the GMP on the dense decode, its root path against the
+// keys' root positions.
+void RuntimeEnergy::add_root_translation(const RuntimeWindowProblem& p, const EnergyWeights& w, const ActiveTerms& a,
+                                         RuntimeEnergyTerms* out) {
+  gmp_inputs();
+  model_->predict_global(gmp_in_, GmpUse::Default, &gmp_ws_, &gmp_out_);
+  root_path(p.anchor);
+  if (gradient_) g_path_.setZero(p.length, 3);
+  double sum = 0;
+  for (int k = 0; k < p.num_keys(); ++k) {
+    const float mask = p.key_root_mask[k];
+    if (mask == 0) continue;
+    const int f = p.key_frames[k];
+    const Eigen::Matrix<float, 1, 3> d = path_.row(f) - p.key_root.row(k);
+    const Penalised pen = squared_penalty(d.squaredNorm(), w.penalty);
+    sum += mask * pen.value;
+    if (gradient_)
+      g_path_.row(f).head<3>() += static_cast<float>(w.root_translation / a.n_root * mask * pen.slope * 2) * d;
+  }
+  out->terms.emplace_back("root_translation", w.root_translation * sum / a.n_root);
+  if (!gradient_) return;
+  root_path_vjp(p.anchor);
+  model_->predict_global_vjp(&gmp_ws_, GmpUse::Default, g_gmp_out_, &g_gmp_in_);
+  gmp_inputs_vjp();
+}
+
+// gmp_inputs() of representation.h from the dense decode: per frame the
+// joints' positions with the heading H removed (H^T p) and the 6D of H^T R_root.
+void RuntimeEnergy::gmp_inputs() {
+  const int T = static_cast<int>(rotations_.rows()), J = kinematics_.joints();
+  headings_.resize(T, 9);
+  gmp_in_.resize(T, J * 3 + 6);
+  for (int t = 0; t < T; ++t) {
+    kernels::heading_rotation(&rotations_(t, 0), root_forward_.data(), &headings_(t, 0));
+    const ConstMap3 h(&headings_(t, 0)), root(&rotations_(t, 0));
+    for (int j = 0; j < J; ++j) {
+      gmp_in_.row(t).segment<3>(j * 3) = (h.transpose() * positions_.row(t).segment<3>(j * 3).transpose()).transpose();
+    }
+    const Matrix3 free = h.transpose() * root;
+    for (int i = 0; i < 3; ++i) {
+      gmp_in_(t, J * 3 + i) = free(i, 0);
+      gmp_in_(t, J * 3 + 3 + i) = free(i, 1);
+    }
+  }
+}
+
+// NemfModel::root_positions() then the alignment of energies.cc: the heading
+// frame's velocity turned to the canonical frame, integrated by forward Euler
+// from the origin (summed in double, as libtorch's float cumsum does), the
+// height as predicted; then the ground position at the anchor moved to the origin.
+void RuntimeEnergy::root_path(int anchor) {
+  const int T = static_cast<int>(gmp_out_.rows());
+  const float fps = static_cast<float>(model_->config().fps);
+  path_.resize(T, 3);
+  double x = 0, z = 0;
+  for (int t = 0; t < T; ++t) {
+    path_(t, 0) = static_cast<float>(x);
+    path_(t, 1) = gmp_out_(t, 3);
+    path_(t, 2) = static_cast<float>(z);
+    const Eigen::Vector3f v = ConstMap3(&headings_(t, 0)) * gmp_out_.row(t).head<3>().transpose();
+    x += v.x() / fps;
+    z += v.z() / fps;
+  }
+  const float ax = path_(anchor, 0), az = path_(anchor, 2);
+  path_.col(0).array() -= ax;
+  path_.col(2).array() -= az;
+}
+
+// The gradient of root_path(): from g_path_ to the GMP's outputs (g_gmp_out_)
+// and the headings (g_headings_, started here).
+void RuntimeEnergy::root_path_vjp(int anchor) {
+  const int T = static_cast<int>(gmp_out_.rows());
+  const float fps = static_cast<float>(model_->config().fps);
+  g_gmp_out_.setZero(T, gmp_out_.cols());
+  g_headings_.setZero(T, 9);
+  g_path_(anchor, 0) -= g_path_.col(0).sum();
+  g_path_(anchor, 2) -= g_path_.col(2).sum();
+  float later_x = 0, later_z = 0;  // the ground gradient of the frames after t: frame t's step feeds them
+  for (int t = T - 1; t >= 0; --t) {
+    const Eigen::Vector3f g_world(later_x / fps, 0.0f, later_z / fps);
+    const ConstMap3 h(&headings_(t, 0));
+    g_gmp_out_.row(t).head<3>() = (h.transpose() * g_world).transpose();
+    Map3(&g_headings_(t, 0)) += g_world * gmp_out_.row(t).head<3>();
+    g_gmp_out_(t, 3) = g_path_(t, 1);
+    later_x += g_path_(t, 0);
+    later_z += g_path_(t, 2);
+  }
+}
+
+// The gradient of gmp_inputs(): from g_gmp_in_ (and the headings' gradient)
+// to the decoded rotations and positions.
+void RuntimeEnergy::gmp_inputs_vjp() {
+  const int T = static_cast<int>(rotations_.rows()), J = kinematics_.joints();
+  for (int t = 0; t < T; ++t) {
+    const ConstMap3 h(&headings_(t, 0)), root(&rotations_(t, 0));
+    Map3 g_h(&g_headings_(t, 0)), g_root(&g_rotations_(t, 0));
+    for (int j = 0; j < J; ++j) {
+      const Eigen::Vector3f g = g_gmp_in_.row(t).segment<3>(j * 3).transpose();
+      g_positions_.row(t).segment<3>(j * 3) += (h * g).transpose();
+      g_h += positions_.row(t).segment<3>(j * 3).transpose() * g.transpose();
+    }
+    Matrix3 g_free = Matrix3::Zero();
+    g_free.col(0) = g_gmp_in_.row(t).segment<3>(J * 3).transpose();
+    g_free.col(1) = g_gmp_in_.row(t).segment<3>(J * 3 + 3).transpose();
+    g_root += h * g_free;
+    g_h += root * g_free.transpose();
+    Matrix3 g_from_heading;
+    kernels::heading_rotation_vjp(&rotations_(t, 0), root_forward_.data(), &g_headings_(t, 0), g_from_heading.data());
+    g_root += g_from_heading;
+  }
+}
+
+// From the gradients of the decoded rotations and positions to the latents.
+void RuntimeEnergy::backward(const ActiveTerms& a, Eigen::VectorXf* g_zl, Eigen::VectorXf* g_zg) {
+  if (a.dense || a.pos) {
+    kinematics_.vjp(rotations_, globals_, g_positions_, nullptr, &g_local_, &g_root_);
+    g_rotations_ += g_local_;
+  }
+  runtime::sixd_to_matrix_vjp(sixd_, g_rotations_, &g_sixd_);
+  model_->decode_vjp(&decoder_ws_, g_sixd_, g_zl, g_zg);
+}
+
+}  // namespace mf
