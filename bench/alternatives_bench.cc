@@ -9,22 +9,27 @@
 // (the alternative index with the highest mean L2P), the diversity (mean
 // pairwise joint position distance over the gap's frames between all the
 // solutions of a window, cm) and the largest constraint error of any solution
-// (docs/BENCHMARKS.md, "Alternatives").
+// (docs/BENCHMARKS.md, "Alternatives"). With --features EXTRACTOR, NeMF's FID
+// and diversity (bench/motion_features.h) of the method's solutions and of
+// all alternatives against the real windows, and the features' mean pairwise
+// distance between the alternatives of one request.
 //
 //   alternatives-bench [--model FILE] [--split validation|train] [--max-windows N] [--threads N]
 //                      [--gaps 15,30] [--alternatives 4] [--method nemf-detail] [--seed 0]
-//                      [--with-targets] [--source PATH] [--cache-dir DIR] [--out FILE]
+//                      [--with-targets] [--features FILE] [--source PATH] [--cache-dir DIR] [--out FILE]
 #include <ATen/Parallel.h>
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "bench/metrics.h"
+#include "bench/motion_features.h"
 #include "bench/options.h"
 #include "bench/protocol.h"
 #include "bench/text.h"
@@ -40,6 +45,7 @@ struct Args : mf::bench::ModelBenchOptions {
   std::string method = "nemf-detail";
   uint64_t seed = 0;
   bool with_targets = false;
+  std::string features;
   std::string out;
 };
 
@@ -53,8 +59,36 @@ void add_options(CLI::App& app, Args& a) {
   app.add_flag("--with-targets", a.with_targets,
                "add end-effector targets (both hands at the gap's middle frame) and a contact pin (the longest "
                "run of gap frames where a foot stays within 2 cm in the ground truth) from the ground truth");
+  app.add_option("--features", a.features,
+                 "the motion feature extractor (docs/BENCHMARKS.md, \"Distribution metrics\"): adds NeMF's FID and "
+                 "diversity of the solutions and of the alternatives");
   app.add_option("--out", a.out, "also write the markdown to FILE");
 }
+
+// The features of one request's windows, when an extractor is given.
+struct FeatureLog {
+  const mf::bench::MotionFeatures* extractor = nullptr;
+  mf::bench::FeatureSets sets;
+  double within_request = 0.0;  // sum over requests of the alternatives' mean pairwise feature distance
+  int requests = 0;
+
+  void add(int T, const mf::Motion& truth, const std::vector<mf::Motion>& solutions) {
+    if (!extractor) return;
+    const std::string gap = "gap " + std::to_string(T);
+    const Eigen::VectorXd real = extractor->features(truth);
+    sets.add(gap + " / method's solution", real, extractor->features(solutions[0]));
+    std::vector<Eigen::VectorXd> alternatives;
+    for (size_t i = 1; i < solutions.size(); ++i) {
+      alternatives.push_back(extractor->features(solutions[i]));
+      sets.add(gap + " / alternatives", real, alternatives.back());
+    }
+    double sum = 0.0;
+    int pairs = 0;
+    for (size_t x = 0; x < alternatives.size(); ++x)
+      for (size_t y = x + 1; y < alternatives.size(); ++y, ++pairs) sum += (alternatives[x] - alternatives[y]).norm();
+    if (pairs) within_request += sum / pairs, ++requests;
+  }
+};
 
 struct ContactPinChoice {
   int joint = -1, first = 0, last = 0;
@@ -103,7 +137,7 @@ std::string metric_cells(const mf::bench::MetricSummary& m) {
 
 // One gap length: the table rows.
 std::string run_gap(const Args& args, int T, const std::vector<mf::Clip>& clips, const mf::bench::EvalStats& stats,
-                    const mf::TaskContext& ctx) {
+                    const mf::TaskContext& ctx, FeatureLog* features) {
   const int context = 10, length = context + T + 1, a = context, b = context + T;
   const std::vector<mf::Window> windows =
       mf::bench::cap_windows(mf::bench::protocol_windows(clips, length, 40), args.split.max_windows);
@@ -124,6 +158,7 @@ std::string run_gap(const Args& args, int T, const std::vector<mf::Clip>& clips,
     const mf::ConstrainedResult r = mf::run_constrained(input, c, args.method, N, ctx);
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     base.add(truth, r.motions[0], evaluated, known);
+    features->add(T, truth, r.motions);
     mf::bench::MetricAccumulator one_base(stats);
     one_base.add(truth, r.motions[0], evaluated, known);
     const double l2p0 = one_base.summary().l2p;
@@ -178,8 +213,24 @@ int run(Args& args, const std::string& command) {
      << "| gap | windows | solution | L2P | L2Q | NPSS | skating (cm) | diversity (cm) | alternatives within 10 % "
         "of the method's L2P | constraints (largest error of any solution), time |\n"
      << "|---:|---:|---|---:|---:|---:|---:|---:|---:|---|\n";
+  std::unique_ptr<mf::bench::MotionFeatures> extractor;
+  FeatureLog features;
+  if (!args.features.empty()) {
+    extractor = std::make_unique<mf::bench::MotionFeatures>(args.features);
+    features.extractor = extractor.get();
+  }
   mf::bench::stream_gap_table(
-      md.str(), args.gaps, [&](int T) { return run_gap(args, T, clips, bench.stats, bench.ctx); }, args.out);
+      md.str(), args.gaps, [&](int T) { return run_gap(args, T, clips, bench.stats, bench.ctx, &features); },
+      args.out);
+  if (extractor) {
+    std::ostringstream f;
+    f << "\nNeMF's FID and diversity (features of " << args.features << "):\n\n"
+      << features.sets.table() << "\nMean feature distance between two alternatives of one request: "
+      << fixed(features.requests ? features.within_request / features.requests : 0.0, 3) << " (" << features.requests
+      << " requests)\n";
+    std::cout << f.str();
+    if (!args.out.empty()) std::ofstream(args.out, std::ios::app) << f.str();
+  }
   return 0;
 }
 
