@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "tasks/constraints/seams.h"
 #include "tasks/latent/fallback.h"
 
 namespace mf::bench {
@@ -51,6 +52,7 @@ void WindowLog::set_labels(const std::string& clip, Labels labels) { labels_[cli
 void WindowLog::add(const EvalStats& stats, WindowRecord r, const ScoredWindow& w) {
   r.l2p = window_l2p(stats, *w.truth, *w.pred, w, &r.l2q);
   r.key_motion_cm = key_motion_cm(*w.truth, *w.known);
+  r.seam_cm = seam_excess_cm(*w.pred, *w.known);
   r.diagnostics = mean_per_name(w.diagnostics);
   const std::string key = reference_key(r);
   if (r.method == "interp") {
@@ -67,7 +69,7 @@ std::string WindowLog::csv() const {
     for (const auto& d : r.diagnostics) names.insert(d.first);
   std::ostringstream out;
   out.precision(9);
-  out << "dataset,rig,content,clip,task,row,method,start,l2p,l2q,l2p_to_interp,key_motion_cm";
+  out << "dataset,rig,content,clip,task,row,method,start,l2p,l2q,l2p_to_interp,key_motion_cm,seam_cm";
   for (const std::string& n : names) out << "," << n;
   out << "\n";
   for (const WindowRecord& r : records_) {
@@ -76,7 +78,7 @@ std::string WindowLog::csv() const {
     out << dataset_ << "," << labels.rig << "," << labels.content << "," << r.clip << "," << r.task << "," << r.row
         << "," << r.method << "," << r.start << "," << r.l2p << "," << r.l2q << ",";
     if (r.l2p_to_interp >= 0) out << r.l2p_to_interp;
-    out << "," << r.key_motion_cm;
+    out << "," << r.key_motion_cm << "," << r.seam_cm;
     for (const std::string& n : names) {
       out << ",";
       for (const auto& d : r.diagnostics)

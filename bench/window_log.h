@@ -9,6 +9,8 @@
 // * key_motion_cm: how far the known frames move across the unknown runs (the
 //   mean over runs of the mean joint distance between the known frames either
 //   side), in cm on the model's rig;
+// * seam_cm: how much the prediction jumps at its known frames beyond the
+//   keys' own pace (seam_excess_cm(), tasks/constraints/seams.h), cm;
 // * the method's diagnostics (TaskContext::diagnostics; the latent solvers'
 //   energy terms before and after the minimisation), averaged over the
 //   entries of one name (one per solved window).
@@ -33,6 +35,7 @@ struct WindowRecord {
   double l2p = 0.0, l2q = 0.0;
   double l2p_to_interp = -1.0;  ///< -1: no interpolation of this window was logged before
   double key_motion_cm = 0.0;
+  double seam_cm = 0.0;  ///< seam_excess_cm() of the prediction
   std::vector<std::pair<std::string, double>> diagnostics;  ///< averaged per name, in first-seen order
 };
 

@@ -18,6 +18,8 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "tasks/constraints/interpolation_fill.h"
+#include "tasks/constraints/seams.h"
+#include "tasks/transformer/inbetweener_fill.h"
 #include "tasks/latent/initializers.h"
 #include "tasks/methods/jobs.h"
 #include "tasks/methods/transformer_methods.h"
@@ -94,6 +96,7 @@ class LinearInbetweener : public InbetweenModel {
       at::Tensor moved = out.clone();
       moved.select(2, D - 3).add_(0.01 * (1 - batch.known.select(2, J)));
       moved.select(2, 6).add_(0.05 * (1 - batch.known.select(2, 1)));  // joint 1's 6D
+      if (jump_off_keys != 0.0) moved.select(2, D - 3).add_(jump_off_keys * (1 - batch.known.select(2, J)));
       result.stages.push_back(moved);
     }
     return result;
@@ -104,6 +107,7 @@ class LinearInbetweener : public InbetweenModel {
   mutable double unknown_abs_sum = 0.0;
   mutable at::Tensor last_known;
   bool miss_keys = false;
+  double jump_off_keys = 0.0;  // the two-stage's last stage: the root moved by this much (m) at unknown frames
 
  private:
   std::string kind_;
@@ -340,6 +344,66 @@ TEST(TransformerMethods, ResidualAtTheKeysIsSpreadOverTheGap) {
   // A constant miss is taken back completely: no jump next to the keys.
   for (int f = 0; f < in.num_frames(); ++f)
     EXPECT_LT((out.root_positions[f] - interp.root_positions[f]).norm(), 1e-4) << f;
+}
+
+// A run's seam is its jump at the keys beyond the keys' own pace.
+TEST(Seams, AJumpAtTheKeysIsMeasuredBeyondTheKeysPace) {
+  Fixture fx;
+  Motion m = fx.motion(21, 4);
+  for (int f = 0; f < 21; ++f) {
+    for (int j = 0; j < m.num_joints(); ++j) m.rotation(f, j) = m.rotation(0, j);
+    m.root_positions[f] = Eigen::Vector3d(0.01 * f, 0.9, 0.0);  // 1 cm per frame
+  }
+  std::vector<RunSeam> runs = run_seams(forward_kinematics(m), {0, 10, 20});
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_NEAR(runs[0].key_motion_cm, 10.0, 1e-9);
+  EXPECT_NEAR(runs[0].seam_cm, 0.0, 1e-9);
+  EXPECT_FALSE(implausible_seam(runs[0]));
+  for (int f = 11; f < 20; ++f) m.root_positions[f].z() += 0.12;  // 12 cm off between the keys
+  runs = run_seams(forward_kinematics(m), {0, 10, 20});
+  EXPECT_NEAR(runs[0].seam_cm, 0.0, 1e-9);
+  EXPECT_NEAR(runs[1].seam_cm, std::hypot(1.0, 12.0) - 1.0, 1e-6);
+  EXPECT_TRUE(implausible_seam(runs[1]));
+  EXPECT_NEAR(seam_excess_cm(m, {0, 10, 20}), runs[1].seam_cm, 1e-12);
+  EXPECT_EQ(seam_excess_cm(m, {0, 1, 2}), 0.0);  // no run of unknown frames
+  // Keys that barely move: a 2 cm jump is more than 0.3 of their motion.
+  EXPECT_TRUE(implausible_seam(RunSeam{0, 10, 1.0, 2.0}));
+  EXPECT_FALSE(implausible_seam(RunSeam{0, 10, 30.0, 2.0}));
+}
+
+// Where the transformer's output jumps at its keys, the gap is interpolated
+// and a sentence says so; --no-fallback (interpolation_fallback false) keeps it.
+TEST(TransformerMethods, GapsWhoseOutputJumpsAtTheKeysAreInterpolated) {
+  Fixture fx;
+  const Motion in = fx.motion(30, 12);
+  const std::vector<int> keys = {0, 9, 21, 29};
+  const Motion interp = interpolate_motion(in, keys);
+  std::vector<std::string> warnings;
+  const Motion smooth = inbetweener_fill(*fx.twostage, 1, in, MotionConstraints::full_pose(keys),
+                                         LongGapPolicy::Throw, false, {true, &warnings});
+  EXPECT_TRUE(warnings.empty());  // the stand-in's 1 cm step is within a body's reach
+  EXPECT_GT((smooth.root_positions[15] - interp.root_positions[15]).norm(), 0.005);
+
+  fx.twostage->jump_off_keys = 0.3;
+  const Motion kept = inbetweener_fill(*fx.twostage, 1, in, MotionConstraints::full_pose(keys), LongGapPolicy::Throw,
+                                       false, {false, &warnings});
+  EXPECT_TRUE(warnings.empty());
+  EXPECT_GT((kept.root_positions[15] - interp.root_positions[15]).norm(), 0.25);
+  const Motion out = inbetweener_fill(*fx.twostage, 1, in, MotionConstraints::full_pose(keys), LongGapPolicy::Throw,
+                                      false, {true, &warnings});
+  expect_known_exact(in, out, keys);
+  for (int f = 0; f < in.num_frames(); ++f) {
+    EXPECT_LT((out.root_positions[f] - interp.root_positions[f]).norm(), 1e-9) << f;
+    for (int j = 0; j < in.num_joints(); ++j)
+      EXPECT_LT(out.rotation(f, j).angularDistance(interp.rotation(f, j)), 1e-9) << f << " " << j;
+  }
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("interpolation was used for 3 gap(s)"), std::string::npos) << warnings[0];
+  // Through the method, the context's switch decides.
+  TaskContext strict = fx.ctx;
+  strict.interpolation_fallback = false;
+  EXPECT_GT((run_inbetween(in, keys, "detail", strict).root_positions[15] - interp.root_positions[15]).norm(), 0.25);
+  EXPECT_LT((run_inbetween(in, keys, "detail", fx.ctx).root_positions[15] - interp.root_positions[15]).norm(), 1e-9);
 }
 
 TEST(TransformerMethods, EndsHeldLikeInterpolation) {

@@ -15,6 +15,7 @@
 #include "prior/motion/rotations.h"
 #include "tasks/constraints/interpolation_fill.h"
 #include "tasks/constraints/residuals.h"
+#include "tasks/constraints/seams.h"
 #include "tasks/fixups/foot_locking.h"
 #include "tasks/transformer/inbetweener_files.h"
 
@@ -202,6 +203,31 @@ void take_owned_frames(const Motion& piece, const FillWindow& w, const KeyIndex&
   }
 }
 
+// The gaps of `piece` (window `w`) whose output jumps at its keys
+// (implausible_seam()), set to `interpolated`'s frames and flagged in
+// `jumps->frames`.
+struct Jumps {
+  std::vector<bool> frames;  // per frame of the motion: its gap was interpolated
+  int gaps = 0;
+  double worst_cm = 0.0;
+};
+void interpolate_jumps(const Motion& interpolated, const FillWindow& w, const KeyIndex& keys, Motion* piece,
+                       Jumps* jumps) {
+  std::vector<int> bounds;
+  for (int f = w.owned_from; f <= w.end; ++f)
+    if (keys.key_of[f] >= 0) bounds.push_back(f - w.start);
+  for (const RunSeam& run : run_seams(forward_kinematics(*piece), bounds)) {
+    if (!implausible_seam(run)) continue;
+    ++jumps->gaps;
+    jumps->worst_cm = std::max(jumps->worst_cm, run.seam_cm);
+    for (int f = run.from + 1; f < run.to; ++f) {
+      for (int j = 0; j < piece->num_joints(); ++j) piece->rotation(f, j) = interpolated.rotation(w.start + f, j);
+      piece->root_positions[f] = interpolated.root_positions[w.start + f];
+      jumps->frames[static_cast<size_t>(w.start + f)] = true;
+    }
+  }
+}
+
 // Constrained values exactly as given.
 void copy_constrained(const Motion& input, const MotionConstraints& c, Motion* out) {
   for (size_t k = 0; k < c.keys.size(); ++k) {
@@ -255,10 +281,14 @@ at::Tensor canonical_trajectory(const at::Tensor& world, const GroundTransform& 
 }
 
 Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
-                        const MotionConstraints& constraints, LongGapPolicy policy, bool foot_lock) {
+                        const MotionConstraints& constraints, LongGapPolicy policy, bool foot_lock,
+                        const FillFallback& fallback) {
   const int used_stage = checked_stage(model, stage, input, constraints);
   // Reads only the constrained values; every frame holds something sensible.
   Motion out = fill_by_interpolation(input, constraints);
+  const Motion interpolated = fallback.interpolate_jumps ? out : Motion();
+  Jumps jumps;
+  jumps.frames.assign(static_cast<size_t>(input.num_frames()), false);
   std::vector<float> contacts;  // [frames, feet] when the feet are locked
   const KeyIndex keys = index_keys(constraints, input.num_frames());
   const std::vector<FillWindow> windows =
@@ -287,12 +317,20 @@ Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& in
       Motion piece = Motion::identity(input.skeleton, T, input.fps);
       write_window(rotations, root, fill.transforms[b], &piece, 0);
       spread_gap_residuals(input, constraints, keys, w, &piece);
+      if (fallback.interpolate_jumps) interpolate_jumps(interpolated, w, keys, &piece, &jumps);
       take_owned_frames(piece, w, keys, constraints, &out);
       if (!lock) continue;
       const auto c = contact.accessor<float, 3>();
       for (int f = w.owned_from + 1; f <= w.end; ++f)
-        for (int k = 0; k < feet; ++k) contacts[static_cast<size_t>(f) * feet + k] = c[b][f - w.start][k];
+        for (int k = 0; k < feet && !jumps.frames[static_cast<size_t>(f)]; ++k)
+          contacts[static_cast<size_t>(f) * feet + k] = c[b][f - w.start][k];
     }
+  }
+  if (jumps.gaps > 0 && fallback.warnings) {
+    fallback.warnings->push_back(
+        "interpolation was used for " + std::to_string(jumps.gaps) + " gap(s): the " + inbetweener_title(model.kind()) +
+        "'s output jumped at their keys (by up to " + std::to_string(static_cast<int>(std::lround(jumps.worst_cm))) +
+        " cm in one frame), which on motion unlike its training data means interpolation is closer");
   }
   copy_constrained(input, constraints, &out);
   if (!contacts.empty()) lock_feet(model.rig(), constraints, contacts, kFootLockRamp, &out);

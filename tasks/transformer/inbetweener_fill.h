@@ -39,6 +39,11 @@
 //    are interpolated). Without trajectory rows the batch has none and a
 //    trajectory-conditioned kind interpolates between the known roots itself.
 //    Callers (CLI, C ABI, batch) only fill MotionConstraints::trajectory.
+//  * Jumps at the keys (`fallback.interpolate_jumps`): a gap whose output
+//    jumps where it leaves or reaches its keys by more than a body can
+//    (implausible_seam() of tasks/constraints/seams.h: the model answered with a
+//    pose of its own, as on motion unlike its training data) is interpolated
+//    like fill_by_interpolation(), and a sentence says so.
 //  * Foot locking (`foot_lock`): when the model predicts foot contacts (its
 //    contact head reads the last stage, so only when that stage is used),
 //    lock_feet() of tasks/fixups/foot_locking.h holds the planted ankles with those
@@ -49,6 +54,9 @@
 #pragma once
 
 #include <ATen/core/Tensor.h>
+
+#include <string>
+#include <vector>
 
 #include "prior/model/representation.h"
 #include "prior/motion/motion.h"
@@ -63,6 +71,14 @@ enum class LongGapPolicy {
   Interpolate,  ///< that gap stays interpolated
 };
 
+/// What inbetweener_fill() does where the model's output jumps at its keys
+/// (see the top of this file).
+struct FillFallback {
+  bool interpolate_jumps = false;
+  /// Where the sentence about interpolated gaps goes (may be null).
+  std::vector<std::string>* warnings = nullptr;
+};
+
 /// Completes `input` under `constraints` (full or partial keys; end-effector
 /// targets are ignored) with one pass of `model`, using the output of stage
 /// `stage` (0-based; -1 = the last stage). See the top of this file. Throws
@@ -70,7 +86,8 @@ enum class LongGapPolicy {
 /// joint count differs from the model's, a stage the model does not have, or
 /// (LongGapPolicy::Throw) a gap longer than the window.
 Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
-                        const MotionConstraints& constraints, LongGapPolicy policy, bool foot_lock = false);
+                        const MotionConstraints& constraints, LongGapPolicy policy, bool foot_lock = false,
+                        const FillFallback& fallback = {});
 
 /// The ground trajectory of every frame of `input`, [frames, 4] float (world:
 /// x, z, forward_x, forward_z as trajectory_features() of
