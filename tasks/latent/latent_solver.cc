@@ -233,8 +233,8 @@ struct RuntimeWindow {
 // carries the runtime of `model` and it ports every term that either stage
 // makes active (RuntimeEnergy::ports(): the is-active rule of
 // evaluate_energy()); null otherwise, and the window keeps the libtorch energy
-// (Adam, a model without a runtime, a window with effectors, contact pins,
-// trajectory rows or a skating or smoothness weight).
+// (Adam, a context without this model's runtime, a window on which an
+// effector, contact, trajectory, foot-skating or smoothness term is active).
 std::unique_ptr<RuntimeWindow> runtime_window(const NemfModel& model, const TaskContext& ctx, const WindowProblem& p,
                                               const LatentSolverOptions& options, const EnergyWeights& keyed) {
   if (options.optimizer != LatentOptimizer::Lbfgs || !ctx.runtime || ctx.model.get() != &model) return nullptr;
