@@ -27,6 +27,7 @@
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "bench/foreign_data.h"
 #include "bench/synthetic_rigs.h"
 #include "prior/util/command_line.h"
@@ -78,6 +79,7 @@ struct Args {
   double foreign_fps = 0;  // the foreign clips captured at this rate only, at it (0: every clip at the model's rate)
   std::string windows_csv;  // per-window scores and signals (bench/window_log.h)
   bool no_fallback = false;  // the latent solvers keep their own result everywhere
+  bool libtorch_energy = false;  // no Eigen runtime in the context: the latent solvers minimise the libtorch energy
   std::string features;  // the feature extractor of the distribution metrics (bench/motion_features.h)
 };
 
@@ -141,6 +143,9 @@ void add_options(CLI::App& app, Args& args) {
   app.add_flag("--no-fallback", args.no_fallback,
                "the latent solvers keep their own result where the prior cannot reach the keys (by default they fall "
                "back to interpolation there: tasks/latent/fallback.h)");
+  app.add_flag("--libtorch-energy", args.libtorch_energy,
+               "load no Eigen runtime of the prior: the latent solvers' L-BFGS minimises the libtorch energy "
+               "(tasks/latent/energies.h) instead of the Eigen one (tasks/latent/runtime_energy.h), to compare them");
   app.add_flag("--print-stats", args.print_stats,
                "add the table of training statistics (position mean / std, standing heights)");
 }
@@ -340,6 +345,8 @@ int run(Args& args, const std::string& command) {
     std::cerr << "loading model " << args.model << "\n";
     model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));  // frozen
     ctx.model = model;
+    if (!args.libtorch_energy)
+      ctx.runtime = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
     mf::bench::load_transformers(args.transformers, args.model, &ctx, true);
     ctx.model_anatomy = mf::load_rig_anatomy_next_to(args.model, model->rig().skeleton);
   }

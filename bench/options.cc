@@ -8,6 +8,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/rig/mirror.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 #include "tasks/context/model_rig.h"
@@ -87,6 +88,7 @@ BenchContext load_bench_context(const ModelBenchOptions& options) {
   set_compute_threads(options.threads);
   auto model = std::make_shared<NemfModel>(load_nemf(b.model_path));  // frozen
   b.ctx.model = model;
+  b.ctx.runtime = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::load(b.model_path));
   load_transformers(options.transformers, b.model_path, &b.ctx, false);
   b.ctx.model_anatomy = load_rig_anatomy_next_to(b.model_path, model->rig().skeleton);
   b.data = load_data(options.data, false);

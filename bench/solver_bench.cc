@@ -14,7 +14,7 @@
 //                [--keyed-iterations N] [--adam-iterations N] [--adam-tol X] [--lock-ramp N] [--effector-falloff N] [--overwrite 0|1]
 //                [--penalty squared|absolute] [--init NAME] [--twostage FILE] [--citl FILE]
 //                [--w-rot X] [--w-pos X] [--w-root-rot X] [--w-root X] [--w-prior X] [--w-skate X]
-//                [--w-smooth X] [--w-effector X]
+//                [--w-smooth X] [--w-effector X] [--libtorch-energy]
 //
 // Tasks: gap and sparse as in the protocol; effector and partial add targets
 // (hands, feet) or partial keys (root only, legs only) at frames 15, 45, 75,
@@ -30,7 +30,10 @@
 // overwrite) and the floor (one decoder forward + backward over 128 frames,
 // times the iterations) per solve. --op-profile adds, after each gap or sparse table and
 // after the speed table, the operators run per energy evaluation and the time in
-// them (bench/op_profile.h; with --threads 1).
+// them (bench/op_profile.h; with --threads 1). L-BFGS minimises the Eigen
+// runtime's energy where it ports the window's terms, as the product does
+// (tasks/latent/latent_solver.h); --libtorch-energy loads no runtime, so that
+// it minimises the libtorch energy everywhere, for comparison.
 //
 // Transformers (tasks/methods/transformer_methods.h): --twostage/--citl FILE, else
 // motionfield-twostage.mfm / motionfield-citl.mfm next to --model when they
@@ -67,6 +70,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 #include "tasks/constraints/interpolation_fill.h"
@@ -107,6 +111,8 @@ struct Args {
   std::string init;
   mf::bench::TransformerFiles transformer_files;  // default: next to --model
   mf::TaskContext transformers;  // the loaded transformers (filled by run())
+  bool libtorch_energy = false;  // no Eigen runtime: the latent solvers minimise the libtorch energy
+  mf::TaskContext prior;  // the prior and (unless libtorch_energy) its Eigen runtime, as the solvers' context (run())
 };
 
 // A stage of an in-betweener ("context", "detail", "citl"): one transformer
@@ -139,6 +145,9 @@ void add_options(CLI::App& app, Args& a) {
   app.add_flag("--op-profile", a.op_profile,
                "count the operators of each gap and sparse row and of each method's --speed solves (bench/op_profile.h; "
                "slows them; use --threads 1)");
+  app.add_flag("--libtorch-energy", a.libtorch_energy,
+               "load no Eigen runtime of the prior: L-BFGS minimises the libtorch energy (tasks/latent/energies.h) "
+               "instead of the Eigen one (tasks/latent/runtime_energy.h), to compare them");
   app.add_option("--out", a.out, "also write the markdown to FILE");
   app.add_option("--penalty", a.penalty, "squared or absolute (default: the solver's, squared)")
       ->check(CLI::IsMember({"squared", "absolute"}));
@@ -241,7 +250,7 @@ mf::Motion complete(const mf::NemfModel& model, const Args& args, const std::str
     const mf::InbetweenModel& t = mf::require_inbetweener(args.transformers, kind->name, "method '" + method + "'");
     return mf::inbetweener_fill(t, stage, input, constraints, mf::LongGapPolicy::Throw);
   }
-  return mf::complete_motion(model, input, constraints, solver_options(args, method), {}, report);
+  return mf::complete_motion(model, input, constraints, solver_options(args, method), args.prior, report);
 }
 
 struct Row {
@@ -578,8 +587,12 @@ std::string profile_table(const mf::bench::OpProfile& profile, const std::string
 int run(Args& args, const std::string& command) {
   mf::set_compute_threads(args.threads);
 
-  mf::NemfModel model = mf::load_nemf(args.model);
-  model.set_requires_grad(false);
+  auto loaded = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));
+  loaded->set_requires_grad(false);
+  const mf::NemfModel& model = *loaded;
+  args.prior.model = loaded;
+  if (!args.libtorch_energy)
+    args.prior.runtime = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
   mf::bench::load_transformers(args.transformer_files, args.model, &args.transformers, false);
   const mf::Dataset data = mf::bench::load_data(args.data, false);
   const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);

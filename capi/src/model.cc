@@ -17,6 +17,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/rig/retarget.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/util/binary_io.h"
 #include "tasks/context/model_rig.h"
 #include "tasks/transformer/inbetweener_files.h"
@@ -59,9 +60,13 @@ std::unique_ptr<mf_model> make_model(NemfModel model) {  // frozen by deserializ
   return handle;
 }
 
+// The prior of a model file's bytes, for libtorch and for the Eigen runtime
+// (whose energy the latent solvers minimise: ModelSet::runtime).
 std::unique_ptr<mf_model> load_bytes(const uint8_t* data, size_t size, const std::string& source) {
   try {
-    return make_model(deserialize_nemf(data, size, source));
+    std::unique_ptr<mf_model> handle = make_model(deserialize_nemf(data, size, source));
+    handle->runtime = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::from_bytes(data, size, source));
+    return handle;
   } catch (const InputError& e) {
     throw ApiError(MF_ERROR_MODEL, e.what());
   }

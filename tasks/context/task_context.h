@@ -15,6 +15,9 @@
 #include <vector>
 
 namespace mf {
+namespace runtime {
+class NemfRuntime;
+}
 
 class NemfModel;
 class InbetweenModel;
@@ -45,6 +48,14 @@ class CancelledError : public std::runtime_error {
 struct ModelSet {
   /// The prior; required by methods with needs_model, unused by the baselines.
   std::shared_ptr<const NemfModel> model;
+  /// The same prior on the Eigen runtime (prior/runtime/nemf_runtime.h), read
+  /// from the same model file. With it, the latent solvers' L-BFGS minimises
+  /// the Eigen energy (tasks/latent/runtime_energy.h) of every window whose
+  /// active terms it ports (complete_motion(), tasks/latent/latent_solver.h).
+  /// Null (a model built without a file, or a caller that wants the libtorch
+  /// energy throughout): they minimise the libtorch energy
+  /// (tasks/latent/energies.h).
+  std::shared_ptr<const runtime::NemfRuntime> runtime;
   /// The in-betweeners by kind (prior/inbetween/inbetweener.h: the product's
   /// kinds are inbetweener_kinds()), on the prior's skeleton and frozen
   /// (set_requires_grad(false)). The C API loads each kind's file_name next

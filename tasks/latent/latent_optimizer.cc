@@ -10,8 +10,11 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <limits>
 #include <sstream>
+#include <string>
+#include <utility>
 
 #include "prior/motion/errors.h"
 
@@ -26,25 +29,35 @@ double with_gradient(const LatentEnergy& energy, const at::Tensor& x, at::Tensor
   return e.item<double>();
 }
 
+// The cost at x ([n]) and, when `gradient` is not null, its gradient there.
+using Evaluation = std::function<double(const double* x, double* gradient)>;
+
+// A tensor energy as an Evaluation: x rounded to float, the gradient from autograd.
+Evaluation tensor_evaluation(const LatentEnergy& energy, int n) {
+  return [&energy, n](const double* parameters, double* gradient) {
+    at::Tensor x = at::from_blob(const_cast<double*>(parameters), {n}, at::kDouble).to(at::kFloat);
+    if (!gradient) {
+      at::NoGradGuard no_grad;
+      return energy(x).item<double>();
+    }
+    at::Tensor g;
+    const double cost = with_gradient(energy, x, &g);
+    at::Tensor gd = g.to(at::kDouble).contiguous();
+    std::copy(gd.data_ptr<double>(), gd.data_ptr<double>() + n, gradient);
+    return cost;
+  };
+}
+
 class CeresEnergy final : public ceres::FirstOrderFunction {
  public:
-  CeresEnergy(const LatentEnergy& e, int n) : energy_(e), n_(n) {}
+  CeresEnergy(Evaluation evaluate, int n) : evaluate_(std::move(evaluate)), n_(n) {}
   int NumParameters() const override { return n_; }
   bool Evaluate(const double* parameters, double* cost, double* gradient) const override {
     ++evaluations_;
     try {
-      at::Tensor x = at::from_blob(const_cast<double*>(parameters), {n_}, at::kDouble).to(at::kFloat);
-      if (!gradient) {
-        at::NoGradGuard no_grad;
-        *cost = energy_(x).item<double>();
-        return std::isfinite(*cost);
-      }
-      at::Tensor g;
-      *cost = with_gradient(energy_, x, &g);
-      at::Tensor gd = g.to(at::kDouble).contiguous();
-      std::copy(gd.data_ptr<double>(), gd.data_ptr<double>() + n_, gradient);
+      *cost = evaluate_(parameters, gradient);
       if (!std::isfinite(*cost)) return false;
-      for (int i = 0; i < n_; ++i) {
+      for (int i = 0; gradient && i < n_; ++i) {
         if (!std::isfinite(gradient[i])) return false;
       }
       return true;
@@ -57,7 +70,7 @@ class CeresEnergy final : public ceres::FirstOrderFunction {
   std::exception_ptr error() const { return error_; }
 
  private:
-  const LatentEnergy& energy_;
+  Evaluation evaluate_;
   int n_;
   mutable int evaluations_ = 0;
   mutable std::exception_ptr error_;
@@ -82,15 +95,15 @@ class ProgressCallback final : public ceres::IterationCallback {
   int offset_, total_;
 };
 
-at::Tensor lbfgs(const LatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& o,
-                 const TaskContext& ctx, int offset, int total, LatentOptimizerStats* stats) {
+at::Tensor lbfgs(Evaluation evaluate, const at::Tensor& x0, const LatentOptimizerSettings& o, const TaskContext& ctx,
+                 int offset, int total, LatentOptimizerStats* stats) {
   const int n = static_cast<int>(x0.numel());
   std::vector<double> x(n);
   {
     at::Tensor d = x0.to(at::kDouble).contiguous();
     std::copy(d.data_ptr<double>(), d.data_ptr<double>() + n, x.begin());
   }
-  auto* function = new CeresEnergy(energy, n);
+  auto* function = new CeresEnergy(std::move(evaluate), n);
   ceres::GradientProblem problem(function);  // takes ownership
   ceres::GradientProblemSolver::Options options;
   options.line_search_direction_type = ceres::LBFGS;
@@ -183,8 +196,23 @@ at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, con
   *stats = LatentOptimizerStats{};
   const int total = iteration_total > 0 ? iteration_total : settings.max_iterations;
   return settings.optimizer == LatentOptimizer::Lbfgs
-             ? lbfgs(energy, x0, settings, ctx, iteration_offset, total, stats)
+             ? lbfgs(tensor_evaluation(energy, static_cast<int>(x0.numel())), x0, settings, ctx, iteration_offset,
+                     total, stats)
              : adam(energy, x0, settings, ctx, iteration_offset, total, stats);
+}
+
+at::Tensor minimize_latent(DirectLatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
+                           const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset,
+                           int iteration_total) {
+  if (settings.optimizer != LatentOptimizer::Lbfgs)
+    throw InputError("an energy evaluated without tensors is minimised with L-BFGS only");
+  if (x0.numel() != energy.size())
+    throw InputError("the start has " + std::to_string(x0.numel()) + " values, the energy " +
+                     std::to_string(energy.size()));
+  *stats = LatentOptimizerStats{};
+  const int total = iteration_total > 0 ? iteration_total : settings.max_iterations;
+  return lbfgs([&energy](const double* x, double* gradient) { return energy.evaluate(x, gradient); }, x0, settings,
+               ctx, iteration_offset, total, stats);
 }
 
 }  // namespace mf

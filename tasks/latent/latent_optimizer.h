@@ -1,12 +1,16 @@
 // The optimiser shared by every latent-space task (tasks/latent/latent_solver.h,
 // tasks/renav/renav.h): minimises a differentiable energy of a flat latent vector
 // x = [z_l, z_g] with L-BFGS (Ceres GradientProblemSolver, gradients from
-// torch autograd) or with Adam (NeMF's reference), reporting progress through
-// the task context once per iteration so that callers can observe and cancel.
+// torch autograd, or written out by an energy that evaluates itself without
+// tensors: DirectLatentEnergy) or with Adam (NeMF's reference, on torch),
+// reporting progress through the task context once per iteration so that
+// callers can observe and cancel.
 #pragma once
 
 #include <ATen/core/Tensor.h>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "tasks/context/task_context.h"
 #include "tasks/latent/latent_energy.h"
@@ -62,6 +66,21 @@ struct LatentOptimizerStats {
   std::string message;       ///< the stop reason
 };
 
+/// An energy of x ([size()] values) that evaluates itself and its gradient
+/// without tensors: the Eigen runtime's (RuntimeLatentEnergy,
+/// tasks/latent/runtime_problem.h). It keeps buffers between evaluations, so
+/// evaluating is not const; one per thread.
+class DirectLatentEnergy {
+ public:
+  virtual ~DirectLatentEnergy() = default;
+  virtual int size() const = 0;
+  /// The total at x and, when `gradient` is not null, its gradient there.
+  virtual double evaluate(const double* x, double* gradient) = 0;
+  /// Each active term's weighted value (named and ordered as EnergyTerms,
+  /// tasks/latent/latent_energy.h) and, in *total, their sum at x.
+  virtual std::vector<std::pair<std::string, double>> terms(const double* x, double* total) = 0;
+};
+
 /// Minimises `energy` from x0 ([n] float) with settings.optimizer, at most
 /// settings.max_iterations iterations; returns the solution ([n] float).
 /// Progress reports carry iteration = `iteration_offset` + this run's
@@ -69,6 +88,13 @@ struct LatentOptimizerStats {
 /// Throws CancelledError when the context asks to stop, mf::InputError for
 /// invalid settings, and rethrows any exception raised by the energy.
 at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
+                           const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset = 0,
+                           int iteration_total = 0);
+
+/// minimize_latent() with L-BFGS on an energy that evaluates itself
+/// (settings.optimizer must be Lbfgs: Adam runs on tensor energies only;
+/// InputError otherwise).
+at::Tensor minimize_latent(DirectLatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
                            const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset = 0,
                            int iteration_total = 0);
 

@@ -16,12 +16,14 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/util/threads.h"
 #include "tasks/constraints/interpolation_fill.h"
 #include "tasks/constraints/residuals.h"
 #include "tasks/fixups/effector_ik.h"
 #include "tasks/fixups/foot_locking.h"
 #include "tasks/latent/latent_optimizer.h"
+#include "tasks/latent/runtime_problem.h"
 #include "tasks/latent/windows.h"
 
 namespace mf {
@@ -213,6 +215,35 @@ InitialGuess perturbed(InitialGuess g, const LatentSolverOptions& o, int window)
   return g;
 }
 
+// A window's energies on the Eigen runtime: the full and the keys-only
+// energy of solve_window_latents(), sharing one evaluator.
+struct RuntimeWindow {
+  RuntimeWindow(const runtime::NemfRuntime& model, const WindowProblem& p, const EnergyWeights& full_weights,
+                const EnergyWeights& keyed_weights)
+      : evaluator(model),
+        problem(to_runtime_problem(p, model.rig().num_joints())),
+        full(evaluator, problem, full_weights, model.config().zl, model.config().zg),
+        keyed(evaluator, problem, keyed_weights, model.config().zl, model.config().zg) {}
+  RuntimeEnergy evaluator;
+  RuntimeWindowProblem problem;
+  RuntimeLatentEnergy full, keyed;
+};
+
+// The window's energies on the Eigen runtime when L-BFGS runs, the context
+// carries the runtime of `model` and it ports every term that either stage
+// makes active (RuntimeEnergy::ports(): the is-active rule of
+// evaluate_energy()); null otherwise, and the window keeps the libtorch energy
+// (Adam, a context without this model's runtime, a window on which an
+// effector, contact, trajectory, foot-skating or smoothness term is active).
+std::unique_ptr<RuntimeWindow> runtime_window(const NemfModel& model, const TaskContext& ctx, const WindowProblem& p,
+                                              const LatentSolverOptions& options, const EnergyWeights& keyed) {
+  if (options.optimizer != LatentOptimizer::Lbfgs || !ctx.runtime || ctx.model.get() != &model) return nullptr;
+  auto window = std::make_unique<RuntimeWindow>(*ctx.runtime, p, options.weights, keyed);
+  const bool ported = window->evaluator.ports(window->problem, options.weights) &&
+                      window->evaluator.ports(window->problem, keyed);
+  return ported ? std::move(window) : nullptr;
+}
+
 // solve_latents() on options the caller validated: complete_motion() checks
 // them once per call, not once per window.
 LatentSolution solve_window_latents(const NemfModel& model, const WindowProblem& problem, const InitialGuess& start,
@@ -235,10 +266,11 @@ LatentSolution solve_window_latents(const NemfModel& model, const WindowProblem&
   keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
   keyed.trajectory = keyed.trajectory_facing = 0.0;
   const FlatLatentEnergy cheap(window_energy(model, problem, keyed), zl, zg);
-  if (caps.keyed > 0) first = {&cheap, caps.keyed};
+  const std::unique_ptr<RuntimeWindow> direct = runtime_window(model, ctx, problem, options, keyed);
+  if (caps.keyed > 0) first = {&cheap, caps.keyed, direct ? &direct->keyed : nullptr};
   LatentSolution out;
   const at::Tensor x = minimize_window(energy, x0, options.capped(caps.full), ctx, iteration_offset, total,
-                                       &out.summary, first);
+                                       &out.summary, first, direct ? &direct->full : nullptr);
   out.z_l = energy.z_l(x);
   out.z_g = energy.z_g(x);
   out.summary.wall_ms = ms_since(t0);

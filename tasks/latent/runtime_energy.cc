@@ -31,15 +31,21 @@ TermCounts term_counts(const RuntimeWindowProblem& p, int J, int feet) {
   return c;
 }
 
-void refuse_unported(const ActiveTerms& a) {
+// The first active term not ported; null when all are.
+const char* unported_term(const ActiveTerms& a) {
   const std::pair<bool, const char*> unported[] = {{a.eff, "effector"},       {a.pin, "contact"},
                                                    {a.traj, "trajectory"},    {a.facing, "trajectory_facing"},
                                                    {a.skate, "foot_skating"}, {a.smooth, "smoothness"}};
   for (const auto& u : unported) {
-    if (u.first) {
-      throw InputError(std::string("the Eigen runtime's energy does not implement the ") + u.second +
-                       " term: give it a zero weight or use the libtorch energy (tasks/latent/energies.h)");
-    }
+    if (u.first) return u.second;
+  }
+  return nullptr;
+}
+
+void refuse_unported(const ActiveTerms& a) {
+  if (const char* term = unported_term(a)) {
+    throw InputError(std::string("the Eigen runtime's energy does not implement the ") + term +
+                     " term: give it a zero weight or use the libtorch energy (tasks/latent/energies.h)");
   }
 }
 
@@ -115,6 +121,11 @@ RuntimeEnergyTerms RuntimeEnergy::evaluate(const RuntimeWindowProblem& problem, 
     *g_zg += static_cast<float>(w.latent_prior) * z_g;
   }
   return out;
+}
+
+bool RuntimeEnergy::ports(const RuntimeWindowProblem& problem, const EnergyWeights& w) const {
+  const RigInfo& rig = model_->rig();
+  return unported_term(active_terms(term_counts(problem, rig.num_joints(), rig.num_feet()), w)) == nullptr;
 }
 
 // Decodes the whole window when a dense term is active, else the key frames,

@@ -72,6 +72,10 @@ class RuntimeEnergy {
                               const Eigen::Ref<const Eigen::VectorXf>& z_g, Eigen::VectorXf* g_zl,
                               Eigen::VectorXf* g_zg);
 
+  /// Whether every term that `weights` make active on `problem` (the rule
+  /// above) is ported, i.e. evaluate() does not refuse them.
+  bool ports(const RuntimeWindowProblem& problem, const EnergyWeights& weights) const;
+
  private:
   void decode(const RuntimeWindowProblem& problem, const ActiveTerms& a, const Eigen::Ref<const Eigen::VectorXf>& z_l,
               const Eigen::Ref<const Eigen::VectorXf>& z_g);

@@ -35,4 +35,29 @@ RuntimeWindowProblem to_runtime_problem(const WindowProblem& problem, int joints
   return p;
 }
 
+RuntimeLatentEnergy::RuntimeLatentEnergy(RuntimeEnergy& energy, const RuntimeWindowProblem& problem,
+                                         const EnergyWeights& weights, int zl, int zg)
+    : energy_(&energy), problem_(&problem), weights_(weights), zl_(zl), zg_(zg), x_(zl + zg) {}
+
+RuntimeEnergyTerms RuntimeLatentEnergy::run(const double* x, bool gradient) {
+  for (int i = 0; i < size(); ++i) x_[i] = static_cast<float>(x[i]);
+  return energy_->evaluate(*problem_, weights_, x_.head(zl_), x_.tail(zg_), gradient ? &g_zl_ : nullptr,
+                           gradient ? &g_zg_ : nullptr);
+}
+
+double RuntimeLatentEnergy::evaluate(const double* x, double* gradient) {
+  const double total = run(x, gradient != nullptr).total;
+  if (gradient) {
+    for (int i = 0; i < zl_; ++i) gradient[i] = g_zl_[i];
+    for (int i = 0; i < zg_; ++i) gradient[zl_ + i] = g_zg_[i];
+  }
+  return total;
+}
+
+std::vector<std::pair<std::string, double>> RuntimeLatentEnergy::terms(const double* x, double* total) {
+  RuntimeEnergyTerms t = run(x, false);
+  *total = t.total;
+  return std::move(t.terms);
+}
+
 }  // namespace mf

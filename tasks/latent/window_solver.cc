@@ -1,32 +1,57 @@
 #include "tasks/latent/window_solver.h"
 
 #include <ATen/ATen.h>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "tasks/latent/windows.h"
 
 namespace mf {
 
+namespace {
+
+// The terms and total at x: of `direct` when there is one, else of `energy`.
+std::vector<std::pair<std::string, double>> terms_at(const FlatLatentEnergy& energy, DirectLatentEnergy* direct,
+                                                     const at::Tensor& x, double* total) {
+  if (!direct) return energy.terms(x, total);
+  const at::Tensor d = x.to(at::kDouble).contiguous();
+  return direct->terms(d.data_ptr<double>(), total);
+}
+
+at::Tensor minimize(const FlatLatentEnergy& energy, DirectLatentEnergy* direct, const at::Tensor& x0,
+                    const LatentOptimizerSettings& settings, const TaskContext& ctx, LatentOptimizerStats* stats,
+                    int iteration_offset, int iteration_total) {
+  return direct ? minimize_latent(*direct, x0, settings, ctx, stats, iteration_offset, iteration_total)
+                : minimize_latent(energy.total(), x0, settings, ctx, stats, iteration_offset, iteration_total);
+}
+
+}  // namespace
+
 at::Tensor minimize_window(const FlatLatentEnergy& energy, const at::Tensor& x0,
                            const LatentOptimizerSettings& settings, const TaskContext& ctx, int iteration_offset,
                            int iteration_total, SolveSummary* summary,
-                           const FirstStage& first) {
+                           const FirstStage& first, DirectLatentEnergy* direct) {
+  const bool lbfgs = settings.optimizer == LatentOptimizer::Lbfgs;
+  DirectLatentEnergy* full = lbfgs ? direct : nullptr;
   SolveSummary& s = *summary;
-  s.initial_terms = energy.terms(x0, &s.initial_energy);
+  s.initial_terms = terms_at(energy, full, x0, &s.initial_energy);
   at::Tensor x = x0;
   if (first.energy && first.max_iterations > 0) {
     LatentOptimizerStats stats;
-    x = minimize_latent(first.energy->total(), x, settings.capped(first.max_iterations), ctx, &stats,
-                        iteration_offset, iteration_total);
+    x = minimize(*first.energy, lbfgs ? first.direct : nullptr, x, settings.capped(first.max_iterations), ctx, &stats,
+                 iteration_offset, iteration_total);
     s.keyed_iterations = stats.iterations;
     s.evaluations += stats.evaluations;
   }
   LatentOptimizerStats stats;
-  x = minimize_latent(energy.total(), x, settings, ctx, &stats, iteration_offset + s.keyed_iterations, iteration_total);
+  x = minimize(energy, full, x, settings, ctx, &stats, iteration_offset + s.keyed_iterations, iteration_total);
   s.iterations = s.keyed_iterations + stats.iterations;
   s.evaluations += stats.evaluations;
   s.converged = stats.converged;
   s.message = stats.message;
-  s.final_terms = energy.terms(x, &s.final_energy);
+  s.runtime_energy = full != nullptr;
+  s.final_terms = terms_at(energy, full, x, &s.final_energy);
   return x;
 }
 

@@ -41,12 +41,17 @@ struct SolveSummary {
   /// of the whole window, initialisation included (renavigate()).
   double wall_ms = 0.0;
   std::string message;       ///< the optimiser's stop reason
+  /// The stages minimised the Eigen runtime's energy
+  /// (tasks/latent/runtime_energy.h), not the libtorch one.
+  bool runtime_energy = false;
 };
 
 /// An optional first stage of a window's minimisation on a cheaper energy.
 struct FirstStage {
   const FlatLatentEnergy* energy = nullptr;  ///< null: no first stage
   int max_iterations = 0;                    ///< 0: no first stage
+  /// `energy` evaluated without tensors (see minimize_window()); null: none.
+  DirectLatentEnergy* direct = nullptr;
 };
 
 /// Minimises `energy` from x0 ([zl + zg] float) with settings.optimizer:
@@ -57,12 +62,15 @@ struct FirstStage {
 /// the last stage's convergence and stop reason; not wall_ms) and returns the
 /// solution x. Progress reports carry iteration = `iteration_offset` + the
 /// window's iteration and max_iterations = `iteration_total`
-/// (minimize_latent(), tasks/latent/latent_optimizer.h). Throws
-/// CancelledError when the context asks to stop.
+/// (minimize_latent(), tasks/latent/latent_optimizer.h). `direct`, when not
+/// null, is `energy` evaluated without tensors (and first.direct is
+/// first.energy's): with L-BFGS the stages minimise them and the terms
+/// before and after are read from `direct`; Adam runs on the tensor energies.
+/// Throws CancelledError when the context asks to stop.
 at::Tensor minimize_window(const FlatLatentEnergy& energy, const at::Tensor& x0,
                            const LatentOptimizerSettings& settings, const TaskContext& ctx, int iteration_offset,
                            int iteration_total, SolveSummary* summary,
-                           const FirstStage& first = {});
+                           const FirstStage& first = {}, DirectLatentEnergy* direct = nullptr);
 
 /// A window of a solve: output frames [start, start + length); its window
 /// frames [shared_begin, shared_end) are also in windows solved before it

@@ -1,0 +1,159 @@
+// The latent solver on the Eigen runtime's energy (complete_motion(),
+// tasks/latent/latent_solver.h, with ModelSet::runtime): with the shipped
+// model on windows of the sample walk, L-BFGS on the Eigen energy ends where
+// L-BFGS on the libtorch energy does (the energies agree to about 1e-6, so
+// the paths differ only in the last digits); windows with a term the runtime
+// does not port, Adam, and contexts without the model's runtime keep the
+// libtorch energy.
+#include <ATen/ATen.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "prior/motion/errors.h"
+#include "prior/util/threads.h"
+#include "tasks/latent/latent_solver.h"
+#include "tasks/latent/runtime_problem.h"
+#include "tests/runtime_test_util.h"
+
+// In mf::test, where the helpers of runtime_test_util.h are.
+namespace mf::test {
+namespace {
+
+// The shipped models as a context (not owning them): with the runtime or without.
+TaskContext context(bool with_runtime) {
+  const BothModels& m = shipped_models();
+  TaskContext ctx;
+  ctx.model = std::shared_ptr<const NemfModel>(std::shared_ptr<const NemfModel>(), &m.frozen);
+  if (with_runtime) ctx.runtime = std::shared_ptr<const runtime::NemfRuntime>(std::shared_ptr<const void>(), &m.runtime);
+  return ctx;
+}
+
+// The largest angle (rad) between the local rotations of two motions.
+double max_angle(const Motion& a, const Motion& b) {
+  double worst = 0;
+  for (size_t i = 0; i < a.rotations.size(); ++i) worst = std::max(worst, a.rotations[i].angularDistance(b.rotations[i]));
+  return worst;
+}
+
+struct Solved {
+  Motion motion;
+  CompletionReport report;
+};
+
+Solved solve(const Motion& input, const MotionConstraints& c, const LatentSolverOptions& o, const TaskContext& ctx) {
+  Solved s;
+  s.motion = complete_motion(*ctx.model, input, c, o, ctx, &s.report);
+  return s;
+}
+
+TEST(LatentSolverRuntime, EigenEnergyEndsWhereTheLibtorchEnergyDoes) {
+  ScopedComputeThreads one_thread(1);
+  const Motion& walk = walk_on_model_rig();
+  const struct {
+    const char* name;
+    Motion input;
+    MotionConstraints constraints;
+  } cases[] = {{"gap 30", walk.slice(0, 41), MotionConstraints::full_pose({0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 40})},
+               {"keys every 15", walk, MotionConstraints::full_pose({0, 15, 30, 45, 60})}};
+  const LatentSolverOptions o = default_solver_options(LatentOptimizer::Lbfgs);
+  for (const auto& c : cases) {
+    const Solved eigen = solve(c.input, c.constraints, o, context(true));
+    const Solved torch = solve(c.input, c.constraints, o, context(false));
+    ASSERT_EQ(eigen.report.windows.size(), 1u) << c.name;
+    ASSERT_EQ(torch.report.windows.size(), 1u) << c.name;
+    const SolveSummary& e = eigen.report.windows[0];
+    const SolveSummary& t = torch.report.windows[0];
+    EXPECT_TRUE(e.runtime_energy) << c.name;
+    EXPECT_FALSE(t.runtime_energy) << c.name;
+    // The same start: the initial energies agree as the energies do.
+    EXPECT_NEAR(e.initial_energy, t.initial_energy, 1e-5 * t.initial_energy) << c.name;
+    ASSERT_EQ(e.final_terms.size(), t.final_terms.size()) << c.name;
+    for (size_t i = 0; i < e.final_terms.size(); ++i) EXPECT_EQ(e.final_terms[i].first, t.final_terms[i].first);
+    const double energy_gap = std::abs(e.final_energy - t.final_energy) / t.final_energy;
+    const double angle = max_angle(eigen.motion, torch.motion);
+    std::printf("%s: iterations %d / %d, final energy %.6g / %.6g (relative %.2e), largest angle %.2e rad\n", c.name,
+                e.iterations, t.iterations, e.final_energy, t.final_energy, energy_gap, angle);
+    EXPECT_LT(energy_gap, 1e-2) << c.name;
+    EXPECT_LT(angle, 1e-2) << c.name;
+  }
+}
+
+TEST(LatentSolverRuntime, KeepsTheLibtorchEnergyWhereTheRuntimeDoesNotServe) {
+  ScopedComputeThreads one_thread(1);
+  const Motion input = walk_on_model_rig().slice(0, 41);
+  const MotionConstraints gap = MotionConstraints::full_pose({0, 9, 40});
+  MotionConstraints effector = gap;
+  effector.effectors.push_back(
+      {20, shipped_models().runtime.rig().foot_joints[0], input.root_positions[20] + Eigen::Vector3d(0.1, -0.8, 0.1),
+       1.0});
+  LatentSolverOptions lbfgs = default_solver_options(LatentOptimizer::Lbfgs);
+  lbfgs.max_iterations = 3;
+  lbfgs.keyed_iterations = 2;
+  LatentSolverOptions adam = default_solver_options(LatentOptimizer::Adam);
+  adam.max_iterations = 3;
+  LatentSolverOptions skating = lbfgs;
+  skating.weights.foot_skating = 1.0;
+  TaskContext other_model = context(true);
+  other_model.model = nullptr;
+  const struct {
+    const char* name;
+    MotionConstraints constraints;
+    LatentSolverOptions options;
+    TaskContext ctx;
+    bool runtime;
+  } cases[] = {{"gap", gap, lbfgs, context(true), true},
+               {"effector target", effector, lbfgs, context(true), false},
+               {"foot skating weight", gap, skating, context(true), false},
+               {"Adam", gap, adam, context(true), false},
+               {"runtime of another model", gap, lbfgs, other_model, false}};
+  for (const auto& c : cases) {
+    CompletionReport report;
+    complete_motion(shipped_models().frozen, input, c.constraints, c.options, c.ctx, &report);
+    ASSERT_EQ(report.windows.size(), 1u) << c.name;
+    EXPECT_EQ(report.windows[0].runtime_energy, c.runtime) << c.name;
+    EXPECT_GT(report.windows[0].iterations, 0) << c.name;
+  }
+}
+
+// The runtime's energy as the optimiser sees it is the tensor energy's, terms
+// and total, and only L-BFGS minimises it.
+TEST(LatentSolverRuntime, RuntimeLatentEnergyIsTheFlatEnergy) {
+  const BothModels& m = shipped_models();
+  const int zl = m.runtime.config().zl, zg = m.runtime.config().zg;
+  const WindowProblem problem =
+      make_window_problem(m.frozen.rig(), walk_on_model_rig(), 0, 41, MotionConstraints::full_pose({0, 9, 40}), 0);
+  const RuntimeWindowProblem rp = to_runtime_problem(problem, m.runtime.rig().num_joints());
+  const EnergyWeights w;
+  RuntimeEnergy evaluator(m.runtime);
+  RuntimeLatentEnergy direct(evaluator, rp, w, zl, zg);
+  const FlatLatentEnergy flat(
+      [&](const at::Tensor& z_l, const at::Tensor& z_g) { return evaluate_energy(m.frozen, problem, w, z_l, z_g); }, zl,
+      zg);
+  at::manual_seed(8);
+  const at::Tensor x = at::randn({zl + zg});
+  const at::Tensor xd = x.to(at::kDouble).contiguous();
+  double direct_total = 0, flat_total = 0;
+  const auto direct_terms = direct.terms(xd.data_ptr<double>(), &direct_total);
+  const auto flat_terms = flat.terms(x, &flat_total);
+  ASSERT_EQ(direct_terms.size(), flat_terms.size());
+  for (size_t i = 0; i < flat_terms.size(); ++i) {
+    EXPECT_EQ(direct_terms[i].first, flat_terms[i].first);
+    EXPECT_NEAR(direct_terms[i].second, flat_terms[i].second, kOutputTolerance * flat_terms[i].second);
+  }
+  EXPECT_NEAR(direct_total, flat_total, kOutputTolerance * flat_total);
+  std::vector<double> gradient(zl + zg);
+  EXPECT_EQ(direct.evaluate(xd.data_ptr<double>(), gradient.data()), direct_total);
+
+  LatentOptimizerStats stats;
+  LatentOptimizerSettings adam;
+  adam.optimizer = LatentOptimizer::Adam;
+  adam.max_iterations = 2;
+  EXPECT_THROW(minimize_latent(direct, x, adam, TaskContext{}, &stats), InputError);
+}
+
+}  // namespace
+}  // namespace mf::test
