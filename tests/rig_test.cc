@@ -379,6 +379,25 @@ TEST(Retarget, RestPoseFramesOfTAndAPoseRigsAreTheWholeMotionsAnatomy) {
   EXPECT_FALSE(take_rest_pose_frames(sample().skeleton, find_rig_parts(sample().skeleton), &native));
 }
 
+// A T-pose rig whose rest pose has the elbows' convention of its motion (the
+// synthetic rigs are built on the training rig's anatomy): bent elbows measure
+// the same hinge up to the noise of a few frames, and the rest pose's exact
+// frames are kept (user_rig_anatomy, kElbowConventionDegrees).
+TEST(Retarget, BentElbowsKeepARestPoseThatAgreesWithThem) {
+  const bench::VariantMotion vm = bench::make_variant(sample(), sample_anatomy(), bench::rig_variant("mixamo"));
+  const RigMap map = map_rig(vm.motion.skeleton, sample().skeleton);
+  const std::vector<int> few = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10};
+  const std::array<double, 2> bend = mean_elbow_bend(vm.motion, map.user_parts, few);
+  ASSERT_GE(std::min(bend[0], bend[1]), 0.15) << "the premise: the elbows bend";
+  RigAnatomy rest = estimate_anatomy(vm.motion, map.user_parts, few);
+  ASSERT_TRUE(take_rest_pose_frames(vm.motion.skeleton, map.user_parts, &rest));
+  const RigAnatomy a = user_rig_anatomy(vm.motion, map.user_parts, few);
+  for (int s = 0; s < 2; ++s) {
+    const int fore = map.user_parts.arms[s].fore;
+    EXPECT_LT(geodesic_angle(a.frames[fore], rest.frames[fore]), 1e-9) << "arm " << s;
+  }
+}
+
 // The rest pose is read whichever axis it stands along and wherever it faces:
 // the whole rig turned turns every frame read from it with it. An arm raised
 // out of the pose is not read.

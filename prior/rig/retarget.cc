@@ -409,7 +409,15 @@ RigAnatomy user_rig_anatomy(const Motion& motion, const RigParts& parts, const s
   RigAnatomy anatomy = estimate_anatomy(motion, parts, frames);
   constexpr double kMinBend = 0.15;  // mean sine of the elbow's bend: about 9 degrees
   const std::array<double, 2> bend = mean_elbow_bend(motion, parts, frames);
-  take_rest_pose_frames(motion.skeleton, parts, &anatomy, {bend[0] >= kMinBend, bend[1] >= kMinBend});
+  RigAnatomy rest = anatomy;
+  take_rest_pose_frames(motion.skeleton, parts, &rest, {false, false});
+  std::array<bool, 2> keep{};
+  for (int s = 0; s < 2; ++s) {
+    const int fore = parts.arms[s].fore;
+    keep[s] = bend[s] >= kMinBend &&
+              (fore < 0 || geodesic_angle(anatomy.frames[fore], rest.frames[fore]) > kElbowConventionDegrees * M_PI / 180);
+  }
+  take_rest_pose_frames(motion.skeleton, parts, &anatomy, keep);
   return anatomy;
 }
 

@@ -90,7 +90,14 @@ bool rest_pose_is_t_or_a(const Skeleton& skeleton, const RigParts& parts);
 /// on the frames `frames` (all when empty), then the rest pose's frames when
 /// it is a T or A pose (take_rest_pose_frames()), except for an arm whose
 /// elbow is bent on average by more than about 9 degrees in those frames
-/// (mean_elbow_bend() at least 0.15), whose measured hinge is kept.
+/// (mean_elbow_bend() at least 0.15) and whose measured hinge differs from
+/// the rest pose's by more than kElbowConventionDegrees: the rest pose then
+/// has another elbow convention than the joints' positions show (CMU's
+/// T-pose: 26-47 degrees on the foreign capture), and the measured hinge is
+/// kept; a smaller difference is the few frames' noise (T-pose rigs built on
+/// the training rig's anatomy: median 7.5, 90th percentile 21 degrees), and
+/// the rest pose's exact hinge wins (docs/RIGS.md).
+inline constexpr double kElbowConventionDegrees = 25.0;
 RigAnatomy user_rig_anatomy(const Motion& motion, const RigParts& parts, const std::vector<int>& frames = {});
 
 /// Fills anatomy->locked_axes from `motion` (mean_local must be set, e.g. by
