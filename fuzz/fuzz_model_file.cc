@@ -1,5 +1,6 @@
 // Fuzz target: the model-file loaders, the prior's (deserialize_nemf,
-// prior/model/model_file.h) and every in-betweener kind's
+// prior/model/model_file.h; and the Eigen runtime's, NemfRuntime::from_bytes,
+// prior/runtime/nemf_runtime.h) and every in-betweener kind's
 // (deserialize_inbetweener, prior/inbetween/inbetweener.h), on any bytes.
 // Contract checked: a bad file throws mf::InputError (any other exception, a
 // crash, a sanitizer report or an allocation beyond libFuzzer's -rss_limit_mb /
@@ -18,6 +19,7 @@
 #include "prior/inbetween/inbetweener.h"
 #include "prior/model/model_file.h"
 #include "prior/motion/errors.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/util/binary_io.h"
 #include "prior/util/threads.h"
 
@@ -53,6 +55,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fix_checksum(bytes);
   try {
     const mf::NemfModel model = mf::deserialize_nemf(bytes.data(), bytes.size(), "in.mfm");
+  } catch (const mf::InputError&) {
+  }
+  try {
+    const mf::runtime::NemfRuntime runtime = mf::runtime::NemfRuntime::from_bytes(bytes.data(), bytes.size(), "in.mfm");
   } catch (const mf::InputError&) {
   }
   try {
