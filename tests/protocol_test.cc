@@ -253,7 +253,8 @@ TEST(ProtocolTest, WindowLogHasOneRowPerWindowAndMethod) {
   run_gap_filling(val, stats, "zerovel", options);
   const auto rows = csv_rows(log.csv());
   const std::vector<std::string> header = {"dataset", "rig", "content", "clip", "task", "row",
-                                           "method", "start", "l2p", "l2q", "l2p_to_interp", "key_motion_cm"};
+                                           "method", "start", "l2p", "l2q", "l2p_to_interp", "key_motion_cm",
+                                           "seam_cm"};
   ASSERT_EQ(rows.size(), 1u + 2 * (5 + 3));  // windows of T = 5 and 30 (GapFillingCounts...), two methods
   EXPECT_EQ(rows[0], header);
   for (size_t i = 1; i < rows.size(); ++i) {
@@ -270,9 +271,11 @@ TEST(ProtocolTest, WindowLogHasOneRowPerWindowAndMethod) {
     EXPECT_GT(r.key_motion_cm, 0.0);
     if (r.method == "interp") {
       EXPECT_NEAR(r.l2p, 0.0, 1e-6);
+      EXPECT_NEAR(r.seam_cm, 0.0, 1e-6);  // it moves at the keys' own pace
     } else {
       EXPECT_GT(r.l2p, 0.0);
       EXPECT_NEAR(r.l2p_to_interp, r.l2p, 1e-6);
+      EXPECT_GT(r.seam_cm, 0.5 * r.key_motion_cm);  // holds, then makes the whole move in one frame
     }
   }
 }
