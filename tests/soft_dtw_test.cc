@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "prior/motion/errors.h"
+#include "tasks/renav/soft_dtw_kernels.h"
 
 namespace mf {
 namespace {
@@ -440,6 +441,41 @@ TEST(SoftDtw, BadInputThrowsInputError) {
   // Finite costs whose sum along every path overflows double.
   EXPECT_THROW(soft_dtw(at::full({2, 3, 4}, 1e308, kF64), 0.1), InputError);
   EXPECT_THROW(soft_dtw_sequences(at::full({1, 3, 2}, 1e154, kF64), at::full({1, 4, 2}, -1e154, kF64), 0.1),
+               InputError);
+}
+
+// The torch-free kernel entry (the Eigen runtime's re-navigation energy) gives
+// the torch function's value and gradient to the last bit, with sdtw(y, y)
+// computed or given, and refuses what the torch function refuses.
+TEST(SoftDtw, KernelDivergenceIsTheTorchDivergenceBitForBit) {
+  at::manual_seed(11);
+  const at::Tensor x = at::randn({1, 37, 6}, kF64), y = at::randn({1, 29, 6}, kF64);
+  at::Tensor xg = x.clone().requires_grad_(true);
+  const at::Tensor value = soft_dtw_divergence(xg, y, kNemfSoftDtwGamma);
+  value.sum().backward();
+  const at::Tensor grad = xg.grad().contiguous();
+
+  const sdtw::RowMatrixXd xe = Eigen::Map<const sdtw::RowMatrixXd>(x.data_ptr<double>(), 37, 6);
+  const sdtw::RowMatrixXd ye = Eigen::Map<const sdtw::RowMatrixXd>(y.data_ptr<double>(), 29, 6);
+  sdtw::RowMatrixXd ge;
+  EXPECT_EQ(sdtw::divergence(xe, ye, kNemfSoftDtwGamma, &ge), value.item<double>());
+  ASSERT_EQ(ge.rows(), 37);
+  ASSERT_EQ(ge.cols(), 6);
+  const double* g = grad.data_ptr<double>();
+  for (Eigen::Index k = 0; k < ge.size(); ++k) ASSERT_EQ(ge.data()[k], g[k]) << k;
+  const double self_y = sdtw::self_value(ye, kNemfSoftDtwGamma);
+  EXPECT_EQ(sdtw::divergence(xe, ye, kNemfSoftDtwGamma, nullptr, &self_y), value.item<double>());
+  EXPECT_EQ(sdtw::divergence(xe, xe, kNemfSoftDtwGamma, nullptr), 0.0);
+
+  EXPECT_THROW(sdtw::divergence(xe, ye.leftCols(5), 0.1, nullptr), InputError);
+  EXPECT_THROW(sdtw::divergence(xe.topRows(0), ye, 0.1, nullptr), InputError);
+  EXPECT_THROW(sdtw::divergence(xe, ye, 0.0, nullptr), InputError);
+  sdtw::RowMatrixXd bad = xe;
+  bad(3, 2) = std::nan("");
+  EXPECT_THROW(sdtw::divergence(bad, ye, 0.1, &ge), InputError);
+  // Finite values whose costs overflow double.
+  EXPECT_THROW(sdtw::divergence(sdtw::RowMatrixXd::Constant(3, 2, 1e154), sdtw::RowMatrixXd::Constant(4, 2, -1e154),
+                                0.1, nullptr),
                InputError);
 }
 

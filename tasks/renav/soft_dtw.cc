@@ -4,38 +4,34 @@
 #include <ATen/Parallel.h>
 #include <torch/csrc/autograd/custom_function.h>
 
-// The cost products are small: never let Eigen start OpenMP threads for them
-// (it would when this file is compiled with -fopenmp).
-#ifndef EIGEN_DONT_PARALLELIZE
-#define EIGEN_DONT_PARALLELIZE
-#endif
-#include <Eigen/Core>
-
 #include <algorithm>
 #include <cmath>
-#include <limits>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "prior/motion/errors.h"
+#include "tasks/renav/soft_dtw_kernels.h"
 
 namespace mf {
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
+using sdtw::Dims;
+using sdtw::item_backward;
+using sdtw::item_forward;
+using sdtw::kWavefrontMinSide;
+using sdtw::pair_cost;
+using sdtw::pair_grad;
+
+// at::parallel_for as the kernels' ParallelFor (an OpenMP loop in GCC builds).
+void torch_parallel_for(int64_t begin, int64_t end, int64_t grain, const std::function<void(int64_t, int64_t)>& body) {
+  at::parallel_for(begin, end, grain, body);
+}
+
 // Below this many cells in a call, everything stays on the calling thread: waking
 // a second OpenMP thread costs milliseconds when the other core is busy.
 constexpr int64_t kMinParallelCells = int64_t{1} << 16;
-// A single matrix runs as a tiled wavefront when both sides reach this.
-constexpr int64_t kWavefrontMinSide = 512;
-constexpr int64_t kTile = 128;
-// Soft-argmin weights below exp(-345) ~ 1e-150 and alignment weights below
-// 1e-150 are set to 0: the products of the backward then never leave the normal
-// range (denormal arithmetic and the underflow path of exp() cost 10-100x more
-// than normal numbers), and the change is far below double rounding of E in [0, 1].
-constexpr double kMinExponent = -345.0;
-constexpr double kMinWeight = 1e-150;
 
 std::string shape_string(const at::Tensor& t) {
   std::string s = "[";
@@ -75,153 +71,14 @@ at::Tensor checked_values(const std::vector<double>& values, const at::TensorOpt
   return at::tensor(values, at::TensorOptions().dtype(at::kDouble)).to(options.dtype());
 }
 
-// Sizes of one cost matrix and of its working memory. R is (m+1) x (n+1); P (the
-// soft-argmin probabilities of the diagonal, up and left predecessors) and G
-// (dValue/dR) are (m+2) x (n+2), so that the backward needs no bounds tests: the
-// padding row m+1 and column n+1 hold zeros, except the seed G[m+1][n+1] = 1
-// with P[m+1][n+1] = (1, 0, 0), which makes G[m][n] = 1.
-struct Dims {
-  int64_t m, n;
-  int64_t rs() const { return n + 1; }
-  int64_t ps() const { return n + 2; }
-  int64_t p_size() const { return 3 * (m + 2) * (n + 2); }
-  int64_t g_size() const { return (m + 2) * (n + 2); }
-};
-
-template <typename T>
-struct ForwardArgs {
-  const T* D;  // m x n, row-major
-  Dims dm;
-  double gamma, inv_gamma;
-  double* R;
-  double* P;  // null: no gradient wanted
-};
-
-// One cell: softmin over the three predecessors with the log-sum-exp shift by
-// the smallest one, whose exponential is exactly 1, so two exp and one log.
-template <typename T>
-inline void forward_cell(const ForwardArgs<T>& f, int64_t i, int64_t j) {
-  const int64_t rs = f.dm.rs();
-  const double a = f.R[(i - 1) * rs + j - 1], b = f.R[(i - 1) * rs + j], c = f.R[i * rs + j - 1];
-  const double ab_lo = std::min(a, b), ab_hi = std::max(a, b);
-  const double lo = std::min(ab_lo, c), hi = std::max(ab_hi, c);  // lo is finite: some predecessor is
-  const double mid = std::max(ab_lo, std::min(ab_hi, c));
-  // Ties give exactly 0 even when 1/gamma overflows (0 * inf would be NaN).
-  const double t_mid = lo == mid ? 0.0 : (lo - mid) * f.inv_gamma;
-  const double t_hi = lo == hi ? 0.0 : (lo - hi) * f.inv_gamma;
-  const double e_mid = t_mid > kMinExponent ? std::exp(std::max(t_mid, kMinExponent)) : 0.0;
-  const double e_hi = t_hi > kMinExponent ? std::exp(std::max(t_hi, kMinExponent)) : 0.0;
-  const double s = 1.0 + e_mid + e_hi;  // in [1, 3]
-  f.R[i * rs + j] = static_cast<double>(f.D[(i - 1) * f.dm.n + j - 1]) + (lo - f.gamma * std::log(s));
-  if (f.P) {
-    const double inv_s = 1.0 / s;
-    double* p = f.P + 3 * (i * f.dm.ps() + j);
-    p[0] = (a == lo ? 1.0 : a == mid ? e_mid : e_hi) * inv_s;
-    p[1] = (b == lo ? 1.0 : b == mid ? e_mid : e_hi) * inv_s;
-    p[2] = (c == lo ? 1.0 : c == mid ? e_mid : e_hi) * inv_s;
-  }
-}
-
-// Rows [i0, i1) and columns [j0, j1) (1-based cells), two rows at a time with
-// the second one column behind, so that two independent cells are in flight
-// (the recursion is otherwise one long chain of exp/log latencies).
-template <typename T>
-void forward_block(const ForwardArgs<T>& f, int64_t i0, int64_t i1, int64_t j0, int64_t j1) {
-  int64_t i = i0;
-  for (; i + 2 <= i1; i += 2) {
-    forward_cell(f, i, j0);
-    for (int64_t j = j0 + 1; j < j1; ++j) {
-      forward_cell(f, i, j);
-      forward_cell(f, i + 1, j - 1);
-    }
-    forward_cell(f, i + 1, j1 - 1);
-  }
-  for (; i < i1; ++i)
-    for (int64_t j = j0; j < j1; ++j) forward_cell(f, i, j);
-}
-
-// The same block backwards: G[i][j] = sum over the successors of (i, j) of
-// G[successor] * the probability that the successor came from (i, j).
-void backward_block(Dims dm, const double* P, double* G, int64_t i0, int64_t i1, int64_t j0, int64_t j1) {
-  const int64_t ps = dm.ps();
-  for (int64_t i = i1 - 1; i >= i0; --i) {
-    double* Gi = G + i * ps;
-    const double* Gdown = G + (i + 1) * ps;
-    const double* Pi = P + 3 * i * ps;
-    const double* Pdown = P + 3 * (i + 1) * ps;
-    for (int64_t j = j1 - 1; j >= j0; --j) {
-      const double g =
-          Gdown[j + 1] * Pdown[3 * (j + 1)] + Gdown[j] * Pdown[3 * j + 1] + Gi[j + 1] * Pi[3 * (j + 1) + 2];
-      Gi[j] = g >= kMinWeight ? g : 0.0;
-    }
-  }
-}
-
-// Runs `block(i0, i1, j0, j1)` over the cells 1..m x 1..n: one block when
-// serial, else kTile x kTile tiles by anti-diagonals (in reverse for the backward).
-template <typename F>
-void run_blocks(Dims dm, bool wavefront, bool reverse, const F& block) {
-  if (!wavefront) {
-    block(1, dm.m + 1, 1, dm.n + 1);
-    return;
-  }
-  const int64_t ti_count = (dm.m + kTile - 1) / kTile, tj_count = (dm.n + kTile - 1) / kTile;
-  const int64_t diagonals = ti_count + tj_count - 1;
-  auto tile = [&](int64_t ti, int64_t tj) {
-    block(1 + ti * kTile, 1 + std::min(dm.m, (ti + 1) * kTile), 1 + tj * kTile, 1 + std::min(dm.n, (tj + 1) * kTile));
-  };
-  for (int64_t k = 0; k < diagonals; ++k) {
-    const int64_t d = reverse ? diagonals - 1 - k : k;
-    const int64_t lo = std::max<int64_t>(0, d - tj_count + 1), hi = std::min(d, ti_count - 1);
-    if (lo == hi) {
-      tile(lo, d - lo);
-      continue;
-    }
-    at::parallel_for(lo, hi + 1, 1, [&](int64_t begin, int64_t end) {
-      for (int64_t ti = begin; ti < end; ++ti) tile(ti, d - ti);
-    });
-  }
-}
-
-// Soft-DTW of one cost matrix; fills P (when not null) for the backward.
-template <typename T>
-double item_forward(const T* D, Dims dm, double gamma, double* P, bool wavefront) {
-  const int64_t rs = dm.rs();
-  std::unique_ptr<double[]> R(new double[(dm.m + 1) * rs]);
-  R[0] = 0.0;
-  for (int64_t j = 1; j <= dm.n; ++j) R[j] = kInf;
-  for (int64_t i = 1; i <= dm.m; ++i) R[i * rs] = kInf;
-  if (P) {
-    const int64_t ps = dm.ps();
-    std::fill(P + 3 * (dm.m + 1) * ps, P + 3 * (dm.m + 2) * ps, 0.0);
-    for (int64_t i = 0; i <= dm.m; ++i) std::fill(P + 3 * (i * ps + dm.n + 1), P + 3 * (i * ps + dm.n + 2), 0.0);
-    P[3 * ((dm.m + 1) * ps + dm.n + 1)] = 1.0;
-  }
-  const ForwardArgs<T> f{D, dm, gamma, 1.0 / gamma, R.get(), P};
-  run_blocks(dm, wavefront, false,
-             [&](int64_t i0, int64_t i1, int64_t j0, int64_t j1) { forward_block(f, i0, i1, j0, j1); });
-  return R[dm.m * rs + dm.n];
-}
-
-// dValue/dR from the probabilities: G[i][j] for 1 <= i <= m, 1 <= j <= n is
-// dValue/dD[i-1][j-1] (stride dm.ps()).
-std::unique_ptr<double[]> item_backward(const double* P, Dims dm, bool wavefront) {
-  std::unique_ptr<double[]> G(new double[dm.g_size()]);
-  const int64_t ps = dm.ps();
-  std::fill(G.get() + (dm.m + 1) * ps, G.get() + (dm.m + 2) * ps, 0.0);
-  for (int64_t i = 0; i <= dm.m; ++i) G[i * ps + dm.n + 1] = 0.0;
-  G[(dm.m + 1) * ps + dm.n + 1] = 1.0;
-  run_blocks(dm, wavefront, true,
-             [&](int64_t i0, int64_t i1, int64_t j0, int64_t j1) { backward_block(dm, P, G.get(), i0, i1, j0, j1); });
-  return G;
-}
-
 // How B items of `cells` cells each are spread over threads.
 struct Plan {
   bool batch_parallel = false;
   int64_t grain = 1;
   bool wavefront = false;  // inside each item, for matrices with both sides >= kWavefrontMinSide
-  bool wavefront_for(Dims dm) const { return wavefront && std::min(dm.m, dm.n) >= kWavefrontMinSide; }
+  sdtw::ParallelFor wavefront_for(Dims dm) const {
+    return wavefront && std::min(dm.m, dm.n) >= kWavefrontMinSide ? torch_parallel_for : nullptr;
+  }
 };
 
 Plan make_plan(int64_t B, int64_t cells, int64_t min_side) {
@@ -314,66 +171,6 @@ at::Tensor soft_dtw_checked(const at::Tensor& cost, double gamma) {
 
 // ---- soft-DTW and its divergence on sequences, with the squared Euclidean cost ----
 
-// One cost matrix of a sequence pair: D[i][j] = |a_i - b_j|^2 = |a_i|^2 + |b_j|^2 -
-// 2 a_i.b_j (a [m, d], b [n, d]), through an Eigen matrix product (single-threaded):
-// 10x faster than the explicit differences, and in double the cancellation error
-// (~1e-16 (|a_i|^2 + |b_j|^2)) is far below any useful gamma. Clamped at 0. Equal
-// inputs give bitwise equal matrices, so the divergence stays exactly 0 at x = y.
-void pair_cost(const double* a, int64_t m, const double* b, int64_t n, int64_t d, double* D) {
-  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  const Eigen::Map<const RowMajor> A(a, m, d), Bm(b, n, d);
-  Eigen::Map<RowMajor> Dm(D, m, n);
-  Dm.noalias() = A * Bm.transpose();
-  const Eigen::VectorXd na = A.rowwise().squaredNorm(), nb = Bm.rowwise().squaredNorm();
-  for (int64_t i = 0; i < m; ++i)
-    for (int64_t j = 0; j < n; ++j) D[i * n + j] = std::max(0.0, (na[i] + nb[j]) - 2.0 * D[i * n + j]);
-}
-
-// Adds w dValue/da and w dValue/db for the pair's alignment E (G of
-// item_backward): with dD[i][j]/da_i = 2 (a_i - b_j) = -dD[i][j]/db_j,
-//   ga_i += 2 w (sum_j E_ij a_i - sum_j E_ij b_j),  gb_j += 2 w (sum_i E_ij b_j - sum_i E_ij a_i).
-// Rows of a, then rows of b, each summed in a fixed order, so that the result
-// does not depend on how the rows are split over threads; ga and gb may alias (a = b).
-void pair_grad(const double* G, Dims dm, const double* a, const double* b, int64_t d, double w, double* ga, double* gb,
-               bool parallel) {
-  const int64_t ps = dm.ps();
-  const double* E = G + ps + 1;  // E[i][j] = E[i * ps + j]
-  const double scale = 2.0 * w;
-  auto rows_of_a = [&](int64_t i0, int64_t i1) {
-    std::vector<double> acc(d);
-    for (int64_t i = i0; i < i1; ++i) {
-      std::fill(acc.begin(), acc.end(), 0.0);
-      double sum = 0.0;
-      for (int64_t j = 0; j < dm.n; ++j) {
-        const double e = E[i * ps + j];
-        if (e == 0.0) continue;  // common far from the path at small gamma
-        sum += e;
-        for (int64_t k = 0; k < d; ++k) acc[k] += e * b[j * d + k];
-      }
-      for (int64_t k = 0; k < d; ++k) ga[i * d + k] += scale * (sum * a[i * d + k] - acc[k]);
-    }
-  };
-  auto rows_of_b = [&](int64_t j0, int64_t j1) {
-    std::vector<double> acc((j1 - j0) * d, 0.0), sum(j1 - j0, 0.0);
-    for (int64_t i = 0; i < dm.m; ++i)
-      for (int64_t j = j0; j < j1; ++j) {
-        const double e = E[i * ps + j];
-        if (e == 0.0) continue;
-        sum[j - j0] += e;
-        for (int64_t k = 0; k < d; ++k) acc[(j - j0) * d + k] += e * a[i * d + k];
-      }
-    for (int64_t j = j0; j < j1; ++j)
-      for (int64_t k = 0; k < d; ++k) gb[j * d + k] += scale * (sum[j - j0] * b[j * d + k] - acc[(j - j0) * d + k]);
-  };
-  if (parallel) {
-    at::parallel_for(0, dm.m, 1, rows_of_a);
-    at::parallel_for(0, dm.n, 1, rows_of_b);
-  } else {
-    rows_of_a(0, dm.m);
-    rows_of_b(0, dm.n);
-  }
-}
-
 enum class SequenceMode : int64_t { kValue = 0, kDivergence = 1 };
 
 // A pair of the computation: sdtw(first, second) with weight w.
@@ -441,7 +238,7 @@ class SoftDtwSequenceFunction : public torch::autograd::Function<SoftDtwSequence
         double total = 0.0;
         for (size_t k = 0; k < pairs.size(); ++k) {
           const PairSpec& p = pairs[k];
-          const bool wavefront = plan.wavefront_for(p.dm);
+          const sdtw::ParallelFor wavefront = plan.wavefront_for(p.dm);
           std::unique_ptr<double[]> D(new double[p.dm.m * p.dm.n]);
           pair_cost((p.first_is_x ? xd : yd).data(), p.dm.m, (p.second_is_x ? xd : yd).data(), p.dm.n, d, D.get());
           const double v = item_forward(D.get(), p.dm, gamma, pbase[k] ? pbase[k] + b * p.dm.p_size() : nullptr,
@@ -505,7 +302,7 @@ class SoftDtwSequenceFunction : public torch::autograd::Function<SoftDtwSequence
         for (size_t k = 0; k < pairs.size(); ++k) {
           if (!pbase[k]) continue;
           const PairSpec& p = pairs[k];
-          const bool wavefront = plan.wavefront_for(p.dm);
+          const sdtw::ParallelFor wavefront = plan.wavefront_for(p.dm);
           auto G = item_backward(pbase[k] + b * p.dm.p_size(), p.dm, wavefront);
           pair_grad(G.get(), p.dm, (p.first_is_x ? xd : yd).data(), (p.second_is_x ? xd : yd).data(), d,
                     p.weight * g[b], p.first_is_x ? gxb : gyb, p.second_is_x ? gxb : gyb, wavefront);
