@@ -18,25 +18,9 @@ namespace mf {
 
 namespace {
 
-std::string lower(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
 
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return 0.0;
-  size_t k = static_cast<size_t>(p * (v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[k];
-}
 
-Eigen::Matrix3d rot_y(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
 
-double heading_yaw(const Eigen::Quaterniond& root_rotation, const Eigen::Vector3d& forward) {
-  Eigen::Vector3d f = root_rotation * forward;
-  if (f.x() * f.x() + f.z() * f.z() < 1e-12) return 0.0;
-  return std::atan2(f.x(), f.z());
-}
 
 // Rotation vector of the small relative rotation a * b^T, via its skew part.
 at::Tensor skew_vector(const at::Tensor& a, const at::Tensor& b) {
@@ -119,95 +103,18 @@ FkTensors heading_free_fk(const at::Tensor& local_rotations, const RigInfo& rig)
 
 }  // namespace
 
-std::vector<int> find_foot_joints(const Skeleton& skeleton, std::vector<bool>* toe_flags) {
-  std::vector<int> ankles, toes;
-  for (int j = 0; j < skeleton.num_joints(); ++j) {
-    std::string n = lower(skeleton.names[j]);
-    if (n.find("toe") != std::string::npos) {
-      toes.push_back(j);
-    } else if (n.find("foot") != std::string::npos || n.find("ankle") != std::string::npos) {
-      ankles.push_back(j);
-    }
-  }
-  std::vector<int> feet = ankles;
-  feet.insert(feet.end(), toes.begin(), toes.end());
-  if (toe_flags) {
-    toe_flags->assign(ankles.size(), false);
-    toe_flags->insert(toe_flags->end(), toes.size(), true);
-  }
-  return feet;
-}
 
-RigInfo measure_rig(const Skeleton& skeleton, const std::vector<const Motion*>& clips) {
-  RigInfo rig;
-  rig.skeleton = skeleton;
-  std::vector<bool> is_toe;
-  rig.foot_joints = find_foot_joints(skeleton, &is_toe);
 
-  // Forward axis: the signed root-local axis whose ground projection follows the velocity best.
-  const Eigen::Vector3d axes[6] = {Eigen::Vector3d::UnitX(),  -Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
-                                   -Eigen::Vector3d::UnitY(), Eigen::Vector3d::UnitZ(),  -Eigen::Vector3d::UnitZ()};
-  double score[6] = {0, 0, 0, 0, 0, 0};
-  std::vector<std::vector<double>> per_clip_heights(rig.foot_joints.size());
-  for (const Motion* m : clips) {
-    const int T = m->num_frames();
-    for (int f = 0; f + 1 < T; ++f) {
-      Eigen::Vector3d v = (m->root_positions[f + 1] - m->root_positions[f]) * m->fps;
-      v.y() = 0;
-      if (v.norm() < 0.5) continue;
-      v.normalize();
-      for (int a = 0; a < 6; ++a) {
-        Eigen::Vector3d d = m->rotation(f, 0) * axes[a];
-        d.y() = 0;
-        if (d.norm() > 1e-6) score[a] += d.normalized().dot(v);
-      }
-    }
-    if (rig.foot_joints.empty()) continue;
-    GlobalPose pose = forward_kinematics(*m);
-    for (size_t k = 0; k < rig.foot_joints.size(); ++k) {
-      std::vector<double> h(T);
-      for (int f = 0; f < T; ++f) h[f] = pose.position(f, rig.foot_joints[k]).y();
-      per_clip_heights[k].push_back(percentile(h, 0.05));
-    }
-  }
-  int best = static_cast<int>(std::max_element(score, score + 6) - score);
-  if (score[best] > 0) rig.root_forward = axes[best];
-  for (size_t k = 0; k < rig.foot_joints.size(); ++k) {
-    rig.foot_heights.push_back(percentile(per_clip_heights[k], 0.5));
-    rig.foot_thresholds.push_back(is_toe[k] ? 0.04 : 0.08);
-  }
-  return rig;
-}
 
-GroundTransform canonical_transform(const Motion& motion, int anchor_frame, const RigInfo& rig) {
-  GroundTransform t;
-  t.yaw = heading_yaw(motion.rotation(anchor_frame, 0), rig.root_forward);
-  t.x = motion.root_positions[anchor_frame].x();
-  t.z = motion.root_positions[anchor_frame].z();
-  return t;
-}
+
 
 WindowTensors window_tensors(const Motion& motion, int begin, int length, const RigInfo& rig, int anchor) {
+  const WindowMatrices m = window_matrices(motion, begin, length, rig, anchor);
   const int J = motion.num_joints();
-  if (begin < 0 || length < 1 || begin + length > motion.num_frames() || anchor < 0 || anchor >= length) {
-    throw InputError("window out of the motion's range");
-  }
-  GroundTransform g = canonical_transform(motion, begin + anchor, rig);
-  const Eigen::Matrix3d unturn = rot_y(-g.yaw);
   at::Tensor rot = at::empty({1, length, J, 3, 3}, at::kFloat);
   at::Tensor pos = at::empty({1, length, 3}, at::kFloat);
-  float* r = rot.data_ptr<float>();
-  float* p = pos.data_ptr<float>();
-  for (int t = 0; t < length; ++t) {
-    for (int j = 0; j < J; ++j) {
-      Eigen::Matrix3d m = motion.rotation(begin + t, j).normalized().toRotationMatrix();
-      if (j == 0) m = unturn * m;
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) *r++ = static_cast<float>(m(a, b));
-    }
-    Eigen::Vector3d x = unturn * (motion.root_positions[begin + t] - Eigen::Vector3d(g.x, 0, g.z));
-    for (int a = 0; a < 3; ++a) *p++ = static_cast<float>(x[a]);
-  }
+  std::copy(m.local_rotations.data(), m.local_rotations.data() + m.local_rotations.size(), rot.data_ptr<float>());
+  std::copy(m.root_positions.data(), m.root_positions.data() + m.root_positions.size(), pos.data_ptr<float>());
   return {rot, pos};
 }
 
@@ -219,24 +126,11 @@ void write_window(const at::Tensor& local_rotations, const at::Tensor& root_posi
   if (pos.dim() == 3) pos = pos.squeeze(0);
   const int T = static_cast<int>(rot.size(0));
   const int J = static_cast<int>(rot.size(1));
-  if (J != motion->num_joints() || begin < 0 || begin + T > motion->num_frames()) {
-    throw InputError("window does not fit the motion");
-  }
-  const Eigen::Matrix3d turn = rot_y(transform.yaw);
-  const double* r = rot.data_ptr<double>();
-  const double* p = pos.data_ptr<double>();
-  for (int t = 0; t < T; ++t) {
-    for (int j = 0; j < J; ++j) {
-      Eigen::Matrix3d m;
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) m(a, b) = *r++;
-      if (j == 0) m = turn * m;
-      motion->rotation(begin + t, j) = Eigen::Quaterniond(m).normalized();
-    }
-    Eigen::Vector3d x(p[0], p[1], p[2]);
-    p += 3;
-    motion->root_positions[begin + t] = turn * x + Eigen::Vector3d(transform.x, 0, transform.z);
-  }
+  if (rot.dim() != 4 || pos.dim() != 2 || pos.size(0) != T || pos.size(1) != 3)
+    throw InputError("write_window: expected rotations [T, J, 3, 3] and root positions [T, 3]");
+  using Rows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  write_window(Eigen::Map<const Rows>(rot.data_ptr<double>(), T, J * 9),
+               Eigen::Map<const Rows>(pos.data_ptr<double>(), T, 3), transform, motion, begin);
 }
 
 at::Tensor ground_xz(const at::Tensor& points) { return at::stack({points.select(-1, 0), points.select(-1, 2)}, -1); }

@@ -22,21 +22,11 @@
 #include <string>
 #include <vector>
 
-#include "prior/model/rig_info.h"
+#include "prior/model/canonical_window.h"  // GroundTransform, canonical_transform(), window_matrices()
+#include "prior/model/rig_info.h"            // RigInfo, find_foot_joints(), measure_rig()
 #include "prior/motion/motion.h"
 
 namespace mf {
-
-/// Foot joints of a skeleton by name (ankle: "foot"/"ankle", toe: "toe",
-/// case-insensitive), ankles first; `toe_flags` (optional) tells which are toes.
-std::vector<int> find_foot_joints(const Skeleton& skeleton, std::vector<bool>* toe_flags = nullptr);
-
-/// Rig facts measured from clips: the root's forward axis (the root-local
-/// principal axis best aligned with the horizontal velocity while moving), the
-/// feet and their standing heights (median over clips of each clip's
-/// 5th-percentile height), contact thresholds (ankle 8 cm, toe 4 cm above
-/// standing height, as NeMF's, measured relative to this rig's standing height).
-RigInfo measure_rig(const Skeleton& skeleton, const std::vector<const Motion*>& clips);
 
 /// Motion frames [begin, begin + length) as tensors [1, length, ...] in the
 /// canonical frame of frame `begin + anchor`.
@@ -45,14 +35,6 @@ struct WindowTensors {
   at::Tensor root_positions;   ///< [1, T, 3]
 };
 WindowTensors window_tensors(const Motion& motion, int begin, int length, const RigInfo& rig, int anchor = 0);
-
-/// The rigid ground transform that made a window canonical: world = R_y(yaw) * canonical + (x, 0, z).
-struct GroundTransform {
-  double yaw = 0.0;
-  double x = 0.0;
-  double z = 0.0;
-};
-GroundTransform canonical_transform(const Motion& motion, int anchor_frame, const RigInfo& rig);
 
 /// Writes canonical tensors (one window, [T, ...] or [1, T, ...]) back into
 /// `motion` frames [begin, begin + T), undoing `transform`.

@@ -1,6 +1,7 @@
-// What the prior knows about its rig beyond the skeleton: torch-free, shared by
-// the model file's container (model_container.h), the libtorch prior (nemf.h)
-// and the Eigen runtime (prior/runtime/).
+// What the prior knows about its rig beyond the skeleton, and how it is
+// measured from clips: torch-free, shared by the model file's container
+// (model_container.h), the libtorch prior (nemf.h) and the Eigen runtime
+// (prior/runtime/).
 #pragma once
 
 #include <Eigen/Core>
@@ -9,6 +10,8 @@
 #include "prior/motion/skeleton.h"
 
 namespace mf {
+
+struct Motion;
 
 /// What the prior needs to know about a rig beyond its skeleton; measured from
 /// the training data and stored in the model file.
@@ -23,5 +26,16 @@ struct RigInfo {
   int num_joints() const { return skeleton.num_joints(); }
   int num_feet() const { return static_cast<int>(foot_joints.size()); }
 };
+
+/// Foot joints of a skeleton by name (ankle: "foot"/"ankle", toe: "toe",
+/// case-insensitive), ankles first; `toe_flags` (optional) tells which are toes.
+std::vector<int> find_foot_joints(const Skeleton& skeleton, std::vector<bool>* toe_flags = nullptr);
+
+/// Rig facts measured from clips: the root's forward axis (the root-local
+/// principal axis best aligned with the horizontal velocity while moving), the
+/// feet and their standing heights (median over clips of each clip's
+/// 5th-percentile height), contact thresholds (ankle 8 cm, toe 4 cm above
+/// standing height, as NeMF's, measured relative to this rig's standing height).
+RigInfo measure_rig(const Skeleton& skeleton, const std::vector<const Motion*>& clips);
 
 }  // namespace mf

@@ -9,7 +9,7 @@
 
 #include <vector>
 
-#include "prior/model/representation.h"
+#include "prior/model/rig_info.h"
 #include "prior/motion/motion.h"
 
 namespace mf {

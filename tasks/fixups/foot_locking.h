@@ -33,7 +33,7 @@
 #include <string>
 #include <vector>
 
-#include "prior/model/representation.h"
+#include "prior/model/rig_info.h"
 #include "prior/motion/motion.h"
 #include "tasks/constraints/motion_constraints.h"
 
