@@ -10,6 +10,14 @@ namespace {
 // libtorch's LayerNorm default.
 constexpr float kLayerNormEps = 1e-5f;
 
+// Softmax scores more than 80 below the row's largest count as 0 (their
+// terms are below 2e-35 of its): clamped there before the exponential and
+// zeroed after it. Eigen's exp of a masked key's score (-1e9) would be a
+// denormal (libtorch's is 0), and every product with a denormal costs ~100
+// cycles.
+constexpr float kLowestScore = -80.0f;
+constexpr float kNegligibleTerm = 2e-35f;  // above exp(-80) = 1.8e-35
+
 // Index of the last row at or before t where `flag` holds (`none` without
 // one); with `forward` false, the first at or after (blocks::nearest_flagged).
 std::vector<int> nearest_flagged(const std::vector<bool>& flag, bool forward, int none) {
@@ -31,7 +39,9 @@ void linear_rows(ConstMatrixRef x, const Conv1dWeights& w, MatrixRXf* y) { conv1
 void softmax_rows(MatrixRef x) {
   for (Eigen::Index i = 0; i < x.rows(); ++i) {
     auto row = x.row(i).array();
-    row = (row - row.maxCoeff()).exp();
+    row = (row - row.maxCoeff()).max(kLowestScore).exp();
+    float* __restrict v = x.row(i).data();
+    for (Eigen::Index j = 0; j < x.cols(); ++j) v[j] = v[j] > kNegligibleTerm ? v[j] : 0.0f;
     row *= 1.0f / row.sum();
   }
 }
