@@ -152,20 +152,29 @@ RelativeAttention::RelativeAttention(WeightReader& w, const std::string& prefix,
 void attend_heads(ConstMatrixRef q, ConstMatrixRef k, ConstMatrixRef v, int heads, const MatrixRXf* relative_bias,
                   const RowVectorXf& key_mask, MatrixRXf* o) {
   const Eigen::Index Tq = q.rows(), Tk = k.rows(), dh = q.cols() / heads;
-  MatrixRXf scores(Tq, Tk);
+  // Masked keys get no weight (their softmax terms are 0, as libtorch's
+  // underflow to 0) unless every key is masked: only the others are attended.
+  std::vector<Eigen::Index> keys;
+  for (Eigen::Index j = 0; j < Tk; ++j)
+    if (key_mask[j] > 0.5f * static_cast<float>(blocks::kMasked)) keys.push_back(j);
+  if (keys.empty() || static_cast<Eigen::Index>(keys.size()) == Tk) {
+    keys.resize(Tk);
+    for (Eigen::Index j = 0; j < Tk; ++j) keys[j] = j;
+  }
+  const Eigen::Index K = static_cast<Eigen::Index>(keys.size());
+  MatrixRXf k_kept(K, k.cols()), v_kept(K, v.cols()), scores(Tq, K);
+  for (Eigen::Index n = 0; n < K; ++n) k_kept.row(n) = k.row(keys[n]), v_kept.row(n) = v.row(keys[n]);
   o->resize(Tq, v.cols());
   for (int h = 0; h < heads; ++h) {
-    gemm(q.middleCols(h * dh, dh), false, k.middleCols(h * dh, dh), true, scores, 0.0f);
-    if (relative_bias) {
-      const MatrixRXf& b = *relative_bias;
-      for (Eigen::Index i = 0; i < Tq; ++i) {
-        for (Eigen::Index j = 0; j < Tk; ++j) scores(i, j) += b(j - i + Tk - 1, h) + key_mask[j];
+    gemm(q.middleCols(h * dh, dh), false, k_kept.middleCols(h * dh, dh), true, scores, 0.0f);
+    for (Eigen::Index i = 0; i < Tq; ++i) {
+      for (Eigen::Index n = 0; n < K; ++n) {
+        const Eigen::Index j = keys[n];
+        scores(i, n) += relative_bias ? (*relative_bias)(j - i + Tk - 1, h) + key_mask[j] : key_mask[j];
       }
-    } else {
-      scores.rowwise() += key_mask;
     }
     softmax_rows(scores);
-    gemm(scores, false, v.middleCols(h * dh, dh), false, o->middleCols(h * dh, dh), 0.0f);
+    gemm(scores, false, v_kept.middleCols(h * dh, dh), false, o->middleCols(h * dh, dh), 0.0f);
   }
 }
 

@@ -80,6 +80,8 @@ RowVectorXf additive_mask(const std::vector<bool>& keep);
 /// v; q already scaled by 1 / sqrt(dh)): o [Tq, W] (resized). Scores get,
 /// per key j, key_mask[j] [Tk] added, and with a relative bias [2 Tk - 1, H]
 /// (self-attention, Tq = Tk) first bias(j - i + Tk - 1, h) + key_mask[j].
+/// Keys masked with blocks::kMasked are left out (their weight is 0) unless
+/// every key is masked, when all are attended (uniformly, as in libtorch).
 void attend_heads(ConstMatrixRef q, ConstMatrixRef k, ConstMatrixRef v, int heads, const MatrixRXf* relative_bias,
                   const RowVectorXf& key_mask, MatrixRXf* o);
 
