@@ -239,6 +239,32 @@ TEST(RuntimeInbetweenEquivalence, SmallKeyframe) {
                       {}, true);
 }
 
+// No known value at all: every key of the context stage (and CITL's) masked.
+// The keyframe kind gets a random trajectory: without one every frame's
+// input is alike, the score logits tie to float rounding, and which of the
+// tied frames is picked is rounding's choice (on both sides).
+TEST(RuntimeInbetweenEquivalence, WindowsWithoutKnownValues) {
+  const std::vector<std::pair<std::string, std::map<std::string, double>>> kinds = {
+      {kTwoStageKind, {{"width", 16}, {"layers", 1}, {"heads", 2}, {"window", 24}}},
+      {kCitlKind, {{"width", 16}, {"layers", 1}, {"heads", 2}, {"time_dim", 4}, {"window", 24}}},
+      {kKeyframeKind, {{"width", 16}, {"layers", 1}, {"heads", 2}, {"window", 24}, {"min_spacing", 2}, {"max_spacing", 5}}}};
+  for (const auto& [kind, hp] : kinds) {
+    std::unique_ptr<InbetweenModel> model = small_model(kind, hp, 5);
+    const auto rt = runtime_of(*model);
+    const int64_t J = model->rig().num_joints();
+    at::manual_seed(5);
+    at::Tensor valid = at::ones({24});
+    valid.narrow(0, 20, 4).zero_();
+    at::Tensor trajectory;
+    if (kind == kKeyframeKind) {
+      trajectory = at::randn({24, 4});
+      trajectory.narrow(1, 2, 2).div_(trajectory.narrow(1, 2, 2).norm(2, -1, true));
+    }
+    const Case c = make_case(at::randn({24, model->pose_size()}), at::zeros({24, J + 1}), valid, trajectory);
+    compare(*model, *rt, c, "small " + kind + " without known values");
+  }
+}
+
 TEST(RuntimeInbetweenEquivalence, FilesWithOtherTensorsAreRefused) {
   std::unique_ptr<InbetweenModel> model = small_model(kTwoStageKind, {{"width", 8}, {"layers", 1}, {"window", 16}}, 1);
   std::vector<std::pair<std::string, at::Tensor>> tensors = {{"stats.pose_mean", model->stats().pose_mean},

@@ -4,7 +4,10 @@
 // interpolated) and "refine" (raw poses [T, D]), RefineNet's foot contact
 // logits [T, F] and the keyframe outputs (InbetweenResult). Reads the
 // window's trajectory when it has one, else makes one from the known values
-// as the libtorch model does.
+// as the libtorch model does. The keyframes are picked by comparing score
+// logits, which agree with libtorch's to float rounding: where two
+// candidates' logits are that close (inputs alike on every frame), the two
+// implementations may pick different frames, and the stages differ there.
 #pragma once
 
 #include <string>
