@@ -57,6 +57,22 @@ void HyperparameterReader::finish() const {
   }
 }
 
+namespace {
+
+// The keys of the kinds built on blocks::TrunkSize (two-stage, keyframe), in
+// the order their messages list them.
+void read_trunk_keys(HyperparameterReader& r, int* width, int* layers, int* heads, int* ffn, int* window,
+                     double* fps) {
+  r.integer("width", 4, 4096, width);
+  r.integer("layers", 1, 64, layers);
+  r.integer("heads", 1, 64, heads);
+  r.integer("ffn", 1, 16384, ffn);
+  r.integer("window", 2, 4096, window);
+  r.positive("fps", 1000, fps);
+}
+
+}  // namespace
+
 void check_window_and_fps(const std::map<std::string, double>& hyperparameters, const std::string& source) {
   for (const char* key : {"window", "fps"}) {
     auto it = hyperparameters.find(key);
@@ -76,12 +92,7 @@ std::map<std::string, double> TwoStageConfig::to_map() const {
 TwoStageConfig parse_two_stage_config(const std::map<std::string, double>& values) {
   TwoStageConfig c;
   HyperparameterReader r("twostage", values);
-  r.integer("width", 4, 4096, &c.width);
-  r.integer("layers", 1, 64, &c.layers);
-  r.integer("heads", 1, 64, &c.heads);
-  r.integer("ffn", 1, 16384, &c.ffn);
-  r.integer("window", 2, 4096, &c.window);
-  r.positive("fps", 1000, &c.fps);
+  read_trunk_keys(r, &c.width, &c.layers, &c.heads, &c.ffn, &c.window, &c.fps);
   r.integer("interp_input", 0, 1, &c.interp_input);
   r.check(c.width % c.heads == 0,
           "heads (" + std::to_string(c.heads) + ") must divide width (" + std::to_string(c.width) + ")");
@@ -121,12 +132,7 @@ std::map<std::string, double> KeyframeConfig::to_map() const {
 KeyframeConfig parse_keyframe_config(const std::map<std::string, double>& values) {
   KeyframeConfig c;
   HyperparameterReader r("keyframe", values);
-  r.integer("width", 4, 4096, &c.width);
-  r.integer("layers", 1, 64, &c.layers);
-  r.integer("heads", 1, 64, &c.heads);
-  r.integer("ffn", 1, 16384, &c.ffn);
-  r.integer("window", 2, 4096, &c.window);
-  r.positive("fps", 1000, &c.fps);
+  read_trunk_keys(r, &c.width, &c.layers, &c.heads, &c.ffn, &c.window, &c.fps);
   r.integer("min_spacing", 1, 4096, &c.min_spacing);
   r.integer("max_spacing", 2, 4096, &c.max_spacing);
   r.check(c.width % c.heads == 0,
