@@ -10,6 +10,9 @@
 // Eigen runtime's (tasks/latent/runtime_energy.h), on a gap window (10 known
 // frames, a 30-frame gap, the frame after it) and a 128-frame window with
 // keys every 15 frames, cut from a motion the prior decodes from zero codes.
+// Last, the two-stage in-betweener's forward pass (both stages) on a 128-frame
+// window with keys every 15 frames, libtorch against the Eigen runtime
+// (prior/runtime/inbetween_runtime.h), from the file next to the prior.
 // Prints markdown tables; median of --reps evaluations, in the calling
 // thread's CPU time unless --wall-clock.
 #include <ATen/ATen.h>
@@ -22,14 +25,17 @@
 #include <string>
 #include <vector>
 
+#include "prior/inbetween/inbetweener.h"
 #include "prior/model/model_file.h"
 #include "prior/model/representation.h"
+#include "prior/runtime/inbetween_runtime.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 #include "tasks/latent/energies.h"
 #include "tasks/latent/runtime_energy.h"
 #include "tasks/latent/runtime_problem.h"
+#include "tasks/transformer/inbetweener_files.h"
 
 namespace {
 
@@ -180,6 +186,37 @@ void print_energy_times(const mf::NemfModel& model, const mf::runtime::NemfRunti
   }
 }
 
+// The two-stage in-betweener next to the prior on a random 128-frame window
+// (its pose values random, full keys every 15 frames and at the last).
+void print_two_stage_times(const std::string& prior_path, int reps) {
+  const std::string path = mf::inbetweener_path_next_to(prior_path, mf::kTwoStageKind);
+  const std::unique_ptr<mf::InbetweenModel> model = mf::load_inbetweener(path);
+  model->set_requires_grad(false);
+  const std::unique_ptr<const mf::runtime::InbetweenerRuntime> rt = mf::runtime::load_inbetweener_runtime(path);
+  const int T = std::min(128, rt->window()), J = rt->rig().num_joints();
+  std::mt19937 rng(T);
+  mf::runtime::InbetweenWindow w;
+  w.pose = random_matrix(T, rt->pose_size(), rng);
+  w.known = MatrixRXf::Zero(T, J + 1);
+  for (int t = 0; t < T; t += 15) w.known.row(t).setOnes();
+  w.known.row(T - 1).setOnes();
+  w.valid = Eigen::VectorXf::Ones(T);
+  mf::InbetweenBatch batch;
+  batch.pose = at::from_blob(w.pose.data(), {1, T, w.pose.cols()}, at::kFloat).clone();
+  batch.known = at::from_blob(w.known.data(), {1, T, J + 1}, at::kFloat).clone();
+  batch.valid = at::ones({1, T});
+  const double torch_ms = median_ms(reps, [&] {
+    at::NoGradGuard no_grad;
+    model->forward(batch);
+  });
+  mf::runtime::InbetweenResult out;
+  const double runtime_ms = median_ms(reps, [&] { rt->forward(w, &out); });
+  std::printf("\nThe two-stage in-betweener's forward pass (context + detail), %d frames, keys every 15 (%s)\n\n"
+              "| libtorch forward (ms) | Eigen runtime (ms) | speed-up |\n|---|---|---|\n"
+              "| %.3f | %.3f | %.1fx |\n",
+              T, path.c_str(), torch_ms, runtime_ms, torch_ms / runtime_ms);
+}
+
 int run(const std::string& model_path, int reps) {
   mf::set_compute_threads(1);
   const mf::NemfModel model = mf::load_nemf(model_path);
@@ -211,6 +248,7 @@ int run(const std::string& model_path, int reps) {
                 r.forward_vjp_ms / floor_ms, shape_floor_ms, r.forward_vjp_ms / shape_floor_ms);
   }
   print_energy_times(model, rt, reps);
+  print_two_stage_times(model_path, reps);
   return 0;
 }
 
@@ -221,7 +259,7 @@ int main(int argc, char** argv) {
   int reps = 200;
   CLI::App app{"Times the prior's decoder through the Eigen runtime and through libtorch at one thread, against "
                "its matrix-product floor (FLOPs / measured SGEMM rate), and the default solve's energy + gradient both "
-               "ways.",
+               "ways, and the two-stage in-betweener's forward pass both ways.",
                "runtime-bench"};
   mf::cli::use_tool_defaults(app);
   app.add_option("--model", model_path, "the prior's model file (default: the shipped one)");

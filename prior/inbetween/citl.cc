@@ -22,39 +22,6 @@ namespace {
 // gives a uniform softmax instead of NaN.
 constexpr double kMasked = -1e9;
 
-struct CitlConfig {
-  int width = 64;
-  int layers = 2;
-  int heads = 4;
-  int ffn = 256;
-  int time_dim = 16;
-  int window = 128;
-  double fps = 30.0;
-
-  std::map<std::string, double> to_map() const {
-    return {{"width", width},   {"layers", layers}, {"heads", heads}, {"ffn", ffn},
-            {"time_dim", time_dim}, {"window", window}, {"fps", fps}};
-  }
-};
-
-CitlConfig parse_config(const std::map<std::string, double>& values) {
-  CitlConfig c;
-  HyperparameterReader r("CITL", values);
-  r.integer("width", 8, 2048, &c.width);
-  r.integer("layers", 1, 32, &c.layers);
-  r.integer("heads", 1, 64, &c.heads);
-  r.integer("ffn", 1, 16384, &c.ffn);
-  r.integer("time_dim", 2, 256, &c.time_dim);
-  r.integer("window", 2, 4096, &c.window);
-  r.positive("fps", 1000, &c.fps);
-  r.check(c.width % c.heads == 0,
-          "heads (" + std::to_string(c.heads) + ") must divide width (" + std::to_string(c.width) + ")");
-  r.check(c.time_dim % 2 == 0, "time_dim must be even (got " + std::to_string(c.time_dim) + ")");
-  r.check(c.time_dim < c.width, "time_dim must be smaller than width");
-  r.finish();
-  return c;
-}
-
 struct RmsNormImpl : torch::nn::Module {
   explicit RmsNormImpl(int width) { weight = register_parameter("weight", at::ones({width})); }
   at::Tensor forward(const at::Tensor& x) { return x * at::rsqrt(x.pow(2).mean(-1, true) + 1e-6) * weight; }
@@ -270,11 +237,11 @@ class CitlModel final : public NetworkModel<CitlConfig, CitlNet> {
 }  // namespace
 
 std::unique_ptr<InbetweenModel> make_citl(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {
-  return make_network_model<CitlModel>("CITL", parse_config(hyperparameters), rig);
+  return make_network_model<CitlModel>("CITL", parse_citl_config(hyperparameters), rig);
 }
 
 int64_t citl_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {
-  const CitlConfig c = parse_config(hyperparameters);
+  const CitlConfig c = parse_citl_config(hyperparameters);
   const int64_t W = c.width, pose_size = rig.num_joints() * 6 + 3;
   auto linear = [](int64_t in, int64_t out) { return in * out + out; };
   const int64_t feed_forward = linear(W, c.ffn) + linear(c.ffn, W);

@@ -20,55 +20,6 @@
 
 namespace mf {
 
-HyperparameterReader::HyperparameterReader(std::string model_name, const std::map<std::string, double>& values)
-    : name_(std::move(model_name)), unread_(values) {}
-
-void HyperparameterReader::integer(const std::string& key, int lo, int hi, int* out) {
-  known_.push_back(key);
-  auto it = unread_.find(key);
-  if (it == unread_.end()) return;
-  const double v = it->second;
-  unread_.erase(it);
-  if (!std::isfinite(v) || v != std::floor(v) || v < lo || v > hi) {
-    std::ostringstream e;
-    e << key << " must be an integer in [" << lo << ", " << hi << "] (got " << v << "); ";
-    problems_ += e.str();
-    return;
-  }
-  *out = static_cast<int>(v);
-}
-
-void HyperparameterReader::positive(const std::string& key, double hi, double* out) {
-  known_.push_back(key);
-  auto it = unread_.find(key);
-  if (it == unread_.end()) return;
-  const double v = it->second;
-  unread_.erase(it);
-  if (!std::isfinite(v) || !(v > 0) || v > hi) {
-    std::ostringstream e;
-    e << key << " must be in (0, " << hi << "] (got " << v << "); ";
-    problems_ += e.str();
-    return;
-  }
-  *out = v;
-}
-
-void HyperparameterReader::check(bool ok, const std::string& message) {
-  if (!ok) problems_ += message + "; ";
-}
-
-void HyperparameterReader::finish() const {
-  std::string message = problems_;
-  for (const auto& [key, v] : unread_) {
-    std::string list;
-    for (const std::string& k : known_) list += (list.empty() ? "" : ", ") + k;
-    message += "unknown hyperparameter '" + key + "' (" + name_ + " takes " + list + "); ";
-  }
-  if (!message.empty()) {
-    throw InputError("invalid " + name_ + " hyperparameters: " + message.substr(0, message.size() - 2));
-  }
-}
-
 namespace {
 
 // Loss weights (see inbetween_pose_loss in the header).
@@ -266,12 +217,7 @@ std::vector<uint8_t> serialize_inbetweener(const InbetweenModel& model) {
 
 std::unique_ptr<InbetweenModel> deserialize_inbetweener(const uint8_t* data, size_t size, const std::string& source) {
   ModelFileContents c = parse_model_file(data, size, source, known_kinds());
-  for (const char* key : {"window", "fps"}) {
-    auto it = c.hyperparameters.find(key);
-    if (it == c.hyperparameters.end() || !(it->second > 0) || !std::isfinite(it->second)) {
-      throw InputError(source + ": invalid hyperparameters: '" + key + "' missing or not positive");
-    }
-  }
+  check_window_and_fps(c.hyperparameters, source);
   // Hyperparameters within their bounds can still describe a network of
   // billions of parameters; building it would take minutes and gigabytes
   // before the first tensor's shape is found wrong, so the count comes first.

@@ -33,13 +33,10 @@
 #include <cstdint>
 #include <vector>
 
+#include "prior/inbetween/inbetween_config.h"
 #include "prior/model/representation.h"
 
 namespace mf {
-
-constexpr char kTwoStageKind[] = "twostage";
-constexpr char kCitlKind[] = "citl";
-constexpr char kKeyframeKind[] = "keyframe";
 
 /// Pose features [B, T, J * 6 + 3] from local rotations [B, T, J, 3, 3] and
 /// root positions [B, T, 3].
@@ -144,31 +141,6 @@ class InbetweenModel {
 std::unique_ptr<InbetweenModel> make_inbetweener(const std::string& kind,
                                                  const std::map<std::string, double>& hyperparameters,
                                                  const RigInfo& rig);
-
-/// Reads a kind's hyperparameters (make_inbetweener's map) into its config,
-/// collecting every problem so that one InputError names them all:
-///   HyperparameterReader r("CITL", values);
-///   r.integer("width", 8, 2048, &c.width);
-///   r.check(c.width % c.heads == 0, "heads must divide width");
-///   r.finish();  // throws on any problem or on a key no call read
-class HyperparameterReader {
- public:
-  HyperparameterReader(std::string model_name, const std::map<std::string, double>& values);
-  /// values[key], when present, must be an integer in [lo, hi].
-  void integer(const std::string& key, int lo, int hi, int* out);
-  /// values[key], when present, must be finite and in (0, hi].
-  void positive(const std::string& key, double hi, double* out);
-  /// Records `message` as a problem unless `ok`.
-  void check(bool ok, const std::string& message);
-  /// Throws mf::InputError listing the problems and the unknown keys.
-  void finish() const;
-
- private:
-  std::string name_;
-  std::map<std::string, double> unread_;
-  std::vector<std::string> known_;
-  std::string problems_;
-};
 
 /// Makes a fresh model of one kind from its hyperparameters (missing ones take
 /// the kind's defaults; InputError for invalid ones).

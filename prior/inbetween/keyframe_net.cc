@@ -7,6 +7,7 @@
 #include <sstream>
 #include <vector>
 
+#include "prior/inbetween/keyframe_selection.h"
 #include "prior/inbetween/network_model.h"
 #include "prior/inbetween/transformer_blocks.h"
 #include "prior/motion/errors.h"
@@ -19,67 +20,6 @@ namespace {
 
 using blocks::Positions;
 using blocks::Stage;
-
-// Trajectory channels: ground x, z, forward_x, forward_z.
-constexpr int kTrajectorySize = 4;
-// Below this length an interpolated facing direction falls back to the previous known one.
-constexpr double kMinFacingNorm = 1e-3;
-
-struct KeyframeConfig {
-  int width = 64;
-  int layers = 2;
-  int heads = 4;
-  int ffn = 128;
-  int window = 256;
-  double fps = 30.0;
-  int min_spacing = 5;
-  int max_spacing = 30;
-
-  std::map<std::string, double> to_map() const {
-    return {{"width", width},   {"layers", layers}, {"heads", heads},
-            {"ffn", ffn},       {"window", window}, {"fps", fps},
-            {"min_spacing", min_spacing}, {"max_spacing", max_spacing}};
-  }
-  blocks::TrunkSize trunk() const { return {width, layers, heads, ffn, window}; }
-};
-
-KeyframeConfig parse_config(const std::map<std::string, double>& values) {
-  KeyframeConfig c;
-  HyperparameterReader r("keyframe", values);
-  r.integer("width", 4, 4096, &c.width);
-  r.integer("layers", 1, 64, &c.layers);
-  r.integer("heads", 1, 64, &c.heads);
-  r.integer("ffn", 1, 16384, &c.ffn);
-  r.integer("window", 2, 4096, &c.window);
-  r.positive("fps", 1000, &c.fps);
-  r.integer("min_spacing", 1, 4096, &c.min_spacing);
-  r.integer("max_spacing", 2, 4096, &c.max_spacing);
-  r.check(c.width % c.heads == 0,
-          "heads (" + std::to_string(c.heads) + ") must divide width (" + std::to_string(c.width) + ")");
-  r.check(c.max_spacing >= 2 * c.min_spacing, "max_spacing (" + std::to_string(c.max_spacing) +
-                                                  ") must be at least twice min_spacing (" +
-                                                  std::to_string(c.min_spacing) + ")");
-  r.finish();
-  return c;
-}
-
-// The picks between anchors a < b (frames) into `picked`, from the scores s.
-void select_between(const float* s, int a, int b, int min_spacing, int max_spacing, bool* picked) {
-  int prev = a;
-  while (true) {
-    const int lo = prev + min_spacing;
-    const int hi = std::min(prev + max_spacing, b - min_spacing);
-    if (lo > hi) return;
-    int best = lo;
-    for (int t = lo + 1; t <= hi; ++t) {
-      if (s[t] >= s[best]) best = t;  // ties: the later frame (longer spacings)
-    }
-    const bool forced = b - prev > max_spacing;
-    if (!forced && !(s[best] > 0.0f)) return;  // logit > 0: score above 0.5
-    picked[best] = true;
-    prev = best;
-  }
-}
 
 // Facing directions [B, T, 2] interpolated between the frames where `known`
 // holds and normalised; where that cancels out, the previous known facing (the
@@ -118,19 +58,7 @@ at::Tensor select_keyframes(const at::Tensor& logits, const at::Tensor& anchors,
     const bool* ab = a[b].data_ptr<bool>();
     const bool* vb = v[b].data_ptr<bool>();
     bool* ob = out[b].data_ptr<bool>();
-    std::vector<int> points;
-    for (int t = 0; t < T; ++t) {
-      if (!vb[t]) continue;
-      if (ab[t] || points.empty()) points.push_back(t);
-    }
-    int last_valid = -1;
-    for (int t = 0; t < T; ++t) {
-      if (vb[t]) last_valid = t;
-    }
-    if (last_valid >= 0 && (points.empty() || points.back() != last_valid)) points.push_back(last_valid);
-    for (size_t k = 0; k + 1 < points.size(); ++k) {
-      select_between(sb, points[k], points[k + 1], min_spacing, max_spacing, ob);
-    }
+    select_window_keyframes(sb, ab, vb, static_cast<int>(T), min_spacing, max_spacing, ob);
   }
   return out.to(logits.device());
 }
@@ -320,11 +248,11 @@ class KeyframeModel final : public NetworkModel<KeyframeConfig, KeyframeNet> {
 
 std::unique_ptr<InbetweenModel> make_keyframe_net(const std::map<std::string, double>& hyperparameters,
                                                   const RigInfo& rig) {
-  return make_network_model<KeyframeModel>("keyframe", parse_config(hyperparameters), rig);
+  return make_network_model<KeyframeModel>("keyframe", parse_keyframe_config(hyperparameters), rig);
 }
 
 int64_t keyframe_net_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {
-  const KeyframeConfig c = parse_config(hyperparameters);
+  const KeyframeConfig c = parse_keyframe_config(hyperparameters);
   const int pose_size = rig.num_joints() * 6 + 3, inputs = pose_size + rig.num_joints() + 1 + kTrajectorySize;
   return blocks::stage_parameter_count(c.trunk(), inputs, pose_size + 1, true) +
          blocks::stage_parameter_count(c.trunk(), inputs + 1, pose_size + rig.num_feet(), false);

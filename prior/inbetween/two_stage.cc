@@ -17,40 +17,6 @@ namespace {
 using blocks::Positions;
 using blocks::Stage;
 
-struct TwoStageConfig {
-  int width = 64;
-  int layers = 2;
-  int heads = 4;
-  int ffn = 128;
-  int window = 128;
-  double fps = 30.0;
-  int interp_input = 0;
-
-  std::map<std::string, double> to_map() const {
-    std::map<std::string, double> m{{"width", width}, {"layers", layers}, {"heads", heads},
-                                    {"ffn", ffn},     {"window", window}, {"fps", fps}};
-    if (interp_input) m["interp_input"] = interp_input;  // absent in files of the original design
-    return m;
-  }
-  blocks::TrunkSize trunk() const { return {width, layers, heads, ffn, window}; }
-};
-
-TwoStageConfig parse_config(const std::map<std::string, double>& values) {
-  TwoStageConfig c;
-  HyperparameterReader r("twostage", values);
-  r.integer("width", 4, 4096, &c.width);
-  r.integer("layers", 1, 64, &c.layers);
-  r.integer("heads", 1, 64, &c.heads);
-  r.integer("ffn", 1, 16384, &c.ffn);
-  r.integer("window", 2, 4096, &c.window);
-  r.positive("fps", 1000, &c.fps);
-  r.integer("interp_input", 0, 1, &c.interp_input);
-  r.check(c.width % c.heads == 0,
-          "heads (" + std::to_string(c.heads) + ") must divide width (" + std::to_string(c.width) + ")");
-  r.finish();
-  return c;
-}
-
 struct TwoStageNetImpl : torch::nn::Module {
   TwoStageNetImpl(const TwoStageConfig& c, int joints, int feet)
       : config(c), joints(joints), feet(feet), pose_size(joints * 6 + 3) {
@@ -145,11 +111,11 @@ class TwoStageModel final : public NetworkModel<TwoStageConfig, TwoStageNet> {
 
 std::unique_ptr<InbetweenModel> make_two_stage(const std::map<std::string, double>& hyperparameters,
                                                const RigInfo& rig) {
-  return make_network_model<TwoStageModel>("twostage", parse_config(hyperparameters), rig);
+  return make_network_model<TwoStageModel>("twostage", parse_two_stage_config(hyperparameters), rig);
 }
 
 int64_t two_stage_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig) {
-  const TwoStageConfig c = parse_config(hyperparameters);
+  const TwoStageConfig c = parse_two_stage_config(hyperparameters);
   const int pose_size = rig.num_joints() * 6 + 3, inputs = pose_size + rig.num_joints() + 1;
   return blocks::stage_parameter_count(c.trunk(), inputs, pose_size, true) +
          blocks::stage_parameter_count(c.trunk(), inputs, pose_size + rig.num_feet(), false) + c.interp_input;

@@ -1,13 +1,17 @@
 // The Eigen runtime on its own: built and linked against mf_runtime only (no
 // libtorch; the runtime_links_no_torch test checks this binary), it loads the
-// shipped prior and evaluates it. tests/runtime_equivalence_test.cc compares
-// it with libtorch and its gradients with finite differences.
+// shipped prior and evaluates it, and runs the shipped in-betweeners
+// (inbetween_runtime.h). tests/runtime_equivalence_test.cc compares
+// it with libtorch and its gradients with finite differences,
+// tests/runtime_inbetween_equivalence_test.cc the in-betweeners.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <string>
 
 #include "prior/motion/errors.h"
+#include "prior/runtime/inbetween_runtime.h"
 #include "prior/runtime/kinematics.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/runtime/rotations.h"
@@ -162,6 +166,37 @@ TEST(RuntimeStandalone, RefusesAFileWithoutItsWeights) {
   const std::string bytes = "MFMODEL";
   EXPECT_THROW(NemfRuntime::from_bytes(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), "x.mfm"),
                InputError);
+}
+
+// Every shipped in-betweener loads and fills a window (5 context frames and
+// the target known): its stages [T, D], finite; CITL exact on the known values.
+TEST(RuntimeStandalone, InbetweenersFillAWindow) {
+  for (const char* file : {"motionfield-twostage.mfm", "motionfield-citl.mfm", "motionfield-keyframe.mfm"}) {
+    const auto model = load_inbetweener_runtime(std::string(MF_SOURCE_DIR) + "/models/" + file);
+    const int T = std::min(40, model->window()), J = model->rig().num_joints(), D = model->pose_size();
+    std::mt19937 rng(3);
+    InbetweenWindow w;
+    w.pose = normal_matrix(T, D, rng);
+    w.known = MatrixRXf::Zero(T, J + 1);
+    w.known.topRows(5).setOnes();
+    w.known.row(T - 1).setOnes();
+    w.valid = Eigen::VectorXf::Ones(T);
+    InbetweenResult out;
+    model->forward(w, &out);
+    ASSERT_EQ(out.stages.size(), model->stage_names().size()) << file;
+    for (const MatrixRXf& stage : out.stages) {
+      EXPECT_EQ(stage.rows(), T);
+      EXPECT_EQ(stage.cols(), D);
+      EXPECT_TRUE(stage.allFinite()) << file;
+    }
+    if (model->kind() == "citl") {
+      EXPECT_EQ(out.stages[0].topRows(5), w.pose.topRows(5));
+      EXPECT_EQ(out.stages[0].row(T - 1), w.pose.row(T - 1));
+    } else {
+      EXPECT_EQ(out.contact_logits.rows(), T) << file;
+      EXPECT_EQ(out.contact_logits.cols(), model->rig().num_feet()) << file;
+    }
+  }
 }
 
 }  // namespace
