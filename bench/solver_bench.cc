@@ -248,7 +248,8 @@ mf::Motion complete(const mf::NemfModel& model, const Args& args, const std::str
   int stage = 0;
   if (const mf::InbetweenerKind* kind = mf::find_inbetweener_stage(method, &stage)) {
     const mf::InbetweenModel& t = mf::require_inbetweener(args.transformers, kind->name, "method '" + method + "'");
-    return mf::inbetweener_fill(t, stage, input, constraints, mf::LongGapPolicy::Throw);
+    return mf::inbetweener_fill(t, args.transformers.inbetweener_runtime(kind->name), stage, input, constraints,
+                                mf::LongGapPolicy::Throw);
   }
   return mf::complete_motion(model, input, constraints, solver_options(args, method), args.prior, report);
 }

@@ -207,9 +207,9 @@ TEST(KeyframeNetGlue, FillReadsTheTrajectory) {
   for (int f = 0; f < 10; ++f) known.push_back(f);
   known.push_back(kFrames - 1);
   MotionConstraints c = MotionConstraints::full_pose(known);
-  const Motion plain = inbetweener_fill(*model, -1, m, c, LongGapPolicy::Throw);
+  const Motion plain = inbetweener_fill(*model, nullptr, -1, m, c, LongGapPolicy::Throw);
   for (int f = 10; f < kFrames - 1; ++f) c.trajectory.push_back({f, 0.1 * f, 2.0, 1.0, 0.0});
-  const Motion along = inbetweener_fill(*model, -1, m, c, LongGapPolicy::Throw);
+  const Motion along = inbetweener_fill(*model, nullptr, -1, m, c, LongGapPolicy::Throw);
   double moved = 0.0;
   for (int f = 10; f < kFrames - 1; ++f) moved = std::max(moved, (along.root_positions[f] - plain.root_positions[f]).norm());
   EXPECT_GT(moved, 1e-4);

@@ -379,17 +379,17 @@ TEST(TransformerMethods, GapsWhoseOutputJumpsAtTheKeysAreInterpolated) {
   const std::vector<int> keys = {0, 9, 21, 29};
   const Motion interp = interpolate_motion(in, keys);
   std::vector<std::string> warnings;
-  const Motion smooth = inbetweener_fill(*fx.twostage, 1, in, MotionConstraints::full_pose(keys),
+  const Motion smooth = inbetweener_fill(*fx.twostage, nullptr, 1, in, MotionConstraints::full_pose(keys),
                                          LongGapPolicy::Throw, false, {true, &warnings});
   EXPECT_TRUE(warnings.empty());  // the stand-in's 1 cm step is within a body's reach
   EXPECT_GT((smooth.root_positions[15] - interp.root_positions[15]).norm(), 0.005);
 
   fx.twostage->jump_off_keys = 0.3;
-  const Motion kept = inbetweener_fill(*fx.twostage, 1, in, MotionConstraints::full_pose(keys), LongGapPolicy::Throw,
+  const Motion kept = inbetweener_fill(*fx.twostage, nullptr, 1, in, MotionConstraints::full_pose(keys), LongGapPolicy::Throw,
                                        false, {false, &warnings});
   EXPECT_TRUE(warnings.empty());
   EXPECT_GT((kept.root_positions[15] - interp.root_positions[15]).norm(), 0.25);
-  const Motion out = inbetweener_fill(*fx.twostage, 1, in, MotionConstraints::full_pose(keys), LongGapPolicy::Throw,
+  const Motion out = inbetweener_fill(*fx.twostage, nullptr, 1, in, MotionConstraints::full_pose(keys), LongGapPolicy::Throw,
                                       false, {true, &warnings});
   expect_known_exact(in, out, keys);
   for (int f = 0; f < in.num_frames(); ++f) {
@@ -427,7 +427,7 @@ TEST(TransformerMethods, PartialKeysGiveTheirKnownMask) {
   c.keys.push_back({10, {0}, true});       // root only: fixes the root
   c.keys.push_back({20, {3, 4}, false});   // two joints, no root position
   c.keys.push_back({31, {}, true});
-  const Motion out = inbetweener_fill(*fx.citl, -1, in, c, LongGapPolicy::Throw);
+  const Motion out = inbetweener_fill(*fx.citl, nullptr, -1, in, c, LongGapPolicy::Throw);
   ASSERT_TRUE(fx.citl->last_known.defined());
   // One window [0, 31], canonical at 0.
   ASSERT_EQ(fx.citl->last_known.size(0), 1);
@@ -442,7 +442,7 @@ TEST(TransformerMethods, PartialKeysGiveTheirKnownMask) {
   EXPECT_EQ(out.rotation(20, 3).coeffs(), in.rotation(20, 3).coeffs());
   EXPECT_EQ(out.rotation(20, 4).coeffs(), in.rotation(20, 4).coeffs());
   expect_finite(out);
-  EXPECT_THROW(inbetweener_fill(*fx.twostage, 2, in, c, LongGapPolicy::Throw), InputError);  // no stage 2
+  EXPECT_THROW(inbetweener_fill(*fx.twostage, nullptr, 2, in, c, LongGapPolicy::Throw), InputError);  // no stage 2
 }
 
 TEST(TransformerInitializers, FiniteCodesOfThePriorsShapeFromEachTransformer) {

@@ -78,10 +78,10 @@ FileBytes read_file(const std::string& file) { return read_file_bytes(file); }  
 // The in-betweener file `file` for the prior of `model`: MF_ERROR_IO when
 // unreadable, MF_ERROR_MODEL when it is not an in-betweener or not on the
 // prior's skeleton.
-std::shared_ptr<const InbetweenModel> load_inbetweener_file(const std::string& file, const mf_model& model) {
+LoadedInbetweener load_user_inbetweener(const std::string& file, const mf_model& model) {
   const FileBytes bytes = read_file(file);
   try {
-    return frozen_inbetweener(deserialize_inbetweener(bytes.data(), bytes.size(), file), file, "", model.model.get());
+    return inbetweener_from_bytes(bytes.data(), bytes.size(), file, "", model.model.get());
   } catch (const InputError& e) {
     throw ApiError(MF_ERROR_MODEL, e.what());
   }
@@ -121,7 +121,8 @@ std::unique_ptr<mf_model> load_model_set(const char* path, const char* const* in
   for (size_t i = 0; i < count; ++i) {
     require(inbetweeners[i], "an in-betweener path");
     if (!*inbetweeners[i]) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the transformer model path is empty");
-    handle->add_inbetweener(load_inbetweener_file(inbetweeners[i], *handle));
+    LoadedInbetweener loaded = load_user_inbetweener(inbetweeners[i], *handle);
+    handle->add_inbetweener(std::move(loaded.model), std::move(loaded.runtime));
   }
   return handle;
 }
@@ -185,7 +186,8 @@ int mf_model_with_inbetweener(const mf_model* model, const char* path, mf_model*
     require(out, "out");
     if (!*path) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the transformer model path is empty");
     auto handle = std::make_unique<mf_model>(*model);
-    handle->add_inbetweener(mf::capi::load_inbetweener_file(path, *model));
+    mf::LoadedInbetweener loaded = mf::capi::load_user_inbetweener(path, *model);
+    handle->add_inbetweener(std::move(loaded.model), std::move(loaded.runtime));
     *out = handle.release();
   });
 }

@@ -21,6 +21,9 @@ class NemfRuntime;
 
 class NemfModel;
 class InbetweenModel;
+namespace runtime {
+class InbetweenerRuntime;
+}
 struct RigAnatomy;
 struct RigInfo;
 struct Skeleton;
@@ -71,14 +74,27 @@ struct ModelSet {
   /// Why that file did not load ("" when it did or is absent).
   std::string model_anatomy_error;
 
+  /// The same models on the Eigen runtime (prior/runtime/inbetween_runtime.h),
+  /// by kind, read from the same files: the transformer fills run their
+  /// forward passes there (tasks/transformer/inbetweener_fill.h). A kind
+  /// without one runs on libtorch.
+  std::map<std::string, std::shared_ptr<const runtime::InbetweenerRuntime>> inbetweener_runtimes;
+
   /// The in-betweener of `kind`; null when not loaded.
   const InbetweenModel* inbetweener(const std::string& kind) const {
     auto it = inbetweeners.find(kind);
     return it == inbetweeners.end() ? nullptr : it->second.get();
   }
-  /// Adds (or replaces) the in-betweener of `model`'s kind and forgets that
-  /// kind's load error.
-  void add_inbetweener(std::shared_ptr<const InbetweenModel> model);
+  /// Its twin on the Eigen runtime; null when there is none.
+  const runtime::InbetweenerRuntime* inbetweener_runtime(const std::string& kind) const {
+    auto it = inbetweener_runtimes.find(kind);
+    return it == inbetweener_runtimes.end() ? nullptr : it->second.get();
+  }
+  /// Adds (or replaces) the in-betweener of `model`'s kind, with its twin on
+  /// the Eigen runtime when given (read from the same file; null: none), and
+  /// forgets that kind's load error.
+  void add_inbetweener(std::shared_ptr<const InbetweenModel> model,
+                       std::shared_ptr<const runtime::InbetweenerRuntime> twin = nullptr);
 };
 
 /// What a method may use besides its input: the models, the caller's rig map,

@@ -41,9 +41,14 @@ InitialGuess ZeroInitializer::initialize(const InitRequest& r) const {
   return {at::zeros({1, r.model->config().zl}, at::kFloat), at::zeros({1, r.model->config().zg}, at::kFloat)};
 }
 
-TransformerEncoderInitializer::TransformerEncoderInitializer(std::string name, std::string kind, int stage,
-                                                             std::shared_ptr<const InbetweenModel> bound)
-    : name_(std::move(name)), kind_(std::move(kind)), stage_(stage), bound_(std::move(bound)) {}
+TransformerEncoderInitializer::TransformerEncoderInitializer(
+    std::string name, std::string kind, int stage, std::shared_ptr<const InbetweenModel> bound,
+    std::shared_ptr<const runtime::InbetweenerRuntime> bound_runtime)
+    : name_(std::move(name)),
+      kind_(std::move(kind)),
+      stage_(stage),
+      bound_(std::move(bound)),
+      bound_runtime_(std::move(bound_runtime)) {}
 
 const InbetweenModel& TransformerEncoderInitializer::transformer(const TaskContext* context) const {
   const std::string what = "initialiser '" + name_ + "'";
@@ -51,16 +56,21 @@ const InbetweenModel& TransformerEncoderInitializer::transformer(const TaskConte
   return bound_ ? *bound_ : require_inbetweener(*context, kind_, what);
 }
 
+const runtime::InbetweenerRuntime* TransformerEncoderInitializer::network(const TaskContext* context) const {
+  if (bound_) return bound_runtime_.get();
+  return context ? context->inbetweener_runtime(kind_) : nullptr;
+}
+
 InitialGuess TransformerEncoderInitializer::initialize(const InitRequest& r) const {
   if (!r.model || !r.window || !r.constraints) throw std::invalid_argument("InitRequest is incomplete");
-  const Motion filled =
-      inbetweener_fill(transformer(r.context), stage_, *r.window, *r.constraints, LongGapPolicy::Interpolate);
+  const Motion filled = inbetweener_fill(transformer(r.context), network(r.context), stage_, *r.window,
+                                         *r.constraints, LongGapPolicy::Interpolate);
   return encode_window(*r.model, filled, r.anchor);
 }
 
 std::optional<Motion> TransformerEncoderInitializer::fill_input(const Motion& input, const MotionConstraints& c,
                                                                 const TaskContext& context) const {
-  return inbetweener_fill(transformer(&context), stage_, input, c, LongGapPolicy::Interpolate);
+  return inbetweener_fill(transformer(&context), network(&context), stage_, input, c, LongGapPolicy::Interpolate);
 }
 
 std::vector<std::string> initializer_names() {
@@ -80,12 +90,15 @@ std::shared_ptr<const LatentInitializer> make_named(const std::string& name, con
     for (size_t stage = 0; stage < kind.stages.size(); ++stage) {
       if (name != kind.stages[stage].name + "-encoder") continue;
       std::shared_ptr<const InbetweenModel> bound;
+      std::shared_ptr<const runtime::InbetweenerRuntime> bound_runtime;
       if (context) {
         require_inbetweener(*context, kind.name, "initialiser '" + name + "'");
         bound = context->inbetweeners.at(kind.name);
+        const auto twin = context->inbetweener_runtimes.find(kind.name);
+        if (twin != context->inbetweener_runtimes.end()) bound_runtime = twin->second;
       }
       return std::make_shared<TransformerEncoderInitializer>(name, kind.name, static_cast<int>(stage),
-                                                             std::move(bound));
+                                                             std::move(bound), std::move(bound_runtime));
     }
   }
   std::string list;

@@ -93,13 +93,16 @@ class ZeroInitializer : public LatentInitializer {
 ///   "context-encoder"  stage 0 of the two-stage model
 ///   "detail-encoder"   stage 1 of the two-stage model
 ///   "citl-encoder"     the CITL model
-/// The transformer is the one bound at construction, else the request
-/// context's; initialize() throws mf::InputError when there is none.
+/// The transformer is the one bound at construction (with its twin on the
+/// Eigen runtime, which then runs the pass, when given), else the request
+/// context's (and its twin: ModelSet::inbetweener_runtime()); initialize()
+/// throws mf::InputError when there is none.
 class TransformerEncoderInitializer : public LatentInitializer {
  public:
   /// `kind` an in-betweener kind; `stage` 0-based, -1 = the last.
   TransformerEncoderInitializer(std::string name, std::string kind, int stage,
-                                std::shared_ptr<const InbetweenModel> bound = nullptr);
+                                std::shared_ptr<const InbetweenModel> bound = nullptr,
+                                std::shared_ptr<const runtime::InbetweenerRuntime> bound_runtime = nullptr);
   std::string name() const override { return name_; }
   InitialGuess initialize(const InitRequest& request) const override;
   /// One pass of the transformer over the whole input (its own windows,
@@ -110,9 +113,11 @@ class TransformerEncoderInitializer : public LatentInitializer {
 
  private:
   const InbetweenModel& transformer(const TaskContext* context) const;
+  const runtime::InbetweenerRuntime* network(const TaskContext* context) const;
   std::string name_, kind_;
   int stage_;
   std::shared_ptr<const InbetweenModel> bound_;
+  std::shared_ptr<const runtime::InbetweenerRuntime> bound_runtime_;
 };
 
 /// Names accepted by make_initializer(), the default first: "interp-encoder",

@@ -17,8 +17,9 @@ Method transformer_method(const std::string& name, const std::string& descriptio
   m.complete = [name, kind, stage, locks_feet](const Motion& input, const std::vector<int>& known,
                                                const TaskContext& ctx, CompletionNotes* notes) {
     const InbetweenModel& model = require_inbetweener(ctx, kind, "method '" + name + "'");
-    return inbetweener_fill(model, stage, input, MotionConstraints::full_pose(known), LongGapPolicy::Throw,
-                            locks_feet, {ctx.interpolation_fallback, notes ? &notes->warnings : nullptr});
+    return inbetweener_fill(model, ctx.inbetweener_runtime(kind), stage, input, MotionConstraints::full_pose(known),
+                            LongGapPolicy::Throw, locks_feet,
+                            {ctx.interpolation_fallback, notes ? &notes->warnings : nullptr});
   };
   // Keys (full or partial) and a trajectory, one answer: inbetweener_fill reads both.
   m.complete_constrained = [name, kind, stage, locks_feet](const Motion& input, const MotionConstraints& c,
@@ -29,7 +30,7 @@ Method transformer_method(const std::string& name, const std::string& descriptio
                        "' takes keys and a trajectory only: end-effector targets, contacts and alternatives need a "
                        "latent solver (nemf, nemf-" + name + ", ...)");
     const InbetweenModel& model = require_inbetweener(ctx, kind, "method '" + name + "'");
-    return inbetweener_fill(model, stage, input, c, LongGapPolicy::Throw, locks_feet,
+    return inbetweener_fill(model, ctx.inbetweener_runtime(kind), stage, input, c, LongGapPolicy::Throw, locks_feet,
                             {ctx.interpolation_fallback, warnings});
   };
   return m;

@@ -5,6 +5,8 @@
 #include "prior/inbetween/inbetweener.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/runtime/inbetween_runtime.h"
+#include "prior/util/binary_io.h"
 
 namespace mf {
 
@@ -33,9 +35,17 @@ std::shared_ptr<const InbetweenModel> frozen_inbetweener(std::unique_ptr<Inbetwe
   return std::shared_ptr<const InbetweenModel>(std::move(model));
 }
 
-std::shared_ptr<const InbetweenModel> load_frozen_inbetweener(const std::string& path, const std::string& kind,
-                                                              const NemfModel* prior) {
-  return frozen_inbetweener(load_inbetweener(path), path, kind, prior);
+LoadedInbetweener inbetweener_from_bytes(const uint8_t* data, size_t size, const std::string& source,
+                                         const std::string& kind, const NemfModel* prior) {
+  LoadedInbetweener out;
+  out.model = frozen_inbetweener(deserialize_inbetweener(data, size, source), source, kind, prior);
+  out.runtime = runtime::inbetweener_runtime_from_bytes(data, size, source);
+  return out;
+}
+
+LoadedInbetweener load_inbetweener_file(const std::string& path, const std::string& kind, const NemfModel* prior) {
+  const FileBytes bytes = read_file_bytes(path);
+  return inbetweener_from_bytes(bytes.data(), bytes.size(), path, kind, prior);
 }
 
 void load_inbetweeners(const std::string& prior_path, const std::map<std::string, std::string>& named, bool strict,
@@ -48,7 +58,8 @@ void load_inbetweeners(const std::string& prior_path, const std::map<std::string
     if (!is_named && !std::filesystem::exists(file, ec)) continue;
     if (log) log(kind.title, file);
     try {
-      models->add_inbetweener(load_frozen_inbetweener(file, kind.name, models->model.get()));
+      LoadedInbetweener loaded = load_inbetweener_file(file, kind.name, models->model.get());
+      models->add_inbetweener(std::move(loaded.model), std::move(loaded.runtime));
     } catch (const std::exception& e) {
       if (is_named || strict) throw;
       models->inbetweener_errors[kind.name] = e.what();

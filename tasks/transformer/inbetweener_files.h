@@ -4,6 +4,8 @@
 // in-betweener is not loaded.
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -14,6 +16,9 @@
 namespace mf {
 
 class InbetweenModel;
+namespace runtime {
+class InbetweenerRuntime;
+}
 
 /// The file name of the product kind `kind` (InbetweenerKind::file_name);
 /// InputError listing the kinds otherwise.
@@ -35,9 +40,20 @@ std::shared_ptr<const InbetweenModel> frozen_inbetweener(std::unique_ptr<Inbetwe
                                                          const std::string& source, const std::string& kind,
                                                          const NemfModel* prior = nullptr);
 
-/// load_inbetweener(path), then frozen_inbetweener.
-std::shared_ptr<const InbetweenModel> load_frozen_inbetweener(const std::string& path, const std::string& kind,
-                                                              const NemfModel* prior = nullptr);
+/// A model file's in-betweener, frozen (frozen_inbetweener()), and its twin
+/// on the Eigen runtime (ModelSet::inbetweener_runtimes) read from the same
+/// bytes.
+struct LoadedInbetweener {
+  std::shared_ptr<const InbetweenModel> model;
+  std::shared_ptr<const runtime::InbetweenerRuntime> runtime;
+};
+/// The in-betweener of a model file's bytes (`source` names it in errors:
+/// InputError as frozen_inbetweener()'s and the runtime's loader's).
+LoadedInbetweener inbetweener_from_bytes(const uint8_t* data, size_t size, const std::string& source,
+                                         const std::string& kind, const NemfModel* prior = nullptr);
+/// The same from the file at `path` (FileError when it cannot be read).
+LoadedInbetweener load_inbetweener_file(const std::string& path, const std::string& kind,
+                                        const NemfModel* prior = nullptr);
 
 /// Told the title and the path of each in-betweener file before it loads.
 using InbetweenerLog = std::function<void(const std::string& title, const std::string& path)>;

@@ -11,6 +11,8 @@
 #include "prior/inbetween/inbetweener.h"
 #include "prior/inbetween/keyframe_net.h"
 #include "prior/model/representation.h"
+#include "prior/runtime/inbetween_runtime.h"
+#include "prior/runtime/rotations.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "tasks/constraints/interpolation_fill.h"
@@ -99,51 +101,117 @@ std::vector<FillWindow> plan_windows(const std::vector<int>& roots, int W, LongG
   return windows;
 }
 
-// The model's input for `windows` of `filled` (one batch padded to the longest
-// window, each canonical at its start) and each window's canonical transform.
-struct FillBatch {
-  InbetweenBatch batch;
-  std::vector<GroundTransform> transforms;
+// The model's input for one window of `filled`, canonical at its start
+// (runtime::InbetweenWindow: the batch of one window), and that canonical
+// transform.
+struct FillInput {
+  runtime::InbetweenWindow window;
+  GroundTransform transform;
 };
 
-FillBatch make_batch(const InbetweenModel& model, const Motion& filled, const std::vector<FillWindow>& windows,
-                     const KeyIndex& keys, const MotionConstraints& c, const at::Tensor& world_trajectory) {
-  const RigInfo& rig = model.rig();
+std::vector<FillInput> make_inputs(const RigInfo& rig, const Motion& filled, const std::vector<FillWindow>& windows,
+                                   const KeyIndex& keys, const MotionConstraints& c,
+                                   const at::Tensor& world_trajectory) {
   const int J = filled.num_joints();
-  const int B = static_cast<int>(windows.size());
-  int L = 0;
-  for (const FillWindow& w : windows) L = std::max(L, w.end - w.start + 1);
-  at::Tensor pose = at::zeros({B, L, model.pose_size()}, at::kFloat);
-  at::Tensor known = at::zeros({B, L, J + 1}, at::kFloat);
-  at::Tensor valid = at::zeros({B, L}, at::kFloat);
-  FillBatch out;
-  auto kn = known.accessor<float, 3>();
-  auto va = valid.accessor<float, 2>();
-  for (int b = 0; b < B; ++b) {
-    const FillWindow& w = windows[b];
+  std::vector<FillInput> out;
+  for (const FillWindow& w : windows) {
     const int T = w.end - w.start + 1;
-    out.transforms.push_back(canonical_transform(filled, w.start, rig));
-    const WindowTensors wt = window_tensors(filled, w.start, T, rig, 0);
-    pose.select(0, b).narrow(0, 0, T).copy_(pose_features(wt.local_rotations, wt.root_positions)[0]);
+    FillInput in;
+    in.transform = canonical_transform(filled, w.start, rig);
+    const WindowMatrices m = window_matrices(filled, w.start, T, rig, 0);
+    runtime::InbetweenWindow& x = in.window;
+    x.pose.resize(T, J * 6 + 3);
+    x.known.setZero(T, J + 1);
+    x.valid.setOnes(T);
     for (int t = 0; t < T; ++t) {
-      va[b][t] = 1.0f;
       const int k = keys.key_of[w.start + t];
-      if (k < 0) continue;
-      for (int j = 0; j < J; ++j) kn[b][t][j] = c.key_has_joint(static_cast<size_t>(k), j) ? 1.0f : 0.0f;
-      kn[b][t][J] = c.keys[static_cast<size_t>(k)].root_position ? 1.0f : 0.0f;
+      for (int j = 0; j < J && k >= 0; ++j) x.known(t, j) = c.key_has_joint(static_cast<size_t>(k), j) ? 1.0f : 0.0f;
+      if (k >= 0) x.known(t, J) = c.keys[static_cast<size_t>(k)].root_position ? 1.0f : 0.0f;
+      for (int j = 0; j < J; ++j) {
+        const float* r = &m.local_rotations(t, j * 9);  // row-major 3x3; the 6D is its first two columns
+        const float sixd[6] = {r[0], r[3], r[6], r[1], r[4], r[7]};
+        for (int i = 0; i < 6; ++i) x.pose(t, j * 6 + i) = sixd[i] * x.known(t, j);
+      }
+      for (int i = 0; i < 3; ++i) x.pose(t, J * 6 + i) = m.root_positions(t, i) * x.known(t, J);
     }
-  }
-  out.batch = InbetweenBatch{pose * known_channel_mask(known, J), known, valid};
-  if (world_trajectory.defined()) {
-    std::vector<at::Tensor> rows;
-    for (int b = 0; b < B; ++b) {
-      const FillWindow& w = windows[b];
-      at::Tensor r = canonical_trajectory(world_trajectory.narrow(0, w.start, w.end - w.start + 1), out.transforms[b]);
-      rows.push_back(at::cat({r, r.narrow(0, r.size(0) - 1, 1).expand({L - r.size(0), 4})}, 0));  // padding: held
+    if (world_trajectory.defined()) {
+      const at::Tensor r = canonical_trajectory(world_trajectory.narrow(0, w.start, T), in.transform).contiguous();
+      x.trajectory = Eigen::Map<const runtime::MatrixRXf>(r.data_ptr<float>(), T, 4);
     }
-    out.batch.trajectory = at::stack(rows);
+    out.push_back(std::move(in));
   }
   return out;
+}
+
+// What the model gives for one window: the used stage's raw pose [T, D] and,
+// when it predicts them, its foot contact logits [T, F].
+struct FillOutput {
+  runtime::MatrixRXf pose;
+  runtime::MatrixRXf contact_logits;
+};
+
+// One pass of the libtorch model over all windows as one batch, padded to the
+// longest window (padding frames invalid; a trajectory held over them).
+std::vector<FillOutput> forward_libtorch(const InbetweenModel& model, int stage, const std::vector<FillInput>& inputs) {
+  at::NoGradGuard no_grad;
+  const int B = static_cast<int>(inputs.size()), D = model.pose_size();
+  const int J1 = model.rig().num_joints() + 1;
+  int L = 0;
+  for (const FillInput& in : inputs) L = std::max(L, static_cast<int>(in.window.pose.rows()));
+  InbetweenBatch batch{at::zeros({B, L, D}, at::kFloat), at::zeros({B, L, J1}, at::kFloat),
+                       at::zeros({B, L}, at::kFloat), at::Tensor()};
+  const bool trajectory = inputs.front().window.trajectory.rows() > 0;
+  if (trajectory) batch.trajectory = at::zeros({B, L, 4}, at::kFloat);
+  auto rows = [](const runtime::MatrixRXf& m) {
+    return at::from_blob(const_cast<float*>(m.data()), {m.rows(), m.cols()}, at::kFloat);
+  };
+  for (int b = 0; b < B; ++b) {
+    const runtime::InbetweenWindow& x = inputs[static_cast<size_t>(b)].window;
+    const int64_t T = x.pose.rows();
+    batch.pose[b].narrow(0, 0, T).copy_(rows(x.pose));
+    batch.known[b].narrow(0, 0, T).copy_(rows(x.known));
+    batch.valid[b].narrow(0, 0, T).fill_(1.0f);
+    if (!trajectory) continue;
+    batch.trajectory[b].narrow(0, 0, T).copy_(rows(x.trajectory));
+    batch.trajectory[b].narrow(0, T, L - T).copy_(rows(x.trajectory)[T - 1].expand({L - T, 4}));
+  }
+  const InbetweenOutput result = model.forward(batch);
+  if (stage >= static_cast<int>(result.stages.size()))
+    throw std::logic_error("the in-betweener returned fewer stages than stage_names() lists");
+  const at::Tensor pose = result.stages[static_cast<size_t>(stage)].detach().to(at::kFloat).contiguous();
+  const at::Tensor contacts =
+      result.contact_logits.defined() ? result.contact_logits.detach().to(at::kFloat).contiguous() : at::Tensor();
+  std::vector<FillOutput> out(inputs.size());
+  for (int b = 0; b < B; ++b) {
+    const int64_t T = inputs[static_cast<size_t>(b)].window.pose.rows();
+    out[b].pose = Eigen::Map<const runtime::MatrixRXf>(pose[b].data_ptr<float>(), L, D).topRows(T);
+    if (contacts.defined())
+      out[b].contact_logits =
+          Eigen::Map<const runtime::MatrixRXf>(contacts[b].data_ptr<float>(), L, contacts.size(2)).topRows(T);
+  }
+  return out;
+}
+
+// One pass of the Eigen runtime's model per window.
+std::vector<FillOutput> forward_runtime(const runtime::InbetweenerRuntime& net, int stage,
+                                        const std::vector<FillInput>& inputs) {
+  std::vector<FillOutput> out(inputs.size());
+  runtime::InbetweenResult result;
+  for (size_t b = 0; b < inputs.size(); ++b) {
+    net.forward(inputs[b].window, &result);
+    if (stage >= static_cast<int>(result.stages.size()))
+      throw std::logic_error("the in-betweener returned fewer stages than stage_names() lists");
+    out[b].pose = std::move(result.stages[static_cast<size_t>(stage)]);
+    out[b].contact_logits = std::move(result.contact_logits);
+  }
+  return out;
+}
+
+// A window's canonical output (raw pose [T, D]) written into `piece`'s frames.
+void write_piece(const runtime::MatrixRXf& pose, int J, const GroundTransform& transform, Motion* piece) {
+  runtime::MatrixRXf rotations;
+  runtime::sixd_to_matrix(pose.leftCols(J * 6), &rotations);
+  write_window(rotations.cast<double>(), pose.rightCols(3).cast<double>(), transform, piece, 0);
 }
 
 // The residual at key frame f of `piece` (window frames from `start`): per
@@ -280,9 +348,9 @@ at::Tensor canonical_trajectory(const at::Tensor& world, const GroundTransform& 
   return at::stack({c * x - s * z, s * x + c * z, c * fx - s * fz, s * fx + c * fz}, -1);
 }
 
-Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
-                        const MotionConstraints& constraints, LongGapPolicy policy, bool foot_lock,
-                        const FillFallback& fallback) {
+Motion inbetweener_fill(const InbetweenModel& model, const runtime::InbetweenerRuntime* network, int stage,
+                        const Motion& input, const MotionConstraints& constraints, LongGapPolicy policy,
+                        bool foot_lock, const FillFallback& fallback) {
   const int used_stage = checked_stage(model, stage, input, constraints);
   // Reads only the constrained values; every frame holds something sensible.
   Motion out = fill_by_interpolation(input, constraints);
@@ -294,36 +362,26 @@ Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& in
   const std::vector<FillWindow> windows =
       plan_windows(keys.roots, model.window(), policy, inbetweener_title(model.kind()));
   if (!windows.empty()) {
-    at::NoGradGuard no_grad;
-    const FillBatch fill =
-        make_batch(model, out, windows, keys, constraints, constrained_trajectory(input, constraints, model.rig()));
-    const InbetweenOutput result = model.forward(fill.batch);
-    if (used_stage >= static_cast<int>(result.stages.size()))
-      throw std::logic_error("the in-betweener returned fewer stages than stage_names() lists");
-    const at::Tensor stage_pose = result.stages[static_cast<size_t>(used_stage)].detach().to(at::kFloat).contiguous();
+    const std::vector<FillInput> inputs =
+        make_inputs(model.rig(), out, windows, keys, constraints, constrained_trajectory(input, constraints, model.rig()));
+    const std::vector<FillOutput> outputs =
+        network ? forward_runtime(*network, used_stage, inputs) : forward_libtorch(model, used_stage, inputs);
     // The contact head reads the last stage: its contacts hold for that stage's pose only.
-    const bool lock = foot_lock && result.contact_logits.defined() &&
-                      used_stage == static_cast<int>(result.stages.size()) - 1;
     const int feet = model.rig().num_feet();
-    const at::Tensor contact =
-        lock ? at::sigmoid(result.contact_logits.detach().to(at::kFloat)).contiguous() : at::Tensor();
+    const bool lock = foot_lock && outputs.front().contact_logits.cols() == feet && feet > 0 &&
+                      used_stage == static_cast<int>(model.stage_names().size()) - 1;
     if (lock) contacts.assign(static_cast<size_t>(input.num_frames()) * feet, 0.0f);
     for (size_t b = 0; b < windows.size(); ++b) {
       const FillWindow& w = windows[b];
-      const int T = w.end - w.start + 1;
-      at::Tensor rotations, root;
-      split_pose_features(stage_pose.narrow(0, static_cast<int64_t>(b), 1).narrow(1, 0, T), input.num_joints(),
-                          &rotations, &root);
-      Motion piece = Motion::identity(input.skeleton, T, input.fps);
-      write_window(rotations, root, fill.transforms[b], &piece, 0);
+      Motion piece = Motion::identity(input.skeleton, w.end - w.start + 1, input.fps);
+      write_piece(outputs[b].pose, input.num_joints(), inputs[b].transform, &piece);
       spread_gap_residuals(input, constraints, keys, w, &piece);
       if (fallback.interpolate_jumps) interpolate_jumps(interpolated, w, keys, &piece, &jumps);
       take_owned_frames(piece, w, keys, constraints, &out);
       if (!lock) continue;
-      const auto c = contact.accessor<float, 3>();
       for (int f = w.owned_from + 1; f <= w.end; ++f)
         for (int k = 0; k < feet && !jumps.frames[static_cast<size_t>(f)]; ++k)
-          contacts[static_cast<size_t>(f) * feet + k] = c[b][f - w.start][k];
+          contacts[static_cast<size_t>(f) * feet + k] = 1.0f / (1.0f + std::exp(-outputs[b].contact_logits(f - w.start, k)));
     }
   }
   if (jumps.gaps > 0 && fallback.warnings) {

@@ -14,7 +14,8 @@
 //    if it is at most 40 frames back): the known patterns of training. A
 //    window extends over as many following gaps as fit. Each gap is produced
 //    by exactly one window, so the pieces meet only at known frames; all
-//    windows of a call run as one batch.
+//    windows of a call run as one batch
+//    (on libtorch; the Eigen runtime runs them one by one).
 //  * A gap longer than the window (two keys more than window() - 1 frames
 //    apart) cannot be filled by one pass: LongGapPolicy::Throw says so with
 //    mf::InputError (the methods), LongGapPolicy::Interpolate leaves that gap
@@ -65,6 +66,9 @@
 namespace mf {
 
 class InbetweenModel;
+namespace runtime {
+class InbetweenerRuntime;
+}
 
 enum class LongGapPolicy {
   Throw,        ///< mf::InputError naming the keys and the window
@@ -81,13 +85,17 @@ struct FillFallback {
 
 /// Completes `input` under `constraints` (full or partial keys; end-effector
 /// targets are ignored) with one pass of `model`, using the output of stage
-/// `stage` (0-based; -1 = the last stage). See the top of this file. Throws
+/// `stage` (0-based; -1 = the last stage). See the top of this file.
+/// `network`, when given, is the same model file on the Eigen runtime
+/// (prior/runtime/inbetween_runtime.h; ModelSet::inbetweener_runtime()): the
+/// forward pass then runs there, window by window, without libtorch; the
+/// libtorch model still answers for its kind, stages and rig. Throws
 /// mf::InputError for constraints that do not validate, a skeleton whose
 /// joint count differs from the model's, a stage the model does not have, or
 /// (LongGapPolicy::Throw) a gap longer than the window.
-Motion inbetweener_fill(const InbetweenModel& model, int stage, const Motion& input,
-                        const MotionConstraints& constraints, LongGapPolicy policy, bool foot_lock = false,
-                        const FillFallback& fallback = {});
+Motion inbetweener_fill(const InbetweenModel& model, const runtime::InbetweenerRuntime* network, int stage,
+                        const Motion& input, const MotionConstraints& constraints, LongGapPolicy policy,
+                        bool foot_lock = false, const FillFallback& fallback = {});
 
 /// The ground trajectory of every frame of `input`, [frames, 4] float (world:
 /// x, z, forward_x, forward_z as trajectory_features() of
