@@ -6,17 +6,6 @@
 
 namespace mf {
 
-double smoothstep(double t) { return t * t * (3.0 - 2.0 * t); }
-
-ResidualBracket residual_bracket(int f, const std::vector<int>& frames, ResidualRamp ramp) {
-  const auto it = std::lower_bound(frames.begin(), frames.end(), f);
-  if (it == frames.end()) return {frames.size() - 1, frames.size() - 1, 0.0};
-  const size_t b = static_cast<size_t>(it - frames.begin());
-  if (*it == f || b == 0) return {b, b, 0.0};
-  const double u = static_cast<double>(f - frames[b - 1]) / (frames[b] - frames[b - 1]);
-  return {b - 1, b, ramp == ResidualRamp::Smoothstep ? smoothstep(u) : u};
-}
-
 Eigen::Quaterniond rotation_residual(const Eigen::Quaterniond& given, const Eigen::Quaterniond& solution) {
   return (given.normalized() * solution.normalized().conjugate()).normalized();
 }

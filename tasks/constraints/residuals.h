@@ -15,28 +15,9 @@
 #include <vector>
 
 #include "prior/motion/motion.h"
+#include "tasks/constraints/residual_bracket.h"
 
 namespace mf {
-
-/// 3 t^2 - 2 t^3: from 0 at t = 0 to 1 at t = 1 with zero slope at both ends.
-double smoothstep(double t);
-
-/// How the residual ramps between two known frames a < b, over
-/// u = (f - a) / (b - a): linearly (u) or with smoothstep(u) (no kink at the
-/// known frames).
-enum class ResidualRamp { Linear, Smoothstep };
-
-/// Where frame `f` takes its residual from, among the sorted, unique known
-/// `frames` (non-empty): indices a <= b into `frames` and the weight s of
-/// b's residual (the residual is r[a] (1 - s) + r[b] s). Between two known
-/// frames, the ramp of the position between them; at a known frame, before
-/// the first and after the last: a = b (that frame, the first, the last) and
-/// s = 0.
-struct ResidualBracket {
-  size_t a = 0, b = 0;
-  double s = 0.0;
-};
-ResidualBracket residual_bracket(int f, const std::vector<int>& frames, ResidualRamp ramp);
 
 /// The rotation residual given * solution^-1 (both normalised; normalised).
 Eigen::Quaterniond rotation_residual(const Eigen::Quaterniond& given, const Eigen::Quaterniond& solution);

@@ -53,8 +53,8 @@ struct ModelSet {
   std::shared_ptr<const NemfModel> model;
   /// The same prior on the Eigen runtime (prior/runtime/nemf_runtime.h), read
   /// from the same model file. With it, the latent solvers' L-BFGS minimises
-  /// the Eigen energy (tasks/latent/runtime_energy.h) of every window whose
-  /// active terms it ports (complete_motion(), tasks/latent/latent_solver.h).
+  /// the Eigen energy (tasks/latent/runtime_energy.h) of every window
+  /// (complete_motion(), tasks/latent/latent_solver.h).
   /// Null (a model built without a file, or a caller that wants the libtorch
   /// energy throughout): they minimise the libtorch energy
   /// (tasks/latent/energies.h).

@@ -10,7 +10,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations_torch.h"
-#include "tasks/constraints/residuals.h"
+#include "tasks/constraints/residual_bracket.h"
 #include "tasks/context/task_context.h"
 
 namespace mf {
@@ -216,29 +216,17 @@ struct Brackets {
 };
 
 // key_frame[k] = frame of key k; on[k] = whether key k constrains the series
-// (residual_bracket() over the frames of those keys, as key indices).
-void bracket_series(const std::vector<int64_t>& key_frame, const std::vector<char>& on, int T, int64_t* a, int64_t* b,
+// (key_brackets(), tasks/constraints/residual_bracket.h), written with `stride`.
+void bracket_series(const std::vector<int>& key_frame, const std::vector<char>& on, int T, int64_t* a, int64_t* b,
                     float* s, float* has, int64_t stride) {
-  std::vector<std::pair<int64_t, int64_t>> keys;  // (frame, key index)
-  for (size_t k = 0; k < on.size(); ++k) {
-    if (on[k]) keys.emplace_back(key_frame[k], static_cast<int64_t>(k));
-  }
-  std::sort(keys.begin(), keys.end());
-  std::vector<int> frames;
-  for (const auto& k : keys) frames.push_back(static_cast<int>(k.first));
+  std::vector<KeyBracket> brackets;
+  key_brackets(key_frame, on, T, &brackets);
   for (int f = 0; f < T; ++f) {
     const int64_t i = static_cast<int64_t>(f) * stride;
-    if (keys.empty()) {
-      a[i] = b[i] = 0;
-      s[i] = 0.0f;
-      has[i] = 0.0f;
-      continue;
-    }
-    const ResidualBracket br = residual_bracket(f, frames, ResidualRamp::Smoothstep);
-    has[i] = 1.0f;
-    a[i] = keys[br.a].second;
-    b[i] = keys[br.b].second;
-    s[i] = static_cast<float>(br.s);
+    a[i] = brackets[f].a;
+    b[i] = brackets[f].b;
+    s[i] = brackets[f].s;
+    has[i] = brackets[f].has ? 1.0f : 0.0f;
   }
 }
 
@@ -246,7 +234,7 @@ void bracket_series(const std::vector<int64_t>& key_frame, const std::vector<cha
 void residual_brackets(const WindowProblem& p, int J, Brackets* joints, Brackets* root) {
   const int K = p.num_keys(), T = p.length;
   const at::Tensor key_frames = p.key_frames.contiguous();
-  const std::vector<int64_t> frames(key_frames.data_ptr<int64_t>(), key_frames.data_ptr<int64_t>() + K);
+  const std::vector<int> frames(key_frames.data_ptr<int64_t>(), key_frames.data_ptr<int64_t>() + K);
   const at::Tensor rmask = p.key_rotation_mask.contiguous();
   const float* m = rmask.data_ptr<float>();
   auto alloc = [](Brackets* br, int64_t n) {

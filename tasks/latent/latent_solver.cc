@@ -229,19 +229,13 @@ struct RuntimeWindow {
   RuntimeLatentEnergy full, keyed;
 };
 
-// The window's energies on the Eigen runtime when L-BFGS runs, the context
-// carries the runtime of `model` and it ports every term that either stage
-// makes active (RuntimeEnergy::ports(): the is-active rule of
-// evaluate_energy()); null otherwise, and the window keeps the libtorch energy
-// (Adam, a context without this model's runtime, a window on which an
-// effector, contact, trajectory, foot-skating or smoothness term is active).
+// The window's energies on the Eigen runtime when L-BFGS runs and the
+// context carries the runtime of `model`; null otherwise, and the window keeps
+// the libtorch energy (Adam, a context without this model's runtime).
 std::unique_ptr<RuntimeWindow> runtime_window(const NemfModel& model, const TaskContext& ctx, const WindowProblem& p,
                                               const LatentSolverOptions& options, const EnergyWeights& keyed) {
   if (options.optimizer != LatentOptimizer::Lbfgs || !ctx.runtime || ctx.model.get() != &model) return nullptr;
-  auto window = std::make_unique<RuntimeWindow>(*ctx.runtime, p, options.weights, keyed);
-  const bool ported = window->evaluator.ports(window->problem, options.weights) &&
-                      window->evaluator.ports(window->problem, keyed);
-  return ported ? std::move(window) : nullptr;
+  return std::make_unique<RuntimeWindow>(*ctx.runtime, p, options.weights, keyed);
 }
 
 // solve_latents() on options the caller validated: complete_motion() checks

@@ -7,8 +7,7 @@
 //                    search; cost and gradient from the Eigen runtime's energy
 //                    (tasks/latent/runtime_energy.h, no tensors per
 //                    evaluation) when the context carries the prior's runtime
-//                    (ModelSet::runtime) and it ports every term the window
-//                    makes active, else by torch autograd (the double
+//                    (ModelSet::runtime), else by torch autograd (the double
 //                    parameters of Ceres converted to float and back either way;
 //                    the two energies agree to about 1e-6, relative).
 //   Adam             NeMF's reference: lr 0.1, 600 iterations, x0.7 every 200;

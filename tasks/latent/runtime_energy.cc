@@ -1,11 +1,13 @@
 #include "tasks/latent/runtime_energy.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
 #include "prior/motion/errors.h"
 #include "prior/motion/rotation_kernels.h"
 #include "prior/runtime/rotations.h"
+#include "tasks/latent/runtime_penalties.h"
 
 namespace mf {
 namespace {
@@ -14,6 +16,9 @@ using runtime::MatrixRXf;
 using Matrix3 = Eigen::Matrix<float, 3, 3, Eigen::RowMajor>;
 using Map3 = Eigen::Map<Matrix3>;
 using ConstMap3 = Eigen::Map<const Matrix3>;
+using runtime_penalties::angle_penalty;
+using runtime_penalties::Penalised;
+using runtime_penalties::squared_penalty;
 
 TermCounts term_counts(const RuntimeWindowProblem& p, int J, int feet) {
   TermCounts c;
@@ -23,30 +28,31 @@ TermCounts term_counts(const RuntimeWindowProblem& p, int J, int feet) {
     c.positions = p.key_position_mask.sum();
     c.root_positions = p.key_root_mask.sum();
   }
-  c.effectors = p.num_effectors;
-  c.pin_steps = p.num_pin_steps;
-  c.trajectory_rows = p.num_trajectory;
+  c.effectors = p.num_effectors();
+  c.pin_steps = p.num_pin_steps();
+  c.trajectory_rows = p.num_trajectory();
   c.feet = feet;
   c.length = p.length;
   return c;
 }
 
-// The first active term not ported; null when all are.
-const char* unported_term(const ActiveTerms& a) {
-  const std::pair<bool, const char*> unported[] = {{a.eff, "effector"},       {a.pin, "contact"},
-                                                   {a.traj, "trajectory"},    {a.facing, "trajectory_facing"},
-                                                   {a.skate, "foot_skating"}, {a.smooth, "smoothness"}};
-  for (const auto& u : unported) {
-    if (u.first) return u.second;
-  }
-  return nullptr;
-}
-
-void refuse_unported(const ActiveTerms& a) {
-  if (const char* term = unported_term(a)) {
-    throw InputError(std::string("the Eigen runtime's energy does not implement the ") + term +
-                     " term: give it a zero weight or use the libtorch energy (tasks/latent/energies.h)");
-  }
+// Throws unless every index of the effectors, pins and trajectory rows lies
+// inside the window of J joints and their targets have their sizes.
+void check_output_constraints(const RuntimeWindowProblem& p, int J) {
+  const int T = p.length, E = p.num_effectors(), R = p.num_trajectory();
+  auto inside = [](const std::vector<int>& v, int end) {
+    return std::all_of(v.begin(), v.end(), [end](int i) { return i >= 0 && i < end; });
+  };
+  if (static_cast<int>(p.effector_joints.size()) != E || p.effector_targets.rows() != E ||
+      (E > 0 && p.effector_targets.cols() != 3) || p.effector_weights.size() != E || !inside(p.effector_frames, T) ||
+      !inside(p.effector_joints, J))
+    throw InputError("runtime energy: the end-effector targets do not fit the window");
+  if (p.pin_to.size() != p.pin_from.size() || !inside(p.pin_from, T * J) || !inside(p.pin_to, T * J))
+    throw InputError("runtime energy: the contact pins do not fit the window");
+  if (p.trajectory_ground.rows() != R || p.trajectory_forward.rows() != R ||
+      (R > 0 && (p.trajectory_ground.cols() != 2 || p.trajectory_forward.cols() != 2)) ||
+      !inside(p.trajectory_frames, T))
+    throw InputError("runtime energy: the trajectory rows do not fit the window");
 }
 
 void check_problem(const RuntimeWindowProblem& p, int J, int window) {
@@ -63,24 +69,7 @@ void check_problem(const RuntimeWindowProblem& p, int J, int window) {
       p.key_root.cols() != 3 || p.key_root_mask.size() != K)
     throw InputError("runtime energy: the keys' targets do not match " + std::to_string(K) + " keys of " +
                      std::to_string(J) + " joints");
-}
-
-// A penalised residual and its derivative with respect to the residual.
-struct Penalised {
-  float value, slope;
-};
-
-// The penalty of an angle (rad).
-Penalised angle_penalty(float angle, Penalty p) {
-  return p == Penalty::Squared ? Penalised{angle * angle, 2 * angle} : Penalised{angle, 1.0f};
-}
-
-// The penalty of a distance given as its square d2, and its derivative with
-// respect to d2 (the 1e-12 of energies.cc smooths the absolute penalty at 0).
-Penalised squared_penalty(float d2, Penalty p) {
-  if (p == Penalty::Squared) return {d2, 1.0f};
-  const float s = std::sqrt(d2 + 1e-12f);
-  return {s, 0.5f / s};
+  check_output_constraints(p, J);
 }
 
 }  // namespace
@@ -99,13 +88,12 @@ RuntimeEnergyTerms RuntimeEnergy::evaluate(const RuntimeWindowProblem& problem, 
     throw InputError("runtime energy: expected z_l [" + std::to_string(config.zl) + "] and z_g [" +
                      std::to_string(config.zg) + "]");
   const ActiveTerms a = active_terms(term_counts(problem, rig.num_joints(), rig.num_feet()), w);
-  refuse_unported(a);
   gradient_ = g_zl != nullptr && g_zg != nullptr;
   RuntimeEnergyTerms out;
   const bool decoded = a.keyed || a.dense;
   if (decoded) decode(problem, a, z_l, z_g);
   if (a.keyed) add_key_terms(problem, w, a, &out);
-  if (a.dense) add_root_translation(problem, w, a, &out);
+  if (a.dense) add_dense_terms(problem, w, a, &out);
   if (w.latent_prior > 0)
     out.terms.emplace_back("latent_prior", w.latent_prior * 0.5 * (z_l.squaredNorm() + z_g.squaredNorm()));
   for (const auto& t : out.terms) out.total += t.second;
@@ -121,11 +109,6 @@ RuntimeEnergyTerms RuntimeEnergy::evaluate(const RuntimeWindowProblem& problem, 
     *g_zg += static_cast<float>(w.latent_prior) * z_g;
   }
   return out;
-}
-
-bool RuntimeEnergy::ports(const RuntimeWindowProblem& problem, const EnergyWeights& w) const {
-  const RigInfo& rig = model_->rig();
-  return unported_term(active_terms(term_counts(problem, rig.num_joints(), rig.num_feet()), w)) == nullptr;
 }
 
 // Decodes the whole window when a dense term is active, else the key frames,
@@ -185,14 +168,26 @@ void RuntimeEnergy::add_key_terms(const RuntimeWindowProblem& p, const EnergyWei
   if (a.pos) out->terms.emplace_back("position", w.position * sum_pos / a.n_pos);
 }
 
-// root_translation: the GMP on the dense decode, its root path against the
-// keys' root positions.
-void RuntimeEnergy::add_root_translation(const RuntimeWindowProblem& p, const EnergyWeights& w, const ActiveTerms& a,
-                                         RuntimeEnergyTerms* out) {
+// The terms on the dense decode: the GMP on it and its root path, then
+// root_translation and the output terms (runtime_energy_output.cc), and
+// their gradient back to the decoded rotations and positions.
+void RuntimeEnergy::add_dense_terms(const RuntimeWindowProblem& p, const EnergyWeights& w, const ActiveTerms& a,
+                                    RuntimeEnergyTerms* out) {
   gmp_inputs();
   model_->predict_global(gmp_in_, GmpUse::Default, &gmp_ws_, &gmp_out_);
   root_path(p.anchor);
   if (gradient_) g_path_.setZero(p.length, 3);
+  if (a.root) add_root_translation(p, w, a, out);
+  if (a.eff || a.pin || a.traj || a.facing || a.skate || a.smooth) add_output_terms(p, w, a, out);
+  if (!gradient_) return;
+  root_path_vjp(p.anchor);
+  model_->predict_global_vjp(&gmp_ws_, GmpUse::Default, g_gmp_out_, &g_gmp_in_);
+  gmp_inputs_vjp();
+}
+
+// root_translation: the root path against the keys' root positions.
+void RuntimeEnergy::add_root_translation(const RuntimeWindowProblem& p, const EnergyWeights& w, const ActiveTerms& a,
+                                         RuntimeEnergyTerms* out) {
   double sum = 0;
   for (int k = 0; k < p.num_keys(); ++k) {
     const float mask = p.key_root_mask[k];
@@ -205,10 +200,6 @@ void RuntimeEnergy::add_root_translation(const RuntimeWindowProblem& p, const En
       g_path_.row(f).head<3>() += static_cast<float>(w.root_translation / a.n_root * mask * pen.slope * 2) * d;
   }
   out->terms.emplace_back("root_translation", w.root_translation * sum / a.n_root);
-  if (!gradient_) return;
-  root_path_vjp(p.anchor);
-  model_->predict_global_vjp(&gmp_ws_, GmpUse::Default, g_gmp_out_, &g_gmp_in_);
-  gmp_inputs_vjp();
 }
 
 // gmp_inputs() of representation.h from the dense decode: per frame the

@@ -1,19 +1,20 @@
 // The latent solvers' energy on the Eigen runtime (prior/runtime/), without
 // libtorch, with its gradient with respect to the latent codes written out:
-// the terms of evaluate_energy() (tasks/latent/energies.h) that the default
-// in-betweening and gap-filling solves use, rotation, position,
-// root_orientation, root_translation (the GMP on the dense decode, its root
-// path integrated and aligned at the anchor) and latent_prior, under either
-// penalty. Values and gradients match the libtorch energy
+// every term of evaluate_energy() (tasks/latent/energies.h), in its order,
+// under either penalty and with the same rule of which terms are active
+// (active_terms(), energy_weights.h). runtime_energy.cc: the decode, the key
+// terms (rotation, root_orientation, position), root_translation (the GMP on
+// the dense decode, its root path integrated and aligned at the anchor) and
+// latent_prior; runtime_energy_output.cc: the terms on the output motion
+// (effector, contact, trajectory, trajectory_facing, foot_skating,
+// smoothness), which see the keys' residuals blended in when
+// EnergyWeights::on_output asks (tasks/latent/runtime_blend.h). As in
+// energies.cc, foot_skating's contact probabilities are constants of its
+// gradient.
+// Values and gradients match the libtorch energy
 // (tests/runtime_energy_test.cc: values within 1e-5, gradients within 1e-4,
-// relative).
-//
-// Not ported yet: effector, contact, trajectory, trajectory_facing,
-// foot_skating and smoothness (and with them the on-output residual blending
-// that only those terms see). A problem and weights that make one of them
-// active (the rule of evaluate_energy: a positive weight and something to
-// measure) are refused with an InputError naming the term; they are never
-// silently left out.
+// relative; a contact term of small velocities, which float, libtorch's too,
+// gives to 2e-5 only, within 1e-5 of the float64 prior's).
 //
 // This header and its implementation include no libtorch;
 // tasks/latent/runtime_problem.h converts the tensor WindowProblem.
@@ -27,6 +28,7 @@
 #include "prior/runtime/kinematics.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "tasks/latent/energy_weights.h"
+#include "tasks/latent/runtime_blend.h"
 
 namespace mf {
 
@@ -42,11 +44,26 @@ struct RuntimeWindowProblem {
   runtime::MatrixRXf key_position_mask;  ///< [K, J] 1 where the joint and its ancestors are constrained
   runtime::MatrixRXf key_root;           ///< [K, 3] canonical root positions
   Eigen::VectorXf key_root_mask;         ///< [K] 1 where the root position is constrained
-  /// The constraints of terms not ported, counted only: an energy whose
-  /// weights make one of their terms active refuses the problem.
-  int num_effectors = 0, num_pin_steps = 0, num_trajectory = 0;
+
+  // E end-effector targets.
+  std::vector<int> effector_frames;     ///< [E] window frames
+  std::vector<int> effector_joints;     ///< [E]
+  runtime::MatrixRXf effector_targets;  ///< [E, 3] canonical positions
+  Eigen::VectorXf effector_weights;     ///< [E]
+
+  /// Contact pins: P steps between consecutive pinned frames, as flat
+  /// frame * J + joint indices.
+  std::vector<int> pin_from, pin_to;
+
+  // R trajectory rows.
+  std::vector<int> trajectory_frames;     ///< [R] window frames
+  runtime::MatrixRXf trajectory_ground;   ///< [R, 2] canonical ground position (x, z)
+  runtime::MatrixRXf trajectory_forward;  ///< [R, 2] canonical facing (x, z), unit length
 
   int num_keys() const { return static_cast<int>(key_frames.size()); }
+  int num_effectors() const { return static_cast<int>(effector_frames.size()); }
+  int num_pin_steps() const { return static_cast<int>(pin_from.size()); }
+  int num_trajectory() const { return static_cast<int>(trajectory_frames.size()); }
 };
 
 /// An evaluation's weighted terms (named and ordered as evaluate_energy's)
@@ -65,24 +82,31 @@ class RuntimeEnergy {
 
   /// The energy of (z_l [zl], z_g [zg]) on `problem` under `weights`, and,
   /// when g_zl and g_zg are not null, its gradient with respect to them
-  /// (resized). Throws InputError when an active term is not ported (see the
-  /// top of this file) or the problem does not fit the model.
+  /// (resized). Throws InputError when the problem does not fit the model.
   RuntimeEnergyTerms evaluate(const RuntimeWindowProblem& problem, const EnergyWeights& weights,
                               const Eigen::Ref<const Eigen::VectorXf>& z_l,
                               const Eigen::Ref<const Eigen::VectorXf>& z_g, Eigen::VectorXf* g_zl,
                               Eigen::VectorXf* g_zg);
-
-  /// Whether every term that `weights` make active on `problem` (the rule
-  /// above) is ported, i.e. evaluate() does not refuse them.
-  bool ports(const RuntimeWindowProblem& problem, const EnergyWeights& weights) const;
 
  private:
   void decode(const RuntimeWindowProblem& problem, const ActiveTerms& a, const Eigen::Ref<const Eigen::VectorXf>& z_l,
               const Eigen::Ref<const Eigen::VectorXf>& z_g);
   void add_key_terms(const RuntimeWindowProblem& problem, const EnergyWeights& w, const ActiveTerms& a,
                      RuntimeEnergyTerms* out);
+  void add_dense_terms(const RuntimeWindowProblem& problem, const EnergyWeights& w, const ActiveTerms& a,
+                       RuntimeEnergyTerms* out);
   void add_root_translation(const RuntimeWindowProblem& problem, const EnergyWeights& w, const ActiveTerms& a,
                             RuntimeEnergyTerms* out);
+  void output_motion(const RuntimeWindowProblem& problem, const EnergyWeights& w);
+  void add_output_terms(const RuntimeWindowProblem& problem, const EnergyWeights& w, const ActiveTerms& a,
+                        RuntimeEnergyTerms* out);
+  void add_effector(const RuntimeWindowProblem& problem, const EnergyWeights& w, RuntimeEnergyTerms* out);
+  void add_contact(const RuntimeWindowProblem& problem, const EnergyWeights& w, RuntimeEnergyTerms* out);
+  void add_trajectory(const RuntimeWindowProblem& problem, const EnergyWeights& w, const ActiveTerms& a,
+                      RuntimeEnergyTerms* out);
+  void add_foot_skating(const EnergyWeights& w, RuntimeEnergyTerms* out);
+  void add_smoothness(const EnergyWeights& w, RuntimeEnergyTerms* out);
+  void output_motion_vjp(const RuntimeWindowProblem& problem);
   void gmp_inputs();
   void root_path(int anchor);
   void root_path_vjp(int anchor);
@@ -102,6 +126,13 @@ class RuntimeEnergy {
   // Their gradients.
   runtime::MatrixRXf g_rotations_, g_positions_, g_headings_, g_gmp_out_, g_gmp_in_, g_path_;
   runtime::MatrixRXf g_local_, g_root_, g_sixd_;
+  // The output motion of the dense output terms (rotations are rotations_
+  // itself when nothing is blended) and its gradients.
+  bool blended_ = false;
+  RuntimeResidualBlend blend_;
+  runtime::MatrixRXf blended_rotations_, out_path_, out_positions_, out_globals_;
+  runtime::MatrixRXf g_out_rotations_, g_out_path_, g_out_positions_;
+  const runtime::MatrixRXf& out_rotations() const { return blended_ ? blended_rotations_ : rotations_; }
 };
 
 }  // namespace mf

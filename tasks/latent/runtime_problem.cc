@@ -2,8 +2,17 @@
 
 #include <ATen/ATen.h>
 
+#include <vector>
+
 namespace mf {
 namespace {
+
+// The values of an int64 tensor of n entries.
+std::vector<int> ints_of(const at::Tensor& t, int n) {
+  if (n == 0) return {};
+  const at::Tensor c = t.to(at::kLong).contiguous();
+  return std::vector<int>(c.data_ptr<int64_t>(), c.data_ptr<int64_t>() + n);
+}
 
 // A float tensor of `rows` rows as a row-major matrix of `cols` columns.
 runtime::MatrixRXf matrix_of(const at::Tensor& t, int rows, int cols) {
@@ -19,19 +28,23 @@ RuntimeWindowProblem to_runtime_problem(const WindowProblem& problem, int joints
   const int K = problem.num_keys(), J = joints;
   p.length = problem.length;
   p.anchor = problem.anchor;
-  if (K > 0) {
-    const at::Tensor frames = problem.key_frames.to(at::kLong).contiguous();
-    p.key_frames.assign(frames.data_ptr<int64_t>(), frames.data_ptr<int64_t>() + K);
-  }
+  p.key_frames = ints_of(problem.key_frames, K);
   p.key_rotations = matrix_of(problem.key_rotations, K, J * 9);
   p.key_rotation_mask = matrix_of(problem.key_rotation_mask, K, J);
   p.key_positions = matrix_of(problem.key_positions, K, J * 3);
   p.key_position_mask = matrix_of(problem.key_position_mask, K, J);
   p.key_root = matrix_of(problem.key_root, K, 3);
   p.key_root_mask = matrix_of(problem.key_root_mask, K, 1).col(0);
-  p.num_effectors = problem.num_effectors();
-  p.num_pin_steps = problem.num_pin_steps();
-  p.num_trajectory = problem.num_trajectory();
+  const int E = problem.num_effectors(), P = problem.num_pin_steps(), R = problem.num_trajectory();
+  p.effector_frames = ints_of(problem.effector_frames, E);
+  p.effector_joints = ints_of(problem.effector_joints, E);
+  p.effector_targets = matrix_of(problem.effector_targets, E, 3);
+  p.effector_weights = matrix_of(problem.effector_weights, E, 1).col(0);
+  p.pin_from = ints_of(problem.pin_from, P);
+  p.pin_to = ints_of(problem.pin_to, P);
+  p.trajectory_frames = ints_of(problem.trajectory_frames, R);
+  p.trajectory_ground = matrix_of(problem.trajectory_ground, R, 2);
+  p.trajectory_forward = matrix_of(problem.trajectory_forward, R, 2);
   return p;
 }
 

@@ -17,17 +17,14 @@
 
 namespace mf {
 
-/// The keys' targets copied to float matrices (one row per key) for a rig of
-/// `joints` joints; the constraints of terms the runtime energy does not port
-/// (effectors, contact pins, trajectory rows) are only counted.
+/// The problem's constraints copied to float matrices (one row per key,
+/// effector or trajectory row) and index vectors, for a rig of `joints` joints.
 RuntimeWindowProblem to_runtime_problem(const WindowProblem& problem, int joints);
 
 /// RuntimeEnergy::evaluate() on one window's problem under `weights` as a
 /// function of x = [z_l, z_g] (zl + zg values, rounded to float as the
 /// tensor energy's x is), as FlatLatentEnergy (tasks/latent/latent_energy.h)
-/// is the tensor energy's. `energy` and `problem` must outlive it; the
-/// problem must be one `energy` ports (RuntimeEnergy::ports()), else
-/// evaluating throws InputError.
+/// is the tensor energy's. `energy` and `problem` must outlive it.
 class RuntimeLatentEnergy final : public DirectLatentEnergy {
  public:
   RuntimeLatentEnergy(RuntimeEnergy& energy, const RuntimeWindowProblem& problem, const EnergyWeights& weights, int zl,

@@ -111,8 +111,8 @@ TEST(RuntimeStandalone, GemmBackendsAgree) {
 
 // The latent energy without libtorch: full keys at what z0 decodes to give a
 // near-zero energy and gradient at z0 and a larger energy away from it; the
-// latent prior is 0.5 |z|^2 weighted; an active term it does not implement
-// is refused.
+// latent prior is 0.5 |z|^2 weighted; a dense term adds its own; an
+// effector outside the window is refused.
 TEST(RuntimeStandalone, LatentEnergyVanishesAtAPerfectFit) {
   const NemfRuntime& m = shipped();
   const int J = m.rig().num_joints();
@@ -143,7 +143,15 @@ TEST(RuntimeStandalone, LatentEnergyVanishesAtAPerfectFit) {
   w.latent_prior = 2.0;
   const double with_prior = energy.evaluate(p, w, z_l, z_g, nullptr, nullptr).total;
   EXPECT_NEAR(with_prior - at_fit.total, z_l.squaredNorm() + z_g.squaredNorm(), 1e-3);
-  w.smoothness = 1.0;
+  w.smoothness = 1.0;  // a term on the dense decode: the whole window decoded
+  const RuntimeEnergyTerms smooth = energy.evaluate(p, w, z_l, z_g, nullptr, nullptr);
+  ASSERT_EQ(smooth.terms.size(), 5u);  // rotation, root_orientation, position, smoothness, latent_prior
+  EXPECT_EQ(smooth.terms[3].first, "smoothness");
+  EXPECT_GT(smooth.terms[3].second, 0.0);
+  p.effector_frames = {p.length};  // outside the window
+  p.effector_joints = {0};
+  p.effector_targets = MatrixRXf::Zero(1, 3);
+  p.effector_weights = Eigen::VectorXf::Ones(1);
   EXPECT_THROW(energy.evaluate(p, w, z_l, z_g, nullptr, nullptr), InputError);
 }
 
