@@ -79,6 +79,8 @@ void add_model_bench_options(CLI::App& app, ModelBenchOptions& options) {
   add_split_options(app, options.split);
   add_transformer_options(app, options.transformers);
   add_threads_option(app, options.threads);
+  app.add_flag("--libtorch-energy", options.libtorch_energy,
+               "no Eigen runtime of the prior: the latent solvers minimise the libtorch energy (for comparisons)");
 }
 
 BenchContext load_bench_context(const ModelBenchOptions& options) {
@@ -88,7 +90,8 @@ BenchContext load_bench_context(const ModelBenchOptions& options) {
   set_compute_threads(options.threads);
   auto model = std::make_shared<NemfModel>(load_nemf(b.model_path));  // frozen
   b.ctx.model = model;
-  b.ctx.runtime = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::load(b.model_path));
+  if (!options.libtorch_energy)
+    b.ctx.runtime = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::load(b.model_path));
   load_transformers(options.transformers, b.model_path, &b.ctx, false);
   b.ctx.model_anatomy = load_rig_anatomy_next_to(b.model_path, model->rig().skeleton);
   b.data = load_data(options.data, false);
