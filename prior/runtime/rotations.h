@@ -18,7 +18,8 @@ using Quaternion4f = Eigen::Vector4f;
 
 /// The quaternion of a rotation matrix m [9] (row-major), w >= 0, built from
 /// the largest of 4w^2, 4x^2, 4y^2, 4z^2, as torch_rot::matrix_to_quat in
-/// prior/motion/rotations_torch.h computes it (float).
+/// prior/motion/rotations_torch.h computes it (float; the kernels of
+/// prior/motion/quaternion_kernels.h, as the three below).
 Quaternion4f matrix_to_quat(const float* m);
 /// The rotation matrix m [9] of a quaternion (any length), as torch_rot::quat_to_matrix.
 void quat_to_matrix(const Quaternion4f& q, float* m);
