@@ -23,11 +23,11 @@ using ParallelFor = void (*)(int64_t begin, int64_t end, int64_t grain,
 /// only when both its sides reach this.
 inline constexpr int64_t kWavefrontMinSide = 512;
 
-// Sizes of one cost matrix and of its working memory. R is (m+1) x (n+1); P (the
-// soft-argmin probabilities of the diagonal, up and left predecessors) and G
-// (dValue/dR) are (m+2) x (n+2), so that the backward needs no bounds tests: the
-// padding row m+1 and column n+1 hold zeros, except the seed G[m+1][n+1] = 1
-// with P[m+1][n+1] = (1, 0, 0), which makes G[m][n] = 1.
+/// Sizes of one cost matrix and of its working memory. R is (m+1) x (n+1); P (the
+/// soft-argmin probabilities of the diagonal, up and left predecessors) and G
+/// (dValue/dR) are (m+2) x (n+2), so that the backward needs no bounds tests: the
+/// padding row m+1 and column n+1 hold zeros, except the seed G[m+1][n+1] = 1
+/// with P[m+1][n+1] = (1, 0, 0), which makes G[m][n] = 1.
 struct Dims {
   int64_t m, n;
   int64_t rs() const { return n + 1; }
@@ -38,7 +38,7 @@ struct Dims {
 
 /// Soft-DTW of one cost matrix D [m, n] (row-major); fills P [dm.p_size()]
 /// (when not null) with the soft-argmin probabilities for item_backward().
-/// With `wavefront`, kTile x kTile tiles of one anti-diagonal run in parallel.
+/// With `wavefront`, the 128 x 128 tiles of each anti-diagonal run in parallel.
 template <typename T>
 double item_forward(const T* D, Dims dm, double gamma, double* P, ParallelFor wavefront);
 
