@@ -17,6 +17,8 @@
 
 #include "prior/model/model_file.h"
 #include "prior/model/representation.h"
+#include "prior/motion/rotations_torch.h"
+#include "prior/runtime/local_features.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/util/threads.h"
 #include "tests/runtime_test_util.h"
@@ -177,6 +179,42 @@ TEST(RuntimeEquivalence, EncodersAndDecoderOnARealWindow) {
               diffs[1], diffs[2], diffs[3]);
   // The decoder at the walk's own latents, on its frames.
   expect_decoders_agree(Eigen::VectorXd::LinSpaced(T, 0.0, T - 1.0), to_vector(t.mu_l), to_vector(t.mu_g), 5);
+}
+
+// The encoders' input on Eigen (prior/runtime/local_features.h) against
+// local_features() on the sample walk and on random rotations (one frame,
+// two, a full window), and the walk's codes on the Eigen features against
+// libtorch's encode().
+TEST(RuntimeEquivalence, LocalFeaturesAndTheCodesOnThem) {
+  ScopedComputeThreads one_thread(1);
+  const test::BothModels& m = models();
+  const runtime::Kinematics kinematics(m.runtime.rig().skeleton);
+  const Eigen::Vector3f forward = m.runtime.rig().root_forward.cast<float>();
+  const double fps = m.frozen.config().fps;
+  const int J = m.runtime.rig().num_joints();
+  at::manual_seed(9);
+  std::vector<at::Tensor> windows = {real_window().local_rotations};
+  for (int T : {1, 2, 128}) windows.push_back(torch_rot::sixd_to_matrix(at::randn({1, T, J, 6})));
+  for (const at::Tensor& rotations : windows) {
+    const int64_t T = rotations.size(1);
+    at::Tensor root6d;
+    const at::Tensor expected = local_features(rotations, m.frozen.rig(), fps, &root6d);
+    MatrixRXf features, root;
+    runtime::local_features(kinematics, to_matrix(rotations[0]), forward, fps, &features, &root);
+    const double d_features = relative_difference(features, to_matrix(expected[0]));
+    const double d_root = relative_difference(root, to_matrix(root6d[0]));
+    std::printf("local features T=%ld: %.2e, root 6D %.2e\n", static_cast<long>(T), d_features, d_root);
+    EXPECT_LT(d_features, kOutputTolerance);
+    EXPECT_LT(d_root, kOutputTolerance);
+  }
+  const at::Tensor& walk = real_window().local_rotations;
+  const int64_t T = walk.size(1);
+  const NemfLatent t = m.frozen.encode(walk, at::ones({1, T}));
+  MatrixRXf features, root;
+  runtime::local_features(kinematics, to_matrix(walk[0]), forward, fps, &features, &root);
+  const runtime::LatentGaussians r = m.runtime.encode_features(features, root, Eigen::VectorXf::Ones(T));
+  EXPECT_LT(relative_vector_difference(r.mu_l, to_vector(t.mu_l)), kOutputTolerance);
+  EXPECT_LT(relative_vector_difference(r.mu_g, to_vector(t.mu_g)), kOutputTolerance);
 }
 
 // Both GMPs on `inputs` [T, J * 3 + 6]: outputs, and the input gradient of
