@@ -17,6 +17,7 @@
 
 #include "prior/model/model_file.h"
 #include "prior/model/representation.h"
+#include "prior/motion/errors.h"
 #include "prior/motion/rotations_torch.h"
 #include "prior/runtime/local_features.h"
 #include "prior/runtime/nemf_runtime.h"
@@ -215,6 +216,10 @@ TEST(RuntimeEquivalence, LocalFeaturesAndTheCodesOnThem) {
   const runtime::LatentGaussians r = m.runtime.encode_features(features, root, Eigen::VectorXf::Ones(T));
   EXPECT_LT(relative_vector_difference(r.mu_l, to_vector(t.mu_l)), kOutputTolerance);
   EXPECT_LT(relative_vector_difference(r.mu_g, to_vector(t.mu_g)), kOutputTolerance);
+  const runtime::LatentGaussians direct = m.runtime.encode_rotations(to_matrix(walk[0]));
+  EXPECT_EQ(direct.mu_l, r.mu_l);
+  EXPECT_EQ(direct.mu_g, r.mu_g);
+  EXPECT_THROW(m.runtime.encode_rotations(MatrixRXf::Zero(T, 9)), InputError);
 }
 
 // Both GMPs on `inputs` [T, J * 3 + 6]: outputs, and the input gradient of

@@ -3,6 +3,7 @@
 #include "prior/model/model_container.h"
 #include "prior/motion/errors.h"
 #include "prior/util/binary_io.h"
+#include "prior/runtime/local_features.h"
 #include "prior/runtime/weight_reader.h"
 
 namespace mf::runtime {
@@ -36,6 +37,7 @@ NemfRuntime NemfRuntime::from_bytes(const uint8_t* data, size_t size, const std:
   r.stats_ = read_stats(w, J);
   r.encoders_ = std::make_shared<const NemfEncoders>(r.config_, r.rig_.skeleton.parents, w);
   r.decoder_ = std::make_shared<const NemfDecoder>(r.config_, J, w);
+  r.kinematics_ = std::make_shared<const Kinematics>(r.rig_.skeleton);
   r.gmp_ = std::make_shared<const NemfGmpNetwork>(r.config_, J, F, "gmp", w);
   if (r.config_.steering_gmp) r.steering_gmp_ = std::make_shared<const NemfGmpNetwork>(r.config_, J, F, "steering_gmp", w);
   w.finish();
@@ -104,6 +106,17 @@ LatentGaussians NemfRuntime::encode_features(ConstMatrixRef features, ConstMatri
   }
   const Eigen::VectorXf l = encoders_->local(local), g = encoders_->global(global);
   return {l.head(config_.zl), l.tail(config_.zl), g.head(config_.zg), g.tail(config_.zg)};
+}
+
+LatentGaussians NemfRuntime::encode_rotations(ConstMatrixRef local_rotations) const {
+  const Eigen::Index T = local_rotations.rows();
+  if (T < 1 || T > config_.window || local_rotations.cols() != rig_.num_joints() * 9) {
+    throw InputError("encode: expected local rotations [T, " + std::to_string(rig_.num_joints() * 9) +
+                     "] with 1 <= T <= " + std::to_string(config_.window));
+  }
+  MatrixRXf features, root6d;
+  local_features(*kinematics_, local_rotations, rig_.root_forward.cast<float>(), config_.fps, &features, &root6d);
+  return encode_features(features, root6d, Eigen::VectorXf::Ones(T));
 }
 
 }  // namespace mf::runtime

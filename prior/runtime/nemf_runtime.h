@@ -23,6 +23,7 @@
 #include "prior/runtime/decoder.h"
 #include "prior/runtime/encoders.h"
 #include "prior/runtime/gmp.h"
+#include "prior/runtime/kinematics.h"
 #include "prior/runtime/tensor_ops.h"
 
 namespace mf::runtime {
@@ -77,6 +78,11 @@ class NemfRuntime {
   /// present), 1 <= T <= window; frames beyond T count as missing.
   LatentGaussians encode_features(ConstMatrixRef features, ConstMatrixRef root6d,
                                   const Eigen::Ref<const Eigen::VectorXf>& mask) const;
+  /// The encoders on one canonical window of local rotations [T, J * 9]
+  /// (window_matrices() of prior/model/canonical_window.h), every frame
+  /// present, 1 <= T <= window: its local_features() at the model's frame
+  /// rate, then encode_features(). Throws InputError on a bad shape.
+  LatentGaussians encode_rotations(ConstMatrixRef local_rotations) const;
 
  private:
   NemfRuntime() = default;
@@ -87,6 +93,7 @@ class NemfRuntime {
   std::shared_ptr<const NemfDecoder> decoder_;
   std::shared_ptr<const NemfEncoders> encoders_;
   std::shared_ptr<const NemfGmpNetwork> gmp_, steering_gmp_;
+  std::shared_ptr<const Kinematics> kinematics_;
 };
 
 }  // namespace mf::runtime
