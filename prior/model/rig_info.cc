@@ -4,6 +4,7 @@
 #include <cctype>
 #include <string>
 
+#include "prior/motion/errors.h"
 #include "prior/motion/motion.h"
 
 namespace mf {
@@ -81,6 +82,15 @@ RigInfo measure_rig(const Skeleton& skeleton, const std::vector<const Motion*>& 
     rig.foot_thresholds.push_back(is_toe[k] ? 0.04 : 0.08);
   }
   return rig;
+}
+
+void check_model_skeleton(const RigInfo& rig, const Skeleton& skeleton, const std::string& whose) {
+  if (skeleton.num_joints() != rig.num_joints() || skeleton.names != rig.skeleton.names ||
+      skeleton.parents != rig.skeleton.parents) {
+    throw InputError("the " + whose + "'s skeleton does not match the model's: " +
+                     std::to_string(skeleton.num_joints()) + " joints given, the model has " +
+                     std::to_string(rig.num_joints()) + " (joint names and parents must agree)");
+  }
 }
 
 }  // namespace mf

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <string>
 #include <vector>
 
 #include "prior/motion/skeleton.h"
@@ -37,5 +38,9 @@ std::vector<int> find_foot_joints(const Skeleton& skeleton, std::vector<bool>* t
 /// 5th-percentile height), contact thresholds (ankle 8 cm, toe 4 cm above
 /// standing height, as NeMF's, measured relative to this rig's standing height).
 RigInfo measure_rig(const Skeleton& skeleton, const std::vector<const Motion*>& clips);
+
+/// Throws mf::InputError "the <whose>'s skeleton does not match the model's:
+/// ..." unless `skeleton` has the joints (names) and parents of `rig`'s.
+void check_model_skeleton(const RigInfo& rig, const Skeleton& skeleton, const std::string& whose);
 
 }  // namespace mf

@@ -26,13 +26,4 @@ void ModelSet::add_inbetweener(std::shared_ptr<const InbetweenModel> m,
   inbetweener_errors.erase(kind);
 }
 
-void check_model_skeleton(const RigInfo& rig, const Skeleton& skeleton, const std::string& whose) {
-  if (skeleton.num_joints() != rig.num_joints() || skeleton.names != rig.skeleton.names ||
-      skeleton.parents != rig.skeleton.parents) {
-    throw InputError("the " + whose + "'s skeleton does not match the model's: " +
-                     std::to_string(skeleton.num_joints()) + " joints given, the model has " +
-                     std::to_string(rig.num_joints()) + " (joint names and parents must agree)");
-  }
-}
-
 }  // namespace mf

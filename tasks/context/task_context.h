@@ -14,6 +14,8 @@
 #include <utility>
 #include <vector>
 
+#include "prior/model/rig_info.h"
+
 namespace mf {
 namespace runtime {
 class NemfRuntime;
@@ -25,8 +27,6 @@ namespace runtime {
 class InbetweenerRuntime;
 }
 struct RigAnatomy;
-struct RigInfo;
-struct Skeleton;
 
 /// Progress of a long-running method (a solver's iterations).
 struct TaskProgress {
@@ -141,9 +141,5 @@ struct TaskContext : ModelSet {
 /// The prior of `ctx`; throws mf::ModelMissingError "<what> needs a model
 /// (the prior), and none is loaded" when there is none.
 const NemfModel& require_prior(const TaskContext& ctx, const std::string& what);
-
-/// Throws mf::InputError "the <whose>'s skeleton does not match the model's:
-/// ..." unless `skeleton` has the joints (names) and parents of `rig`'s.
-void check_model_skeleton(const RigInfo& rig, const Skeleton& skeleton, const std::string& whose);
 
 }  // namespace mf

@@ -16,8 +16,6 @@
 namespace mf {
 namespace {
 
-Eigen::Matrix3d rot_y(double yaw) { return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitY()).toRotationMatrix(); }
-
 // sum(values * mask) / count, count > 0 known by the caller.
 at::Tensor masked_mean(const at::Tensor& values, const at::Tensor& mask, double count) {
   return (values * mask).sum() / count;
@@ -48,148 +46,50 @@ int WindowProblem::num_effectors() const {
 
 namespace {
 
-// Throws unless the window fits the motion, its keys lie inside it and
-// `anchor` is a key that fixes the root.
-void check_window(const RigInfo& rig, const Motion& motion, int begin, int length, const MotionConstraints& c,
-                  int anchor) {
-  check_model_skeleton(rig, motion.skeleton, "motion");
-  if (begin < 0 || length < 2 || begin + length > motion.num_frames())
-    throw InputError("window [" + std::to_string(begin) + ", " + std::to_string(begin + length) +
-                     ") does not fit the motion (at least 2 frames)");
-  int anchor_key = -1;
-  for (size_t k = 0; k < c.keys.size(); ++k) {
-    const int f = c.keys[k].frame;
-    if (f < 0 || f >= length) throw InputError("a key lies outside its window");
-    if (f == anchor && c.key_fixes_root(k)) anchor_key = static_cast<int>(k);
-  }
-  if (anchor_key < 0) throw InputError("the window's anchor frame must be a key that fixes the root");
+at::Tensor long_tensor(const std::vector<int>& v) {
+  return at::tensor(std::vector<int64_t>(v.begin(), v.end()), at::kLong);
 }
 
-// The pose keys' targets in the canonical frame (see WindowProblem).
-void set_key_targets(const RigInfo& rig, const Motion& motion, int begin, const MotionConstraints& c,
-                     WindowProblem* p) {
-  const Skeleton& s = rig.skeleton;
-  const int J = s.num_joints(), K = static_cast<int>(c.keys.size());
-  const Eigen::Matrix3d unturn = rot_y(-p->transform.yaw);
-  const Eigen::Vector3d origin(p->transform.x, 0.0, p->transform.z);
-  p->key_frames = at::empty({K}, at::kLong);
-  p->key_rotations = at::eye(3, at::kFloat).repeat({K, J, 1, 1}).contiguous();
-  p->key_rotation_mask = at::zeros({K, J}, at::kFloat);
-  p->key_position_mask = at::zeros({K, J}, at::kFloat);
-  p->key_root = at::zeros({K, 3}, at::kFloat);
-  p->key_root_mask = at::zeros({K}, at::kFloat);
-  int64_t* kf = p->key_frames.data_ptr<int64_t>();
-  float* rot = p->key_rotations.data_ptr<float>();
-  float* rmask = p->key_rotation_mask.data_ptr<float>();
-  float* pmask = p->key_position_mask.data_ptr<float>();
-  float* root = p->key_root.data_ptr<float>();
-  float* root_mask = p->key_root_mask.data_ptr<float>();
-  std::vector<char> chain(J);
-  for (int k = 0; k < K; ++k) {
-    const PoseKey& key = c.keys[k];
-    const int f = begin + key.frame;
-    kf[k] = key.frame;
-    for (int j = 0; j < J; ++j) {
-      const bool on = c.key_has_joint(k, j);
-      chain[j] = on && (j == 0 || chain[s.parents[j]]);
-      if (j > 0 && chain[j]) pmask[k * J + j] = 1.0f;
-      if (!on) continue;
-      rmask[k * J + j] = 1.0f;
-      Eigen::Matrix3d m = motion.rotation(f, j).normalized().toRotationMatrix();
-      if (j == 0) m = unturn * m;
-      float* out = rot + (static_cast<int64_t>(k) * J + j) * 9;
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) out[a * 3 + b] = static_cast<float>(m(a, b));
-    }
-    if (key.root_position) {
-      Eigen::Vector3d x = unturn * (motion.root_positions[f] - origin);
-      for (int a = 0; a < 3; ++a) root[k * 3 + a] = static_cast<float>(x[a]);
-      root_mask[k] = 1.0f;
-    }
-  }
-  at::Tensor offsets = offsets_tensor(s);
-  p->key_positions = forward_kinematics(s.parents, offsets, p->key_rotations, at::zeros({K, 3}, at::kFloat)).positions;
+// A float matrix as a tensor of `shape`.
+at::Tensor float_tensor(const runtime::MatrixRXf& m, at::IntArrayRef shape) {
+  return at::from_blob(const_cast<float*>(m.data()), {static_cast<int64_t>(m.size())}, at::kFloat)
+      .clone()
+      .reshape(shape);
 }
-
-// The end-effector targets in the canonical frame.
-void set_effector_targets(int J, int length, const MotionConstraints& c, WindowProblem* p) {
-  const Eigen::Matrix3d unturn = rot_y(-p->transform.yaw);
-  const Eigen::Vector3d origin(p->transform.x, 0.0, p->transform.z);
-  const int E = static_cast<int>(c.effectors.size());
-  p->effector_frames = at::empty({E}, at::kLong);
-  p->effector_joints = at::empty({E}, at::kLong);
-  p->effector_targets = at::empty({E, 3}, at::kFloat);
-  p->effector_weights = at::empty({E}, at::kFloat);
-  for (int e = 0; e < E; ++e) {
-    const EffectorTarget& t = c.effectors[e];
-    if (t.frame < 0 || t.frame >= length) throw InputError("an end-effector target lies outside its window");
-    if (t.joint < 0 || t.joint >= J) throw InputError("end-effector joint out of range");
-    p->effector_frames[e] = t.frame;
-    p->effector_joints[e] = t.joint;
-    Eigen::Vector3d x = unturn * (t.position - origin);
-    for (int a = 0; a < 3; ++a) p->effector_targets[e][a] = static_cast<float>(x[a]);
-    p->effector_weights[e] = static_cast<float>(t.weight);
-  }
-}
-
-// The contact pins as pairs of consecutive pinned frames (flat frame * J +
-// joint indices into the window's [T, J] positions).
-void set_contact_pins(int J, int length, const MotionConstraints& c, WindowProblem* p) {
-  std::vector<int64_t> from, to;
-  for (const ContactPin& pin : c.contacts) {
-    if (pin.joint < 0 || pin.joint >= J) throw InputError("contact joint out of range");
-    for (int f = std::max(pin.first, 0) + 1; f <= std::min(pin.last, length - 1); ++f) {
-      from.push_back(static_cast<int64_t>(f - 1) * J + pin.joint);
-      to.push_back(static_cast<int64_t>(f) * J + pin.joint);
-    }
-  }
-  p->pin_from = at::tensor(from, at::kLong);
-  p->pin_to = at::tensor(to, at::kLong);
-}
-
-// The trajectory rows the solver follows, in the canonical frame.
-void set_trajectory_targets(int length, const MotionConstraints& c, WindowProblem* p) {
-  const std::vector<TrajectoryPoint> rows = c.followed_trajectory();
-  const Eigen::Matrix3d unturn = rot_y(-p->transform.yaw);
-  const Eigen::Vector3d origin(p->transform.x, 0.0, p->transform.z);
-  const int R = static_cast<int>(rows.size());
-  p->trajectory_frames = at::empty({R}, at::kLong);
-  p->trajectory_ground = at::empty({R, 2}, at::kFloat);
-  p->trajectory_forward = at::empty({R, 2}, at::kFloat);
-  int64_t* frames = p->trajectory_frames.data_ptr<int64_t>();
-  float* ground = p->trajectory_ground.data_ptr<float>();
-  float* forward = p->trajectory_forward.data_ptr<float>();
-  for (int r = 0; r < R; ++r) {
-    const TrajectoryPoint& t = rows[r];
-    if (t.frame < 0 || t.frame >= length) throw InputError("a trajectory row lies outside its window");
-    frames[r] = t.frame;
-    const Eigen::Vector3d x = unturn * (Eigen::Vector3d(t.x, 0.0, t.z) - origin);
-    const Eigen::Vector3d f = (unturn * Eigen::Vector3d(t.forward_x, 0.0, t.forward_z)).normalized();
-    ground[r * 2] = static_cast<float>(x.x());
-    ground[r * 2 + 1] = static_cast<float>(x.z());
-    forward[r * 2] = static_cast<float>(f.x());
-    forward[r * 2 + 1] = static_cast<float>(f.z());
-  }
+at::Tensor float_tensor(const Eigen::VectorXf& v) {
+  return at::from_blob(const_cast<float*>(v.data()), {static_cast<int64_t>(v.size())}, at::kFloat).clone();
 }
 
 }  // namespace
 
+WindowProblem to_tensor_problem(const RuntimeWindowProblem& r, int J) {
+  WindowProblem p;
+  const int64_t K = r.num_keys(), E = r.num_effectors(), R = r.num_trajectory();
+  p.length = r.length;
+  p.anchor = r.anchor;
+  p.transform = r.transform;
+  p.key_frames = long_tensor(r.key_frames);
+  p.key_rotations = float_tensor(r.key_rotations, {K, J, 3, 3});
+  p.key_rotation_mask = float_tensor(r.key_rotation_mask, {K, J});
+  p.key_positions = float_tensor(r.key_positions, {K, J, 3});
+  p.key_position_mask = float_tensor(r.key_position_mask, {K, J});
+  p.key_root = float_tensor(r.key_root, {K, 3});
+  p.key_root_mask = float_tensor(r.key_root_mask);
+  p.effector_frames = long_tensor(r.effector_frames);
+  p.effector_joints = long_tensor(r.effector_joints);
+  p.effector_targets = float_tensor(r.effector_targets, {E, 3});
+  p.effector_weights = float_tensor(r.effector_weights);
+  p.pin_from = long_tensor(r.pin_from);
+  p.pin_to = long_tensor(r.pin_to);
+  p.trajectory_frames = long_tensor(r.trajectory_frames);
+  p.trajectory_ground = float_tensor(r.trajectory_ground, {R, 2});
+  p.trajectory_forward = float_tensor(r.trajectory_forward, {R, 2});
+  return p;
+}
+
 WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int begin, int length,
                                   const MotionConstraints& constraints, int anchor) {
-  check_window(rig, motion, begin, length, constraints, anchor);
-  WindowProblem p;
-  p.length = length;
-  p.anchor = anchor;
-  const Eigen::Quaterniond& r = motion.rotation(begin + anchor, 0);
-  Eigen::Vector3d f = r.normalized() * rig.root_forward;
-  p.transform.yaw = (f.x() * f.x() + f.z() * f.z() < 1e-12) ? 0.0 : std::atan2(f.x(), f.z());
-  p.transform.x = motion.root_positions[begin + anchor].x();
-  p.transform.z = motion.root_positions[begin + anchor].z();
-  set_key_targets(rig, motion, begin, constraints, &p);
-  set_effector_targets(rig.num_joints(), length, constraints, &p);
-  set_contact_pins(rig.num_joints(), length, constraints, &p);
-  set_trajectory_targets(length, constraints, &p);
-  return p;
+  return to_tensor_problem(make_runtime_problem(rig, motion, begin, length, constraints, anchor), rig.num_joints());
 }
 
 // ---------------------------------------------------------------------------

@@ -66,6 +66,7 @@
 #include "tasks/constraints/motion_constraints.h"
 #include "tasks/latent/energy_weights.h"
 #include "tasks/latent/latent_energy.h"
+#include "tasks/latent/window_problem.h"
 #include "tasks/latent/window_solver.h"
 
 namespace mf {
@@ -117,6 +118,11 @@ struct WindowProblem {
 /// match the rig, a bad range or a bad anchor.
 WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int begin, int length,
                                   const MotionConstraints& constraints, int anchor);
+
+/// The problem `runtime` (make_runtime_problem(), tasks/latent/window_problem.h)
+/// as tensors, for a rig of `joints` joints: what make_window_problem()
+/// returns for the same window.
+WindowProblem to_tensor_problem(const RuntimeWindowProblem& runtime, int joints);
 
 /// Evaluates the energy of (z_l [1, zl], z_g [1, zg]) on `problem`: the
 /// active terms, weighted, in the order above (EnergyTerms, tasks/latent/latent_energy.h).

@@ -29,42 +29,9 @@
 #include "prior/runtime/nemf_runtime.h"
 #include "tasks/latent/energy_weights.h"
 #include "tasks/latent/runtime_blend.h"
+#include "tasks/latent/window_problem.h"
 
 namespace mf {
-
-/// The constraints of one window in its canonical frame: WindowProblem
-/// (energies.h) as Eigen matrices (float, one row per key; J joints).
-struct RuntimeWindowProblem {
-  int length = 0;                        ///< T, frames of the window
-  int anchor = 0;                        ///< window frame of the canonical transform (a key that fixes the root)
-  std::vector<int> key_frames;           ///< [K] window frames
-  runtime::MatrixRXf key_rotations;      ///< [K, J * 9] targets, row-major 3x3 per joint
-  runtime::MatrixRXf key_rotation_mask;  ///< [K, J] 1 where the joint's rotation is constrained
-  runtime::MatrixRXf key_positions;      ///< [K, J * 3] root-relative FK positions of the targets
-  runtime::MatrixRXf key_position_mask;  ///< [K, J] 1 where the joint and its ancestors are constrained
-  runtime::MatrixRXf key_root;           ///< [K, 3] canonical root positions
-  Eigen::VectorXf key_root_mask;         ///< [K] 1 where the root position is constrained
-
-  // E end-effector targets.
-  std::vector<int> effector_frames;     ///< [E] window frames
-  std::vector<int> effector_joints;     ///< [E]
-  runtime::MatrixRXf effector_targets;  ///< [E, 3] canonical positions
-  Eigen::VectorXf effector_weights;     ///< [E]
-
-  /// Contact pins: P steps between consecutive pinned frames, as flat
-  /// frame * J + joint indices.
-  std::vector<int> pin_from, pin_to;
-
-  // R trajectory rows.
-  std::vector<int> trajectory_frames;     ///< [R] window frames
-  runtime::MatrixRXf trajectory_ground;   ///< [R, 2] canonical ground position (x, z)
-  runtime::MatrixRXf trajectory_forward;  ///< [R, 2] canonical facing (x, z), unit length
-
-  int num_keys() const { return static_cast<int>(key_frames.size()); }
-  int num_effectors() const { return static_cast<int>(effector_frames.size()); }
-  int num_pin_steps() const { return static_cast<int>(pin_from.size()); }
-  int num_trajectory() const { return static_cast<int>(trajectory_frames.size()); }
-};
 
 /// An evaluation's weighted terms (named and ordered as evaluate_energy's)
 /// and their sum.
