@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <random>
 #include <string>
 
 #include "prior/motion/errors.h"
@@ -95,14 +96,17 @@ TEST(LatentSolverRuntime, EigenEnergyEndsWhereTheLibtorchEnergyDoes) {
     const double angle = max_angle(eigen.motion, torch.motion);
     std::printf("%s: iterations %d / %d, final energy %.6g / %.6g (relative %.2e), largest angle %.2e rad\n", c.name,
                 e.iterations, t.iterations, e.final_energy, t.final_energy, energy_gap, angle);
+    // The Eigen solve also starts from the Eigen encoders' codes (6e-7 off
+    // libtorch's) and decodes on the runtime: 1.3e-2 rad measured on the keys
+    // every 15, where the paths part after a few iterations.
     EXPECT_LT(energy_gap, 1e-2) << c.name;
-    EXPECT_LT(angle, 1e-2) << c.name;
+    EXPECT_LT(angle, 2e-2) << c.name;
   }
 }
 
-// L-BFGS with the model's runtime minimises the Eigen energy whatever terms
-// are active; Adam and a context without the model's runtime keep libtorch's.
-TEST(LatentSolverRuntime, UsesTheEigenEnergyForLbfgsWithTheModelsRuntime) {
+// L-BFGS and Adam with the model's runtime minimise the Eigen energy whatever
+// terms are active; a context without the model's runtime keeps libtorch's.
+TEST(LatentSolverRuntime, UsesTheEigenEnergyWithTheModelsRuntime) {
   ScopedComputeThreads one_thread(1);
   const Motion input = walk_on_model_rig().slice(0, 41);
   const MotionConstraints gap = MotionConstraints::full_pose({0, 9, 40});
@@ -128,7 +132,8 @@ TEST(LatentSolverRuntime, UsesTheEigenEnergyForLbfgsWithTheModelsRuntime) {
   } cases[] = {{"gap", gap, lbfgs, context(true), true},
                {"effector target", effector, lbfgs, context(true), true},
                {"foot skating weight", gap, skating, context(true), true},
-               {"Adam", gap, adam, context(true), false},
+               {"Adam", gap, adam, context(true), true},
+               {"Adam without the runtime", gap, adam, context(false), false},
                {"runtime of another model", gap, lbfgs, other_model, false}};
   for (const auto& c : cases) {
     CompletionReport report;
@@ -139,8 +144,9 @@ TEST(LatentSolverRuntime, UsesTheEigenEnergyForLbfgsWithTheModelsRuntime) {
   }
 }
 
-// The runtime's energy as the optimiser sees it is the tensor energy's, terms
-// and total, and only L-BFGS minimises it.
+// The runtime's energy as the optimiser sees it is the tensor energy's, terms,
+// total and gradient; both optimisers minimise it, and a start of the wrong
+// size is refused.
 TEST(LatentSolverRuntime, RuntimeLatentEnergyIsTheFlatEnergy) {
   const BothModels& m = shipped_models();
   const int zl = m.runtime.config().zl, zg = m.runtime.config().zg;
@@ -150,29 +156,35 @@ TEST(LatentSolverRuntime, RuntimeLatentEnergyIsTheFlatEnergy) {
   const EnergyWeights w;
   RuntimeEnergy evaluator(m.runtime);
   RuntimeLatentEnergy direct(evaluator, rp, w, zl, zg);
-  const FlatLatentEnergy flat(
+  FlatLatentEnergy flat(
       [&](const at::Tensor& z_l, const at::Tensor& z_g) { return evaluate_energy(m.frozen, problem, w, z_l, z_g); }, zl,
       zg);
-  at::manual_seed(8);
-  const at::Tensor x = at::randn({zl + zg});
-  const at::Tensor xd = x.to(at::kDouble).contiguous();
+  std::mt19937 rng(8);
+  const Eigen::VectorXd x = normal_matrix(1, zl + zg, rng).row(0).transpose().cast<double>();
   double direct_total = 0, flat_total = 0;
-  const auto direct_terms = direct.terms(xd.data_ptr<double>(), &direct_total);
-  const auto flat_terms = flat.terms(x, &flat_total);
+  const auto direct_terms = direct.terms(x.data(), &direct_total);
+  const auto flat_terms = flat.terms(x.data(), &flat_total);
   ASSERT_EQ(direct_terms.size(), flat_terms.size());
   for (size_t i = 0; i < flat_terms.size(); ++i) {
     EXPECT_EQ(direct_terms[i].first, flat_terms[i].first);
     EXPECT_NEAR(direct_terms[i].second, flat_terms[i].second, kOutputTolerance * flat_terms[i].second);
   }
   EXPECT_NEAR(direct_total, flat_total, kOutputTolerance * flat_total);
-  std::vector<double> gradient(zl + zg);
-  EXPECT_EQ(direct.evaluate(xd.data_ptr<double>(), gradient.data()), direct_total);
+  Eigen::VectorXd g_direct(zl + zg), g_flat(zl + zg);
+  EXPECT_EQ(direct.evaluate(x.data(), g_direct.data()), direct_total);
+  flat.evaluate(x.data(), g_flat.data());
+  EXPECT_LT((g_direct - g_flat).cwiseAbs().maxCoeff(), kGradientTolerance * g_flat.cwiseAbs().maxCoeff());
 
-  LatentOptimizerStats stats;
-  LatentOptimizerSettings adam;
-  adam.optimizer = LatentOptimizer::Adam;
-  adam.max_iterations = 2;
-  EXPECT_THROW(minimize_latent(direct, x, adam, TaskContext{}, &stats), InputError);
+  for (LatentOptimizer method : {LatentOptimizer::Lbfgs, LatentOptimizer::Adam}) {
+    LatentOptimizerStats stats;
+    LatentOptimizerSettings settings;
+    settings.optimizer = method;
+    settings.max_iterations = 5;
+    const Eigen::VectorXd solved = minimize_latent(direct, x, settings, TaskContext{}, &stats);
+    EXPECT_GT(stats.iterations, 0);
+    EXPECT_LT(direct.evaluate(solved.data(), nullptr), direct_total);
+    EXPECT_THROW(minimize_latent(direct, x.head(zl), settings, TaskContext{}, &stats), InputError);
+  }
 }
 
 }  // namespace

@@ -125,4 +125,14 @@ std::vector<double> log_column(const std::string& path, const std::string& name)
   return out;
 }
 
+at::Tensor window_rotations(const DecodedWindow& d) {
+  const int64_t T = d.local_rotations.rows(), J = d.local_rotations.cols() / 9;
+  return at::from_blob(const_cast<float*>(d.local_rotations.data()), {T, J, 3, 3}, at::kFloat).clone();
+}
+
+at::Tensor window_root_positions(const DecodedWindow& d) {
+  const int64_t T = d.root_positions.rows();
+  return at::from_blob(const_cast<float*>(d.root_positions.data()), {T, 3}, at::kFloat).clone();
+}
+
 }  // namespace mf::test

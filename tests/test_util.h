@@ -9,6 +9,7 @@
 #include "prior/inbetween/inbetweener.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/motion.h"
+#include "tasks/latent/window_problem.h"
 
 namespace mf::test {
 
@@ -43,5 +44,10 @@ std::string scratch_dir(const std::string& name);
 /// Column `name` of a trainer's log.csv, one value per epoch (empty when the
 /// file or the column is missing).
 std::vector<double> log_column(const std::string& path, const std::string& name);
+
+/// A decoded window's local rotations as [T, J, 3, 3] and its root path as
+/// [T, 3] float tensors.
+at::Tensor window_rotations(const DecodedWindow& d);
+at::Tensor window_root_positions(const DecodedWindow& d);
 
 }  // namespace mf::test

@@ -165,7 +165,7 @@ TEST(TrajectoryRows, EnergyIsZeroOnTheDecodedPathAndGrowsAwayFromIt) {
   const DecodedWindow d = decode_window(model, p, zl, zg);
   // Rows at every other frame: the decoded root's ground position and facing.
   p.trajectory_frames = at::arange(1, 24, 2, at::kLong);
-  const at::Tensor f = trajectory_features(d.local_rotations.squeeze(0).select(1, 0), d.root_positions.squeeze(0),
+  const at::Tensor f = trajectory_features(test::window_rotations(d).select(1, 0), test::window_root_positions(d),
                                            rig.root_forward)
                            .index_select(0, p.trajectory_frames);
   p.trajectory_ground = f.narrow(1, 0, 2).clone();

@@ -462,16 +462,16 @@ TEST(TransformerInitializers, FiniteCodesOfThePriorsShapeFromEachTransformer) {
   for (const char* name : {"context-encoder", "detail-encoder", "citl-encoder"}) {
     ASSERT_NE(std::find(names.begin(), names.end(), name), names.end()) << name;
     const InitialGuess bound = make_initializer(name, fx.ctx)->initialize(r);
-    ASSERT_EQ(bound.z_l.sizes(), (std::vector<int64_t>{1, fx.prior->config().zl})) << name;
-    ASSERT_EQ(bound.z_g.sizes(), (std::vector<int64_t>{1, fx.prior->config().zg})) << name;
-    EXPECT_TRUE(at::isfinite(bound.z_l).all().item<bool>()) << name;
-    EXPECT_TRUE(at::isfinite(bound.z_g).all().item<bool>()) << name;
+    ASSERT_EQ(bound.z_l.size(), fx.prior->config().zl) << name;
+    ASSERT_EQ(bound.z_g.size(), fx.prior->config().zg) << name;
+    EXPECT_TRUE(bound.z_l.allFinite()) << name;
+    EXPECT_TRUE(bound.z_g.allFinite()) << name;
     const InitialGuess from_context = make_initializer(name)->initialize(r);
-    EXPECT_TRUE(at::equal(bound.z_l, from_context.z_l)) << name;
+    EXPECT_EQ(bound.z_l, from_context.z_l) << name;
   }
   // Detail differs from context (stage 1 vs stage 0).
-  EXPECT_FALSE(at::equal(make_initializer("context-encoder")->initialize(r).z_l,
-                         make_initializer("detail-encoder")->initialize(r).z_l));
+  EXPECT_NE(make_initializer("context-encoder")->initialize(r).z_l,
+            make_initializer("detail-encoder")->initialize(r).z_l);
   // Without a transformer in the request's context: the missing-file error.
   TaskContext bare;
   r.context = &bare;

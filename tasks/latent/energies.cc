@@ -354,12 +354,11 @@ EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem
 DecodedWindow decode_window(const NemfModel& model, const WindowProblem& problem, const at::Tensor& z_l,
                             const at::Tensor& z_g) {
   at::NoGradGuard no_grad;
-  DecodedWindow d;
-  d.local_rotations = model.decode(at::arange(problem.length, at::kFloat), z_l, z_g);
-  GmpOutput gmp = model.predict_global(d.local_rotations);
-  d.root_positions = aligned_root_path(model, problem, d.local_rotations, gmp);
-  d.contacts = at::sigmoid(gmp.contact_logits);
-  return d;
+  const int64_t T = problem.length, J = model.rig().num_joints(), F = model.rig().num_feet();
+  const at::Tensor rotations = model.decode(at::arange(T, at::kFloat), z_l, z_g);
+  GmpOutput gmp = model.predict_global(rotations);
+  return {rows_of(rotations, T, J * 9), rows_of(aligned_root_path(model, problem, rotations, gmp), T, 3),
+          rows_of(at::sigmoid(gmp.contact_logits), T, F)};
 }
 
 }  // namespace mf

@@ -5,12 +5,24 @@
 #include "prior/inbetween/inbetweener.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/model/canonical_window.h"
 #include "prior/motion/rotations.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "tasks/constraints/interpolation_fill.h"
+#include "tasks/latent/latent_energy.h"
 #include "tasks/transformer/inbetweener_files.h"
 #include "tasks/transformer/inbetweener_fill.h"
 
 namespace mf {
+
+InitialGuess encode_window(const runtime::NemfRuntime& model, const Motion& window, int anchor) {
+  const int T = window.num_frames();
+  if (T < 2 || T > model.config().window)
+    throw InputError("encode_window: the window must have 2 to " + std::to_string(model.config().window) + " frames");
+  const runtime::LatentGaussians z =
+      model.encode_rotations(window_matrices(window, 0, T, model.rig(), anchor).local_rotations);
+  return {z.mu_l, z.mu_g};
+}
 
 InitialGuess encode_window(const NemfModel& model, const Motion& window, int anchor) {
   at::NoGradGuard no_grad;
@@ -19,7 +31,13 @@ InitialGuess encode_window(const NemfModel& model, const Motion& window, int anc
     throw InputError("encode_window: the window must have 2 to " + std::to_string(model.config().window) + " frames");
   WindowTensors w = window_tensors(window, 0, T, model.rig(), anchor);
   NemfLatent z = model.encode(w.local_rotations, at::ones({1, T}, at::kFloat));
-  return {z.mu_l.detach().clone(), z.mu_g.detach().clone()};
+  return {codes_vector(z.mu_l), codes_vector(z.mu_g)};
+}
+
+InitialGuess encode_window(const InitRequest& r, const Motion& window) {
+  if (r.runtime) return encode_window(*r.runtime, window, r.anchor);
+  if (!r.model) throw std::invalid_argument("InitRequest is incomplete");
+  return encode_window(*r.model, window, r.anchor);
 }
 
 std::optional<Motion> LatentInitializer::fill_input(const Motion&, const MotionConstraints&, const TaskContext&) const {
@@ -27,8 +45,8 @@ std::optional<Motion> LatentInitializer::fill_input(const Motion&, const MotionC
 }
 
 InitialGuess InterpolationEncoderInitializer::initialize(const InitRequest& r) const {
-  if (!r.model || !r.window || !r.constraints) throw std::invalid_argument("InitRequest is incomplete");
-  return encode_window(*r.model, fill_by_interpolation(*r.window, *r.constraints), r.anchor);
+  if (!r.window || !r.constraints) throw std::invalid_argument("InitRequest is incomplete");
+  return encode_window(r, fill_by_interpolation(*r.window, *r.constraints));
 }
 
 std::optional<Motion> InterpolationEncoderInitializer::fill_input(const Motion& input, const MotionConstraints& c,
@@ -37,8 +55,9 @@ std::optional<Motion> InterpolationEncoderInitializer::fill_input(const Motion& 
 }
 
 InitialGuess ZeroInitializer::initialize(const InitRequest& r) const {
-  if (!r.model) throw std::invalid_argument("InitRequest is incomplete");
-  return {at::zeros({1, r.model->config().zl}, at::kFloat), at::zeros({1, r.model->config().zg}, at::kFloat)};
+  if (!r.model && !r.runtime) throw std::invalid_argument("InitRequest is incomplete");
+  const NemfConfig& config = r.runtime ? r.runtime->config() : r.model->config();
+  return {Eigen::VectorXf::Zero(config.zl), Eigen::VectorXf::Zero(config.zg)};
 }
 
 TransformerEncoderInitializer::TransformerEncoderInitializer(
@@ -62,10 +81,10 @@ const runtime::InbetweenerRuntime* TransformerEncoderInitializer::network(const 
 }
 
 InitialGuess TransformerEncoderInitializer::initialize(const InitRequest& r) const {
-  if (!r.model || !r.window || !r.constraints) throw std::invalid_argument("InitRequest is incomplete");
+  if (!r.window || !r.constraints) throw std::invalid_argument("InitRequest is incomplete");
   const Motion filled = inbetweener_fill(transformer(r.context), network(r.context), stage_, *r.window,
                                          *r.constraints, LongGapPolicy::Interpolate);
-  return encode_window(*r.model, filled, r.anchor);
+  return encode_window(r, filled);
 }
 
 std::optional<Motion> TransformerEncoderInitializer::fill_input(const Motion& input, const MotionConstraints& c,

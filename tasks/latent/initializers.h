@@ -8,7 +8,7 @@
 // transformer in-betweener instead of interpolation (TransformerEncoderInitializer).
 #pragma once
 
-#include <ATen/core/Tensor.h>
+#include <Eigen/Core>
 #include <memory>
 #include <optional>
 #include <string>
@@ -25,8 +25,8 @@ class InbetweenModel;
 
 /// Starting codes of one window.
 struct InitialGuess {
-  at::Tensor z_l;  ///< [1, zl]
-  at::Tensor z_g;  ///< [1, zg]
+  Eigen::VectorXf z_l;  ///< [zl]
+  Eigen::VectorXf z_g;  ///< [zg]
 };
 
 /// What an initialiser knows about a window. `window` holds the window's frames
@@ -36,6 +36,9 @@ struct InitialGuess {
 /// (a key that fixes the root).
 struct InitRequest {
   const NemfModel* model = nullptr;
+  /// The model's Eigen runtime: when set, windows are encoded on it, not on
+  /// `model` (which may then be null).
+  const runtime::NemfRuntime* runtime = nullptr;
   const Motion* window = nullptr;
   const MotionConstraints* constraints = nullptr;
   int anchor = 0;
@@ -134,6 +137,10 @@ std::shared_ptr<const LatentInitializer> make_initializer(const std::string& nam
 
 /// The window `window` (all frames meaningful) canonicalised at `anchor` and
 /// encoded: the posterior means. For initialisers that produce a full motion.
+/// On the Eigen runtime, or on libtorch for a model without one.
+InitialGuess encode_window(const runtime::NemfRuntime& model, const Motion& window, int anchor);
 InitialGuess encode_window(const NemfModel& model, const Motion& window, int anchor);
+/// encode_window() on the request's runtime when it has one, else on its model.
+InitialGuess encode_window(const InitRequest& request, const Motion& window);
 
 }  // namespace mf

@@ -4,9 +4,7 @@
 #include <ceres/gradient_problem.h>
 #include <ceres/gradient_problem_solver.h>
 #include <ceres/iteration_callback.h>
-#include <torch/csrc/autograd/autograd.h>
 
-#include <ATen/ATen.h>
 #include <algorithm>
 #include <cmath>
 #include <exception>
@@ -21,32 +19,8 @@
 namespace mf {
 namespace {
 
-// Cost and gradient at x (a fresh leaf is made from it).
-double with_gradient(const LatentEnergy& energy, const at::Tensor& x, at::Tensor* gradient) {
-  at::Tensor leaf = x.detach().clone().requires_grad_(true);
-  at::Tensor e = energy(leaf);
-  *gradient = torch::autograd::grad({e}, {leaf})[0];
-  return e.item<double>();
-}
-
 // The cost at x ([n]) and, when `gradient` is not null, its gradient there.
 using Evaluation = std::function<double(const double* x, double* gradient)>;
-
-// A tensor energy as an Evaluation: x rounded to float, the gradient from autograd.
-Evaluation tensor_evaluation(const LatentEnergy& energy, int n) {
-  return [&energy, n](const double* parameters, double* gradient) {
-    at::Tensor x = at::from_blob(const_cast<double*>(parameters), {n}, at::kDouble).to(at::kFloat);
-    if (!gradient) {
-      at::NoGradGuard no_grad;
-      return energy(x).item<double>();
-    }
-    at::Tensor g;
-    const double cost = with_gradient(energy, x, &g);
-    at::Tensor gd = g.to(at::kDouble).contiguous();
-    std::copy(gd.data_ptr<double>(), gd.data_ptr<double>() + n, gradient);
-    return cost;
-  };
-}
 
 class CeresEnergy final : public ceres::FirstOrderFunction {
  public:
@@ -95,14 +69,10 @@ class ProgressCallback final : public ceres::IterationCallback {
   int offset_, total_;
 };
 
-at::Tensor lbfgs(Evaluation evaluate, const at::Tensor& x0, const LatentOptimizerSettings& o, const TaskContext& ctx,
-                 int offset, int total, LatentOptimizerStats* stats) {
-  const int n = static_cast<int>(x0.numel());
-  std::vector<double> x(n);
-  {
-    at::Tensor d = x0.to(at::kDouble).contiguous();
-    std::copy(d.data_ptr<double>(), d.data_ptr<double>() + n, x.begin());
-  }
+Eigen::VectorXd lbfgs(Evaluation evaluate, const Eigen::VectorXd& x0, const LatentOptimizerSettings& o,
+                      const TaskContext& ctx, int offset, int total, LatentOptimizerStats* stats) {
+  const int n = static_cast<int>(x0.size());
+  Eigen::VectorXd x = x0;
   auto* function = new CeresEnergy(std::move(evaluate), n);
   ceres::GradientProblem problem(function);  // takes ownership
   ceres::GradientProblemSolver::Options options;
@@ -127,50 +97,52 @@ at::Tensor lbfgs(Evaluation evaluate, const at::Tensor& x0, const LatentOptimize
   stats->evaluations = function->evaluations();
   stats->converged = s.termination_type == ceres::CONVERGENCE;
   stats->message = s.message;
-  return at::from_blob(x.data(), {n}, at::kDouble).to(at::kFloat);
+  return x;
 }
 
-at::Tensor adam(const LatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& o,
-                const TaskContext& ctx, int offset, int total, LatentOptimizerStats* stats) {
+// Whether the best energy improved by less than the tolerance over the
+// patience window ending at iteration `it`.
+bool adam_converged(const std::vector<double>& best_so_far, int it, const LatentOptimizerSettings& o) {
+  if (it < o.adam_patience) return false;
+  const double before = best_so_far[it - o.adam_patience];
+  return before - best_so_far[it] <= o.adam_tolerance * std::abs(before);
+}
+
+Eigen::VectorXd adam(DirectLatentEnergy& energy, const Eigen::VectorXd& x0, const LatentOptimizerSettings& o,
+                     const TaskContext& ctx, int offset, int total, LatentOptimizerStats* stats) {
   if (!(o.adam_lr > 0) || o.adam_decay_every < 1 || !(o.adam_decay > 0) || o.adam_patience < 1)
     throw InputError("invalid Adam settings");
   const double b1 = 0.9, b2 = 0.999, eps = 1e-8;
-  at::Tensor x = x0.to(at::kFloat).clone();
-  at::Tensor m = at::zeros_like(x), v = at::zeros_like(x);
-  at::Tensor best_x = x.clone();
+  Eigen::VectorXd x = x0, best_x = x0, g(x0.size());
+  Eigen::ArrayXd m = Eigen::ArrayXd::Zero(x0.size()), v = m;
   double best = std::numeric_limits<double>::infinity();
   std::vector<double> history;
   stats->message = "iteration cap reached";
   int it = 0;
   for (; it < o.max_iterations; ++it) {
-    at::Tensor g;
-    const double f = with_gradient(energy, x, &g);
+    const double f = energy.evaluate(x.data(), g.data());
     ++stats->evaluations;
-    if (!std::isfinite(f)) {
+    if (!std::isfinite(f) || !g.allFinite()) {
       stats->message = "non-finite energy";
       break;
     }
     if (f < best) {
       best = f;
-      best_x = x.clone();
+      best_x = x;
     }
     history.push_back(best);
     ctx.report({offset + it, total, f});
-    if (it >= o.adam_patience) {
-      const double before = history[it - o.adam_patience];
-      if (before - best <= o.adam_tolerance * std::abs(before)) {
-        stats->converged = true;
-        stats->message = "converged: the energy improved by less than the tolerance over the patience window";
-        ++it;
-        break;
-      }
+    if (adam_converged(history, it, o)) {
+      stats->converged = true;
+      stats->message = "converged: the energy improved by less than the tolerance over the patience window";
+      ++it;
+      break;
     }
     const double lr = o.adam_lr * std::pow(o.adam_decay, it / o.adam_decay_every);
-    at::NoGradGuard no_grad;
-    m.mul_(b1).add_(g, 1 - b1);
-    v.mul_(b2).addcmul_(g, g, 1 - b2);
+    m = b1 * m + (1 - b1) * g.array();
+    v = b2 * v + (1 - b2) * g.array().square();
     const double c1 = 1 - std::pow(b1, it + 1), c2 = 1 - std::pow(b2, it + 1);
-    x = x - (m / c1) / ((v / c2).sqrt() + eps) * lr;
+    x -= (lr * (m / c1) / ((v / c2).sqrt() + eps)).matrix();
   }
   stats->iterations = it;
   return best_x;
@@ -190,27 +162,15 @@ std::string LatentOptimizerSettings::validate() const {
   return e.str();
 }
 
-at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
-                           const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset,
-                           int iteration_total) {
-  *stats = LatentOptimizerStats{};
-  const int total = iteration_total > 0 ? iteration_total : settings.max_iterations;
-  return settings.optimizer == LatentOptimizer::Lbfgs
-             ? lbfgs(tensor_evaluation(energy, static_cast<int>(x0.numel())), x0, settings, ctx, iteration_offset,
-                     total, stats)
-             : adam(energy, x0, settings, ctx, iteration_offset, total, stats);
-}
-
-at::Tensor minimize_latent(DirectLatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
-                           const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset,
-                           int iteration_total) {
-  if (settings.optimizer != LatentOptimizer::Lbfgs)
-    throw InputError("an energy evaluated without tensors is minimised with L-BFGS only");
-  if (x0.numel() != energy.size())
-    throw InputError("the start has " + std::to_string(x0.numel()) + " values, the energy " +
+Eigen::VectorXd minimize_latent(DirectLatentEnergy& energy, const Eigen::VectorXd& x0,
+                                const LatentOptimizerSettings& settings, const TaskContext& ctx,
+                                LatentOptimizerStats* stats, int iteration_offset, int iteration_total) {
+  if (x0.size() != energy.size())
+    throw InputError("the start has " + std::to_string(x0.size()) + " values, the energy " +
                      std::to_string(energy.size()));
   *stats = LatentOptimizerStats{};
   const int total = iteration_total > 0 ? iteration_total : settings.max_iterations;
+  if (settings.optimizer == LatentOptimizer::Adam) return adam(energy, x0, settings, ctx, iteration_offset, total, stats);
   return lbfgs([&energy](const double* x, double* gradient) { return energy.evaluate(x, gradient); }, x0, settings,
                ctx, iteration_offset, total, stats);
 }

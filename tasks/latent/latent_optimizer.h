@@ -1,19 +1,19 @@
 // The optimiser shared by every latent-space task (tasks/latent/latent_solver.h,
-// tasks/renav/renav.h): minimises a differentiable energy of a flat latent vector
-// x = [z_l, z_g] with L-BFGS (Ceres GradientProblemSolver, gradients from
-// torch autograd, or written out by an energy that evaluates itself without
-// tensors: DirectLatentEnergy) or with Adam (NeMF's reference, on torch),
-// reporting progress through the task context once per iteration so that
-// callers can observe and cancel.
+// tasks/renav/renav.h): minimises an energy of a flat latent vector
+// x = [z_l, z_g] that evaluates itself and its gradient (DirectLatentEnergy:
+// the Eigen runtime's energies, or a libtorch energy through
+// TensorLatentEnergy of tasks/latent/latent_energy.h) with L-BFGS (Ceres
+// GradientProblemSolver) or with Adam (NeMF's reference), reporting progress
+// through the task context once per iteration so that callers can observe
+// and cancel. No libtorch here.
 #pragma once
 
-#include <ATen/core/Tensor.h>
+#include <Eigen/Core>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "tasks/context/task_context.h"
-#include "tasks/latent/latent_energy.h"
 
 namespace mf {
 
@@ -66,10 +66,10 @@ struct LatentOptimizerStats {
   std::string message;       ///< the stop reason
 };
 
-/// An energy of x ([size()] values) that evaluates itself and its gradient
-/// without tensors: the Eigen runtime's (RuntimeLatentEnergy,
-/// tasks/latent/runtime_problem.h). It keeps buffers between evaluations, so
-/// evaluating is not const; one per thread.
+/// An energy of x ([size()] values) that evaluates itself and its gradient:
+/// the Eigen runtime's (RuntimeLatentEnergy, tasks/latent/runtime_problem.h)
+/// or a libtorch energy's adapter (TensorLatentEnergy). It keeps buffers
+/// between evaluations, so evaluating is not const; one per thread.
 class DirectLatentEnergy {
  public:
   virtual ~DirectLatentEnergy() = default;
@@ -81,21 +81,17 @@ class DirectLatentEnergy {
   virtual std::vector<std::pair<std::string, double>> terms(const double* x, double* total) = 0;
 };
 
-/// Minimises `energy` from x0 ([n] float) with settings.optimizer, at most
-/// settings.max_iterations iterations; returns the solution ([n] float).
-/// Progress reports carry iteration = `iteration_offset` + this run's
-/// iteration and max_iterations = `iteration_total` (0: this run's cap).
+/// Minimises `energy` from x0 ([energy.size()] values) with
+/// settings.optimizer, at most settings.max_iterations iterations; returns the
+/// solution. Progress reports carry iteration = `iteration_offset` + this
+/// run's iteration and max_iterations = `iteration_total` (0: this run's cap).
+/// Adam runs in double on the energy's gradients (torch.optim.Adam's update,
+/// beta 0.9 / 0.999, eps 1e-8) and returns the best x it evaluated.
 /// Throws CancelledError when the context asks to stop, mf::InputError for
-/// invalid settings, and rethrows any exception raised by the energy.
-at::Tensor minimize_latent(const LatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
-                           const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset = 0,
-                           int iteration_total = 0);
-
-/// minimize_latent() with L-BFGS on an energy that evaluates itself
-/// (settings.optimizer must be Lbfgs: Adam runs on tensor energies only;
-/// InputError otherwise).
-at::Tensor minimize_latent(DirectLatentEnergy& energy, const at::Tensor& x0, const LatentOptimizerSettings& settings,
-                           const TaskContext& ctx, LatentOptimizerStats* stats, int iteration_offset = 0,
-                           int iteration_total = 0);
+/// invalid settings or a start of the wrong size, and rethrows any exception
+/// raised by the energy.
+Eigen::VectorXd minimize_latent(DirectLatentEnergy& energy, const Eigen::VectorXd& x0,
+                                const LatentOptimizerSettings& settings, const TaskContext& ctx,
+                                LatentOptimizerStats* stats, int iteration_offset = 0, int iteration_total = 0);
 
 }  // namespace mf

@@ -1,7 +1,6 @@
 #include "tasks/latent/latent_solver.h"
 
 #include <ATen/ATen.h>
-#include <ATen/CPUGeneratorImpl.h>
 
 #include <algorithm>
 #include <cassert>
@@ -11,6 +10,7 @@
 #include <limits>
 #include <memory>
 #include <optional>
+#include <random>
 #include <sstream>
 
 #include "prior/model/nemf.h"
@@ -59,7 +59,7 @@ std::vector<int> key_frames_of(const WindowProblem& p) {
 
 // The energy of a window's problem as a function of the codes.
 CodeEnergy window_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& weights) {
-  return [&model, &problem, &weights](const at::Tensor& z_l, const at::Tensor& z_g) {
+  return [&model, &problem, weights](const at::Tensor& z_l, const at::Tensor& z_g) {
     return evaluate_energy(model, problem, weights, z_l, z_g);
   };
 }
@@ -209,64 +209,100 @@ Motion window_source(const Motion& input, const Motion& out, const WindowPlan& w
 // (LatentSolverOptions::start_noise), its own stream per window.
 InitialGuess perturbed(InitialGuess g, const LatentSolverOptions& o, int window) {
   if (o.start_noise <= 0.0) return g;
-  at::Generator gen = at::make_generator<at::CPUGeneratorImpl>(o.start_seed * 1000003ull + static_cast<uint64_t>(window));
-  g.z_l = g.z_l + o.start_noise * at::randn(g.z_l.sizes(), gen, g.z_l.options());
-  g.z_g = g.z_g + o.start_noise * at::randn(g.z_g.sizes(), gen, g.z_g.options());
+  std::mt19937_64 rng(o.start_seed * 1000003ull + static_cast<uint64_t>(window));
+  std::normal_distribution<float> normal(0.0f, 1.0f);
+  for (Eigen::VectorXf* z : {&g.z_l, &g.z_g}) {
+    for (Eigen::Index i = 0; i < z->size(); ++i) (*z)[i] += static_cast<float>(o.start_noise) * normal(rng);
+  }
   return g;
 }
 
-// A window's energies on the Eigen runtime: the full and the keys-only
-// energy of solve_window_latents(), sharing one evaluator.
-struct RuntimeWindow {
-  RuntimeWindow(const runtime::NemfRuntime& model, const WindowProblem& p, const EnergyWeights& full_weights,
-                const EnergyWeights& keyed_weights)
-      : evaluator(model),
-        problem(to_runtime_problem(p, model.rig().num_joints())),
-        full(evaluator, problem, full_weights, model.config().zl, model.config().zg),
-        keyed(evaluator, problem, keyed_weights, model.config().zl, model.config().zg) {}
-  RuntimeEnergy evaluator;
-  RuntimeWindowProblem problem;
-  RuntimeLatentEnergy full, keyed;
+// A window's full and keys-only energies (solve_window_latents()): on the
+// Eigen runtime when the context carries the runtime of `model`, else on
+// libtorch.
+struct WindowEnergies {
+  virtual ~WindowEnergies() = default;
+  virtual DirectLatentEnergy& full() = 0;
+  virtual DirectLatentEnergy& keyed() = 0;
+  virtual DecodedWindow decode(const Eigen::VectorXf& z_l, const Eigen::VectorXf& z_g) = 0;
+  bool runtime = false;
 };
 
-// The window's energies on the Eigen runtime when L-BFGS runs and the
-// context carries the runtime of `model`; null otherwise, and the window keeps
-// the libtorch energy (Adam, a context without this model's runtime).
-std::unique_ptr<RuntimeWindow> runtime_window(const NemfModel& model, const TaskContext& ctx, const WindowProblem& p,
-                                              const LatentSolverOptions& options, const EnergyWeights& keyed) {
-  if (options.optimizer != LatentOptimizer::Lbfgs || !ctx.runtime || ctx.model.get() != &model) return nullptr;
-  return std::make_unique<RuntimeWindow>(*ctx.runtime, p, options.weights, keyed);
+struct RuntimeWindowEnergies final : WindowEnergies {
+  RuntimeWindowEnergies(const runtime::NemfRuntime& model, const WindowProblem& p, const EnergyWeights& full_weights,
+                        const EnergyWeights& keyed_weights)
+      : evaluator(model),
+        problem(to_runtime_problem(p, model.rig().num_joints())),
+        full_energy(evaluator, problem, full_weights, model.config().zl, model.config().zg),
+        keyed_energy(evaluator, problem, keyed_weights, model.config().zl, model.config().zg) {
+    runtime = true;
+  }
+  DirectLatentEnergy& full() override { return full_energy; }
+  DirectLatentEnergy& keyed() override { return keyed_energy; }
+  DecodedWindow decode(const Eigen::VectorXf& z_l, const Eigen::VectorXf& z_g) override {
+    return evaluator.decode_window(problem, z_l, z_g);
+  }
+  RuntimeEnergy evaluator;
+  RuntimeWindowProblem problem;
+  RuntimeLatentEnergy full_energy, keyed_energy;
+};
+
+struct TensorWindowEnergies final : WindowEnergies {
+  TensorWindowEnergies(const NemfModel& m, const WindowProblem& p, const EnergyWeights& full_weights,
+                       const EnergyWeights& keyed_weights)
+      : model(m),
+        problem(p),
+        full_energy(window_energy(m, p, full_weights), m.config().zl, m.config().zg),
+        keyed_energy(window_energy(m, p, keyed_weights), m.config().zl, m.config().zg) {}
+  DirectLatentEnergy& full() override { return full_energy; }
+  DirectLatentEnergy& keyed() override { return keyed_energy; }
+  DecodedWindow decode(const Eigen::VectorXf& z_l, const Eigen::VectorXf& z_g) override {
+    return decode_window(model, problem, codes_tensor(z_l), codes_tensor(z_g));
+  }
+  const NemfModel& model;
+  const WindowProblem& problem;
+  FlatLatentEnergy full_energy, keyed_energy;
+};
+
+std::unique_ptr<WindowEnergies> window_energies(const NemfModel& model, const TaskContext& ctx,
+                                                const WindowProblem& p, const EnergyWeights& full,
+                                                const EnergyWeights& keyed) {
+  if (ctx.runtime && ctx.model.get() == &model)
+    return std::make_unique<RuntimeWindowEnergies>(*ctx.runtime, p, full, keyed);
+  return std::make_unique<TensorWindowEnergies>(model, p, full, keyed);
+}
+
+// The keys-only weights of a window's first stage.
+EnergyWeights keyed_weights(const EnergyWeights& full) {
+  EnergyWeights keyed = full;
+  keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
+  keyed.trajectory = keyed.trajectory_facing = 0.0;
+  return keyed;
 }
 
 // solve_latents() on options the caller validated: complete_motion() checks
 // them once per call, not once per window.
-LatentSolution solve_window_latents(const NemfModel& model, const WindowProblem& problem, const InitialGuess& start,
-                                    const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset,
-                                    int iteration_total) {
+LatentSolution solve_window_latents(WindowEnergies& energies, const NemfConfig& config, const WindowProblem& problem,
+                                    const InitialGuess& start, const LatentSolverOptions& options,
+                                    const TaskContext& ctx, int iteration_offset, int iteration_total) {
   assert(options.validate().empty());
-  const int zl = model.config().zl, zg = model.config().zg;
-  if (!start.z_l.defined() || !start.z_g.defined() || start.z_l.numel() != zl || start.z_g.numel() != zg)
+  const int zl = config.zl, zg = config.zg;
+  if (start.z_l.size() != zl || start.z_g.size() != zg)
     throw InputError("initial codes must have " + std::to_string(zl) + " + " + std::to_string(zg) + " values");
   const auto t0 = Clock::now();
-  const FlatLatentEnergy energy(window_energy(model, problem, options.weights), zl, zg);
-  const at::Tensor x0 = energy.join(start.z_l, start.z_g);
   const WindowCaps caps =
       window_caps(options, key_frames_of(problem),
                   problem.num_effectors() > 0 || problem.num_pin_steps() > 0 || problem.num_trajectory() > 0, problem.length);
   const int total = iteration_total > 0 ? iteration_total : caps.keyed + caps.full;
-
   FirstStage first;
-  EnergyWeights keyed = options.weights;
-  keyed.root_translation = keyed.effector = keyed.foot_skating = keyed.smoothness = 0.0;
-  keyed.trajectory = keyed.trajectory_facing = 0.0;
-  const FlatLatentEnergy cheap(window_energy(model, problem, keyed), zl, zg);
-  const std::unique_ptr<RuntimeWindow> direct = runtime_window(model, ctx, problem, options, keyed);
-  if (caps.keyed > 0) first = {&cheap, caps.keyed, direct ? &direct->keyed : nullptr};
+  if (caps.keyed > 0) first = {&energies.keyed(), caps.keyed};
   LatentSolution out;
-  const at::Tensor x = minimize_window(energy, x0, options.capped(caps.full), ctx, iteration_offset, total,
-                                       &out.summary, first, direct ? &direct->full : nullptr);
-  out.z_l = energy.z_l(x);
-  out.z_g = energy.z_g(x);
+  const Eigen::VectorXd x = minimize_window(energies.full(), join_codes(start.z_l, start.z_g),
+                                            options.capped(caps.full), ctx, iteration_offset, total, &out.summary,
+                                            first);
+  out.z_l = head_codes(x, zl);
+  out.z_g = tail_codes(x, zg);
+  out.summary.runtime_energy = energies.runtime;
   out.summary.wall_ms = ms_since(t0);
   return out;
 }
@@ -285,25 +321,28 @@ SolvedWindow solve_window(const NemfModel& model, const Motion& input, const Win
   const WindowProblem problem = make_window_problem(model.rig(), src, 0, w.length, w.constraints, w.anchor);
   InitRequest request;
   request.model = &model;
+  if (ctx.runtime && ctx.model.get() == &model) request.runtime = ctx.runtime.get();
   request.window = &src;
   request.constraints = &w.constraints;
   request.anchor = w.anchor;
   request.context = &ctx;
   const InitialGuess start =
-      perturbed(whole ? encode_window(model, whole->slice(w.start, w.start + w.length), w.anchor)
+      perturbed(whole ? encode_window(request, whole->slice(w.start, w.start + w.length))
                       : init.initialize(request),
                 options, window_ctx.window);
   LatentSolverOptions window_options = options;
   window_options.keyed_iterations = w.caps.keyed;
   window_options.max_iterations = w.caps.full;
-  const LatentSolution sol =
-      solve_window_latents(model, problem, start, window_options, window_ctx, iteration_offset, iteration_total);
+  const std::unique_ptr<WindowEnergies> energies =
+      window_energies(model, ctx, problem, options.weights, keyed_weights(options.weights));
+  const LatentSolution sol = solve_window_latents(*energies, model.config(), problem, start, window_options,
+                                                  window_ctx, iteration_offset, iteration_total);
   rep->windows.push_back(sol.summary);
   rep->window_starts.push_back(w.start);
   std::vector<int> keys;
   for (const PoseKey& k : w.user.keys) keys.push_back(k.frame);
   rep->trust.push_back(judge_window(options.fallback, sol.summary, src, keys));
-  return {decode_window(model, problem, sol.z_l, sol.z_g), problem.transform, sol.summary.iterations};
+  return {energies->decode(sol.z_l, sol.z_g), problem.transform, sol.summary.iterations};
 }
 
 // Solves the windows of `plan` in order (the progress total is the sum of
@@ -412,7 +451,10 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
                              const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset,
                              int iteration_total) {
   check_solver_options(options);
-  return solve_window_latents(model, problem, start, options, ctx, iteration_offset, iteration_total);
+  const std::unique_ptr<WindowEnergies> energies =
+      window_energies(model, ctx, problem, options.weights, keyed_weights(options.weights));
+  return solve_window_latents(*energies, model.config(), problem, start, options, ctx, iteration_offset,
+                              iteration_total);
 }
 
 Motion complete_motion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,

@@ -63,7 +63,7 @@
 //    there is no seam (the window loop of tasks/latent/window_solver.h).
 #pragma once
 
-#include <ATen/core/Tensor.h>
+#include <Eigen/Core>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -165,8 +165,8 @@ WindowCaps window_caps(const LatentSolverOptions& options, const std::vector<int
 LatentSolverOptions default_solver_options(LatentOptimizer optimizer = LatentOptimizer::Lbfgs);
 
 struct LatentSolution {
-  at::Tensor z_l;  ///< [1, zl]
-  at::Tensor z_g;  ///< [1, zg]
+  Eigen::VectorXf z_l;  ///< [zl]
+  Eigen::VectorXf z_g;  ///< [zg]
   SolveSummary summary;  ///< wall_ms: the minimisation, initialisation excluded
 };
 

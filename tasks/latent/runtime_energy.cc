@@ -111,6 +111,22 @@ RuntimeEnergyTerms RuntimeEnergy::evaluate(const RuntimeWindowProblem& problem, 
   return out;
 }
 
+DecodedWindow RuntimeEnergy::decode_window(const RuntimeWindowProblem& problem,
+                                           const Eigen::Ref<const Eigen::VectorXf>& z_l,
+                                           const Eigen::Ref<const Eigen::VectorXf>& z_g) {
+  check_problem(problem, model_->rig().num_joints(), model_->config().window);
+  ActiveTerms dense;
+  dense.dense = true;
+  gradient_ = false;
+  decode(problem, dense, z_l, z_g);
+  gmp_inputs();
+  model_->predict_global(gmp_in_, GmpUse::Default, &gmp_ws_, &gmp_out_);
+  root_path(problem.anchor);
+  const int F = model_->rig().num_feet();
+  runtime::MatrixRXf contacts = (1.0f / (1.0f + (-gmp_out_.rightCols(F).array()).exp())).matrix();
+  return {rotations_, path_, std::move(contacts)};
+}
+
 // Decodes the whole window when a dense term is active, else the key frames,
 // and runs FK (root at the origin) when a term reads positions.
 void RuntimeEnergy::decode(const RuntimeWindowProblem& problem, const ActiveTerms& a,

@@ -55,6 +55,12 @@ class RuntimeEnergy {
                               const Eigen::Ref<const Eigen::VectorXf>& z_g, Eigen::VectorXf* g_zl,
                               Eigen::VectorXf* g_zg);
 
+  /// The solution (z_l, z_g) of `problem`'s window (decode_window() of
+  /// energies.h): the whole window decoded, the GMP's root path aligned at
+  /// the anchor and its contact probabilities.
+  DecodedWindow decode_window(const RuntimeWindowProblem& problem, const Eigen::Ref<const Eigen::VectorXf>& z_l,
+                              const Eigen::Ref<const Eigen::VectorXf>& z_g);
+
  private:
   void decode(const RuntimeWindowProblem& problem, const ActiveTerms& a, const Eigen::Ref<const Eigen::VectorXf>& z_l,
               const Eigen::Ref<const Eigen::VectorXf>& z_g);

@@ -14,13 +14,6 @@ std::vector<int> ints_of(const at::Tensor& t, int n) {
   return std::vector<int>(c.data_ptr<int64_t>(), c.data_ptr<int64_t>() + n);
 }
 
-// A float tensor of `rows` rows as a row-major matrix of `cols` columns.
-runtime::MatrixRXf matrix_of(const at::Tensor& t, int rows, int cols) {
-  if (rows == 0) return runtime::MatrixRXf(0, cols);
-  const at::Tensor c = t.detach().to(at::kFloat).contiguous().reshape({rows, cols});
-  return Eigen::Map<const runtime::MatrixRXf>(c.data_ptr<float>(), rows, cols);
-}
-
 }  // namespace
 
 RuntimeWindowProblem to_runtime_problem(const WindowProblem& problem, int joints) {
@@ -29,22 +22,22 @@ RuntimeWindowProblem to_runtime_problem(const WindowProblem& problem, int joints
   p.length = problem.length;
   p.anchor = problem.anchor;
   p.key_frames = ints_of(problem.key_frames, K);
-  p.key_rotations = matrix_of(problem.key_rotations, K, J * 9);
-  p.key_rotation_mask = matrix_of(problem.key_rotation_mask, K, J);
-  p.key_positions = matrix_of(problem.key_positions, K, J * 3);
-  p.key_position_mask = matrix_of(problem.key_position_mask, K, J);
-  p.key_root = matrix_of(problem.key_root, K, 3);
-  p.key_root_mask = matrix_of(problem.key_root_mask, K, 1).col(0);
+  p.key_rotations = rows_of(problem.key_rotations, K, J * 9);
+  p.key_rotation_mask = rows_of(problem.key_rotation_mask, K, J);
+  p.key_positions = rows_of(problem.key_positions, K, J * 3);
+  p.key_position_mask = rows_of(problem.key_position_mask, K, J);
+  p.key_root = rows_of(problem.key_root, K, 3);
+  p.key_root_mask = rows_of(problem.key_root_mask, K, 1).col(0);
   const int E = problem.num_effectors(), P = problem.num_pin_steps(), R = problem.num_trajectory();
   p.effector_frames = ints_of(problem.effector_frames, E);
   p.effector_joints = ints_of(problem.effector_joints, E);
-  p.effector_targets = matrix_of(problem.effector_targets, E, 3);
-  p.effector_weights = matrix_of(problem.effector_weights, E, 1).col(0);
+  p.effector_targets = rows_of(problem.effector_targets, E, 3);
+  p.effector_weights = rows_of(problem.effector_weights, E, 1).col(0);
   p.pin_from = ints_of(problem.pin_from, P);
   p.pin_to = ints_of(problem.pin_to, P);
   p.trajectory_frames = ints_of(problem.trajectory_frames, R);
-  p.trajectory_ground = matrix_of(problem.trajectory_ground, R, 2);
-  p.trajectory_forward = matrix_of(problem.trajectory_forward, R, 2);
+  p.trajectory_ground = rows_of(problem.trajectory_ground, R, 2);
+  p.trajectory_forward = rows_of(problem.trajectory_forward, R, 2);
   return p;
 }
 

@@ -57,6 +57,16 @@ struct RuntimeWindowProblem {
   int num_trajectory() const { return static_cast<int>(trajectory_frames.size()); }
 };
 
+/// The solution of a window, canonical: local rotations [T, J * 9] (row-major
+/// 3x3 per joint, joint 0's the root's in the canonical frame) at frames
+/// 0..T-1, the global motion predictor's root path [T, 3] and its foot
+/// contact probabilities [T, F] (RigInfo::foot_joints order).
+struct DecodedWindow {
+  runtime::MatrixRXf local_rotations;
+  runtime::MatrixRXf root_positions;
+  runtime::MatrixRXf contacts;
+};
+
 /// Builds the canonical problem of frames [begin, begin + length) of `motion`
 /// under `constraints` (window-relative, i.e. already sliced), anchored at
 /// window frame `anchor`, which must be a key that fixes the root. Reads only

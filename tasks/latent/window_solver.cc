@@ -1,6 +1,5 @@
 #include "tasks/latent/window_solver.h"
 
-#include <ATen/ATen.h>
 #include <string>
 #include <utility>
 #include <vector>
@@ -9,51 +8,38 @@
 
 namespace mf {
 
-namespace {
-
-// The terms and total at x: of `direct` when there is one, else of `energy`.
-std::vector<std::pair<std::string, double>> terms_at(const FlatLatentEnergy& energy, DirectLatentEnergy* direct,
-                                                     const at::Tensor& x, double* total) {
-  if (!direct) return energy.terms(x, total);
-  const at::Tensor d = x.to(at::kDouble).contiguous();
-  return direct->terms(d.data_ptr<double>(), total);
-}
-
-at::Tensor minimize(const FlatLatentEnergy& energy, DirectLatentEnergy* direct, const at::Tensor& x0,
-                    const LatentOptimizerSettings& settings, const TaskContext& ctx, LatentOptimizerStats* stats,
-                    int iteration_offset, int iteration_total) {
-  return direct ? minimize_latent(*direct, x0, settings, ctx, stats, iteration_offset, iteration_total)
-                : minimize_latent(energy.total(), x0, settings, ctx, stats, iteration_offset, iteration_total);
-}
-
-}  // namespace
-
-at::Tensor minimize_window(const FlatLatentEnergy& energy, const at::Tensor& x0,
-                           const LatentOptimizerSettings& settings, const TaskContext& ctx, int iteration_offset,
-                           int iteration_total, SolveSummary* summary,
-                           const FirstStage& first, DirectLatentEnergy* direct) {
-  const bool lbfgs = settings.optimizer == LatentOptimizer::Lbfgs;
-  DirectLatentEnergy* full = lbfgs ? direct : nullptr;
+Eigen::VectorXd minimize_window(DirectLatentEnergy& energy, const Eigen::VectorXd& x0,
+                                const LatentOptimizerSettings& settings, const TaskContext& ctx, int iteration_offset,
+                                int iteration_total, SolveSummary* summary, const FirstStage& first) {
   SolveSummary& s = *summary;
-  s.initial_terms = terms_at(energy, full, x0, &s.initial_energy);
-  at::Tensor x = x0;
+  s.initial_terms = energy.terms(x0.data(), &s.initial_energy);
+  Eigen::VectorXd x = x0;
   if (first.energy && first.max_iterations > 0) {
     LatentOptimizerStats stats;
-    x = minimize(*first.energy, lbfgs ? first.direct : nullptr, x, settings.capped(first.max_iterations), ctx, &stats,
-                 iteration_offset, iteration_total);
+    x = minimize_latent(*first.energy, x, settings.capped(first.max_iterations), ctx, &stats, iteration_offset,
+                        iteration_total);
     s.keyed_iterations = stats.iterations;
     s.evaluations += stats.evaluations;
   }
   LatentOptimizerStats stats;
-  x = minimize(energy, full, x, settings, ctx, &stats, iteration_offset + s.keyed_iterations, iteration_total);
+  x = minimize_latent(energy, x, settings, ctx, &stats, iteration_offset + s.keyed_iterations, iteration_total);
   s.iterations = s.keyed_iterations + stats.iterations;
   s.evaluations += stats.evaluations;
   s.converged = stats.converged;
   s.message = stats.message;
-  s.runtime_energy = full != nullptr;
-  s.final_terms = terms_at(energy, full, x, &s.final_energy);
+  s.final_terms = energy.terms(x.data(), &s.final_energy);
   return x;
 }
+
+Eigen::VectorXd join_codes(const Eigen::VectorXf& z_l, const Eigen::VectorXf& z_g) {
+  Eigen::VectorXd x(z_l.size() + z_g.size());
+  x << z_l.cast<double>(), z_g.cast<double>();
+  return x;
+}
+
+Eigen::VectorXf head_codes(const Eigen::VectorXd& x, int zl) { return x.head(zl).cast<float>(); }
+
+Eigen::VectorXf tail_codes(const Eigen::VectorXd& x, int zg) { return x.tail(zg).cast<float>(); }
 
 WindowSolver::WindowSolver(std::vector<WindowSpan> spans, const Skeleton& skeleton, int frames, double fps, int feet)
     : spans_(std::move(spans)), skeleton_(skeleton), frames_(frames), fps_(fps), feet_(feet) {}
@@ -77,9 +63,9 @@ WindowedSolution WindowSolver::solve(const TaskContext& ctx, const SolveWindowFn
 // counted from the side away from the earlier windows.
 void WindowSolver::blend(const WindowSpan& w, const SolvedWindow& window, WindowedSolution* out) const {
   Motion piece = Motion::identity(skeleton_, w.length, fps_);
-  write_window(window.decoded.local_rotations, window.decoded.root_positions, window.transform, &piece, 0);
-  const at::Tensor pc_tensor = window.decoded.contacts.to(at::kFloat).contiguous();
-  const float* pc = pc_tensor.data_ptr<float>();
+  write_window(window.decoded.local_rotations.cast<double>(), window.decoded.root_positions.cast<double>(),
+               window.transform, &piece, 0);
+  const float* pc = window.decoded.contacts.data();
   const bool solved_before = w.shared_begin < w.shared_end && w.shared_begin == 0;
   const int n_ov = w.shared_end - w.shared_begin;
   for (int f = 0; f < w.length; ++f) {

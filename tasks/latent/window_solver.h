@@ -13,17 +13,17 @@
 // iterations, so that the progress reports of later windows continue.
 #pragma once
 
-#include <ATen/core/Tensor.h>
+#include <Eigen/Core>
 #include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "prior/model/representation.h"
+#include "prior/model/canonical_window.h"
 #include "prior/motion/motion.h"
 #include "tasks/context/task_context.h"
-#include "tasks/latent/latent_energy.h"
 #include "tasks/latent/latent_optimizer.h"
+#include "tasks/latent/window_problem.h"
 
 namespace mf {
 
@@ -42,35 +42,34 @@ struct SolveSummary {
   double wall_ms = 0.0;
   std::string message;       ///< the optimiser's stop reason
   /// The stages minimised the Eigen runtime's energy
-  /// (tasks/latent/runtime_energy.h), not the libtorch one.
+  /// (tasks/latent/runtime_energy.h), not a libtorch one (set by the task).
   bool runtime_energy = false;
 };
 
 /// An optional first stage of a window's minimisation on a cheaper energy.
 struct FirstStage {
-  const FlatLatentEnergy* energy = nullptr;  ///< null: no first stage
-  int max_iterations = 0;                    ///< 0: no first stage
-  /// `energy` evaluated without tensors (see minimize_window()); null: none.
-  DirectLatentEnergy* direct = nullptr;
+  DirectLatentEnergy* energy = nullptr;  ///< null: no first stage
+  int max_iterations = 0;                ///< 0: no first stage
 };
 
-/// Minimises `energy` from x0 ([zl + zg] float) with settings.optimizer:
-/// first, when `first` has an energy and a positive cap, up to
-/// first.max_iterations iterations on first.energy, then up to
-/// settings.max_iterations on `energy`. Fills `summary` (the terms of
-/// `energy` before and after, the iterations and evaluations of both stages,
-/// the last stage's convergence and stop reason; not wall_ms) and returns the
-/// solution x. Progress reports carry iteration = `iteration_offset` + the
-/// window's iteration and max_iterations = `iteration_total`
-/// (minimize_latent(), tasks/latent/latent_optimizer.h). `direct`, when not
-/// null, is `energy` evaluated without tensors (and first.direct is
-/// first.energy's): with L-BFGS the stages minimise them and the terms
-/// before and after are read from `direct`; Adam runs on the tensor energies.
-/// Throws CancelledError when the context asks to stop.
-at::Tensor minimize_window(const FlatLatentEnergy& energy, const at::Tensor& x0,
-                           const LatentOptimizerSettings& settings, const TaskContext& ctx, int iteration_offset,
-                           int iteration_total, SolveSummary* summary,
-                           const FirstStage& first = {}, DirectLatentEnergy* direct = nullptr);
+/// Minimises `energy` from x0 ([zl + zg]) with settings.optimizer: first,
+/// when `first` has an energy and a positive cap, up to first.max_iterations
+/// iterations on first.energy, then up to settings.max_iterations on
+/// `energy`. Fills `summary` (the terms of `energy` before and after, the
+/// iterations and evaluations of both stages, the last stage's convergence
+/// and stop reason; not wall_ms nor runtime_energy) and returns the solution
+/// x. Progress reports carry iteration = `iteration_offset` + the window's
+/// iteration and max_iterations = `iteration_total` (minimize_latent(),
+/// tasks/latent/latent_optimizer.h). Throws CancelledError when the context
+/// asks to stop.
+Eigen::VectorXd minimize_window(DirectLatentEnergy& energy, const Eigen::VectorXd& x0,
+                                const LatentOptimizerSettings& settings, const TaskContext& ctx, int iteration_offset,
+                                int iteration_total, SolveSummary* summary, const FirstStage& first = {});
+
+/// x = [z_l, z_g] of the codes, and the codes of x.
+Eigen::VectorXd join_codes(const Eigen::VectorXf& z_l, const Eigen::VectorXf& z_g);
+Eigen::VectorXf head_codes(const Eigen::VectorXd& x, int zl);
+Eigen::VectorXf tail_codes(const Eigen::VectorXd& x, int zg);
 
 /// A window of a solve: output frames [start, start + length); its window
 /// frames [shared_begin, shared_end) are also in windows solved before it
@@ -78,15 +77,6 @@ at::Tensor minimize_window(const FlatLatentEnergy& energy, const at::Tensor& x0,
 struct WindowSpan {
   int start = 0, length = 0;
   int shared_begin = 0, shared_end = 0;
-};
-
-/// The solution of a window, canonical: local rotations [1, T, J, 3, 3] at
-/// frames 0..T-1, the GMP's root path [1, T, 3] and its foot contact
-/// probabilities [1, T, F] (RigInfo::foot_joints order).
-struct DecodedWindow {
-  at::Tensor local_rotations;
-  at::Tensor root_positions;
-  at::Tensor contacts;
 };
 
 /// A window's solution as a task hands it to the WindowSolver.

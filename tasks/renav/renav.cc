@@ -19,6 +19,7 @@
 #include "tasks/constraints/interpolation_fill.h"
 #include "tasks/context/model_rig.h"
 #include "tasks/latent/initializers.h"
+#include "tasks/latent/latent_energy.h"
 #include "tasks/latent/latent_optimizer.h"
 #include "tasks/latent/windows.h"
 
@@ -275,12 +276,11 @@ RenavEnergy evaluate_renav_energy(const NemfModel& model, const RenavWindow& win
 DecodedWindow decode_renav_window(const NemfModel& model, const RenavWindow& window, const at::Tensor& z_l,
                                   const at::Tensor& z_g) {
   at::NoGradGuard no_grad;
-  DecodedWindow d;
-  d.local_rotations = model.decode(at::arange(window.length, at::kFloat), z_l, z_g);
-  GmpOutput gmp = model.predict_global(d.local_rotations, GmpUse::Steering);
-  d.root_positions = model.root_positions(d.local_rotations, gmp, window.start_xz);
-  d.contacts = at::sigmoid(gmp.contact_logits);
-  return d;
+  const int64_t T = window.length, J = model.rig().num_joints(), F = model.rig().num_feet();
+  const at::Tensor rotations = model.decode(at::arange(T, at::kFloat), z_l, z_g);
+  GmpOutput gmp = model.predict_global(rotations, GmpUse::Steering);
+  return {rows_of(rotations, T, J * 9), rows_of(model.root_positions(rotations, gmp, window.start_xz), T, 3),
+          rows_of(at::sigmoid(gmp.contact_logits), T, F)};
 }
 
 // ---------------------------------------------------------------- solvers
@@ -289,7 +289,7 @@ namespace {
 
 // The energy of a window as a function of the codes.
 CodeEnergy window_energy(const NemfModel& model, const RenavWindow& window, const RenavWeights& weights) {
-  return [&model, &window, &weights](const at::Tensor& z_l, const at::Tensor& z_g) {
+  return [&model, &window, weights](const at::Tensor& z_l, const at::Tensor& z_g) {
     return evaluate_renav_energy(model, window, weights, z_l, z_g);
   };
 }
@@ -421,14 +421,14 @@ std::vector<RenavSpan> renav_spans(int M, int R, int W, int overlap) {
 
 // The initial codes of window `k`: z_l from the reference segment, z_g from
 // each candidate of `inits`; the lowest energy is kept (recorded in *sum).
-at::Tensor initial_codes(const NemfModel& model, const RenavWindow& window, const FlatLatentEnergy& energy,
-                         const std::vector<std::string>& inits, uint64_t seed, int k, RenavWindowSummary* sum) {
+Eigen::VectorXd initial_codes(const NemfModel& model, const RenavWindow& window, FlatLatentEnergy& energy,
+                              const std::vector<std::string>& inits, uint64_t seed, int k, RenavWindowSummary* sum) {
   const int zg = model.config().zg;
   const InitialGuess ref_code = encode_window(model, window.reference_segment, 0);
-  at::Tensor x0;
+  Eigen::VectorXd x0;
   double best = std::numeric_limits<double>::infinity();
   for (const std::string& name : inits) {
-    at::Tensor z_g;
+    Eigen::VectorXf z_g(zg);
     if (name == "turned") {
       z_g = encode_window(model, window.turned_segment, 0).z_g;
     } else if (name == "reference") {
@@ -436,13 +436,12 @@ at::Tensor initial_codes(const NemfModel& model, const RenavWindow& window, cons
     } else {
       std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ull + static_cast<uint64_t>(k));
       std::normal_distribution<float> normal(0.0f, 1.0f);
-      z_g = at::empty({1, zg}, at::kFloat);
-      for (int i = 0; i < zg; ++i) z_g.data_ptr<float>()[i] = normal(rng);
+      for (int i = 0; i < zg; ++i) z_g[i] = normal(rng);
     }
-    const at::Tensor x = energy.join(ref_code.z_l, z_g);
+    const Eigen::VectorXd x = join_codes(ref_code.z_l, z_g);
     const double e = energy.cost(x);
     sum->init_energies.emplace_back(name, e);
-    if (e < best || !x0.defined()) {
+    if (e < best || x0.size() == 0) {
       best = e;
       x0 = x;
       sum->init = name;
@@ -510,10 +509,14 @@ SolvedWindow solve_renav_window(const NemfModel& model, const RenavPlan& plan, i
   sum.length = span.length;
   sum.reference_from = span.ref_begin * plan.pace / fm;
   sum.reference_to = (span.ref_begin + span.ref_length - 1) * plan.pace / fm;
-  const FlatLatentEnergy energy(window_energy(model, window, options.weights), model.config().zl, model.config().zg);
-  const at::Tensor x0 = initial_codes(model, window, energy, inits, seed, k, &sum);
-  const at::Tensor x = minimize_window(energy, x0, options.capped(plan.cap), window_ctx, iteration_offset, total, &sum);
-  SolvedWindow solved{decode_renav_window(model, window, energy.z_l(x), energy.z_g(x)), window.transform,
+  const int zl = model.config().zl, zg = model.config().zg;
+  FlatLatentEnergy energy(window_energy(model, window, options.weights), zl, zg);
+  const Eigen::VectorXd x0 = initial_codes(model, window, energy, inits, seed, k, &sum);
+  const Eigen::VectorXd x =
+      minimize_window(energy, x0, options.capped(plan.cap), window_ctx, iteration_offset, total, &sum);
+  SolvedWindow solved{decode_renav_window(model, window, codes_tensor(head_codes(x, zl)),
+                                          codes_tensor(tail_codes(x, zg))),
+                      window.transform,
                       sum.iterations};
   sum.wall_ms = ms_since(t0);
   rep->windows.push_back(std::move(sum));
