@@ -464,16 +464,20 @@ int run(Args& args, const std::string& command) {
   prior_options.max_windows = args.split.max_windows;
   prior_options.samples = args.samples;
   prior_options.seed = static_cast<uint64_t>(args.seed);
+  // The codec runs on the Eigen runtime, loaded here when --libtorch-energy left the context without one.
+  std::shared_ptr<const mf::runtime::NemfRuntime> codec_runtime = ctx.runtime;
+  if (!codec_runtime && !args.prior_tasks.empty())
+    codec_runtime = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
   for (const std::string& task : args.prior_tasks) {
     std::cerr << "running " << task << " / prior\n";
     const auto t0 = std::chrono::steady_clock::now();
     std::string table;
     if (task == "recon") {
-      table = mf::bench::format_recon(mf::bench::run_recon(*model, clips, stats, prior_options));
+      table = mf::bench::format_recon(mf::bench::run_recon(*model, *codec_runtime, clips, stats, prior_options));
     } else if (task == "fps") {
-      table = mf::bench::format_fps(mf::bench::run_fps(*model, clips, prior_options));
+      table = mf::bench::format_fps(mf::bench::run_fps(*codec_runtime, clips, prior_options));
     } else if (task == "seams") {
-      table = mf::bench::format_seams(mf::bench::run_seams(*model, clips, prior_options),
+      table = mf::bench::format_seams(mf::bench::run_seams(*codec_runtime, clips, prior_options),
                                       prior_options.seam_radius);
     } else {
       if (extractor) {

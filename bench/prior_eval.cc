@@ -18,6 +18,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "prior/motion/rotations_torch.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "tasks/latent/prior_codec.h"
 
 namespace mf::bench {
@@ -183,8 +184,8 @@ void count_limit_exceedances(const Motion& motion, const JointLimits& limits, st
   *frames += motion.num_frames();
 }
 
-ReconResult run_recon(const NemfModel& model, const std::vector<Clip>& clips, const EvalStats& stats,
-                      const PriorEvalOptions& options) {
+ReconResult run_recon(const NemfModel& model, const runtime::NemfRuntime& runtime, const std::vector<Clip>& clips,
+                      const EvalStats& stats, const PriorEvalOptions& options) {
   ReconResult r;
   r.window = model.config().window;
   r.threads = at::get_num_threads();
@@ -199,7 +200,7 @@ ReconResult run_recon(const NemfModel& model, const std::vector<Clip>& clips, co
     for (const Window& w : windows) {
       const Motion truth = window_motion(clips, w);
       const auto t0 = Clock::now();
-      const Motion pred = decode_motion(model, encode_motion(model, truth), truth.fps, truth.num_frames());
+      const Motion pred = decode_motion(runtime, encode_motion(runtime, truth), truth.fps, truth.num_frames());
       ms += ms_since(t0);
       acc.add(truth, pred);
       if (pass == 0) {
@@ -224,7 +225,7 @@ ReconResult run_recon(const NemfModel& model, const std::vector<Clip>& clips, co
   return r;
 }
 
-FpsResult run_fps(const NemfModel& model, const std::vector<Clip>& clips, const PriorEvalOptions& options) {
+FpsResult run_fps(const runtime::NemfRuntime& model, const std::vector<Clip>& clips, const PriorEvalOptions& options) {
   FpsResult r;
   r.threads = at::get_num_threads();
   std::vector<Window> full, short_clips;
@@ -272,7 +273,7 @@ FpsResult run_fps(const NemfModel& model, const std::vector<Clip>& clips, const 
   return r;
 }
 
-SeamResult run_seams(const NemfModel& model, const std::vector<Clip>& clips, const PriorEvalOptions& options) {
+SeamResult run_seams(const runtime::NemfRuntime& model, const std::vector<Clip>& clips, const PriorEvalOptions& options) {
   SeamResult r;
   r.threads = at::get_num_threads();
   const int W = model.config().window;

@@ -32,6 +32,9 @@
 
 namespace mf {
 class NemfModel;
+namespace runtime {
+class NemfRuntime;
+}
 }
 
 namespace mf::bench {
@@ -108,9 +111,10 @@ struct ReconResult {
 
 /// Encode then decode the validation clips' non-overlapping windows of the
 /// model's length (trailing remainders dropped, as NeMF), and separately every
-/// clip shorter than the window as one short window.
-ReconResult run_recon(const NemfModel& model, const std::vector<Clip>& clips, const EvalStats& stats,
-                      const PriorEvalOptions& options = {});
+/// clip shorter than the window as one short window: the codec on `runtime`
+/// (tasks/latent/prior_codec.h), the GMP on the truth on `model`.
+ReconResult run_recon(const NemfModel& model, const runtime::NemfRuntime& runtime, const std::vector<Clip>& clips,
+                      const EvalStats& stats, const PriorEvalOptions& options = {});
 
 struct FpsRow {
   double fps = 0.0;
@@ -129,7 +133,7 @@ struct FpsResult {
 
 /// Encodes the full windows of run_recon once and decodes each at every fps
 /// of options.fps_list over the same time span.
-FpsResult run_fps(const NemfModel& model, const std::vector<Clip>& clips, const PriorEvalOptions& options = {});
+FpsResult run_fps(const runtime::NemfRuntime& model, const std::vector<Clip>& clips, const PriorEvalOptions& options = {});
 
 /// Errors of a set of frames of decoded long clips.
 struct SeamStats {
@@ -153,7 +157,8 @@ struct SeamResult {
 
 /// Encodes and decodes (30 fps, the clips' rate) every validation clip longer
 /// than the model's window through overlapping windows.
-SeamResult run_seams(const NemfModel& model, const std::vector<Clip>& clips, const PriorEvalOptions& options = {});
+SeamResult run_seams(const runtime::NemfRuntime& model, const std::vector<Clip>& clips,
+                     const PriorEvalOptions& options = {});
 
 struct SampleResult {
   int samples = 0;

@@ -1,6 +1,7 @@
-// The prior as a codec (tasks/latent/prior_codec.h) on tiny random models: window
-// layout, blend weights, shapes at any frame rate, short and long clips, the
-// root path's anchoring, and resampling with the residual (known frames exact).
+// The prior as a codec (tasks/latent/prior_codec.h) on tiny random models (on
+// the Eigen runtime): window layout, blend weights, shapes at any frame rate,
+// short and long clips, the root path's anchoring, and resampling with the
+// residual (known frames exact).
 #include "tasks/latent/prior_codec.h"
 
 #include <ATen/ATen.h>
@@ -12,8 +13,9 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
-#include "prior/motion/rotations_torch.h"
+#include "prior/runtime/rotations.h"
 #include "tasks/methods/jobs.h"
+#include "tests/runtime_test_util.h"
 #include "tests/test_util.h"
 
 namespace mf {
@@ -27,6 +29,12 @@ bool all_unit_and_finite(const Motion& m) {
     if (!p.allFinite()) return false;
   }
   return true;
+}
+
+// The tiny prior on the Eigen runtime, built once.
+const runtime::NemfRuntime& tiny_runtime() {
+  static const runtime::NemfRuntime model = test::runtime_of(test::tiny_prior());
+  return model;
 }
 
 TEST(PriorCodec, WindowStartsCoverTheClipAndEndAligned) {
@@ -71,7 +79,7 @@ TEST(PriorCodec, BlendWeightsSumToOneAndAreContinuous) {
 }
 
 TEST(PriorCodec, EncodeSplitsLongClipsIntoWindows) {
-  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
+  const runtime::NemfRuntime* model = &tiny_runtime();
   Motion m = test::random_motion(model->rig().skeleton, 100, 30.0, 7);
   EncodedMotion code = encode_motion(*model, m);
   EXPECT_EQ(code.frames, 100);
@@ -81,23 +89,22 @@ TEST(PriorCodec, EncodeSplitsLongClipsIntoWindows) {
     const WindowCode& w = code.windows[k];
     EXPECT_EQ(w.start, starts[k]);
     EXPECT_EQ(w.length, 32);
-    EXPECT_EQ(w.z_l.sizes(), (at::IntArrayRef{8}));
-    EXPECT_EQ(w.z_g.sizes(), (at::IntArrayRef{4}));
+    EXPECT_EQ(w.z_l.size(), 8);
+    EXPECT_EQ(w.z_g.size(), 4);
     GroundTransform g = canonical_transform(m, w.start, model->rig());
     EXPECT_DOUBLE_EQ(w.transform.yaw, g.yaw);
     EXPECT_DOUBLE_EQ(w.transform.x, g.x);
   }
   // The same window encoded on its own gives the same latent: windows are independent.
-  WindowTensors t = window_tensors(m, 16, 32, model->rig(), 0);
-  NemfLatent z = model->encode(t.local_rotations, at::ones({1, 32}));
-  EXPECT_LT((z.mu_l[0] - code.windows[1].z_l).abs().max().item<float>(), 1e-5);
+  const runtime::LatentGaussians z = model->encode_rotations(window_matrices(m, 16, 32, model->rig(), 0).local_rotations);
+  EXPECT_LT((z.mu_l - code.windows[1].z_l).cwiseAbs().maxCoeff(), 1e-5);
   // A hop of 8 makes more windows.
   EXPECT_EQ(encode_motion(*model, m, CodecOptions{8}).windows.size(), 10u);
   EXPECT_THROW(encode_motion(*model, m, CodecOptions{32}), InputError);
 }
 
 TEST(PriorCodec, ShortClipsAndOtherFrameRatesEncodeAsOneShortWindow) {
-  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
+  const runtime::NemfRuntime* model = &tiny_runtime();
   const Skeleton& s = model->rig().skeleton;
   EncodedMotion a = encode_motion(*model, test::random_motion(s, 2, 30.0, 1));
   ASSERT_EQ(a.windows.size(), 1u);
@@ -118,7 +125,7 @@ TEST(PriorCodec, ShortClipsAndOtherFrameRatesEncodeAsOneShortWindow) {
 }
 
 TEST(PriorCodec, DecodesAtAnyFrameRate) {
-  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
+  const runtime::NemfRuntime* model = &tiny_runtime();
   Motion m = test::random_motion(model->rig().skeleton, 70, 30.0, 11);
   EncodedMotion code = encode_motion(*model, m);
   for (double fps : {24.0, 30.0, 60.0, 120.0, 240.0}) {
@@ -136,22 +143,23 @@ TEST(PriorCodec, DecodesAtAnyFrameRate) {
 }
 
 TEST(PriorCodec, SingleWindowDecodeIsTheModelsDecodeInTheWorldFrame) {
-  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
+  const runtime::NemfRuntime* model = &tiny_runtime();
   Motion m = test::random_motion(model->rig().skeleton, 25, 30.0, 5);
   EncodedMotion code = encode_motion(*model, m);
   ASSERT_EQ(code.windows.size(), 1u);
   const WindowCode& w = code.windows[0];
   std::vector<double> times{0.0, 0.1, 0.35, 24 / 30.0};
   Motion out = decode_times(*model, code, times, 30.0);
-  at::Tensor frames = at::tensor({0.0f, 3.0f, 10.5f, 24.0f});
-  at::Tensor q = torch_rot::matrix_to_quat(model->decode(frames, w.z_l.unsqueeze(0), w.z_g.unsqueeze(0)))
-                     .to(at::kDouble)
-                     .contiguous();
-  const double* p = q.data_ptr<double>();
+  Eigen::VectorXd frames(4);
+  frames << 0.0, 3.0, 10.5, 24.0;
+  runtime::DecoderWorkspace ws;
+  runtime::MatrixRXf sixd, rotations;
+  model->decode(frames, w.z_l, w.z_g, &ws, &sixd);
+  runtime::sixd_to_matrix(sixd, &rotations);
   const Eigen::Quaterniond turn(Eigen::AngleAxisd(w.transform.yaw, Eigen::Vector3d::UnitY()));
   for (int i = 0; i < 4; ++i) {
     for (int j = 0; j < m.num_joints(); ++j) {
-      const double* e = p + (i * m.num_joints() + j) * 4;
+      const Eigen::Vector4d e = runtime::matrix_to_quat(&rotations(i, j * 9)).cast<double>();
       Eigen::Quaterniond expect(e[0], e[1], e[2], e[3]);
       if (j == 0) expect = turn * expect;
       EXPECT_LT(geodesic_angle(out.rotation(i, j), expect), 1e-5) << "time " << i << " joint " << j;
@@ -163,7 +171,7 @@ TEST(PriorCodec, SingleWindowDecodeIsTheModelsDecodeInTheWorldFrame) {
 }
 
 TEST(PriorCodec, OverlapBlendIsTheWeightedMeanOfTheWindows) {
-  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
+  const runtime::NemfRuntime* model = &tiny_runtime();
   Motion m = test::random_motion(model->rig().skeleton, 48, 30.0, 8);
   EncodedMotion code = encode_motion(*model, m);  // windows [0, 31] and [16, 47]
   ASSERT_EQ(code.windows.size(), 2u);
@@ -191,7 +199,7 @@ TEST(PriorCodec, OverlapBlendIsTheWeightedMeanOfTheWindows) {
 }
 
 TEST(PriorCodec, InputRootPathIsInterpolated) {
-  auto model = std::make_shared<const NemfModel>(test::tiny_prior());
+  const runtime::NemfRuntime* model = &tiny_runtime();
   Motion m = test::random_motion(model->rig().skeleton, 20, 15.0, 12);
   EncodedMotion code = encode_motion(*model, m);
   Motion out = decode_motion(*model, code, 30.0, 39, DecodeOptions{RootSource::kInput});
@@ -204,8 +212,7 @@ TEST(PriorCodec, InputRootPathIsInterpolated) {
 
 TEST(PriorCodec, ResampleKeepsInputFramesExactly) {
   auto model = std::make_shared<const NemfModel>(test::tiny_prior());
-  TaskContext ctx;
-  ctx.model = model;
+  TaskContext ctx = test::context_of(model);
   const Skeleton& s = model->rig().skeleton;
   struct Case {
     int frames;
@@ -236,8 +243,7 @@ TEST(PriorCodec, ResidualMakesTheReconstructionExactAtInputFrames) {
   // Without the copy of coinciding frames, the residual alone reproduces the
   // input: check through times that sit 1e-4 frames off the input frames.
   auto model = std::make_shared<const NemfModel>(test::tiny_prior());
-  TaskContext ctx;
-  ctx.model = model;
+  TaskContext ctx = test::context_of(model);
   Motion m = test::random_motion(model->rig().skeleton, 30, 30.0, 4);
   PriorResampleOptions no_residual;
   no_residual.residual = false;
@@ -260,8 +266,7 @@ TEST(PriorCodec, ResidualMakesTheReconstructionExactAtInputFrames) {
 TEST(PriorCodec, PriorResamplingTakesTheQuinticOrTheCodecByTheRatio) {
   auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   ASSERT_DOUBLE_EQ(model->config().fps, 30.0);
-  TaskContext ctx;
-  ctx.model = model;
+  TaskContext ctx = test::context_of(model);
   const std::pair<double, double> dense[] = {{24.0, 30.0}, {30.0, 60.0}, {30.0, 24.0}, {25.0, 120.0}};
   for (const auto& [in_fps, out_fps] : dense) {
     const Motion m = test::random_motion(model->rig().skeleton, 25, in_fps, 3);
@@ -296,8 +301,7 @@ TEST(PriorCodec, PriorResamplingTakesTheQuinticOrTheCodecByTheRatio) {
 // fallback the solve's blend is returned.
 TEST(PriorCodec, PriorResamplingKeepsTheQuinticWhereTheSolveMissesTheInput) {
   auto model = std::make_shared<const NemfModel>(test::tiny_prior());
-  TaskContext ctx;
-  ctx.model = model;
+  TaskContext ctx = test::context_of(model);
   const Motion m = test::random_motion(model->rig().skeleton, 9, 7.5, 5);
   std::vector<std::string> warnings;
   const Motion kept = run_resample(m, 30.0, "prior", &warnings, ctx);
@@ -326,16 +330,20 @@ TEST(PriorCodec, RejectsBadInput) {
   TaskContext none;
   Motion m = test::random_motion(model->rig().skeleton, 10, 30.0, 2);
   EXPECT_THROW(resample_with_prior(m, 60.0, 19, none), InputError);
-  TaskContext ctx;
-  ctx.model = model;
+  TaskContext ctx = test::context_of(model);
   EXPECT_THROW(resample_with_prior(m, -1.0, 19, ctx), InputError);
-  EXPECT_THROW(encode_motion(*model, m.slice(0, 1)), InputError);
+  const runtime::NemfRuntime& rt = *ctx.runtime;
+  EXPECT_THROW(encode_motion(rt, m.slice(0, 1)), InputError);
   Motion other = m;
   other.skeleton.names[1] = "Other";
-  EXPECT_THROW(encode_motion(*model, other), InputError);
-  EncodedMotion code = encode_motion(*model, m);
-  code.windows[0].z_l = at::zeros({3});
-  EXPECT_THROW(decode_motion(*model, code, 30.0, 10), InputError);
+  EXPECT_THROW(encode_motion(rt, other), InputError);
+  EncodedMotion code = encode_motion(rt, m);
+  code.windows[0].z_l = Eigen::VectorXf::Zero(3);
+  EXPECT_THROW(decode_motion(rt, code, 30.0, 10), InputError);
+  // A context with the libtorch prior but no runtime cannot resample with the codec.
+  TaskContext torch_only;
+  torch_only.model = model;
+  EXPECT_THROW(resample_with_prior(m, 60.0, 19, torch_only), ModelMissingError);
   // Through the task entry point: "prior" needs a model.
   EXPECT_THROW(run_resample(m, 60.0, "prior", nullptr, none), InputError);
   EXPECT_EQ(run_resample(m, 60.0, "prior", nullptr, ctx).num_frames(), 19);

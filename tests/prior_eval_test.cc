@@ -12,6 +12,7 @@
 #include "prior/model/representation.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "tests/runtime_test_util.h"
 #include "tests/test_util.h"
 
 namespace mf::bench {
@@ -142,6 +143,7 @@ TEST(PriorEval, JointLimitsCountFramesBeyondThePercentile) {
 
 TEST(PriorEval, TasksRunOnATinyModel) {
   const auto model = std::make_shared<const NemfModel>(test::tiny_prior());
+  const runtime::NemfRuntime rt = test::runtime_of(*model);
   const Skeleton s = test::small_skeleton();
   std::vector<Clip> train = {make_clip("t1", test::random_motion(s, 120, 30.0, 11)),
                              make_clip("t2", test::random_motion(s, 90, 30.0, 12))};
@@ -153,7 +155,7 @@ TEST(PriorEval, TasksRunOnATinyModel) {
   PriorEvalOptions options;
   options.samples = 3;
 
-  const ReconResult recon = run_recon(*model, val, stats, options);
+  const ReconResult recon = run_recon(*model, rt, val, stats, options);
   EXPECT_EQ(recon.window, 32);
   EXPECT_EQ(recon.full.windows, 5);
   EXPECT_EQ(recon.full.frames, 160);
@@ -163,14 +165,14 @@ TEST(PriorEval, TasksRunOnATinyModel) {
   EXPECT_TRUE(std::isfinite(recon.full.fde_cm));
   EXPECT_NE(format_recon(recon).find("| full (32 frames) | 5 | 160 |"), std::string::npos) << format_recon(recon);
 
-  const FpsResult fps = run_fps(*model, val, options);
+  const FpsResult fps = run_fps(rt, val, options);
   ASSERT_EQ(fps.rows.size(), 4u);
   EXPECT_EQ(fps.rows[0].windows, 5);
   EXPECT_NEAR(fps.rows[0].accel, fps.rows[0].accel_30, 1e-9);  // the 30 fps row is its own reference
   for (const FpsRow& row : fps.rows) EXPECT_TRUE(std::isfinite(row.accel));
   EXPECT_NE(format_fps(fps).find("| 240 | 5 |"), std::string::npos);
 
-  const SeamResult seams = run_seams(*model, val, options);
+  const SeamResult seams = run_seams(rt, val, options);
   EXPECT_EQ(seams.clips, 2);  // v1 and v3 are longer than a window
   EXPECT_EQ(seams.near.frames + seams.elsewhere.frames, 170);
   EXPECT_GT(seams.near.frames, 0);

@@ -79,4 +79,16 @@ const Motion& walk_on_model_rig() {
   return m;
 }
 
+runtime::NemfRuntime runtime_of(const NemfModel& model) {
+  const std::vector<uint8_t> bytes = serialize_nemf(model);
+  return runtime::NemfRuntime::from_bytes(bytes.data(), bytes.size(), "test prior");
+}
+
+TaskContext context_of(std::shared_ptr<const NemfModel> model) {
+  TaskContext ctx;
+  ctx.runtime = std::make_shared<const runtime::NemfRuntime>(runtime_of(*model));
+  ctx.model = std::move(model);
+  return ctx;
+}
+
 }  // namespace mf::test

@@ -2,17 +2,20 @@
 // tasks/latent/runtime_energy.h) to the libtorch implementations: the shipped
 // model loaded both ways, conversions between tensors and row-major float
 // matrices, the relative difference the equivalence bounds are stated in, and
-// the sample walk on the model's rig. Linked into mf_tests only.
+// the sample walk on the model's rig; tiny test priors on the runtime.
+// Linked into mf_tests only.
 #pragma once
 
 #include <ATen/ATen.h>
 
+#include <memory>
 #include <random>
 #include <string>
 
 #include "prior/model/model_file.h"
 #include "prior/motion/motion.h"
 #include "prior/runtime/nemf_runtime.h"
+#include "tasks/context/task_context.h"
 
 namespace mf::test {
 
@@ -57,5 +60,10 @@ MatrixRXf normal_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937& rng)
 /// The sample walk (samples/walk_keyframes.bvh, 61 frames) on the shipped
 /// model's rig, retargeted as the tasks do; loaded once.
 const Motion& walk_on_model_rig();
+
+/// `model` (a test's tiny prior) on the Eigen runtime, through its model file's bytes.
+runtime::NemfRuntime runtime_of(const NemfModel& model);
+/// A context with `model` and its twin on the Eigen runtime (runtime_of()).
+TaskContext context_of(std::shared_ptr<const NemfModel> model);
 
 }  // namespace mf::test

@@ -1,16 +1,16 @@
-// mf_encoding: the prior as a codec (tasks/latent/prior_codec.h) at the C boundary.
-#include <ATen/ATen.h>
-
+// mf_encoding: the prior as a codec (tasks/latent/prior_codec.h) at the C
+// boundary, on the model set's Eigen runtime (ModelSet::runtime).
 #include <cmath>
+#include <cstring>
 
 #include "capi/src/capi_internal.h"
-#include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "tasks/latent/prior_codec.h"
 #include "tasks/methods/jobs.h"
 
 struct mf_encoding {
-  std::shared_ptr<const mf::NemfModel> model;
+  std::shared_ptr<const mf::runtime::NemfRuntime> model;
   mf::EncodedMotion code;
   /// Carries the input's BVH layout (its motion is empty).
   mf_motion shell;
@@ -42,9 +42,8 @@ DecodeOptions decode_options(const mf_codec_options& o) {
 std::vector<float> latents(const EncodedMotion& code, bool local) {
   std::vector<float> out;
   for (const WindowCode& w : code.windows) {
-    const at::Tensor t = (local ? w.z_l : w.z_g).to(at::kFloat).contiguous();
-    const float* p = t.data_ptr<float>();
-    out.insert(out.end(), p, p + t.numel());
+    const Eigen::VectorXf& z = local ? w.z_l : w.z_g;
+    out.insert(out.end(), z.data(), z.data() + z.size());
   }
   return out;
 }
@@ -62,11 +61,9 @@ void replace_latents(EncodedMotion* code, bool local, int size, const float* val
     if (!std::isfinite(values[i]))
       throw ApiError(MF_ERROR_INVALID_ARGUMENT,
                      std::string(what) + " latent value " + std::to_string(i) + " is not finite");
-  for (size_t w = 0; w < code->windows.size(); ++w) {
-    at::Tensor t = at::empty({size}, at::kFloat);
-    std::memcpy(t.data_ptr<float>(), values + w * static_cast<size_t>(size), static_cast<size_t>(size) * sizeof(float));
-    (local ? code->windows[w].z_l : code->windows[w].z_g) = t;
-  }
+  for (size_t w = 0; w < code->windows.size(); ++w)
+    (local ? code->windows[w].z_l : code->windows[w].z_g) =
+        Eigen::Map<const Eigen::VectorXf>(values + w * static_cast<size_t>(size), size);
 }
 
 void check_fps(double fps) {
@@ -96,7 +93,8 @@ int mf_encode(const mf_model* model, const mf_motion* input, const mf_codec_opti
     require(input, "input");
     require(out, "out");
     const mf_codec_options o = mf::capi::codec_options(options);
-    const int model_joints = model->model->rig().num_joints();
+    if (!model->runtime) throw mf::ModelMissingError("encoding needs the prior, and none is loaded");
+    const int model_joints = model->runtime->rig().num_joints();
     if (input->motion.num_joints() != model_joints)
       throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the motion has " + std::to_string(input->motion.num_joints()) +
                                                     " joints but the model's skeleton has " +
@@ -105,8 +103,8 @@ int mf_encode(const mf_model* model, const mf_motion* input, const mf_codec_opti
     co.hop = o.hop;
     const mf::capi::TaskThreads threads;
     auto handle = std::make_unique<mf_encoding>();
-    handle->model = model->model;
-    handle->code = mf::encode_motion(*model->model, input->motion, co);
+    handle->model = model->runtime;
+    handle->code = mf::encode_motion(*model->runtime, input->motion, co);
     handle->shell.layout = input->layout;
     handle->shell.layout_fps = input->layout_fps;
     handle->shell.length_scale = input->length_scale;

@@ -1,25 +1,57 @@
 #include "tasks/latent/prior_codec.h"
 
-#include <ATen/ATen.h>
-#include <torch/types.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numeric>
 #include <string>
 
-#include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
-#include "prior/motion/rotations_torch.h"
+#include "prior/runtime/nemf_runtime.h"
+#include "prior/runtime/root_path.h"
+#include "prior/runtime/rotations.h"
 #include "tasks/constraints/interpolation_fill.h"
 
 namespace mf {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-// Windows per encoder / decoder call: bounds memory on long clips.
-constexpr int kWindowBatch = 16;
+
+// CodecPrior on the Eigen runtime, with the buffers of its evaluations: one
+// per call of the codec.
+class RuntimeCodecPrior final : public CodecPrior {
+ public:
+  explicit RuntimeCodecPrior(const runtime::NemfRuntime& model) : model_(model), kinematics_(model.rig().skeleton) {}
+  const NemfConfig& config() const override { return model_.config(); }
+  const RigInfo& rig() const override { return model_.rig(); }
+
+  void encode(const Rows& local_rotations, Eigen::VectorXf* z_l, Eigen::VectorXf* z_g) const override {
+    runtime::LatentGaussians z = model_.encode_rotations(local_rotations);
+    *z_l = std::move(z.mu_l);
+    *z_g = std::move(z.mu_g);
+  }
+
+  void decode(const WindowCode& window, const Eigen::VectorXd& positions, Rows* rotations) const override {
+    model_.decode(positions, window.z_l, window.z_g, &decoder_ws_, &sixd_);
+    runtime::sixd_to_matrix(sixd_, rotations);
+  }
+
+  void root_path(const WindowCode& window, Rows* path) const override {
+    decode(window, Eigen::VectorXd::LinSpaced(window.length, 0.0, window.length - 1.0), &rotations_);
+    zero_root_.setZero(window.length, 3);
+    kinematics_.forward(rotations_, zero_root_, &positions_, &globals_);
+    runtime::gmp_inputs(rotations_, positions_, rig().root_forward.cast<float>(), &headings_, &gmp_in_);
+    model_.predict_global(gmp_in_, GmpUse::Default, &gmp_ws_, &gmp_out_);
+    runtime::integrate_root_path(headings_, gmp_out_, config().fps, path);
+  }
+
+ private:
+  const runtime::NemfRuntime& model_;
+  runtime::Kinematics kinematics_;
+  mutable runtime::DecoderWorkspace decoder_ws_;
+  mutable runtime::GmpWorkspace gmp_ws_;
+  mutable runtime::MatrixRXf sixd_, rotations_, zero_root_, positions_, globals_, headings_, gmp_in_, gmp_out_;
+};
 
 void check_fps(double fps, const char* what) {
   if (!std::isfinite(fps) || fps <= 0.0) throw InputError(std::string(what) + " must be finite and positive");
@@ -59,7 +91,7 @@ double raw_weight(const std::vector<WindowCode>& w, size_t k, double s) {
   return weight;
 }
 
-void check_code(const NemfModel& model, const EncodedMotion& code) {
+void check_code(const CodecPrior& model, const EncodedMotion& code) {
   const NemfConfig& c = model.config();
   if (code.windows.empty() || code.frames < 1) throw InputError("encoded motion has no windows");
   if (code.skeleton.num_joints() != model.rig().num_joints()) {
@@ -72,7 +104,7 @@ void check_code(const NemfModel& model, const EncodedMotion& code) {
       throw InputError("encoded motion's windows are not sorted, overlap the sequence's end or exceed the model window");
     }
     prev = w.start;
-    if (!w.z_l.defined() || !w.z_g.defined() || w.z_l.numel() != c.zl || w.z_g.numel() != c.zg) {
+    if (w.z_l.size() != c.zl || w.z_g.size() != c.zg) {
       throw InputError("encoded motion's latents do not match the model (z_l " + std::to_string(c.zl) + ", z_g " +
                        std::to_string(c.zg) + ")");
     }
@@ -107,11 +139,12 @@ std::vector<double> blend_weights(const std::vector<WindowCode>& windows, double
   return w;
 }
 
-EncodedMotion encode_motion(const NemfModel& model, const Motion& motion, const CodecOptions& options) {
+EncodedMotion encode_motion(const CodecPrior& prior, const Motion& motion, const CodecOptions& options) {
   motion.validate();
   if (motion.num_frames() < 2) throw InputError("the prior needs a motion of at least 2 frames");
-  check_model_skeleton(model.rig(), motion.skeleton, "motion");
-  const NemfConfig& c = model.config();
+  const RigInfo& rig = prior.rig();
+  check_model_skeleton(rig, motion.skeleton, "motion");
+  const NemfConfig& c = prior.config();
   const int hop = options.hop == 0 ? c.window / 2 : options.hop;
   if (hop < 1 || hop >= c.window) {
     throw InputError("codec hop must lie in [1, " + std::to_string(c.window - 1) + "]");
@@ -136,28 +169,20 @@ EncodedMotion encode_motion(const NemfModel& model, const Motion& motion, const 
   code.frames = N;
   code.source_fps = motion.fps;
   code.source_root_positions = motion.root_positions;
-  const std::vector<int> starts = window_starts(N, c.window, hop);
   const int len = std::min(N, c.window);
-
-  at::NoGradGuard no_grad;
-  const RigInfo& rig = model.rig();
-  for (size_t b0 = 0; b0 < starts.size(); b0 += kWindowBatch) {
-    const size_t b1 = std::min(starts.size(), b0 + kWindowBatch);
-    std::vector<at::Tensor> rots;
-    for (size_t k = b0; k < b1; ++k) rots.push_back(window_tensors(*src, starts[k], len, rig, 0).local_rotations);
-    at::Tensor rot = at::cat(rots, 0);
-    NemfLatent z = model.encode(rot, at::ones({rot.size(0), len}, at::kFloat));
-    for (size_t k = b0; k < b1; ++k) {
-      WindowCode w;
-      w.start = starts[k];
-      w.length = len;
-      w.transform = canonical_transform(*src, starts[k], rig);
-      w.z_l = z.mu_l[static_cast<int64_t>(k - b0)].clone();
-      w.z_g = z.mu_g[static_cast<int64_t>(k - b0)].clone();
-      code.windows.push_back(std::move(w));
-    }
+  for (int start : window_starts(N, c.window, hop)) {
+    WindowCode w;
+    w.start = start;
+    w.length = len;
+    w.transform = canonical_transform(*src, start, rig);
+    prior.encode(window_matrices(*src, start, len, rig, 0).local_rotations, &w.z_l, &w.z_g);
+    code.windows.push_back(std::move(w));
   }
   return code;
+}
+
+EncodedMotion encode_motion(const runtime::NemfRuntime& model, const Motion& motion, const CodecOptions& options) {
+  return encode_motion(RuntimeCodecPrior(model), motion, options);
 }
 
 namespace {
@@ -202,82 +227,47 @@ WindowSamples assign_samples(const std::vector<WindowCode>& win, const std::vect
   return out;
 }
 
-// Windows [k0, k1) decoded at their samples' local positions (rows padded to
-// the most samples, `smax`): quaternions [B, smax, J, 4], double.
-at::Tensor decode_window_batch(const NemfModel& model, const std::vector<WindowCode>& win, const WindowSamples& samples,
-                               const std::vector<double>& pos, int k0, int k1, size_t smax, at::Tensor* z_l,
-                               at::Tensor* z_g) {
-  at::Tensor frames = at::zeros({k1 - k0, static_cast<int64_t>(smax)}, at::kFloat);
-  std::vector<at::Tensor> zl, zg;
-  float* f = frames.data_ptr<float>();
-  for (int k = k0; k < k1; ++k) {
-    for (size_t m = 0; m < samples.members[k].size(); ++m) {
-      f[(k - k0) * smax + m] = static_cast<float>(pos[samples.members[k][m]] - win[k].start);
-    }
-    zl.push_back(win[k].z_l.reshape({1, -1}).to(at::kFloat));
-    zg.push_back(win[k].z_g.reshape({1, -1}).to(at::kFloat));
-  }
-  *z_l = at::cat(zl, 0);
-  *z_g = at::cat(zg, 0);
-  return torch_rot::matrix_to_quat(model.decode(frames, *z_l, *z_g)).to(at::kDouble).contiguous();
-}
-
-// Adds the windows' weighted quaternions (root orientation in the world
-// frame), each flipped into the hemisphere of the sum so far, to `qsum` [T * J].
-void accumulate_rotations(const at::Tensor& quat, const std::vector<WindowCode>& win, const WindowSamples& samples,
-                          int k0, int k1, size_t smax, int J, std::vector<Eigen::Vector4d>* qsum) {
-  const double* q = quat.data_ptr<double>();  // [B, smax, J, 4]
-  for (int k = k0; k < k1; ++k) {
-    const Eigen::Quaterniond turn = yaw_quat(win[k].transform.yaw);
-    for (size_t m = 0; m < samples.members[k].size(); ++m) {
-      const int i = samples.members[k][m];
-      const double w = samples.weights[k][m] / samples.weight_sum[i];
-      const double* qs = q + ((static_cast<size_t>(k - k0) * smax + m) * J) * 4;
-      for (int j = 0; j < J; ++j) {
-        Eigen::Vector4d v(qs[4 * j], qs[4 * j + 1], qs[4 * j + 2], qs[4 * j + 3]);
-        if (j == 0) {
-          Eigen::Quaterniond r = turn * Eigen::Quaterniond(v[0], v[1], v[2], v[3]);
-          v = Eigen::Vector4d(r.w(), r.x(), r.y(), r.z());
-        }
-        Eigen::Vector4d& acc = (*qsum)[static_cast<size_t>(i) * J + j];
-        acc += (acc.dot(v) < 0.0 ? -w : w) * v;
+// Adds window k's weighted quaternions, decoded at its samples' local
+// positions (root orientation in the world frame), each flipped into the
+// hemisphere of the sum so far, to `qsum` [T * J].
+void accumulate_rotations(const CodecPrior& prior, const std::vector<WindowCode>& win, const WindowSamples& samples,
+                          const std::vector<double>& pos, int k, int J, std::vector<Eigen::Vector4d>* qsum) {
+  const std::vector<int>& members = samples.members[k];
+  Eigen::VectorXd local(members.size());
+  for (size_t m = 0; m < members.size(); ++m) local[m] = pos[members[m]] - win[k].start;
+  CodecPrior::Rows rotations;
+  prior.decode(win[k], local, &rotations);
+  const Eigen::Quaterniond turn = yaw_quat(win[k].transform.yaw);
+  for (size_t m = 0; m < members.size(); ++m) {
+    const int i = members[m];
+    const double w = samples.weights[k][m] / samples.weight_sum[i];
+    for (int j = 0; j < J; ++j) {
+      Eigen::Vector4d v = runtime::matrix_to_quat(&rotations(m, j * 9)).cast<double>();  // (w, x, y, z)
+      if (j == 0) {
+        Eigen::Quaterniond r = turn * Eigen::Quaterniond(v[0], v[1], v[2], v[3]);
+        v = Eigen::Vector4d(r.w(), r.x(), r.y(), r.z());
       }
+      Eigen::Vector4d& acc = (*qsum)[static_cast<size_t>(i) * J + j];
+      acc += (acc.dot(v) < 0.0 ? -w : w) * v;
     }
   }
 }
 
-// Adds the windows' weighted root paths (the global motion predictor's, per
-// window, placed by its GroundTransform; Catmull-Rom between model frames) to `psum`.
-void accumulate_prior_roots(const NemfModel& model, const std::vector<WindowCode>& win, const WindowSamples& samples,
-                            const std::vector<double>& pos, int k0, int k1, const at::Tensor& z_l,
-                            const at::Tensor& z_g, std::vector<Eigen::Vector3d>* psum) {
-  const int len = win[k0].length;
-  bool same_length = true;
-  for (int k = k0; k < k1; ++k) same_length = same_length && win[k].length == len;
-  // One batch when the windows have one length (always, for encode_motion's codes).
-  std::vector<std::pair<int, int>> groups;
-  if (same_length) {
-    groups.emplace_back(k0, k1);
-  } else {
-    for (int k = k0; k < k1; ++k) groups.emplace_back(k, k + 1);
-  }
-  for (auto [g0, g1] : groups) {
-    const int glen = win[g0].length;
-    at::Tensor dense =
-        model.decode(at::arange(glen, at::kFloat), z_l.narrow(0, g0 - k0, g1 - g0), z_g.narrow(0, g0 - k0, g1 - g0));
-    at::Tensor root = model.root_positions(dense, model.predict_global(dense)).to(at::kDouble).contiguous();  // [G, len, 3]
-    const double* r = root.data_ptr<double>();
-    for (int k = g0; k < g1; ++k) {
-      const Eigen::Matrix3d turn = yaw_quat(win[k].transform.yaw).toRotationMatrix();
-      const Eigen::Vector3d shift(win[k].transform.x, 0.0, win[k].transform.z);
-      const double* rk = r + static_cast<size_t>(k - g0) * glen * 3;
-      for (size_t m = 0; m < samples.members[k].size(); ++m) {
-        const int i = samples.members[k][m];
-        const double w = samples.weights[k][m] / samples.weight_sum[i];
-        const double s = std::clamp(pos[i] - win[k].start, 0.0, static_cast<double>(glen - 1));
-        (*psum)[i] += w * (turn * catmull_rom(rk, glen, s) + shift);
-      }
-    }
+// Adds window k's weighted root path (the global motion predictor's, placed
+// by its GroundTransform; Catmull-Rom between model frames) to `psum`.
+void accumulate_prior_root(const CodecPrior& prior, const std::vector<WindowCode>& win, const WindowSamples& samples,
+                           const std::vector<double>& pos, int k, std::vector<Eigen::Vector3d>* psum) {
+  CodecPrior::Rows path;
+  prior.root_path(win[k], &path);
+  const int len = win[k].length;
+  const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> root = path.cast<double>();
+  const Eigen::Matrix3d turn = yaw_quat(win[k].transform.yaw).toRotationMatrix();
+  const Eigen::Vector3d shift(win[k].transform.x, 0.0, win[k].transform.z);
+  for (size_t m = 0; m < samples.members[k].size(); ++m) {
+    const int i = samples.members[k][m];
+    const double w = samples.weights[k][m] / samples.weight_sum[i];
+    const double s = std::clamp(pos[i] - win[k].start, 0.0, static_cast<double>(len - 1));
+    (*psum)[i] += w * (turn * catmull_rom(root.data(), len, s) + shift);
   }
 }
 
@@ -296,10 +286,10 @@ void input_root_path(const EncodedMotion& code, const std::vector<double>& times
 
 }  // namespace
 
-Motion decode_times(const NemfModel& model, const EncodedMotion& code, const std::vector<double>& times, double fps,
+Motion decode_times(const CodecPrior& prior, const EncodedMotion& code, const std::vector<double>& times, double fps,
                     const DecodeOptions& options) {
   check_fps(fps, "decode fps");
-  check_code(model, code);
+  check_code(prior, code);
   for (double t : times) {
     if (!std::isfinite(t)) throw InputError("decode times must be finite");
   }
@@ -320,15 +310,10 @@ Motion decode_times(const NemfModel& model, const EncodedMotion& code, const std
 
   std::vector<Eigen::Vector4d> qsum(static_cast<size_t>(T) * J, Eigen::Vector4d::Zero());
   std::vector<Eigen::Vector3d> psum(T, Eigen::Vector3d::Zero());
-  at::NoGradGuard no_grad;
-  for (int k0 = 0; k0 < K; k0 += kWindowBatch) {
-    const int k1 = std::min(K, k0 + kWindowBatch);
-    size_t smax = 1;
-    for (int k = k0; k < k1; ++k) smax = std::max(smax, samples.members[k].size());
-    at::Tensor z_l, z_g;
-    const at::Tensor quat = decode_window_batch(model, win, samples, pos, k0, k1, smax, &z_l, &z_g);
-    accumulate_rotations(quat, win, samples, k0, k1, smax, J, &qsum);
-    if (options.root == RootSource::kPrior) accumulate_prior_roots(model, win, samples, pos, k0, k1, z_l, z_g, &psum);
+  for (int k = 0; k < K; ++k) {
+    if (samples.members[k].empty()) continue;
+    accumulate_rotations(prior, win, samples, pos, k, J, &qsum);
+    if (options.root == RootSource::kPrior) accumulate_prior_root(prior, win, samples, pos, k, &psum);
   }
 
   for (int i = 0; i < T; ++i) {
@@ -345,22 +330,32 @@ Motion decode_times(const NemfModel& model, const EncodedMotion& code, const std
   return out;
 }
 
-Motion decode_motion(const NemfModel& model, const EncodedMotion& code, double fps, int frames,
+Motion decode_times(const runtime::NemfRuntime& model, const EncodedMotion& code, const std::vector<double>& times,
+                    double fps, const DecodeOptions& options) {
+  return decode_times(RuntimeCodecPrior(model), code, times, fps, options);
+}
+
+Motion decode_motion(const CodecPrior& prior, const EncodedMotion& code, double fps, int frames,
                      const DecodeOptions& options) {
   check_fps(fps, "decode fps");
   if (frames < 0) throw InputError("decode frame count must not be negative");
   std::vector<double> times(frames);
   for (int i = 0; i < frames; ++i) times[i] = i / fps;
-  return decode_times(model, code, times, fps, options);
+  return decode_times(prior, code, times, fps, options);
+}
+
+Motion decode_motion(const runtime::NemfRuntime& model, const EncodedMotion& code, double fps, int frames,
+                     const DecodeOptions& options) {
+  return decode_motion(RuntimeCodecPrior(model), code, fps, frames, options);
 }
 
 namespace {
 
 // Encodes `input`, decodes at times i / fps and, with the residual, corrects
 // the decode so that it passes through the frames of `input`.
-Motion resample_core(const NemfModel& model, const Motion& input, double fps, int frames,
+Motion resample_core(const CodecPrior& prior, const Motion& input, double fps, int frames,
                      const PriorResampleOptions& options) {
-  EncodedMotion code = encode_motion(model, input, options.codec);
+  EncodedMotion code = encode_motion(prior, input, options.codec);
   const int N = input.num_frames();
   const int J = input.num_joints();
 
@@ -370,7 +365,7 @@ Motion resample_core(const NemfModel& model, const Motion& input, double fps, in
   if (options.residual) {
     for (int k = 0; k < N; ++k) times.push_back(k / input.fps);
   }
-  Motion all = decode_times(model, code, times, fps, DecodeOptions{options.root});
+  Motion all = decode_times(prior, code, times, fps, DecodeOptions{options.root});
   Motion out = all.slice(0, frames);
   if (!options.residual) return out;
 
@@ -405,13 +400,18 @@ Motion resample_core(const NemfModel& model, const Motion& input, double fps, in
 
 }  // namespace
 
-Motion resample_with_prior(const Motion& motion, double fps, int frames, const TaskContext& ctx,
+Motion resample_with_prior(const CodecPrior& prior, const Motion& motion, double fps, int frames,
                            const PriorResampleOptions& options) {
-  if (!ctx.model) throw ModelMissingError("resampling with the prior needs a model, and none is loaded");
   check_fps(fps, "output fps");
   if (frames < 0) throw InputError("output frame count must not be negative");
   motion.validate();
-  return resample_core(*ctx.model, motion, fps, frames, options);
+  return resample_core(prior, motion, fps, frames, options);
+}
+
+Motion resample_with_prior(const Motion& motion, double fps, int frames, const TaskContext& ctx,
+                           const PriorResampleOptions& options) {
+  if (!ctx.runtime) throw ModelMissingError("resampling with the prior needs a model, and none is loaded");
+  return resample_with_prior(RuntimeCodecPrior(*ctx.runtime), motion, fps, frames, options);
 }
 
 }  // namespace mf

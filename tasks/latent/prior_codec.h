@@ -21,10 +21,11 @@
 //      more window is aligned to the end (start N - window). The hop defaults to
 //      window / 2, so every frame is covered by at least two windows except near
 //      the clip's ends, and the end window may overlap its predecessor by more.
-//   3. Each window is made canonical at its first frame (representation.h:
-//      window_tensors with anchor 0); the window keeps that GroundTransform and
-//      its start frame. The latent is the encoder's mean (mu_l, mu_g): encoding
-//      is deterministic.
+//   3. Each window is made canonical at its first frame
+//      (prior/model/canonical_window.h: window_matrices with anchor 0); the
+//      window keeps that GroundTransform and its start frame. The latent is
+//      the encoders' mean (mu_l, mu_g; NemfRuntime::encode_rotations):
+//      encoding is deterministic.
 //
 // Decoding (decode_motion / decode_times):
 //   * Each window is decoded at the local positions s - start that fall inside
@@ -43,10 +44,11 @@
 //     quaternion mean; the windows agree closely where they overlap). Root orientation (joint 0) is blended in the world frame, after
 //     undoing each window's GroundTransform. Positions: weighted sum.
 //   * Root translation, RootSource::kPrior: per window, the model is decoded
-//     densely at the window's model frames, the global motion predictor gives
-//     heading-frame velocity and height, and forward-Euler integration
-//     (NemfModel::root_positions) from the canonical origin gives the window's
-//     root path; its GroundTransform then places the path so that it starts at
+//     densely at the window's model frames, the global motion predictor
+//     (GmpUse::Default) gives heading-frame velocity and height, and
+//     forward-Euler integration from the canonical origin
+//     (prior/runtime/root_path.h, as NemfModel::root_positions) gives the
+//     window's root path; its GroundTransform then places the path so that it starts at
 //     the input's root ground position (x, z) at the window's first frame and
 //     with the input's heading there (height comes from the predictor, not the
 //     input). Between model frames the path follows a uniform Catmull-Rom
@@ -55,10 +57,11 @@
 //     clip. RootSource::kInput: the input's root positions interpolated linearly
 //     at the requested times (kept in EncodedMotion::source_*).
 //
-// Threads and autograd: the functions run under at::NoGradGuard (the codec is
-// not on a solver's differentiable path; solvers call NemfModel directly) and
-// use the caller's torch thread count. The model is only read: one model can
-// serve several threads. Windows are processed in batches to bound memory.
+// Runtime: the networks run on the Eigen runtime (prior/runtime/nemf_runtime.h),
+// without libtorch, one window at a time on the calling thread (its products
+// on the BLAS's threads). The runtime is only read: one runtime can serve
+// several threads. tests/runtime_codec_equivalence_test.cc holds the codec to
+// the libtorch networks (NemfModel) through CodecPrior.
 //
 // Errors: mf::InputError when the motion is invalid, has fewer than 2 frames, or
 // its skeleton does not match the model's rig (joint names and parents), when an
@@ -66,18 +69,21 @@
 // finite, or an EncodedMotion is inconsistent with the model.
 #pragma once
 
-#include <ATen/core/Tensor.h>
 #include <Eigen/Core>
 #include <vector>
 
-#include "prior/model/representation.h"
+#include "prior/model/canonical_window.h"
+#include "prior/model/nemf_config.h"
+#include "prior/model/rig_info.h"
 #include "prior/motion/motion.h"
 #include "tasks/context/task_context.h"
 #include "tasks/latent/windows.h"  // window_starts()
 
 namespace mf {
 
-class NemfModel;
+namespace runtime {
+class NemfRuntime;
+}
 
 struct CodecOptions {
   /// Model frames between window starts; 0 means window / 2. Must lie in
@@ -90,8 +96,8 @@ struct WindowCode {
   int start = 0;              ///< first frame, in model frames of the encoded sequence
   int length = 0;             ///< frames covered: the window, or fewer for a short clip
   GroundTransform transform;  ///< canonical frame of the window (at frame `start`)
-  at::Tensor z_l;             ///< [zl] float, the local encoder's mean
-  at::Tensor z_g;             ///< [zg] float, the global encoder's mean
+  Eigen::VectorXf z_l;        ///< [zl], the local encoder's mean
+  Eigen::VectorXf z_g;        ///< [zg], the global encoder's mean
 };
 
 /// A motion as window latents.
@@ -113,8 +119,31 @@ struct EncodedMotion {
 /// cover s, summing to one. s is clamped to the covered range first.
 std::vector<double> blend_weights(const std::vector<WindowCode>& windows, double s);
 
+/// The networks the codec runs, one window at a time: the Eigen runtime's
+/// behind the functions below that take a runtime::NemfRuntime; the
+/// equivalence test implements it on libtorch. Matrices are row-major float,
+/// one row per frame, rotations row-major 3x3 per joint (J joints of rig()).
+class CodecPrior {
+ public:
+  using Rows = WindowMatrices::Rows;
+  virtual ~CodecPrior() = default;
+  virtual const NemfConfig& config() const = 0;
+  virtual const RigInfo& rig() const = 0;
+  /// The encoders' means z_l [zl] and z_g [zg] (resized) of a canonical
+  /// window's local rotations [T, J * 9] (window_matrices()), every frame present.
+  virtual void encode(const Rows& local_rotations, Eigen::VectorXf* z_l, Eigen::VectorXf* z_g) const = 0;
+  /// The decoder for `window`'s latents at local frame positions [S]:
+  /// rotations [S, J * 9] (resized).
+  virtual void decode(const WindowCode& window, const Eigen::VectorXd& positions, Rows* rotations) const = 0;
+  /// `window`'s root path [length, 3] (resized) at its model frames 0 ..
+  /// length - 1 in its canonical frame: the dense decode, the GMP
+  /// (GmpUse::Default) on it, forward Euler from the origin.
+  virtual void root_path(const WindowCode& window, Rows* path) const = 0;
+};
+
 /// Encodes `motion` (>= 2 frames, any fps) with `model` (see the header comment).
-EncodedMotion encode_motion(const NemfModel& model, const Motion& motion, const CodecOptions& options = {});
+EncodedMotion encode_motion(const runtime::NemfRuntime& model, const Motion& motion, const CodecOptions& options = {});
+EncodedMotion encode_motion(const CodecPrior& prior, const Motion& motion, const CodecOptions& options = {});
 
 enum class RootSource {
   kPrior,  ///< root translation from the global motion predictor, per window
@@ -127,12 +156,16 @@ struct DecodeOptions {
 
 /// Decodes at times i / fps, i = 0 .. frames - 1: a motion on code.skeleton at
 /// `fps` with exactly `frames` frames. frames = 0 gives an empty motion.
-Motion decode_motion(const NemfModel& model, const EncodedMotion& code, double fps, int frames,
+Motion decode_motion(const runtime::NemfRuntime& model, const EncodedMotion& code, double fps, int frames,
+                     const DecodeOptions& options = {});
+Motion decode_motion(const CodecPrior& prior, const EncodedMotion& code, double fps, int frames,
                      const DecodeOptions& options = {});
 
 /// Decodes at arbitrary `times` (seconds from the first frame, any order); the
 /// result has one frame per time and carries `fps` as its frame rate label.
-Motion decode_times(const NemfModel& model, const EncodedMotion& code, const std::vector<double>& times, double fps,
+Motion decode_times(const runtime::NemfRuntime& model, const EncodedMotion& code, const std::vector<double>& times,
+                    double fps, const DecodeOptions& options = {});
+Motion decode_times(const CodecPrior& prior, const EncodedMotion& code, const std::vector<double>& times, double fps,
                     const DecodeOptions& options = {});
 
 struct PriorResampleOptions {
@@ -152,9 +185,12 @@ struct PriorResampleOptions {
 /// rotation and added to the decoded root position. Output times whose input
 /// frame position i * motion.fps / fps lies within 1e-5 (relative, as
 /// resample_interpolate()) of an integer copy that input frame exactly, so known
-/// frames come out as given. Throws mf::InputError when ctx has no model (plus the codec's
-/// errors). Uses ctx.model only.
+/// frames come out as given. Throws mf::ModelMissingError (an InputError)
+/// when ctx has no runtime (plus the codec's errors). Uses ctx.runtime only.
 Motion resample_with_prior(const Motion& motion, double fps, int frames, const TaskContext& ctx,
+                           const PriorResampleOptions& options = {});
+/// The same with the networks of `prior`.
+Motion resample_with_prior(const CodecPrior& prior, const Motion& motion, double fps, int frames,
                            const PriorResampleOptions& options = {});
 
 }  // namespace mf

@@ -6,6 +6,7 @@
 
 #include "prior/motion/errors.h"
 #include "prior/motion/rotation_kernels.h"
+#include "prior/runtime/root_path.h"
 #include "prior/runtime/rotations.h"
 #include "tasks/latent/runtime_penalties.h"
 
@@ -218,43 +219,13 @@ void RuntimeEnergy::add_root_translation(const RuntimeWindowProblem& p, const En
   out->terms.emplace_back("root_translation", w.root_translation * sum / a.n_root);
 }
 
-// gmp_inputs() of representation.h from the dense decode: per frame the
-// joints' positions with the heading H removed (H^T p) and the 6D of H^T R_root.
-void RuntimeEnergy::gmp_inputs() {
-  const int T = static_cast<int>(rotations_.rows()), J = kinematics_.joints();
-  headings_.resize(T, 9);
-  gmp_in_.resize(T, J * 3 + 6);
-  for (int t = 0; t < T; ++t) {
-    kernels::heading_rotation(&rotations_(t, 0), root_forward_.data(), &headings_(t, 0));
-    const ConstMap3 h(&headings_(t, 0)), root(&rotations_(t, 0));
-    for (int j = 0; j < J; ++j) {
-      gmp_in_.row(t).segment<3>(j * 3) = (h.transpose() * positions_.row(t).segment<3>(j * 3).transpose()).transpose();
-    }
-    const Matrix3 free = h.transpose() * root;
-    for (int i = 0; i < 3; ++i) {
-      gmp_in_(t, J * 3 + i) = free(i, 0);
-      gmp_in_(t, J * 3 + 3 + i) = free(i, 1);
-    }
-  }
-}
+// gmp_inputs() of representation.h from the dense decode (prior/runtime/root_path.h).
+void RuntimeEnergy::gmp_inputs() { runtime::gmp_inputs(rotations_, positions_, root_forward_, &headings_, &gmp_in_); }
 
-// NemfModel::root_positions() then the alignment of energies.cc: the heading
-// frame's velocity turned to the canonical frame, integrated by forward Euler
-// from the origin (summed in double, as libtorch's float cumsum does), the
-// height as predicted; then the ground position at the anchor moved to the origin.
+// NemfModel::root_positions() (prior/runtime/root_path.h) then the alignment
+// of energies.cc: the ground position at the anchor moved to the origin.
 void RuntimeEnergy::root_path(int anchor) {
-  const int T = static_cast<int>(gmp_out_.rows());
-  const float fps = static_cast<float>(model_->config().fps);
-  path_.resize(T, 3);
-  double x = 0, z = 0;
-  for (int t = 0; t < T; ++t) {
-    path_(t, 0) = static_cast<float>(x);
-    path_(t, 1) = gmp_out_(t, 3);
-    path_(t, 2) = static_cast<float>(z);
-    const Eigen::Vector3f v = ConstMap3(&headings_(t, 0)) * gmp_out_.row(t).head<3>().transpose();
-    x += v.x() / fps;
-    z += v.z() / fps;
-  }
+  runtime::integrate_root_path(headings_, gmp_out_, model_->config().fps, &path_);
   const float ax = path_(anchor, 0), az = path_(anchor, 2);
   path_.col(0).array() -= ax;
   path_.col(2).array() -= az;
