@@ -38,29 +38,6 @@
 namespace mf::test {
 namespace {
 
-// <g, f(x + h v)> - <g, f(x - h v)> over 2h for a unit v: the directional
-// derivative that `grad`'s dot with v must match, within 1e-4 of |grad|. The
-// networks' (leaky) ReLUs make the energy smooth only piecewise: a kink
-// inside the stencil (one unit switching within h of x) spoils the quotient
-// whatever the gradient, so the quotient at h / 10 is taken too and the
-// closer one counts.
-template <class F>
-void expect_directional_derivatives(const Eigen::VectorXd& grad, F&& value_at, std::mt19937& rng, const char* what) {
-  std::normal_distribution<double> n;
-  for (int d = 0; d < 3; ++d) {
-    Eigen::VectorXd v = d == 0 ? grad : Eigen::VectorXd(grad.unaryExpr([&](double) { return n(rng); }));
-    v.normalize();
-    double numeric = 0;
-    for (double h : {kDifferenceStep, kDifferenceStep / 10}) {
-      const double q = (value_at(h * v) - value_at(-h * v)) / (2 * h);
-      if (h == kDifferenceStep || std::abs(grad.dot(v) - q) < std::abs(grad.dot(v) - numeric)) numeric = q;
-    }
-    EXPECT_NEAR(grad.dot(v), numeric, 1e-4 * grad.norm()) << what << ", direction " << d;
-    std::printf("%s, direction %d: runtime %.6e, differences %.6e, |diff| / |grad| %.2e\n", what, d, grad.dot(v),
-                numeric, std::abs(grad.dot(v) - numeric) / grad.norm());
-  }
-}
-
 Eigen::VectorXd flat(const MatrixRXf& m) {
   return Eigen::Map<const Eigen::VectorXf>(m.data(), m.size()).cast<double>();
 }

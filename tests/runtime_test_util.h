@@ -1,12 +1,16 @@
 // Helpers of the tests that hold the Eigen runtime (prior/runtime/,
 // tasks/latent/runtime_energy.h) to the libtorch implementations: the shipped
 // model loaded both ways, conversions between tensors and row-major float
-// matrices, the relative difference the equivalence bounds are stated in, and
-// the sample walk on the model's rig. Linked into mf_tests only.
+// matrices, the relative difference the equivalence bounds are stated in,
+// the sample walk on the model's rig and the check of gradients against
+// central differences. Linked into mf_tests only.
 #pragma once
 
 #include <ATen/ATen.h>
+#include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 
@@ -53,6 +57,30 @@ double relative_vector_difference(const Eigen::VectorXf& a, const Eigen::VectorX
 
 /// Standard normal entries.
 MatrixRXf normal_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937& rng);
+
+/// <g, f(x + h v)> - <g, f(x - h v)> over 2h for a unit v: the directional
+/// derivative that `grad`'s dot with v must match, within 1e-4 of |grad|. The
+/// networks' (leaky) ReLUs make the energy smooth only piecewise: a kink
+/// inside the stencil (one unit switching within h of x) spoils the quotient
+/// whatever the gradient, so the quotient at h / 10 is taken too and the
+/// closer one counts (h = `step`).
+template <class F>
+void expect_directional_derivatives(const Eigen::VectorXd& grad, F&& value_at, std::mt19937& rng, const char* what,
+                                    double step = kDifferenceStep) {
+  std::normal_distribution<double> n;
+  for (int d = 0; d < 3; ++d) {
+    Eigen::VectorXd v = d == 0 ? grad : Eigen::VectorXd(grad.unaryExpr([&](double) { return n(rng); }));
+    v.normalize();
+    double numeric = 0;
+    for (double h : {step, step / 10}) {
+      const double q = (value_at(h * v) - value_at(-h * v)) / (2 * h);
+      if (h == step || std::abs(grad.dot(v) - q) < std::abs(grad.dot(v) - numeric)) numeric = q;
+    }
+    EXPECT_NEAR(grad.dot(v), numeric, 1e-4 * grad.norm()) << what << ", direction " << d;
+    std::printf("%s, direction %d: runtime %.6e, differences %.6e, |diff| / |grad| %.2e\n", what, d, grad.dot(v),
+                numeric, std::abs(grad.dot(v) - numeric) / grad.norm());
+  }
+}
 
 /// The sample walk (samples/walk_keyframes.bvh, 61 frames) on the shipped
 /// model's rig, retargeted as the tasks do; loaded once.
