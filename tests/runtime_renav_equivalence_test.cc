@@ -92,10 +92,6 @@ std::vector<std::pair<Eigen::VectorXf, Eigen::VectorXf>> codes_for(const RenavWi
           {normal_matrix(rt.config().zl, 1, rng).col(0), normal_matrix(rt.config().zg, 1, rng).col(0)}};
 }
 
-struct Agreement {
-  double value = 0, gradient = 0;
-};
-
 // Both energies at (z_l, z_g): every term and the total within 1e-5, the
 // gradient within 1e-4 (relative).
 Agreement compare(const RenavWindow& window, const RenavWeights& w, const Eigen::VectorXf& z_l,
@@ -109,22 +105,12 @@ Agreement compare(const RenavWindow& window, const RenavWeights& w, const Eigen:
   const RenavEnergy t = evaluate_renav_energy(m.frozen, window, w, t_zl, t_zg);
   t.total.backward();
   Agreement a;
-  EXPECT_EQ(r.terms.size(), t.terms.size()) << what;
-  for (size_t i = 0; i < std::min(r.terms.size(), t.terms.size()); ++i) {
-    EXPECT_EQ(r.terms[i].first, t.terms[i].first) << what;
-    const double ref = t.terms[i].second.item<double>();
-    const double d = std::abs(r.terms[i].second - ref) / std::max(std::abs(ref), 1e-12);
-    EXPECT_LT(d, kOutputTolerance) << what << ": " << t.terms[i].first << " " << r.terms[i].second << " vs " << ref;
-    a.value = std::max(a.value, d);
+  const std::vector<double> d = term_differences(r, t, what);
+  for (size_t i = 0; i < d.size(); ++i) {
+    EXPECT_LT(d[i], kOutputTolerance) << what << ": " << t.terms[i].first << " " << r.terms[i].second;
+    a.value = std::max(a.value, d[i]);
   }
-  const double total = t.total.item<double>();
-  a.value = std::max(a.value, std::abs(r.total - total) / std::abs(total));
-  EXPECT_LT(a.value, kOutputTolerance) << what;
-  Eigen::VectorXf grad(g_zl.size() + g_zg.size()), ref(grad.size());
-  grad << g_zl, g_zg;
-  ref << to_vector(t_zl.grad()), to_vector(t_zg.grad());
-  a.gradient = relative_vector_difference(grad, ref);
-  EXPECT_LT(a.gradient, kGradientTolerance) << what;
+  expect_total_and_gradient(r, t, g_zl, g_zg, t_zl, t_zg, what, &a);
   return a;
 }
 
@@ -141,9 +127,7 @@ TEST(RenavRuntimeEnergy, EveryTermMatchesLibtorchOnWindowsOfTheWalk) {
       Agreement worst;
       for (size_t c = 0; c < codes.size(); ++c) {
         const std::string what = std::string(nw.name) + ", " + w.name + (c == 0 ? ", encoded" : ", random");
-        const Agreement a = compare(nw.window, w.weights, codes[c].first, codes[c].second, what);
-        worst.value = std::max(worst.value, a.value);
-        worst.gradient = std::max(worst.gradient, a.gradient);
+        worst.merge(compare(nw.window, w.weights, codes[c].first, codes[c].second, what));
       }
       std::printf("%s, %s: values within %.2e, gradients within %.2e (relative)\n", nw.name, w.name.c_str(),
                   worst.value, worst.gradient);
@@ -218,15 +202,6 @@ TEST(RenavRuntimeEnergy, RefusesAWindowThatDoesNotFit) {
   EXPECT_THROW(Energy e(rt, bad, RenavWeights{}), InputError);
 }
 
-// The shipped models as a context (not owning them): with the runtime or without.
-TaskContext context(bool with_runtime) {
-  const BothModels& m = shipped_models();
-  TaskContext ctx;
-  ctx.model = std::shared_ptr<const NemfModel>(std::shared_ptr<const NemfModel>(), &m.frozen);
-  if (with_runtime) ctx.runtime = std::shared_ptr<const runtime::NemfRuntime>(std::shared_ptr<const void>(), &m.runtime);
-  return ctx;
-}
-
 struct Renavigated {
   Motion motion;
   RenavReport report;
@@ -238,8 +213,8 @@ Renavigated renavigate_walk(int frames, int iterations, bool with_runtime) {
   RenavOptions o = default_renav_options(LatentOptimizer::Lbfgs);
   o.max_iterations = iterations;
   Renavigated r;
-  r.motion = renavigate(shipped_models().frozen, walk, curved_path(walk, frames, fps), fps, o, context(with_runtime),
-                        &r.report);
+  r.motion = renavigate(shipped_models().frozen, walk, curved_path(walk, frames, fps), fps, o,
+                        shipped_context(with_runtime), &r.report);
   return r;
 }
 

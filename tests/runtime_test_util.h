@@ -9,14 +9,19 @@
 #include <ATen/ATen.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "prior/model/model_file.h"
 #include "prior/motion/motion.h"
 #include "prior/runtime/nemf_runtime.h"
+#include "tasks/context/task_context.h"
+#include "tasks/latent/latent_energy.h"
+#include "tasks/latent/runtime_energy.h"
 
 namespace mf::test {
 
@@ -54,6 +59,36 @@ Eigen::VectorXf to_vector(const at::Tensor& t);
 /// max |a - b| / max |b| (sizes must agree: a failure and 1 otherwise).
 double relative_difference(const Eigen::Ref<const MatrixRXf>& a, const Eigen::Ref<const MatrixRXf>& b);
 double relative_vector_difference(const Eigen::VectorXf& a, const Eigen::VectorXf& b);
+
+/// The relative difference of each of the runtime's terms from libtorch's
+/// (names and order must agree: a failure of `what` otherwise).
+std::vector<double> term_differences(const RuntimeEnergyTerms& runtime, const EnergyTerms& torch,
+                                     const std::string& what);
+
+/// How far a runtime energy is from libtorch's: its values and its gradient.
+struct Agreement {
+  double value = 0, gradient = 0;
+  /// The worse of both, field by field.
+  void merge(const Agreement& o) {
+    value = std::max(value, o.value);
+    gradient = std::max(gradient, o.gradient);
+  }
+};
+
+/// The totals' relative difference (expected within kOutputTolerance, merged
+/// into a->value) and the gradients' (a->gradient, code_gradient_difference(),
+/// expected within kGradientTolerance).
+void expect_total_and_gradient(const RuntimeEnergyTerms& runtime, const EnergyTerms& torch,
+                               const Eigen::VectorXf& g_zl, const Eigen::VectorXf& g_zg, const at::Tensor& t_zl,
+                               const at::Tensor& t_zg, const std::string& what, Agreement* a);
+
+/// relative_vector_difference() of a runtime gradient with respect to the
+/// codes (g_zl, g_zg) and libtorch's (the .grad() of t_zl, t_zg).
+double code_gradient_difference(const Eigen::VectorXf& g_zl, const Eigen::VectorXf& g_zg, const at::Tensor& t_zl,
+                                const at::Tensor& t_zg);
+
+/// The shipped models as a context (not owning them): with the runtime or without.
+TaskContext shipped_context(bool with_runtime);
 
 /// Standard normal entries.
 MatrixRXf normal_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937& rng);
