@@ -12,11 +12,13 @@
 //               [--methods turned,nemf,nemf-adam] [--iterations N] [--adam-iterations N] [--ftol X]
 //               [--w-path X] [--w-joints X] [--w-heading X] [--w-skate X] [--w-continuity X]
 //               [--inits turned,reference,random] [--write N] [--out-dir DIR] [--out FILE]
-//               [--profile N] [--verbose 1]
+//               [--profile N] [--verbose 1] [--libtorch-energy]
 //
 // --profile N prints the cost of one energy evaluation (and its parts) with
 // gradient on a 128-frame window, median of N; --verbose 1 prints every
-// window's terms before and after the solve.
+// window's terms before and after the solve; --libtorch-energy has L-BFGS
+// minimise the libtorch energy instead of the Eigen runtime's (the default,
+// as in the CLI).
 //
 // Reference clips: validation clips whose mean ground speed over their first
 // (up to) 600 frames lies in [0.7, 2.5] m/s (walking and running) and that are
@@ -44,6 +46,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -57,6 +60,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/interpolation.h"
 #include "prior/motion/motion_bvh.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 #include "tasks/renav/renav.h"
@@ -84,6 +88,7 @@ struct Args {
   int write = 2;
   int profile = 0;
   int verbose = 0;
+  bool libtorch_energy = false;
   std::string out_dir = "out/renav";
   std::string out;
 };
@@ -106,6 +111,8 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("--write", a.write, "write BVH results, path CSVs and SVG top views of the first N clips");
   app.add_option("--profile", a.profile, "print the cost of one energy evaluation, median of N (0: no)");
   app.add_option("--verbose", a.verbose, "1: print every window's terms before and after the solve");
+  app.add_flag("--libtorch-energy", a.libtorch_energy,
+               "no Eigen runtime of the prior: L-BFGS minimises the libtorch energy (for comparisons)");
   app.add_option("--out-dir", a.out_dir, "folder of the written results");
   app.add_option("--out", a.out, "also write the markdown to FILE");
   mf::bench::add_number_options(app, a.numbers,
@@ -312,7 +319,7 @@ std::string profile(const mf::NemfModel& model, const mf::Motion& ref, int n) {
   s << "| decoder + GMP + root integration | " << fixed(median_ms(n, [&] {
          at::Tensor r = model.decode(frames, z_l, z_g);
          mf::GmpOutput g = model.predict_global(r, mf::GmpUse::Steering);
-         backward(model.root_positions(r, g, w.start_xz).sum());
+         backward(model.root_positions(r, g).sum());
        }), 2) << " |\n";
   s << "| decoder + heading-frame joints (FK) | " << fixed(median_ms(n, [&] {
          at::Tensor r = model.decode(frames, z_l, z_g);
@@ -339,6 +346,10 @@ int run(Args& args, const std::string& command) {
 
   mf::NemfModel model = mf::load_nemf(args.model);
   model.set_requires_grad(false);
+  mf::TaskContext ctx;  // the model (not owned) and, unless --libtorch-energy, its Eigen runtime
+  ctx.model = std::shared_ptr<const mf::NemfModel>(std::shared_ptr<const mf::NemfModel>(), &model);
+  if (!args.libtorch_energy)
+    ctx.runtime = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
   const mf::RigInfo& rig = model.rig();
   const double fps = model.config().fps;
   const mf::Dataset data = mf::bench::load_data(args.data, false);
@@ -425,7 +436,7 @@ int run(Args& args, const std::string& command) {
           out = turned_baseline(ref, path, rig.root_forward);
         } else {
           mf::RenavReport report;
-          out = mf::renavigate(model, ref, path, fps, options_for(args, method), {}, &report);
+          out = mf::renavigate(model, ref, path, fps, options_for(args, method), ctx, &report);
           sum.iterations += report.iterations;
           for (const auto& w : report.windows) {
             if (args.verbose) {

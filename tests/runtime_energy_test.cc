@@ -38,29 +38,6 @@
 namespace mf::test {
 namespace {
 
-// <g, f(x + h v)> - <g, f(x - h v)> over 2h for a unit v: the directional
-// derivative that `grad`'s dot with v must match, within 1e-4 of |grad|. The
-// networks' (leaky) ReLUs make the energy smooth only piecewise: a kink
-// inside the stencil (one unit switching within h of x) spoils the quotient
-// whatever the gradient, so the quotient at h / 10 is taken too and the
-// closer one counts.
-template <class F>
-void expect_directional_derivatives(const Eigen::VectorXd& grad, F&& value_at, std::mt19937& rng, const char* what) {
-  std::normal_distribution<double> n;
-  for (int d = 0; d < 3; ++d) {
-    Eigen::VectorXd v = d == 0 ? grad : Eigen::VectorXd(grad.unaryExpr([&](double) { return n(rng); }));
-    v.normalize();
-    double numeric = 0;
-    for (double h : {kDifferenceStep, kDifferenceStep / 10}) {
-      const double q = (value_at(h * v) - value_at(-h * v)) / (2 * h);
-      if (h == kDifferenceStep || std::abs(grad.dot(v) - q) < std::abs(grad.dot(v) - numeric)) numeric = q;
-    }
-    EXPECT_NEAR(grad.dot(v), numeric, 1e-4 * grad.norm()) << what << ", direction " << d;
-    std::printf("%s, direction %d: runtime %.6e, differences %.6e, |diff| / |grad| %.2e\n", what, d, grad.dot(v),
-                numeric, std::abs(grad.dot(v) - numeric) / grad.norm());
-  }
-}
-
 Eigen::VectorXd flat(const MatrixRXf& m) {
   return Eigen::Map<const Eigen::VectorXf>(m.data(), m.size()).cast<double>();
 }
@@ -297,10 +274,6 @@ std::vector<std::pair<Eigen::VectorXf, Eigen::VectorXf>> codes_for(const WindowP
           {normal_matrix(c.zl, 1, rng).col(0), normal_matrix(c.zg, 1, rng).col(0)}};
 }
 
-struct Agreement {
-  double value = 0, gradient = 0;
-};
-
 // Both energies and their gradients at (z_l, z_g): every term and the total
 // compared relative to the libtorch value (a term float does not give to
 // 1e-5, libtorch's neither, relative to the float64 prior's value), the
@@ -317,11 +290,10 @@ Agreement compare_energies(const WindowProblem& problem, const EnergyWeights& w,
   const EnergyTerms t = evaluate_energy(m.frozen, problem, w, t_zl, t_zg);
   t.total.backward();
   Agreement a;
-  EXPECT_EQ(r.terms.size(), t.terms.size()) << what;
-  for (size_t i = 0; i < std::min(r.terms.size(), t.terms.size()); ++i) {
-    EXPECT_EQ(r.terms[i].first, t.terms[i].first) << what;
+  const std::vector<double> differences = term_differences(r, t, what);
+  for (size_t i = 0; i < differences.size(); ++i) {
     const double ref = t.terms[i].second.item<double>();
-    const double d = std::abs(r.terms[i].second - ref) / std::abs(ref);
+    const double d = differences[i];
     a.value = std::max(a.value, d);
     if (d < kOutputTolerance) continue;
     // A velocity of a few mm per frame (contact) loses digits to the
@@ -337,14 +309,7 @@ Agreement compare_energies(const WindowProblem& problem, const EnergyWeights& w,
     std::printf("%s: %s %.2e from libtorch's float value, %.2e from float64's (libtorch's float %.2e)\n", what.c_str(),
                 t.terms[i].first.c_str(), d, d64, std::abs(ref - exact) / std::abs(exact));
   }
-  const double total = std::abs(r.total - t.total.item<double>()) / std::abs(t.total.item<double>());
-  EXPECT_LT(total, kOutputTolerance) << what;
-  a.value = std::max(a.value, total);
-  Eigen::VectorXf grad(g_zl.size() + g_zg.size()), ref(grad.size());
-  grad << g_zl, g_zg;
-  ref << to_vector(t_zl.grad()), to_vector(t_zg.grad());
-  a.gradient = relative_vector_difference(grad, ref);
-  EXPECT_LT(a.gradient, kGradientTolerance) << what;
+  expect_total_and_gradient(r, t, g_zl, g_zg, t_zl, t_zg, what, &a);
   return a;
 }
 

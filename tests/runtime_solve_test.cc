@@ -24,15 +24,6 @@
 namespace mf::test {
 namespace {
 
-// The shipped models as a context (not owning them): with the runtime or without.
-TaskContext context(bool with_runtime) {
-  const BothModels& m = shipped_models();
-  TaskContext ctx;
-  ctx.model = std::shared_ptr<const NemfModel>(std::shared_ptr<const NemfModel>(), &m.frozen);
-  if (with_runtime) ctx.runtime = std::shared_ptr<const runtime::NemfRuntime>(std::shared_ptr<const void>(), &m.runtime);
-  return ctx;
-}
-
 // The largest angle (rad) between the local rotations of two motions.
 double max_angle(const Motion& a, const Motion& b) {
   double worst = 0;
@@ -80,8 +71,8 @@ TEST(LatentSolverRuntime, EigenEnergyEndsWhereTheLibtorchEnergyDoes) {
   for (const auto& c : cases) {
     LatentSolverOptions o = default_solver_options(LatentOptimizer::Lbfgs);
     if (c.iterations > 0) o.max_iterations = c.iterations;
-    const Solved eigen = solve(c.input, c.constraints, o, context(true));
-    const Solved torch = solve(c.input, c.constraints, o, context(false));
+    const Solved eigen = solve(c.input, c.constraints, o, shipped_context(true));
+    const Solved torch = solve(c.input, c.constraints, o, shipped_context(false));
     ASSERT_EQ(eigen.report.windows.size(), 1u) << c.name;
     ASSERT_EQ(torch.report.windows.size(), 1u) << c.name;
     const SolveSummary& e = eigen.report.windows[0];
@@ -121,7 +112,7 @@ TEST(LatentSolverRuntime, UsesTheEigenEnergyWithTheModelsRuntime) {
   adam.max_iterations = 3;
   LatentSolverOptions skating = lbfgs;
   skating.weights.foot_skating = 1.0;
-  TaskContext other_model = context(true);
+  TaskContext other_model = shipped_context(true);
   other_model.model = nullptr;
   const struct {
     const char* name;
@@ -129,11 +120,11 @@ TEST(LatentSolverRuntime, UsesTheEigenEnergyWithTheModelsRuntime) {
     LatentSolverOptions options;
     TaskContext ctx;
     bool runtime;
-  } cases[] = {{"gap", gap, lbfgs, context(true), true},
-               {"effector target", effector, lbfgs, context(true), true},
-               {"foot skating weight", gap, skating, context(true), true},
-               {"Adam", gap, adam, context(true), true},
-               {"Adam without the runtime", gap, adam, context(false), false},
+  } cases[] = {{"gap", gap, lbfgs, shipped_context(true), true},
+               {"effector target", effector, lbfgs, shipped_context(true), true},
+               {"foot skating weight", gap, skating, shipped_context(true), true},
+               {"Adam", gap, adam, shipped_context(true), true},
+               {"Adam without the runtime", gap, adam, shipped_context(false), false},
                {"runtime of another model", gap, lbfgs, other_model, false}};
   for (const auto& c : cases) {
     CompletionReport report;

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 
 #include "prior/motion/motion_bvh.h"
@@ -65,6 +67,44 @@ MatrixRXf normal_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937& rng)
   MatrixRXf m(rows, cols);
   for (Eigen::Index i = 0; i < m.size(); ++i) m.data()[i] = n(rng);
   return m;
+}
+
+std::vector<double> term_differences(const RuntimeEnergyTerms& runtime, const EnergyTerms& torch,
+                                     const std::string& what) {
+  EXPECT_EQ(runtime.terms.size(), torch.terms.size()) << what;
+  std::vector<double> d;
+  for (size_t i = 0; i < std::min(runtime.terms.size(), torch.terms.size()); ++i) {
+    EXPECT_EQ(runtime.terms[i].first, torch.terms[i].first) << what;
+    const double ref = torch.terms[i].second.item<double>();
+    d.push_back(std::abs(runtime.terms[i].second - ref) / std::abs(ref));
+  }
+  return d;
+}
+
+double code_gradient_difference(const Eigen::VectorXf& g_zl, const Eigen::VectorXf& g_zg, const at::Tensor& t_zl,
+                                const at::Tensor& t_zg) {
+  Eigen::VectorXf grad(g_zl.size() + g_zg.size()), ref(grad.size());
+  grad << g_zl, g_zg;
+  ref << to_vector(t_zl.grad()), to_vector(t_zg.grad());
+  return relative_vector_difference(grad, ref);
+}
+
+void expect_total_and_gradient(const RuntimeEnergyTerms& runtime, const EnergyTerms& torch,
+                               const Eigen::VectorXf& g_zl, const Eigen::VectorXf& g_zg, const at::Tensor& t_zl,
+                               const at::Tensor& t_zg, const std::string& what, Agreement* a) {
+  const double total = std::abs(runtime.total - torch.total.item<double>()) / std::abs(torch.total.item<double>());
+  EXPECT_LT(total, kOutputTolerance) << what;
+  a->value = std::max(a->value, total);
+  a->gradient = code_gradient_difference(g_zl, g_zg, t_zl, t_zg);
+  EXPECT_LT(a->gradient, kGradientTolerance) << what;
+}
+
+TaskContext shipped_context(bool with_runtime) {
+  const BothModels& m = shipped_models();
+  TaskContext ctx;
+  ctx.model = std::shared_ptr<const NemfModel>(std::shared_ptr<const NemfModel>(), &m.frozen);
+  if (with_runtime) ctx.runtime = std::shared_ptr<const runtime::NemfRuntime>(std::shared_ptr<const void>(), &m.runtime);
+  return ctx;
 }
 
 const Motion& walk_on_model_rig() {

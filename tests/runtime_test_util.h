@@ -1,21 +1,29 @@
 // Helpers of the tests that hold the Eigen runtime (prior/runtime/,
 // tasks/latent/runtime_energy.h) to the libtorch implementations: the shipped
 // model loaded both ways, conversions between tensors and row-major float
-// matrices, the relative difference the equivalence bounds are stated in, and
-// the sample walk on the model's rig; tiny test priors on the runtime.
-// Linked into mf_tests only.
+// matrices, the relative difference the equivalence bounds are stated in,
+// the sample walk on the model's rig, the check of gradients against
+// central differences, and tiny test priors on the runtime. Linked into
+// mf_tests only.
 #pragma once
 
 #include <ATen/ATen.h>
+#include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <memory>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "prior/model/model_file.h"
 #include "prior/motion/motion.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "tasks/context/task_context.h"
+#include "tasks/latent/latent_energy.h"
+#include "tasks/latent/runtime_energy.h"
 
 namespace mf::test {
 
@@ -54,8 +62,62 @@ Eigen::VectorXf to_vector(const at::Tensor& t);
 double relative_difference(const Eigen::Ref<const MatrixRXf>& a, const Eigen::Ref<const MatrixRXf>& b);
 double relative_vector_difference(const Eigen::VectorXf& a, const Eigen::VectorXf& b);
 
+/// The relative difference of each of the runtime's terms from libtorch's
+/// (names and order must agree: a failure of `what` otherwise).
+std::vector<double> term_differences(const RuntimeEnergyTerms& runtime, const EnergyTerms& torch,
+                                     const std::string& what);
+
+/// How far a runtime energy is from libtorch's: its values and its gradient.
+struct Agreement {
+  double value = 0, gradient = 0;
+  /// The worse of both, field by field.
+  void merge(const Agreement& o) {
+    value = std::max(value, o.value);
+    gradient = std::max(gradient, o.gradient);
+  }
+};
+
+/// The totals' relative difference (expected within kOutputTolerance, merged
+/// into a->value) and the gradients' (a->gradient, code_gradient_difference(),
+/// expected within kGradientTolerance).
+void expect_total_and_gradient(const RuntimeEnergyTerms& runtime, const EnergyTerms& torch,
+                               const Eigen::VectorXf& g_zl, const Eigen::VectorXf& g_zg, const at::Tensor& t_zl,
+                               const at::Tensor& t_zg, const std::string& what, Agreement* a);
+
+/// relative_vector_difference() of a runtime gradient with respect to the
+/// codes (g_zl, g_zg) and libtorch's (the .grad() of t_zl, t_zg).
+double code_gradient_difference(const Eigen::VectorXf& g_zl, const Eigen::VectorXf& g_zg, const at::Tensor& t_zl,
+                                const at::Tensor& t_zg);
+
+/// The shipped models as a context (not owning them): with the runtime or without.
+TaskContext shipped_context(bool with_runtime);
+
 /// Standard normal entries.
 MatrixRXf normal_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937& rng);
+
+/// <g, f(x + h v)> - <g, f(x - h v)> over 2h for a unit v: the directional
+/// derivative that `grad`'s dot with v must match, within 1e-4 of |grad|. The
+/// networks' (leaky) ReLUs make the energy smooth only piecewise: a kink
+/// inside the stencil (one unit switching within h of x) spoils the quotient
+/// whatever the gradient, so the quotient at h / 10 is taken too and the
+/// closer one counts (h = `step`).
+template <class F>
+void expect_directional_derivatives(const Eigen::VectorXd& grad, F&& value_at, std::mt19937& rng, const char* what,
+                                    double step = kDifferenceStep) {
+  std::normal_distribution<double> n;
+  for (int d = 0; d < 3; ++d) {
+    Eigen::VectorXd v = d == 0 ? grad : Eigen::VectorXd(grad.unaryExpr([&](double) { return n(rng); }));
+    v.normalize();
+    double numeric = 0;
+    for (double h : {step, step / 10}) {
+      const double q = (value_at(h * v) - value_at(-h * v)) / (2 * h);
+      if (h == step || std::abs(grad.dot(v) - q) < std::abs(grad.dot(v) - numeric)) numeric = q;
+    }
+    EXPECT_NEAR(grad.dot(v), numeric, 1e-4 * grad.norm()) << what << ", direction " << d;
+    std::printf("%s, direction %d: runtime %.6e, differences %.6e, |diff| / |grad| %.2e\n", what, d, grad.dot(v),
+                numeric, std::abs(grad.dot(v) - numeric) / grad.norm());
+  }
+}
 
 /// The sample walk (samples/walk_keyframes.bvh, 61 frames) on the shipped
 /// model's rig, retargeted as the tasks do; loaded once.

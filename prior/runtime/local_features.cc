@@ -20,21 +20,27 @@ void sixd_of(const float* m, float* out) {
 
 }  // namespace
 
-void local_features(const Kinematics& kinematics, ConstMatrixRef local_rotations, const Eigen::Vector3f& root_forward,
-                    double fps, MatrixRXf* features, MatrixRXf* root6d) {
-  const int J = kinematics.joints();
-  const Eigen::Index T = local_rotations.rows();
-  if (T < 1 || local_rotations.cols() != J * 9)
-    throw InputError("local_features: expected local rotations [T >= 1, " + std::to_string(J * 9) + "]");
+void heading_free_positions(const Kinematics& kinematics, ConstMatrixRef local_rotations,
+                            const Eigen::Vector3f& root_forward, MatrixRXf* positions, MatrixRXf* globals) {
   // The root's rotation with its heading removed (H^T R), then FK from the origin.
+  const Eigen::Index T = local_rotations.rows();
   MatrixRXf free = local_rotations;
   for (Eigen::Index t = 0; t < T; ++t) {
     Matrix3 h;
     kernels::heading_rotation(local_rotations.row(t).data(), root_forward.data(), h.data());
     Eigen::Map<Matrix3>(&free(t, 0)) = h.transpose() * ConstMap3(local_rotations.row(t).data());
   }
+  kinematics.forward(free, MatrixRXf::Zero(T, 3), positions, globals);
+}
+
+void local_features(const Kinematics& kinematics, ConstMatrixRef local_rotations, const Eigen::Vector3f& root_forward,
+                    double fps, MatrixRXf* features, MatrixRXf* root6d) {
+  const int J = kinematics.joints();
+  const Eigen::Index T = local_rotations.rows();
+  if (T < 1 || local_rotations.cols() != J * 9)
+    throw InputError("local_features: expected local rotations [T >= 1, " + std::to_string(J * 9) + "]");
   MatrixRXf positions, globals;
-  kinematics.forward(free, MatrixRXf::Zero(T, 3), &positions, &globals);
+  heading_free_positions(kinematics, local_rotations, root_forward, &positions, &globals);
   features->resize(T, J * 15);
   root6d->resize(T, 6);
   const float rate = static_cast<float>(fps);

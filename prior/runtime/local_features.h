@@ -12,6 +12,14 @@
 
 namespace mf::runtime {
 
+/// The joints' positions relative to the root in the heading frame
+/// (heading_relative_positions() of prior/model/representation.h) of local
+/// rotations [T, J * 9]: FK from the origin with the heading removed from
+/// the root's rotation. `positions` [T, J * 3] and the global rotations
+/// `globals` [T, J * 9] (with the heading removed), both resized.
+void heading_free_positions(const Kinematics& kinematics, ConstMatrixRef local_rotations,
+                            const Eigen::Vector3f& root_forward, MatrixRXf* positions, MatrixRXf* globals);
+
 /// The local-motion features of a window's local rotations [T, J * 9]
 /// (canonical frame; joint 0's is the root's rotation, row-major 3x3) at
 /// `fps` frames per second, with the rig's root forward axis: `features`

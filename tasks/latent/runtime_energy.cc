@@ -6,17 +6,11 @@
 
 #include "prior/motion/errors.h"
 #include "prior/motion/rotation_kernels.h"
-#include "prior/runtime/root_path.h"
-#include "prior/runtime/rotations.h"
 #include "tasks/latent/runtime_penalties.h"
 
 namespace mf {
 namespace {
 
-using runtime::MatrixRXf;
-using Matrix3 = Eigen::Matrix<float, 3, 3, Eigen::RowMajor>;
-using Map3 = Eigen::Map<Matrix3>;
-using ConstMap3 = Eigen::Map<const Matrix3>;
 using runtime_penalties::angle_penalty;
 using runtime_penalties::Penalised;
 using runtime_penalties::squared_penalty;
@@ -76,7 +70,7 @@ void check_problem(const RuntimeWindowProblem& p, int J, int window) {
 }  // namespace
 
 RuntimeEnergy::RuntimeEnergy(const runtime::NemfRuntime& model)
-    : model_(&model), kinematics_(model.rig().skeleton), root_forward_(model.rig().root_forward.cast<float>()) {}
+    : RuntimeDecodePass(model) {}
 
 RuntimeEnergyTerms RuntimeEnergy::evaluate(const RuntimeWindowProblem& problem, const EnergyWeights& w,
                                            const Eigen::Ref<const Eigen::VectorXf>& z_l,
@@ -92,7 +86,7 @@ RuntimeEnergyTerms RuntimeEnergy::evaluate(const RuntimeWindowProblem& problem, 
   gradient_ = g_zl != nullptr && g_zg != nullptr;
   RuntimeEnergyTerms out;
   const bool decoded = a.keyed || a.dense;
-  if (decoded) decode(problem, a, z_l, z_g);
+  if (decoded) decode_rows(problem, a, z_l, z_g);
   if (a.keyed) add_key_terms(problem, w, a, &out);
   if (a.dense) add_dense_terms(problem, w, a, &out);
   if (w.latent_prior > 0)
@@ -100,7 +94,7 @@ RuntimeEnergyTerms RuntimeEnergy::evaluate(const RuntimeWindowProblem& problem, 
   for (const auto& t : out.terms) out.total += t.second;
   if (!gradient_) return out;
   if (decoded) {
-    backward(a, g_zl, g_zg);
+    backward(a.dense || a.pos, g_zl, g_zg);
   } else {
     g_zl->setZero(config.zl);
     g_zg->setZero(config.zg);
@@ -119,10 +113,8 @@ DecodedWindow RuntimeEnergy::decode_window(const RuntimeWindowProblem& problem,
   ActiveTerms dense;
   dense.dense = true;
   gradient_ = false;
-  decode(problem, dense, z_l, z_g);
-  gmp_inputs();
-  model_->predict_global(gmp_in_, GmpUse::Default, &gmp_ws_, &gmp_out_);
-  root_path(problem.anchor);
+  decode_rows(problem, dense, z_l, z_g);
+  predict(GmpUse::Default, problem.anchor);
   const int F = model_->rig().num_feet();
   runtime::MatrixRXf contacts = (1.0f / (1.0f + (-gmp_out_.rightCols(F).array()).exp())).matrix();
   return {rotations_, path_, std::move(contacts)};
@@ -130,21 +122,13 @@ DecodedWindow RuntimeEnergy::decode_window(const RuntimeWindowProblem& problem,
 
 // Decodes the whole window when a dense term is active, else the key frames,
 // and runs FK (root at the origin) when a term reads positions.
-void RuntimeEnergy::decode(const RuntimeWindowProblem& problem, const ActiveTerms& a,
-                           const Eigen::Ref<const Eigen::VectorXf>& z_l, const Eigen::Ref<const Eigen::VectorXf>& z_g) {
-  const int S = a.dense ? problem.length : problem.num_keys(), J = kinematics_.joints();
+void RuntimeEnergy::decode_rows(const RuntimeWindowProblem& problem, const ActiveTerms& a,
+                                const Eigen::Ref<const Eigen::VectorXf>& z_l,
+                                const Eigen::Ref<const Eigen::VectorXf>& z_g) {
+  const int S = a.dense ? problem.length : problem.num_keys();
   frames_.resize(S);
   for (int s = 0; s < S; ++s) frames_[s] = a.dense ? s : problem.key_frames[s];
-  model_->decode(frames_, z_l, z_g, &decoder_ws_, &sixd_);
-  runtime::sixd_to_matrix(sixd_, &rotations_);
-  if (a.dense || a.pos) {
-    zero_root_.setZero(S, 3);
-    kinematics_.forward(rotations_, zero_root_, &positions_, &globals_);
-  }
-  if (gradient_) {
-    g_rotations_.setZero(S, J * 9);
-    g_positions_.setZero(S, J * 3);
-  }
+  decode(frames_, z_l, z_g, a.dense || a.pos);
 }
 
 // rotation, root_orientation and position at the keys: means over the
@@ -190,16 +174,11 @@ void RuntimeEnergy::add_key_terms(const RuntimeWindowProblem& p, const EnergyWei
 // their gradient back to the decoded rotations and positions.
 void RuntimeEnergy::add_dense_terms(const RuntimeWindowProblem& p, const EnergyWeights& w, const ActiveTerms& a,
                                     RuntimeEnergyTerms* out) {
-  gmp_inputs();
-  model_->predict_global(gmp_in_, GmpUse::Default, &gmp_ws_, &gmp_out_);
-  root_path(p.anchor);
-  if (gradient_) g_path_.setZero(p.length, 3);
+  predict(GmpUse::Default, p.anchor);
   if (a.root) add_root_translation(p, w, a, out);
   if (a.eff || a.pin || a.traj || a.facing || a.skate || a.smooth) add_output_terms(p, w, a, out);
   if (!gradient_) return;
-  root_path_vjp(p.anchor);
-  model_->predict_global_vjp(&gmp_ws_, GmpUse::Default, g_gmp_out_, &g_gmp_in_);
-  gmp_inputs_vjp();
+  predict_vjp(GmpUse::Default, p.anchor);
 }
 
 // root_translation: the root path against the keys' root positions.
@@ -217,72 +196,6 @@ void RuntimeEnergy::add_root_translation(const RuntimeWindowProblem& p, const En
       g_path_.row(f).head<3>() += static_cast<float>(w.root_translation / a.n_root * mask * pen.slope * 2) * d;
   }
   out->terms.emplace_back("root_translation", w.root_translation * sum / a.n_root);
-}
-
-// gmp_inputs() of representation.h from the dense decode (prior/runtime/root_path.h).
-void RuntimeEnergy::gmp_inputs() { runtime::gmp_inputs(rotations_, positions_, root_forward_, &headings_, &gmp_in_); }
-
-// NemfModel::root_positions() (prior/runtime/root_path.h) then the alignment
-// of energies.cc: the ground position at the anchor moved to the origin.
-void RuntimeEnergy::root_path(int anchor) {
-  runtime::integrate_root_path(headings_, gmp_out_, model_->config().fps, &path_);
-  const float ax = path_(anchor, 0), az = path_(anchor, 2);
-  path_.col(0).array() -= ax;
-  path_.col(2).array() -= az;
-}
-
-// The gradient of root_path(): from g_path_ to the GMP's outputs (g_gmp_out_)
-// and the headings (g_headings_, started here).
-void RuntimeEnergy::root_path_vjp(int anchor) {
-  const int T = static_cast<int>(gmp_out_.rows());
-  const float fps = static_cast<float>(model_->config().fps);
-  g_gmp_out_.setZero(T, gmp_out_.cols());
-  g_headings_.setZero(T, 9);
-  g_path_(anchor, 0) -= g_path_.col(0).sum();
-  g_path_(anchor, 2) -= g_path_.col(2).sum();
-  float later_x = 0, later_z = 0;  // the ground gradient of the frames after t: frame t's step feeds them
-  for (int t = T - 1; t >= 0; --t) {
-    const Eigen::Vector3f g_world(later_x / fps, 0.0f, later_z / fps);
-    const ConstMap3 h(&headings_(t, 0));
-    g_gmp_out_.row(t).head<3>() = (h.transpose() * g_world).transpose();
-    Map3(&g_headings_(t, 0)) += g_world * gmp_out_.row(t).head<3>();
-    g_gmp_out_(t, 3) = g_path_(t, 1);
-    later_x += g_path_(t, 0);
-    later_z += g_path_(t, 2);
-  }
-}
-
-// The gradient of gmp_inputs(): from g_gmp_in_ (and the headings' gradient)
-// to the decoded rotations and positions.
-void RuntimeEnergy::gmp_inputs_vjp() {
-  const int T = static_cast<int>(rotations_.rows()), J = kinematics_.joints();
-  for (int t = 0; t < T; ++t) {
-    const ConstMap3 h(&headings_(t, 0)), root(&rotations_(t, 0));
-    Map3 g_h(&g_headings_(t, 0)), g_root(&g_rotations_(t, 0));
-    for (int j = 0; j < J; ++j) {
-      const Eigen::Vector3f g = g_gmp_in_.row(t).segment<3>(j * 3).transpose();
-      g_positions_.row(t).segment<3>(j * 3) += (h * g).transpose();
-      g_h += positions_.row(t).segment<3>(j * 3).transpose() * g.transpose();
-    }
-    Matrix3 g_free = Matrix3::Zero();
-    g_free.col(0) = g_gmp_in_.row(t).segment<3>(J * 3).transpose();
-    g_free.col(1) = g_gmp_in_.row(t).segment<3>(J * 3 + 3).transpose();
-    g_root += h * g_free;
-    g_h += root * g_free.transpose();
-    Matrix3 g_from_heading;
-    kernels::heading_rotation_vjp(&rotations_(t, 0), root_forward_.data(), &g_headings_(t, 0), g_from_heading.data());
-    g_root += g_from_heading;
-  }
-}
-
-// From the gradients of the decoded rotations and positions to the latents.
-void RuntimeEnergy::backward(const ActiveTerms& a, Eigen::VectorXf* g_zl, Eigen::VectorXf* g_zg) {
-  if (a.dense || a.pos) {
-    kinematics_.vjp(rotations_, globals_, g_positions_, nullptr, &g_local_, &g_root_);
-    g_rotations_ += g_local_;
-  }
-  runtime::sixd_to_matrix_vjp(sixd_, g_rotations_, &g_sixd_);
-  model_->decode_vjp(&decoder_ws_, g_sixd_, g_zl, g_zg);
 }
 
 }  // namespace mf

@@ -2,9 +2,10 @@
 // libtorch, with its gradient with respect to the latent codes written out:
 // every term of evaluate_energy() (tasks/latent/energies.h), in its order,
 // under either penalty and with the same rule of which terms are active
-// (active_terms(), energy_weights.h). runtime_energy.cc: the decode, the key
-// terms (rotation, root_orientation, position), root_translation (the GMP on
-// the dense decode, its root path integrated and aligned at the anchor) and
+// (active_terms(), energy_weights.h). The decode, the GMP on the dense
+// decode and its root path (integrated and aligned at the anchor) are
+// RuntimeDecodePass's (tasks/latent/runtime_decode.h). runtime_energy.cc: the
+// key terms (rotation, root_orientation, position), root_translation and
 // latent_prior; runtime_energy_output.cc: the terms on the output motion
 // (effector, contact, trajectory, trajectory_facing, foot_skating,
 // smoothness), which see the keys' residuals blended in when
@@ -29,6 +30,7 @@
 #include "prior/runtime/nemf_runtime.h"
 #include "tasks/latent/energy_weights.h"
 #include "tasks/latent/runtime_blend.h"
+#include "tasks/latent/runtime_decode.h"
 #include "tasks/latent/window_problem.h"
 
 namespace mf {
@@ -43,7 +45,7 @@ struct RuntimeEnergyTerms {
 /// The energy of one model's latent codes, with the buffers of its
 /// evaluations (reused: after the first evaluation of a problem's size it
 /// allocates little). One per thread; the model must outlive it.
-class RuntimeEnergy {
+class RuntimeEnergy : private RuntimeDecodePass {
  public:
   explicit RuntimeEnergy(const runtime::NemfRuntime& model);
 
@@ -62,8 +64,8 @@ class RuntimeEnergy {
                               const Eigen::Ref<const Eigen::VectorXf>& z_g);
 
  private:
-  void decode(const RuntimeWindowProblem& problem, const ActiveTerms& a, const Eigen::Ref<const Eigen::VectorXf>& z_l,
-              const Eigen::Ref<const Eigen::VectorXf>& z_g);
+  void decode_rows(const RuntimeWindowProblem& problem, const ActiveTerms& a,
+                   const Eigen::Ref<const Eigen::VectorXf>& z_l, const Eigen::Ref<const Eigen::VectorXf>& z_g);
   void add_key_terms(const RuntimeWindowProblem& problem, const EnergyWeights& w, const ActiveTerms& a,
                      RuntimeEnergyTerms* out);
   void add_dense_terms(const RuntimeWindowProblem& problem, const EnergyWeights& w, const ActiveTerms& a,
@@ -80,25 +82,9 @@ class RuntimeEnergy {
   void add_foot_skating(const EnergyWeights& w, RuntimeEnergyTerms* out);
   void add_smoothness(const EnergyWeights& w, RuntimeEnergyTerms* out);
   void output_motion_vjp(const RuntimeWindowProblem& problem);
-  void gmp_inputs();
-  void root_path(int anchor);
-  void root_path_vjp(int anchor);
-  void gmp_inputs_vjp();
-  void backward(const ActiveTerms& a, Eigen::VectorXf* g_zl, Eigen::VectorXf* g_zg);
 
-  const runtime::NemfRuntime* model_;
-  runtime::Kinematics kinematics_;
-  Eigen::Vector3f root_forward_;
-  bool gradient_ = false;  // whether the evaluation in progress accumulates gradients
-  Eigen::VectorXd frames_;
-  runtime::DecoderWorkspace decoder_ws_;
-  runtime::GmpWorkspace gmp_ws_;
   // The decode's rows: the whole window when a dense term is active, else the key frames.
-  runtime::MatrixRXf sixd_, rotations_, positions_, globals_, zero_root_;
-  runtime::MatrixRXf headings_, gmp_in_, gmp_out_, path_;
-  // Their gradients.
-  runtime::MatrixRXf g_rotations_, g_positions_, g_headings_, g_gmp_out_, g_gmp_in_, g_path_;
-  runtime::MatrixRXf g_local_, g_root_, g_sixd_;
+  Eigen::VectorXd frames_;
   // The output motion of the dense output terms (rotations are rotations_
   // itself when nothing is blended) and its gradients.
   bool blended_ = false;

@@ -128,29 +128,10 @@ void RuntimeEnergy::add_trajectory(const RuntimeWindowProblem& p, const EnergyWe
   if (a.facing) out->terms.emplace_back("trajectory_facing", w.trajectory_facing * sum_facing / R);
 }
 
-// foot_skating: the feet's horizontal squared speed weighted by the GMP's
-// contact probability at the later frame (a constant: no gradient to the
-// GMP), mean over frames and feet.
+// foot_skating: RuntimeDecodePass::foot_skating() on the output motion.
 void RuntimeEnergy::add_foot_skating(const EnergyWeights& w, RuntimeEnergyTerms* out) {
-  const RigInfo& rig = model_->rig();
-  const int T = static_cast<int>(out_positions_.rows()), F = rig.num_feet();
-  const float fps = static_cast<float>(model_->config().fps);
-  const double n = static_cast<double>(T - 1) * F;
-  double sum = 0;
-  for (int t = 0; t + 1 < T; ++t) {
-    for (int i = 0; i < F; ++i) {
-      const int j = rig.foot_joints[i];
-      const Row3 v = (out_positions_.row(t + 1).segment<3>(j * 3) - out_positions_.row(t).segment<3>(j * 3)) * fps;
-      const float contact = 1.0f / (1.0f + std::exp(-gmp_out_(t + 1, 4 + i)));
-      sum += contact * (v.x() * v.x() + v.z() * v.z());
-      if (!gradient_) continue;
-      const float g = static_cast<float>(w.foot_skating / n * contact * 2 * fps);
-      const Row3 g_v(g * v.x(), 0.0f, g * v.z());
-      g_out_positions_.row(t + 1).segment<3>(j * 3) += g_v;
-      g_out_positions_.row(t).segment<3>(j * 3) -= g_v;
-    }
-  }
-  out->terms.emplace_back("foot_skating", w.foot_skating * sum / n);
+  const double value = foot_skating(out_positions_, w.foot_skating, &g_out_positions_);
+  out->terms.emplace_back("foot_skating", w.foot_skating * value);
 }
 
 // smoothness: the mean squared second difference of the root-relative joint

@@ -2,6 +2,7 @@
 
 #include <ATen/ATen.h>
 
+#include <utility>
 #include <vector>
 
 namespace mf {
@@ -41,14 +42,22 @@ RuntimeWindowProblem to_runtime_problem(const WindowProblem& problem, int joints
   return p;
 }
 
+RuntimeLatentEnergy::RuntimeLatentEnergy(RuntimeCodeEnergy energy, int zl, int zg)
+    : energy_(std::move(energy)), zl_(zl), zg_(zg), x_(zl + zg) {}
+
 RuntimeLatentEnergy::RuntimeLatentEnergy(RuntimeEnergy& energy, const RuntimeWindowProblem& problem,
                                          const EnergyWeights& weights, int zl, int zg)
-    : energy_(&energy), problem_(&problem), weights_(weights), zl_(zl), zg_(zg), x_(zl + zg) {}
+    : RuntimeLatentEnergy(
+          [&energy, &problem, weights](const Eigen::Ref<const Eigen::VectorXf>& z_l,
+                                       const Eigen::Ref<const Eigen::VectorXf>& z_g, Eigen::VectorXf* g_zl,
+                                       Eigen::VectorXf* g_zg) {
+            return energy.evaluate(problem, weights, z_l, z_g, g_zl, g_zg);
+          },
+          zl, zg) {}
 
 RuntimeEnergyTerms RuntimeLatentEnergy::run(const double* x, bool gradient) {
   for (int i = 0; i < size(); ++i) x_[i] = static_cast<float>(x[i]);
-  return energy_->evaluate(*problem_, weights_, x_.head(zl_), x_.tail(zg_), gradient ? &g_zl_ : nullptr,
-                           gradient ? &g_zg_ : nullptr);
+  return energy_(x_.head(zl_), x_.tail(zg_), gradient ? &g_zl_ : nullptr, gradient ? &g_zg_ : nullptr);
 }
 
 double RuntimeLatentEnergy::evaluate(const double* x, double* gradient) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -21,12 +22,21 @@ namespace mf {
 /// effector or trajectory row) and index vectors, for a rig of `joints` joints.
 RuntimeWindowProblem to_runtime_problem(const WindowProblem& problem, int joints);
 
-/// RuntimeEnergy::evaluate() on one window's problem under `weights` as a
-/// function of x = [z_l, z_g] (zl + zg values, rounded to float as the
-/// tensor energy's x is), as FlatLatentEnergy (tasks/latent/latent_energy.h)
-/// is the tensor energy's. `energy` and `problem` must outlive it.
+/// An energy of the codes (z_l [zl], z_g [zg]) on the Eigen runtime: its
+/// terms and, when g_zl and g_zg are not null, its gradient.
+using RuntimeCodeEnergy =
+    std::function<RuntimeEnergyTerms(const Eigen::Ref<const Eigen::VectorXf>& z_l,
+                                     const Eigen::Ref<const Eigen::VectorXf>& z_g, Eigen::VectorXf* g_zl,
+                                     Eigen::VectorXf* g_zg)>;
+
+/// A runtime energy of the codes as a function of x = [z_l, z_g] (zl + zg
+/// values, rounded to float as the tensor energy's x is), as
+/// FlatLatentEnergy (tasks/latent/latent_energy.h) is the tensor energy's.
 class RuntimeLatentEnergy final : public DirectLatentEnergy {
  public:
+  RuntimeLatentEnergy(RuntimeCodeEnergy energy, int zl, int zg);
+  /// RuntimeEnergy::evaluate() on one window's problem under `weights`;
+  /// `energy` and `problem` must outlive it.
   RuntimeLatentEnergy(RuntimeEnergy& energy, const RuntimeWindowProblem& problem, const EnergyWeights& weights, int zl,
                       int zg);
 
@@ -37,9 +47,7 @@ class RuntimeLatentEnergy final : public DirectLatentEnergy {
  private:
   RuntimeEnergyTerms run(const double* x, bool gradient);
 
-  RuntimeEnergy* energy_;
-  const RuntimeWindowProblem* problem_;
-  EnergyWeights weights_;
+  RuntimeCodeEnergy energy_;
   int zl_, zg_;
   Eigen::VectorXf x_, g_zl_, g_zg_;
 };

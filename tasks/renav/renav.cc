@@ -7,6 +7,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <random>
 #include <sstream>
 
@@ -16,12 +17,15 @@
 #include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations.h"
 #include "prior/motion/rotations_torch.h"
+#include "prior/runtime/local_features.h"
 #include "tasks/constraints/interpolation_fill.h"
 #include "tasks/context/model_rig.h"
 #include "tasks/latent/initializers.h"
 #include "tasks/latent/latent_energy.h"
 #include "tasks/latent/latent_optimizer.h"
+#include "tasks/latent/runtime_problem.h"
 #include "tasks/latent/windows.h"
+#include "tasks/renav/renav_runtime_energy.h"
 
 namespace mf {
 namespace {
@@ -91,15 +95,21 @@ ReferenceCourse reference_course(const Motion& seg, const Eigen::Vector3d& forwa
   return c;
 }
 
+// Heading-frame joint positions [T, J * 3] of canonical local rotations [T, J * 9].
+runtime::MatrixRXf heading_frame_joints(const RigInfo& rig, const runtime::MatrixRXf& local_rotations) {
+  runtime::MatrixRXf positions, globals;
+  runtime::heading_free_positions(runtime::Kinematics(rig.skeleton), local_rotations, rig.root_forward.cast<float>(),
+                                  &positions, &globals);
+  return positions;
+}
+
 // The reference's signals of the energy: heading-frame joint positions and c(t).
 void set_reference_signals(const RigInfo& rig, const Motion& seg, const ReferenceCourse& course, RenavWindow* w) {
-  at::NoGradGuard no_grad;
   const int R = seg.num_frames();
-  const WindowTensors t = window_tensors(seg, 0, R, rig, 0);
-  w->reference_joints = heading_relative_positions(t.local_rotations, rig).flatten(-2).contiguous();
-  w->reference_heading = at::empty({1, R, 1}, at::kFloat);
-  float* c = w->reference_heading.data_ptr<float>();
-  for (int f = 0; f < R; ++f) c[f] = static_cast<float>(std::cos(course.heading[f] - course.travel[f]));
+  w->reference_joints = heading_frame_joints(rig, window_matrices(seg, 0, R, rig, 0).local_rotations);
+  w->reference_heading.resize(R, 1);
+  for (int f = 0; f < R; ++f)
+    w->reference_heading(f, 0) = static_cast<float>(std::cos(course.heading[f] - course.travel[f]));
 }
 
 // The target path of the window and its tangents, in the canonical frame `transform`.
@@ -107,20 +117,15 @@ void set_target_signals(const std::vector<Eigen::Vector2d>& path, const std::vec
                         int length, RenavWindow* w) {
   const double yaw = w->transform.yaw;
   const Eigen::Matrix3d unturn = rot_y(-yaw);
-  w->target_xz = at::empty({length, 2}, at::kFloat);
-  w->target_tangent = at::empty({length, 2}, at::kFloat);
-  float* t = w->target_xz.data_ptr<float>();
-  float* g = w->target_tangent.data_ptr<float>();
+  w->target_xz.resize(length, 2);
+  w->target_tangent.resize(length, 2);
   for (int f = 0; f < length; ++f) {
     const Eigen::Vector2d& p = path[begin + f];
     const Eigen::Vector3d c = unturn * Eigen::Vector3d(p.x() - w->transform.x, 0.0, p.y() - w->transform.z);
-    t[2 * f] = static_cast<float>(c.x());
-    t[2 * f + 1] = static_cast<float>(c.z());
+    w->target_xz.row(f) << static_cast<float>(c.x()), static_cast<float>(c.z());
     const double a = target_yaw[begin + f] - yaw;
-    g[2 * f] = static_cast<float>(std::sin(a));
-    g[2 * f + 1] = static_cast<float>(std::cos(a));
+    w->target_tangent.row(f) << static_cast<float>(std::sin(a)), static_cast<float>(std::cos(a));
   }
-  w->start_xz = at::zeros({1, 2}, at::kFloat);
 }
 
 // The reference turned to follow the target: each frame's root turned about +Y
@@ -156,22 +161,18 @@ Motion turned_reference(const Motion& seg, const ReferenceCourse& course, const 
 // its local rotations (root in the window's canonical frame) and heading-frame
 // joint positions there.
 void set_shared_frames(const RigInfo& rig, const Motion& previous, int begin, int shared, RenavWindow* w) {
-  at::NoGradGuard no_grad;
   const int J = rig.num_joints();
   const Eigen::Matrix3d unturn = rot_y(-w->transform.yaw);
-  w->shared_frames = at::arange(shared, at::kLong);
-  at::Tensor rot = at::empty({1, shared, J, 3, 3}, at::kFloat);
-  float* r = rot.data_ptr<float>();
+  w->shared_rotations.resize(shared, J * 9);
   for (int f = 0; f < shared; ++f) {
     for (int j = 0; j < J; ++j) {
       Eigen::Matrix3d m = previous.rotation(begin + f, j).normalized().toRotationMatrix();
       if (j == 0) m = unturn * m;
       for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) *r++ = static_cast<float>(m(a, b));
+        for (int b = 0; b < 3; ++b) w->shared_rotations(f, j * 9 + a * 3 + b) = static_cast<float>(m(a, b));
     }
   }
-  w->shared_rotations = rot.squeeze(0).contiguous();
-  w->shared_joints = heading_relative_positions(rot, rig).squeeze(0).contiguous();
+  w->shared_joints = heading_frame_joints(rig, w->shared_rotations);
 }
 
 }  // namespace
@@ -212,6 +213,15 @@ RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, i
 
 // ---------------------------------------------------------------- the energy
 
+namespace {
+
+// A window's matrix as a tensor of `shape` (no copy: valid while the window is).
+at::Tensor view(const runtime::MatrixRXf& m, at::IntArrayRef shape) {
+  return at::from_blob(const_cast<float*>(m.data()), shape, at::kFloat);
+}
+
+}  // namespace
+
 RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindow& window, const RenavWeights& w,
                                 const at::Tensor& rot, const at::Tensor& root, const at::Tensor& contacts) {
   const int T = window.length;
@@ -219,12 +229,13 @@ RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindo
     throw InputError("renav_motion_energy: expected rotations [1, T, J, 3, 3] and root positions [1, T, 3] with T = " +
                      std::to_string(T));
   const at::TensorOptions opt = rot.options();
+  const int J = rig.num_joints(), R = static_cast<int>(window.reference_joints.rows());
   RenavEnergy out;
   auto add = [&](const char* name, double weight, const at::Tensor& value) {
     out.terms.emplace_back(name, value * weight);
   };
   if (w.path > 0) {
-    at::Tensor d = ground_xz(root).squeeze(0) - window.target_xz.to(opt);
+    at::Tensor d = ground_xz(root).squeeze(0) - view(window.target_xz, {T, 2}).to(opt);
     add("path", w.path, at::sqrt(d.square() + 1e-6).mean());
   }
   const bool use_cont = w.continuity > 0 && window.num_shared() > 0;
@@ -232,14 +243,15 @@ RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindo
   if (w.joints > 0 || use_cont) hp = heading_relative_positions(rot, rig);  // [1, T, J, 3]
   if (w.joints > 0) {
     add("joints", w.joints,
-        soft_dtw_divergence(hp.flatten(-2), window.reference_joints.to(opt), w.gamma).squeeze(0));
+        soft_dtw_divergence(hp.flatten(-2), view(window.reference_joints, {1, R, J * 3}).to(opt), w.gamma).squeeze(0));
   }
   if (w.heading > 0) {
     at::Tensor h = heading_rotation(rot.select(-3, 0), rig.root_forward);  // [1, T, 3, 3]
     at::Tensor s = h.select(-2, 0).select(-1, 2), c = h.select(-2, 2).select(-1, 2);  // heading = (s, 0, c)
-    at::Tensor tangent = window.target_tangent.to(opt);
+    at::Tensor tangent = view(window.target_tangent, {T, 2}).to(opt);
     at::Tensor signal = (s * tangent.select(-1, 0) + c * tangent.select(-1, 1)).unsqueeze(-1);  // [1, T, 1]
-    add("heading", w.heading, soft_dtw_divergence(signal, window.reference_heading.to(opt), w.gamma).squeeze(0));
+    const at::Tensor reference = view(window.reference_heading, {1, R, 1}).to(opt);
+    add("heading", w.heading, soft_dtw_divergence(signal, reference, w.gamma).squeeze(0));
   }
   if (w.foot_skating > 0 && rig.num_feet() > 0 && T >= 2) {
     if (!contacts.defined()) throw InputError("renav_motion_energy: foot skating needs the contact probabilities");
@@ -252,10 +264,11 @@ RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindo
     add("foot_skating", w.foot_skating, (contacts.narrow(1, 1, T - 1).detach().to(opt) * speed2).mean());
   }
   if (use_cont) {
-    at::Tensor r = rot.squeeze(0).index_select(0, window.shared_frames);
-    at::Tensor angle = torch_rot::geodesic_angle(r, window.shared_rotations.to(opt));
-    at::Tensor p = hp.squeeze(0).index_select(0, window.shared_frames);
-    at::Tensor d2 = (p - window.shared_joints.to(opt)).square().sum(-1);
+    const int S = window.num_shared();
+    at::Tensor r = rot.squeeze(0).narrow(0, 0, S);
+    at::Tensor angle = torch_rot::geodesic_angle(r, view(window.shared_rotations, {S, J, 3, 3}).to(opt));
+    at::Tensor p = hp.squeeze(0).narrow(0, 0, S);
+    at::Tensor d2 = (p - view(window.shared_joints, {S, J, 3}).to(opt)).square().sum(-1);
     add("continuity", w.continuity, angle.square().mean() + 10.0 * d2.mean());
   }
   out.total = at::zeros({}, opt);
@@ -267,7 +280,7 @@ RenavEnergy evaluate_renav_energy(const NemfModel& model, const RenavWindow& win
                                   const at::Tensor& z_l, const at::Tensor& z_g) {
   at::Tensor rot = model.decode(at::arange(window.length, at::kFloat), z_l, z_g);
   GmpOutput gmp = model.predict_global(rot, GmpUse::Steering);
-  at::Tensor root = model.root_positions(rot, gmp, window.start_xz);
+  at::Tensor root = model.root_positions(rot, gmp, at::Tensor());
   at::Tensor contacts;
   if (weights.foot_skating > 0) contacts = at::sigmoid(gmp.contact_logits);
   return renav_motion_energy(model.rig(), model.config().fps, window, weights, rot, root, contacts);
@@ -279,7 +292,7 @@ DecodedWindow decode_renav_window(const NemfModel& model, const RenavWindow& win
   const int64_t T = window.length, J = model.rig().num_joints(), F = model.rig().num_feet();
   const at::Tensor rotations = model.decode(at::arange(T, at::kFloat), z_l, z_g);
   GmpOutput gmp = model.predict_global(rotations, GmpUse::Steering);
-  return {rows_of(rotations, T, J * 9), rows_of(model.root_positions(rotations, gmp, window.start_xz), T, 3),
+  return {rows_of(rotations, T, J * 9), rows_of(model.root_positions(rotations, gmp, at::Tensor()), T, 3),
           rows_of(at::sigmoid(gmp.contact_logits), T, F)};
 }
 
@@ -419,18 +432,49 @@ std::vector<RenavSpan> renav_spans(int M, int R, int W, int overlap) {
   return spans;
 }
 
+// The energies of one window: the Eigen runtime's when the context carries
+// the runtime of the model (which the solve then minimises, starts from and
+// decodes with), else libtorch's.
+struct RenavWindowEnergies {
+  RenavWindowEnergies(const NemfModel& model, const RenavWindow& window, const RenavOptions& options,
+                      const TaskContext& ctx)
+      : torch(window_energy(model, window, options.weights), model.config().zl, model.config().zg) {
+    if (!ctx.runtime || ctx.model.get() != &model) return;
+    runtime = ctx.runtime.get();
+    evaluator = std::make_unique<RenavRuntimeEnergy>(*runtime, window, options.weights);
+    direct = std::make_unique<RuntimeLatentEnergy>(
+        [e = evaluator.get()](const Eigen::Ref<const Eigen::VectorXf>& z_l,
+                              const Eigen::Ref<const Eigen::VectorXf>& z_g, Eigen::VectorXf* g_zl,
+                              Eigen::VectorXf* g_zg) { return e->evaluate(z_l, z_g, g_zl, g_zg); },
+        model.config().zl, model.config().zg);
+  }
+
+  DirectLatentEnergy& energy() { return direct ? static_cast<DirectLatentEnergy&>(*direct) : torch; }
+
+  FlatLatentEnergy torch;
+  const runtime::NemfRuntime* runtime = nullptr;
+  std::unique_ptr<RenavRuntimeEnergy> evaluator;
+  std::unique_ptr<RuntimeLatentEnergy> direct;
+};
+
+// The encoder's mean codes of a segment canonical at its first frame: on the
+// runtime when there is one, else on libtorch.
+InitialGuess encode_segment(const NemfModel& model, const runtime::NemfRuntime* rt, const Motion& seg) {
+  return rt ? encode_window(*rt, seg, 0) : encode_window(model, seg, 0);
+}
+
 // The initial codes of window `k`: z_l from the reference segment, z_g from
 // each candidate of `inits`; the lowest energy is kept (recorded in *sum).
-Eigen::VectorXd initial_codes(const NemfModel& model, const RenavWindow& window, FlatLatentEnergy& energy,
+Eigen::VectorXd initial_codes(const NemfModel& model, const RenavWindow& window, RenavWindowEnergies& energy,
                               const std::vector<std::string>& inits, uint64_t seed, int k, RenavWindowSummary* sum) {
   const int zg = model.config().zg;
-  const InitialGuess ref_code = encode_window(model, window.reference_segment, 0);
+  const InitialGuess ref_code = encode_segment(model, energy.runtime, window.reference_segment);
   Eigen::VectorXd x0;
   double best = std::numeric_limits<double>::infinity();
   for (const std::string& name : inits) {
     Eigen::VectorXf z_g(zg);
     if (name == "turned") {
-      z_g = encode_window(model, window.turned_segment, 0).z_g;
+      z_g = encode_segment(model, energy.runtime, window.turned_segment).z_g;
     } else if (name == "reference") {
       z_g = ref_code.z_g;
     } else {
@@ -439,7 +483,7 @@ Eigen::VectorXd initial_codes(const NemfModel& model, const RenavWindow& window,
       for (int i = 0; i < zg; ++i) z_g[i] = normal(rng);
     }
     const Eigen::VectorXd x = join_codes(ref_code.z_l, z_g);
-    const double e = energy.cost(x);
+    const double e = energy.energy().evaluate(x.data(), nullptr);
     sum->init_energies.emplace_back(name, e);
     if (e < best || x0.size() == 0) {
       best = e;
@@ -448,6 +492,16 @@ Eigen::VectorXd initial_codes(const NemfModel& model, const RenavWindow& window,
     }
   }
   return x0;
+}
+
+// The window decoded at the solution x, on the runtime when the energy is its.
+DecodedWindow decode_solution(const NemfModel& model, const RenavWindow& window, const RenavWindowEnergies& energy,
+                              const Eigen::VectorXd& x) {
+  const Eigen::VectorXf z_l = head_codes(x, model.config().zl), z_g = tail_codes(x, model.config().zg);
+  if (!energy.evaluator) return decode_renav_window(model, window, codes_tensor(z_l), codes_tensor(z_g));
+  DecodedWindow d;
+  energy.evaluator->decode_window(z_l, z_g, &d.local_rotations, &d.root_positions, &d.contacts);
+  return d;
 }
 
 // Mean and maximum horizontal distance of the output's root from the path, cm.
@@ -509,15 +563,12 @@ SolvedWindow solve_renav_window(const NemfModel& model, const RenavPlan& plan, i
   sum.length = span.length;
   sum.reference_from = span.ref_begin * plan.pace / fm;
   sum.reference_to = (span.ref_begin + span.ref_length - 1) * plan.pace / fm;
-  const int zl = model.config().zl, zg = model.config().zg;
-  FlatLatentEnergy energy(window_energy(model, window, options.weights), zl, zg);
+  RenavWindowEnergies energy(model, window, options, window_ctx);
   const Eigen::VectorXd x0 = initial_codes(model, window, energy, inits, seed, k, &sum);
   const Eigen::VectorXd x =
-      minimize_window(energy, x0, options.capped(plan.cap), window_ctx, iteration_offset, total, &sum);
-  SolvedWindow solved{decode_renav_window(model, window, codes_tensor(head_codes(x, zl)),
-                                          codes_tensor(tail_codes(x, zg))),
-                      window.transform,
-                      sum.iterations};
+      minimize_window(energy.energy(), x0, options.capped(plan.cap), window_ctx, iteration_offset, total, &sum);
+  sum.runtime_energy = energy.direct != nullptr;
+  SolvedWindow solved{decode_solution(model, window, energy, x), window.transform, sum.iterations};
   sum.wall_ms = ms_since(t0);
   rep->windows.push_back(std::move(sum));
   return solved;

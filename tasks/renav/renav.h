@@ -85,9 +85,13 @@
 //
 // Solvers: L-BFGS (Ceres GradientProblemSolver, the default, method "nemf")
 // or NeMF's Adam (lr 0.1, decay x0.7 every 200, up to 600 iterations, method
-// "nemf-adam"), both with early stopping, progress reports once per iteration
-// (TaskContext::report: the callback and the cancel flag can stop them:
-// CancelledError) and a per-window summary. Deterministic for a given input,
+// "nemf-adam"). When the context carries the model's Eigen runtime
+// (TaskContext::runtime), L-BFGS minimises the energy on it
+// (tasks/renav/renav_runtime_energy.h), the initial codes come from its
+// encoders (NemfRuntime::encode_rotations) and the solution is decoded on it;
+// otherwise, and for Adam, everything runs on libtorch. Both stop early,
+// report progress once per iteration (TaskContext::report: the callback and
+// the cancel flag can stop them: CancelledError) and fill a per-window summary. Deterministic for a given input,
 // options, seed and thread count.
 #pragma once
 
@@ -106,6 +110,7 @@
 #include "tasks/latent/latent_energy.h"
 #include "tasks/latent/latent_optimizer.h"
 #include "tasks/latent/window_solver.h"
+#include "tasks/renav/renav_window.h"
 #include "tasks/renav/soft_dtw.h"
 
 namespace mf {
@@ -113,37 +118,6 @@ namespace mf {
 class NemfModel;
 
 // ---------------------------------------------------------------- the energy
-
-struct RenavWeights {
-  /// 2: at 1 a path turned from the reference's own direction
-  /// could be traded for a slower walk (docs/BENCHMARKS.md, "Re-navigation").
-  double path = 2.0;
-  double joints = 0.5;
-  double heading = 1.0;
-  double foot_skating = 0.0;
-  double continuity = 1.0;
-  double gamma = kNemfSoftDtwGamma;  ///< soft-DTW smoothing (squared Euclidean cost)
-};
-
-/// One window of a re-navigation problem, canonical (see the top of this file).
-struct RenavWindow {
-  int length = 0;                    ///< T, output frames of the window (2 <= T <= the model's window)
-  GroundTransform transform;         ///< canonical -> world
-  at::Tensor target_xz;              ///< [T, 2] target ground path (x, z), canonical
-  at::Tensor target_tangent;         ///< [T, 2] unit tangent (x, z) of the target path, canonical
-  at::Tensor start_xz;               ///< [1, 2] where the GMP's root path starts (the origin, or the previous solution)
-  at::Tensor reference_joints;       ///< [1, R, J*3] heading-frame joint positions of the reference segment
-  at::Tensor reference_heading;      ///< [1, R, 1] the reference's c(t)
-  // Continuity with the previous window (undefined when there is none).
-  at::Tensor shared_frames;          ///< [S] int64 window frames shared with the previous window
-  at::Tensor shared_rotations;       ///< [S, J, 3, 3] its local rotations there (root in this window's canonical frame)
-  at::Tensor shared_joints;          ///< [S, J, 3] its heading-frame joint positions there
-  // For the initialisation.
-  Motion reference_segment;          ///< the reference frames of this window (model fps, world)
-  Motion turned_segment;             ///< the same turned to follow the target, canonicalising at frame 0 to `transform`
-
-  int num_shared() const { return shared_frames.defined() ? static_cast<int>(shared_frames.size(0)) : 0; }
-};
 
 /// The problem of output frames [begin, begin + length) of a model-rate target
 /// path `path` (world (x, z) per model frame): the reference segment
@@ -169,10 +143,12 @@ RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindo
                                 const at::Tensor& local_rotations, const at::Tensor& root_positions,
                                 const at::Tensor& contacts);
 
-/// The energy of latent codes z_l [1, zl], z_g [1, zg]: the window decoded at
-/// frames 0..T-1, root path from the GMP starting at window.start_xz, then
-/// renav_motion_energy(). Differentiable with respect to the codes (the caller
-/// freezes the network).
+/// The energy of latent codes z_l [1, zl], z_g [1, zg] on libtorch: the window
+/// decoded at frames 0..T-1, root path from the GMP starting at the origin,
+/// then renav_motion_energy(). Differentiable with respect to the codes (the
+/// caller freezes the network). Adam and contexts without the model's Eigen
+/// runtime minimise it; L-BFGS with the runtime minimises RenavRuntimeEnergy
+/// (tasks/renav/renav_runtime_energy.h), the same energy.
 RenavEnergy evaluate_renav_energy(const NemfModel& model, const RenavWindow& window, const RenavWeights& weights,
                                   const at::Tensor& z_l, const at::Tensor& z_g);
 

@@ -53,10 +53,9 @@
 
 #include <ATen/core/Tensor.h>
 
-namespace mf {
+#include "tasks/renav/soft_dtw_kernels.h"  // kNemfSoftDtwGamma
 
-/// The gamma NeMF uses for re-navigation.
-inline constexpr double kNemfSoftDtwGamma = 0.1;
+namespace mf {
 
 /// Soft-DTW value of cost matrices: `cost` [m, n] -> scalar [], or [B, m, n] -> [B],
 /// in cost's dtype. Any real costs (negative ones too). Differentiable with respect

@@ -11,6 +11,13 @@
 #include <functional>
 #include <memory>
 
+namespace mf {
+
+/// The gamma NeMF uses for re-navigation.
+inline constexpr double kNemfSoftDtwGamma = 0.1;
+
+}  // namespace mf
+
 namespace mf::sdtw {
 
 /// Runs body(b, e) over sub-ranges [b, e) of [begin, end), possibly on several
