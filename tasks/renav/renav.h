@@ -86,10 +86,10 @@
 // Solvers: L-BFGS (Ceres GradientProblemSolver, the default, method "nemf")
 // or NeMF's Adam (lr 0.1, decay x0.7 every 200, up to 600 iterations, method
 // "nemf-adam"). When the context carries the model's Eigen runtime
-// (TaskContext::runtime), L-BFGS minimises the energy on it
+// (TaskContext::runtime), either optimiser minimises the energy on it
 // (tasks/renav/renav_runtime_energy.h), the initial codes come from its
 // encoders (NemfRuntime::encode_rotations) and the solution is decoded on it;
-// otherwise, and for Adam, everything runs on libtorch. Both stop early,
+// otherwise everything runs on libtorch. Both stop early,
 // report progress once per iteration (TaskContext::report: the callback and
 // the cancel flag can stop them: CancelledError) and fill a per-window summary. Deterministic for a given input,
 // options, seed and thread count.
