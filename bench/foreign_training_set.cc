@@ -9,8 +9,7 @@
 
 #include "bench/foreign_data.h"
 #include "bench/options.h"
-#include "prior/model/model_file.h"
-#include "prior/model/nemf.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/motion/motion_bvh.h"
 #include "prior/util/command_line.h"
 #include "tasks/context/ground_level.h"
@@ -28,8 +27,8 @@ struct Args {
 int run(const Args& args) {
   mf::TaskContext ctx;
   const std::string model_path = args.model.empty() ? mf::default_model_path() : args.model;
-  auto model = std::make_shared<mf::NemfModel>(mf::load_nemf(model_path));
-  ctx.model = model;
+  ctx.model = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(model_path));
+  const std::shared_ptr<const mf::runtime::NemfRuntime> model = ctx.model;
   ctx.model_anatomy = mf::load_rig_anatomy_next_to(model_path, model->rig().skeleton);
   if (!ctx.model_anatomy) throw mf::InputError("no rig anatomy next to " + model_path);
   const double fps = model->config().fps;

@@ -27,6 +27,7 @@
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
+#include "prior/runtime/inbetween_runtime.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "bench/foreign_data.h"
 #include "bench/synthetic_rigs.h"
@@ -35,6 +36,7 @@
 #include "tasks/context/model_rig.h"
 #include "tasks/methods/jobs.h"
 #include "tasks/methods/transformer_methods.h"
+#include "tasks/reference/libtorch_energies.h"
 
 namespace {
 
@@ -79,7 +81,7 @@ struct Args {
   double foreign_fps = 0;  // the foreign clips captured at this rate only, at it (0: every clip at the model's rate)
   std::string windows_csv;  // per-window scores and signals (bench/window_log.h)
   bool no_fallback = false;  // the latent solvers keep their own result everywhere
-  bool libtorch_energy = false;  // no Eigen runtime in the context: the latent solvers minimise the libtorch energy
+  bool libtorch_energy = false;  // the latent solvers minimise the libtorch energy (TaskContext::reference)
   std::string features;  // the feature extractor of the distribution metrics (bench/motion_features.h)
 };
 
@@ -144,8 +146,8 @@ void add_options(CLI::App& app, Args& args) {
                "the latent solvers keep their own result where the prior cannot reach the keys (by default they fall "
                "back to interpolation there: tasks/latent/fallback.h)");
   app.add_flag("--libtorch-energy", args.libtorch_energy,
-               "load no Eigen runtime of the prior: the latent solvers' L-BFGS minimises the libtorch energy "
-               "(tasks/latent/energies.h) instead of the Eigen one (tasks/latent/runtime_energy.h), to compare them");
+               "the latent solvers minimise the prior's energy on libtorch (tasks/reference/energies.h) instead of "
+               "the Eigen runtime's (tasks/latent/runtime_energy.h), to compare them");
   app.add_flag("--print-stats", args.print_stats,
                "add the table of training statistics (position mean / std, standing heights)");
 }
@@ -340,15 +342,15 @@ int run(Args& args, const std::string& command) {
   // The prior, loaded once, frozen, shared by every method and task.
   mf::TaskContext ctx;
   ctx.interpolation_fallback = !args.no_fallback;
-  std::shared_ptr<mf::NemfModel> model;
+  // The libtorch prior: the prior tasks' reconstruction and sampling, and --libtorch-energy.
+  std::shared_ptr<const mf::NemfModel> model;
   if (!args.model.empty()) {
     std::cerr << "loading model " << args.model << "\n";
-    model = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));  // frozen
-    ctx.model = model;
-    if (!args.libtorch_energy)
-      ctx.runtime = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
+    ctx.model = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
+    model = std::make_shared<const mf::NemfModel>(mf::load_nemf(args.model));  // frozen
+    if (args.libtorch_energy) ctx.reference = mf::libtorch_energies(model);
     mf::bench::load_transformers(args.transformers, args.model, &ctx, true);
-    ctx.model_anatomy = mf::load_rig_anatomy_next_to(args.model, model->rig().skeleton);
+    ctx.model_anatomy = mf::load_rig_anatomy_next_to(args.model, ctx.model->rig().skeleton);
   }
 
   std::cerr << "loading " << args.data.source << "\n";
@@ -370,7 +372,7 @@ int run(Args& args, const std::string& command) {
   md << "- model: " << (model ? args.model + " (" + model->config().describe() + ")" : std::string("none")) << "\n";
   for (const mf::InbetweenerKind& k : mf::inbetweener_kinds()) {
     const std::string& kind = k.name;
-    const mf::InbetweenModel* t = ctx.inbetweener(kind);
+    const mf::runtime::InbetweenerRuntime* t = ctx.inbetweener(kind);
     md << "- " << kind << " transformer: " << (t ? t->describe() : std::string("not loaded")) << "\n";
   }
   md << "- validation clips: " << data.validation.size() << " (" << validation_frames << " frames)"
@@ -464,10 +466,7 @@ int run(Args& args, const std::string& command) {
   prior_options.max_windows = args.split.max_windows;
   prior_options.samples = args.samples;
   prior_options.seed = static_cast<uint64_t>(args.seed);
-  // The codec runs on the Eigen runtime, loaded here when --libtorch-energy left the context without one.
-  std::shared_ptr<const mf::runtime::NemfRuntime> codec_runtime = ctx.runtime;
-  if (!codec_runtime && !args.prior_tasks.empty())
-    codec_runtime = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
+  const std::shared_ptr<const mf::runtime::NemfRuntime> codec_runtime = ctx.model;
   for (const std::string& task : args.prior_tasks) {
     std::cerr << "running " << task << " / prior\n";
     const auto t0 = std::chrono::steady_clock::now();

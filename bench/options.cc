@@ -3,7 +3,7 @@
 #include <iostream>
 #include <memory>
 
-#include "prior/inbetween/inbetweener.h"
+#include "prior/inbetween/inbetweener_kinds.h"
 #include "prior/model/model_file.h"
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
@@ -12,6 +12,7 @@
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 #include "tasks/context/model_rig.h"
+#include "tasks/reference/libtorch_energies.h"
 #include "tasks/transformer/inbetweener_files.h"
 
 namespace mf::bench {
@@ -80,7 +81,8 @@ void add_model_bench_options(CLI::App& app, ModelBenchOptions& options) {
   add_transformer_options(app, options.transformers);
   add_threads_option(app, options.threads);
   app.add_flag("--libtorch-energy", options.libtorch_energy,
-               "no Eigen runtime of the prior: the latent solvers minimise the libtorch energy (for comparisons)");
+               "the latent solvers minimise the prior's energy on libtorch (tasks/reference/), not on the Eigen "
+               "runtime (for comparisons)");
 }
 
 BenchContext load_bench_context(const ModelBenchOptions& options) {
@@ -88,12 +90,11 @@ BenchContext load_bench_context(const ModelBenchOptions& options) {
   b.model_path = options.model.empty() ? default_model_path() : options.model;
   if (b.model_path.empty()) throw InputError("no default model: pass --model FILE");
   set_compute_threads(options.threads);
-  auto model = std::make_shared<NemfModel>(load_nemf(b.model_path));  // frozen
-  b.ctx.model = model;
-  if (!options.libtorch_energy)
-    b.ctx.runtime = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::load(b.model_path));
+  b.ctx.model = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::load(b.model_path));
+  if (options.libtorch_energy)
+    b.ctx.reference = libtorch_energies(std::make_shared<const NemfModel>(load_nemf(b.model_path)));  // frozen
   load_transformers(options.transformers, b.model_path, &b.ctx, false);
-  b.ctx.model_anatomy = load_rig_anatomy_next_to(b.model_path, model->rig().skeleton);
+  b.ctx.model_anatomy = load_rig_anatomy_next_to(b.model_path, b.ctx.model->rig().skeleton);
   b.data = load_data(options.data, false);
   b.stats = compute_eval_stats(b.data.train);
   return b;

@@ -71,7 +71,7 @@ struct ModelBenchOptions {
   SplitChoice split;
   TransformerFiles transformers;
   int threads = 1;
-  bool libtorch_energy = false;  ///< --libtorch-energy: no Eigen runtime of the prior in the context
+  bool libtorch_energy = false;  ///< --libtorch-energy: the libtorch reference energies in the context
 };
 void add_model_bench_options(CLI::App& app, ModelBenchOptions& options);
 

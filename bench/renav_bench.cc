@@ -12,13 +12,12 @@
 //               [--methods turned,nemf,nemf-adam] [--iterations N] [--adam-iterations N] [--ftol X]
 //               [--w-path X] [--w-joints X] [--w-heading X] [--w-skate X] [--w-continuity X]
 //               [--inits turned,reference,random] [--write N] [--out-dir DIR] [--out FILE]
-//               [--profile N] [--verbose 1] [--libtorch-energy]
+//               [--profile N] [--verbose 1]
 //
 // --profile N prints the cost of one energy evaluation (and its parts) with
-// gradient on a 128-frame window, median of N; --verbose 1 prints every
-// window's terms before and after the solve; --libtorch-energy has L-BFGS
-// minimise the libtorch energy instead of the Eigen runtime's (the default,
-// as in the CLI).
+// gradient on a 128-frame window on libtorch (tasks/reference/renav_energy.h),
+// median of N; --verbose 1 prints every window's terms before and after the
+// solve.
 //
 // Reference clips: validation clips whose mean ground speed over their first
 // (up to) 600 frames lies in [0.7, 2.5] m/s (walking and running) and that are
@@ -63,8 +62,9 @@
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
+#include "tasks/reference/renav_energy.h"
+#include "tasks/reference/soft_dtw.h"
 #include "tasks/renav/renav.h"
-#include "tasks/renav/soft_dtw.h"
 
 namespace {
 
@@ -88,7 +88,6 @@ struct Args {
   int write = 2;
   int profile = 0;
   int verbose = 0;
-  bool libtorch_energy = false;
   std::string out_dir = "out/renav";
   std::string out;
 };
@@ -111,8 +110,6 @@ void add_options(CLI::App& app, Args& a) {
   app.add_option("--write", a.write, "write BVH results, path CSVs and SVG top views of the first N clips");
   app.add_option("--profile", a.profile, "print the cost of one energy evaluation, median of N (0: no)");
   app.add_option("--verbose", a.verbose, "1: print every window's terms before and after the solve");
-  app.add_flag("--libtorch-energy", a.libtorch_energy,
-               "no Eigen runtime of the prior: L-BFGS minimises the libtorch energy (for comparisons)");
   app.add_option("--out-dir", a.out_dir, "folder of the written results");
   app.add_option("--out", a.out, "also write the markdown to FILE");
   mf::bench::add_number_options(app, a.numbers,
@@ -299,11 +296,11 @@ double median_ms(int n, Fn&& fn) {
 }
 
 // The cost of one energy evaluation with gradient on a 128-frame window, and of its parts.
-std::string profile(const mf::NemfModel& model, const mf::Motion& ref, int n) {
+std::string profile(const mf::NemfModel& model, const mf::runtime::NemfRuntime& rt, const mf::Motion& ref, int n) {
   const int T = model.config().window;
   std::vector<Eigen::Vector2d> path;
   for (int f = 0; f < T; ++f) path.emplace_back(0.0, 0.04 * f);
-  const mf::RenavWindow w = mf::make_renav_window(model, ref, 0, T, path, 0, T);
+  const mf::RenavWindow w = mf::make_renav_window(rt, ref, 0, T, path, 0, T);
   const int zl = model.config().zl, zg = model.config().zg;
   at::Tensor z_l = at::zeros({1, zl}).requires_grad_(true), z_g = at::zeros({1, zg}).requires_grad_(true);
   const at::Tensor frames = at::arange(T, at::kFloat);
@@ -344,12 +341,9 @@ int run(Args& args, const std::string& command) {
   for (const std::string& p : args.paths) test_polyline(p);  // fails early on an unknown path
   mf::set_compute_threads(args.threads);
 
-  mf::NemfModel model = mf::load_nemf(args.model);
-  model.set_requires_grad(false);
-  mf::TaskContext ctx;  // the model (not owned) and, unless --libtorch-energy, its Eigen runtime
-  ctx.model = std::shared_ptr<const mf::NemfModel>(std::shared_ptr<const mf::NemfModel>(), &model);
-  if (!args.libtorch_energy)
-    ctx.runtime = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
+  mf::TaskContext ctx;
+  ctx.model = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
+  const mf::runtime::NemfRuntime& model = *ctx.model;
   const mf::RigInfo& rig = model.rig();
   const double fps = model.config().fps;
   const mf::Dataset data = mf::bench::load_data(args.data, false);
@@ -410,7 +404,11 @@ int run(Args& args, const std::string& command) {
          ", heading " + fixed(w.heading, 2) + ", foot skating " + fixed(w.foot_skating, 2) + ", continuity " +
          fixed(w.continuity, 2) + "; match pace " + (o.match_pace ? "yes" : "no") + "\n");
   }
-  if (args.profile > 0 && !refs.empty()) emit("\n" + profile(model, refs[0], args.profile));
+  if (args.profile > 0 && !refs.empty()) {
+    mf::NemfModel torch_model = mf::load_nemf(args.model);  // the energy's libtorch reference, for --profile
+    torch_model.set_requires_grad(false);
+    emit("\n" + profile(torch_model, model, refs[0], args.profile));
+  }
   emit("\n| path | method | clips | frames | path error (cm) | foot skating (cm) | skating, reference (cm) | "
        "sDTW joints | sDTW heading | E0 -> E | iterations | s / clip | init (turned/reference/random) |\n"
        "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|\n");

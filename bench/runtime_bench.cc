@@ -32,9 +32,9 @@
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
-#include "tasks/latent/energies.h"
+#include "tasks/reference/energies.h"
 #include "tasks/latent/runtime_energy.h"
-#include "tasks/latent/runtime_problem.h"
+#include "tasks/latent/runtime_latent_energy.h"
 #include "tasks/transformer/inbetweener_files.h"
 
 namespace {

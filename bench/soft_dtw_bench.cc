@@ -1,4 +1,4 @@
-// Times soft-DTW (tasks/renav/soft_dtw.h): forward alone and forward + backward of one
+// Times soft-DTW (tasks/reference/soft_dtw.h): forward alone and forward + backward of one
 // m x n cost matrix (m = n) at each thread count, then the divergence on
 // sequences the size of the re-navigation energy (128 frames, 22 joints x 3).
 // Prints markdown tables (median of several runs).
@@ -15,7 +15,7 @@
 
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
-#include "tasks/renav/soft_dtw.h"
+#include "tasks/reference/soft_dtw.h"
 
 namespace {
 
@@ -100,7 +100,7 @@ int run(int64_t max_length, const std::vector<int>& threads) {
 int main(int argc, char** argv) {
   int64_t max_length = 4096;
   std::vector<int> threads{1, 2};
-  CLI::App app{"Times soft-DTW (tasks/renav/soft_dtw.h) forward and forward + backward per sequence length and thread "
+  CLI::App app{"Times soft-DTW (tasks/reference/soft_dtw.h) forward and forward + backward per sequence length and thread "
                "count, and the divergence at the re-navigation energy's size.",
                "soft-dtw-bench"};
   mf::cli::use_tool_defaults(app);

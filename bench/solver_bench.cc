@@ -32,8 +32,8 @@
 // after the speed table, the operators run per energy evaluation and the time in
 // them (bench/op_profile.h; with --threads 1). L-BFGS minimises the Eigen
 // runtime's energy where it ports the window's terms, as the product does
-// (tasks/latent/latent_solver.h); --libtorch-energy loads no runtime, so that
-// it minimises the libtorch energy everywhere, for comparison.
+// (tasks/latent/latent_solver.h); --libtorch-energy has them minimise the
+// libtorch energy (tasks/reference/libtorch_energies.h), for comparison.
 //
 // Transformers (tasks/methods/transformer_methods.h): --twostage/--citl FILE, else
 // motionfield-twostage.mfm / motionfield-citl.mfm next to --model when they
@@ -70,6 +70,7 @@
 #include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
+#include "prior/runtime/inbetween_runtime.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
@@ -77,6 +78,7 @@
 #include "tasks/latent/initializers.h"
 #include "tasks/latent/latent_solver.h"
 #include "tasks/methods/transformer_methods.h"
+#include "tasks/reference/libtorch_energies.h"
 
 namespace {
 
@@ -111,8 +113,8 @@ struct Args {
   std::string init;
   mf::bench::TransformerFiles transformer_files;  // default: next to --model
   mf::TaskContext transformers;  // the loaded transformers (filled by run())
-  bool libtorch_energy = false;  // no Eigen runtime: the latent solvers minimise the libtorch energy
-  mf::TaskContext prior;  // the prior and (unless libtorch_energy) its Eigen runtime, as the solvers' context (run())
+  bool libtorch_energy = false;  // the latent solvers minimise the libtorch energy (TaskContext::reference)
+  mf::TaskContext prior;  // the prior (and with libtorch_energy the reference energies), as the solvers' context (run())
 };
 
 // A stage of an in-betweener ("context", "detail", "citl"): one transformer
@@ -146,8 +148,8 @@ void add_options(CLI::App& app, Args& a) {
                "count the operators of each gap and sparse row and of each method's --speed solves (bench/op_profile.h; "
                "slows them; use --threads 1)");
   app.add_flag("--libtorch-energy", a.libtorch_energy,
-               "load no Eigen runtime of the prior: L-BFGS minimises the libtorch energy (tasks/latent/energies.h) "
-               "instead of the Eigen one (tasks/latent/runtime_energy.h), to compare them");
+               "the latent solvers minimise the libtorch energy (tasks/reference/energies.h) instead of the Eigen "
+               "runtime's (tasks/latent/runtime_energy.h), to compare them");
   app.add_option("--out", a.out, "also write the markdown to FILE");
   app.add_option("--penalty", a.penalty, "squared or absolute (default: the solver's, squared)")
       ->check(CLI::IsMember({"squared", "absolute"}));
@@ -177,7 +179,7 @@ void add_options(CLI::App& app, Args& a) {
                                  {"w-skate", "weight of foot skating"},
                                  {"w-smooth", "weight of smoothness"},
                                  {"w-effector", "weight of the end-effector targets"}},
-                                "Output and energy weights (default: tasks/latent/latent_solver.h, tasks/latent/energies.h)");
+                                "Output and energy weights (default: tasks/latent/latent_solver.h, tasks/reference/energies.h)");
 }
 
 mf::LatentSolverOptions solver_options(const Args& a, const std::string& method) {
@@ -243,13 +245,13 @@ std::string describe(const mf::LatentSolverOptions& o) {
 
 // A solver method (complete_motion with solver_options) or a transformer pass
 // (inbetweener_fill; `report` stays empty).
-mf::Motion complete(const mf::NemfModel& model, const Args& args, const std::string& method, const mf::Motion& input,
-                    const mf::MotionConstraints& constraints, mf::CompletionReport* report) {
+mf::Motion complete(const mf::runtime::NemfRuntime& model, const Args& args, const std::string& method,
+                    const mf::Motion& input, const mf::MotionConstraints& constraints, mf::CompletionReport* report) {
   int stage = 0;
   if (const mf::InbetweenerKind* kind = mf::find_inbetweener_stage(method, &stage)) {
-    const mf::InbetweenModel& t = mf::require_inbetweener(args.transformers, kind->name, "method '" + method + "'");
-    return mf::inbetweener_fill(t, args.transformers.inbetweener_runtime(kind->name), stage, input, constraints,
-                                mf::LongGapPolicy::Throw);
+    const mf::runtime::InbetweenerRuntime& t =
+        mf::require_inbetweener(args.transformers, kind->name, "method '" + method + "'");
+    return mf::inbetweener_fill(t, stage, input, constraints, mf::LongGapPolicy::Throw);
   }
   return mf::complete_motion(model, input, constraints, solver_options(args, method), args.prior, report);
 }
@@ -262,7 +264,7 @@ struct Row {
 
 // One method on one protocol row.
 struct Runner {
-  const mf::NemfModel& model;
+  const mf::runtime::NemfRuntime& model;
   const Args& args;
 
   mf::Motion solve(const std::string& method, const mf::Motion& input, const std::vector<int>& known, Row* row) const {
@@ -588,12 +590,13 @@ std::string profile_table(const mf::bench::OpProfile& profile, const std::string
 int run(Args& args, const std::string& command) {
   mf::set_compute_threads(args.threads);
 
+  // The libtorch prior times its decoder (--speed) and, with --libtorch-energy,
+  // gives the solvers its energies (TaskContext::reference).
   auto loaded = std::make_shared<mf::NemfModel>(mf::load_nemf(args.model));
   loaded->set_requires_grad(false);
-  const mf::NemfModel& model = *loaded;
-  args.prior.model = loaded;
-  if (!args.libtorch_energy)
-    args.prior.runtime = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
+  args.prior.model = std::make_shared<const mf::runtime::NemfRuntime>(mf::runtime::NemfRuntime::load(args.model));
+  const mf::runtime::NemfRuntime& model = *args.prior.model;
+  if (args.libtorch_energy) args.prior.reference = mf::libtorch_energies(loaded);
   mf::bench::load_transformers(args.transformer_files, args.model, &args.transformers, false);
   const mf::Dataset data = mf::bench::load_data(args.data, false);
   const mf::bench::EvalStats stats = mf::bench::compute_eval_stats(data.train);
@@ -608,7 +611,7 @@ int run(Args& args, const std::string& command) {
        ")\n- split: " + args.split.split + " (" + std::to_string(clips.size()) + " clips)\n- torch threads: " +
        std::to_string(at::get_num_threads()) + "\n- BLAS: " + mf::describe_blas() + "\n");
   for (const mf::InbetweenerKind& kind : mf::inbetweener_kinds()) {
-    const mf::InbetweenModel* t = args.transformers.inbetweener(kind.name);
+    const mf::runtime::InbetweenerRuntime* t = args.transformers.inbetweener(kind.name);
     emit("- " + kind.name + " transformer: " + (t ? t->describe() : std::string("not loaded")) + "\n");
   }
   for (const std::string& m : args.methods) {
@@ -674,7 +677,7 @@ int run(Args& args, const std::string& command) {
   }
 
   if (args.speed > 0) {
-    const double step = decoder_step_ms(model);
+    const double step = decoder_step_ms(*loaded);
     const auto windows = mf::bench::cap_windows(mf::bench::protocol_windows(clips, 128, 40), args.speed);
     const std::vector<int> keys = mf::bench::sparse_keyframes(128, 15);
     std::ostringstream s;

@@ -1,4 +1,4 @@
-// trajectory-bench: the latent solver's trajectory energy (tasks/latent/energies.h,
+// trajectory-bench: the latent solver's trajectory energy (tasks/reference/energies.h,
 // EnergyWeights::trajectory and trajectory_facing) on the gap-filling windows
 // of the benchmark protocol (bench/protocol.h: 10 context frames, a gap of T,
 // the target frame), with the ground truth's trajectory (root ground position
@@ -34,7 +34,7 @@
 #include "bench/options.h"
 #include "bench/protocol.h"
 #include "bench/text.h"
-#include "prior/model/nemf.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/motion/errors.h"
 #include "tasks/constraints/constraint_report.h"
 #include "tasks/constraints/interpolation_fill.h"

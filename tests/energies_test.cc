@@ -1,4 +1,4 @@
-// Energies of the latent solvers (tasks/latent/energies.h): zero at a perfect fit and
+// Energies of the latent solvers (tasks/reference/energies.h): zero at a perfect fit and
 // positive otherwise, gradients to the latents only, partial keys that never
 // read what they do not constrain, constraint validation, and the
 // interpolation initialiser.
@@ -14,8 +14,9 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/kinematics_torch.h"
 #include "tasks/constraints/interpolation_fill.h"
-#include "tasks/latent/energies.h"
+#include "tasks/reference/energies.h"
 #include "tasks/latent/initializers.h"
+#include "tests/runtime_test_util.h"
 #include "tests/test_util.h"
 
 namespace mf {
@@ -248,7 +249,7 @@ TEST(Energies, ConstraintValidation) {
 
 TEST(Initializers, InterpolationEncoderMatchesEncodingTheInterpolatedWindow) {
   at::set_num_threads(1);
-  NemfModel model = test::tiny_prior(11);
+  const runtime::NemfRuntime model = test::runtime_of(test::tiny_prior(11));
   Motion m = test::random_motion(model.rig().skeleton, 24, 30.0, 6);
   MotionConstraints c = MotionConstraints::full_pose({0, 11, 23});
   InitRequest r;

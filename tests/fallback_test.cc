@@ -10,6 +10,7 @@
 #include "tasks/latent/fallback.h"
 #include "tasks/latent/latent_solver.h"
 #include "tasks/methods/jobs.h"
+#include "tests/runtime_test_util.h"
 #include "tests/test_util.h"
 
 namespace mf {
@@ -90,7 +91,7 @@ LatentSolverOptions quick() {
 
 TEST(Fallback, AWindowOutOfThePriorsReachIsInterpolation) {
   at::set_num_threads(1);
-  const NemfModel model = tiny_model();
+  const runtime::NemfRuntime model = test::runtime_of(tiny_model());
   const Motion m = test::random_motion(model.rig().skeleton, 26, 30.0, 7);
   const MotionConstraints keys = MotionConstraints::full_pose({0, 6, 13, 25});
   const Motion interpolated = fill_by_interpolation(m, keys);
@@ -124,7 +125,7 @@ TEST(Fallback, AWindowOutOfThePriorsReachIsInterpolation) {
 TEST(Fallback, JobsReturnTheInputsOwnInterpolationAndSayWhy) {
   at::set_num_threads(1);
   TaskContext ctx;
-  ctx.model = std::make_shared<const NemfModel>(tiny_model());
+  ctx.model = test::shared_runtime_of(tiny_model());
   const Motion m = test::random_motion(ctx.model->rig().skeleton, 26, 30.0, 9);
   // A tiny random prior cannot fit random keys within the shipped thresholds.
   std::vector<std::string> warnings;

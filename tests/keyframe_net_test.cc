@@ -11,6 +11,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations_torch.h"
 #include "tasks/transformer/inbetweener_fill.h"
+#include "tests/runtime_test_util.h"
 #include "tests/test_util.h"
 #include "training/salient_poses.h"
 
@@ -180,24 +181,29 @@ TEST(KeyframeNetGlue, CanonicalTrajectoryUndoesTheGroundTransform) {
   g.x = 1.0;
   g.z = 2.0;
   // world = R_y(yaw) canonical + (x, 0, z): canonical (-1, 0) facing -x is world (1, 3) facing +z.
-  at::Tensor c = canonical_trajectory(at::tensor({1.0f, 3.0f, 0.0f, 1.0f}), g);
-  EXPECT_TRUE(at::allclose(c, at::tensor({-1.0f, 0.0f, -1.0f, 0.0f}), 1e-5, 1e-5)) << c;
-  EXPECT_THROW(canonical_trajectory(at::zeros({3}), g), InputError);
+  runtime::MatrixRXf world(1, 4);
+  world << 1.0f, 3.0f, 0.0f, 1.0f;
+  const runtime::MatrixRXf c = canonical_trajectory(world, g);
+  runtime::MatrixRXf expected(1, 4);
+  expected << -1.0f, 0.0f, -1.0f, 0.0f;
+  EXPECT_TRUE(c.isApprox(expected, 1e-5)) << c;
+  EXPECT_THROW(canonical_trajectory(runtime::MatrixRXf::Zero(1, 3), g), InputError);
 }
 
 TEST(KeyframeNetGlue, ConstrainedTrajectoryKeysWinRowsFillTheRest) {
   const RigInfo rig = test::tiny_rig();
   Motion m = test::random_motion(rig.skeleton, 21, 30.0, 5);
   MotionConstraints c = MotionConstraints::full_pose({0, 20});
-  EXPECT_FALSE(constrained_trajectory(m, c, rig).defined());  // no rows: the model interpolates itself
+  EXPECT_EQ(constrained_trajectory(m, c, rig).rows(), 0);  // no rows: the model interpolates itself
   c.trajectory = {{0, 50.0, 50.0, 1.0, 0.0}, {10, 3.0, -1.0, 0.0, 2.0}};
-  at::Tensor t = constrained_trajectory(m, c, rig);
-  ASSERT_EQ(t.sizes(), (at::IntArrayRef{21, 4}));
-  EXPECT_NEAR(t[0][0].item<float>(), m.root_positions[0].x(), 1e-5);  // the key wins over the row
-  EXPECT_NEAR(t[20][1].item<float>(), m.root_positions[20].z(), 1e-5);
-  EXPECT_NEAR(t[10][0].item<float>(), 3.0, 1e-5);
-  EXPECT_NEAR(t[10][3].item<float>(), 1.0, 1e-5);  // facing normalised
-  EXPECT_NEAR(t[5][0].item<float>(), 0.5 * (m.root_positions[0].x() + 3.0), 1e-4);  // interpolated
+  const runtime::MatrixRXf t = constrained_trajectory(m, c, rig);
+  ASSERT_EQ(t.rows(), 21);
+  ASSERT_EQ(t.cols(), 4);
+  EXPECT_NEAR(t(0, 0), m.root_positions[0].x(), 1e-5);  // the key wins over the row
+  EXPECT_NEAR(t(20, 1), m.root_positions[20].z(), 1e-5);
+  EXPECT_NEAR(t(10, 0), 3.0, 1e-5);
+  EXPECT_NEAR(t(10, 3), 1.0, 1e-5);  // facing normalised
+  EXPECT_NEAR(t(5, 0), 0.5 * (m.root_positions[0].x() + 3.0), 1e-4);  // interpolated
 }
 
 TEST(KeyframeNetGlue, FillReadsTheTrajectory) {
@@ -207,9 +213,10 @@ TEST(KeyframeNetGlue, FillReadsTheTrajectory) {
   for (int f = 0; f < 10; ++f) known.push_back(f);
   known.push_back(kFrames - 1);
   MotionConstraints c = MotionConstraints::full_pose(known);
-  const Motion plain = inbetweener_fill(*model, nullptr, -1, m, c, LongGapPolicy::Throw);
+  const auto net = test::runtime_of(*model);
+  const Motion plain = inbetweener_fill(*net, -1, m, c, LongGapPolicy::Throw);
   for (int f = 10; f < kFrames - 1; ++f) c.trajectory.push_back({f, 0.1 * f, 2.0, 1.0, 0.0});
-  const Motion along = inbetweener_fill(*model, nullptr, -1, m, c, LongGapPolicy::Throw);
+  const Motion along = inbetweener_fill(*net, -1, m, c, LongGapPolicy::Throw);
   double moved = 0.0;
   for (int f = 10; f < kFrames - 1; ++f) moved = std::max(moved, (along.root_positions[f] - plain.root_positions[f]).norm());
   EXPECT_GT(moved, 1e-4);

@@ -18,6 +18,8 @@
 #include "prior/motion/rotations.h"
 #include "tasks/latent/latent_solver.h"
 #include "tasks/methods/jobs.h"
+#include "tasks/reference/energies.h"
+#include "tests/runtime_test_util.h"
 #include "tests/test_util.h"
 
 namespace mf {
@@ -51,6 +53,9 @@ NemfModel tiny_model() {
   return standing_prior(rig);
 }
 
+// The same on the Eigen runtime, as the solvers take it.
+runtime::NemfRuntime tiny_runtime() { return test::runtime_of(tiny_model()); }
+
 LatentSolverOptions quick(LatentOptimizer method) {
   LatentSolverOptions o = default_solver_options(method);
   o.max_iterations = method == LatentOptimizer::Adam ? 60 : 20;
@@ -60,7 +65,7 @@ LatentSolverOptions quick(LatentOptimizer method) {
 // A keyframe problem whose targets the model can reach: exactly what z*
 // decodes to, in the model's own canonical frame.
 struct Reachable {
-  WindowProblem problem;
+  RuntimeWindowProblem problem;
   InitialGuess start;
 };
 Reachable reachable_problem(const NemfModel& model) {
@@ -71,7 +76,7 @@ Reachable reachable_problem(const NemfModel& model) {
   const std::vector<int64_t> keys = {0, 8, 16, 23};
   const int K = static_cast<int>(keys.size());
   Reachable r;
-  WindowProblem& p = r.problem;
+  WindowProblem p;
   p.length = T;
   p.anchor = 0;
   DecodedWindow d = decode_window(model, p, zl, zg);
@@ -88,6 +93,7 @@ Reachable reachable_problem(const NemfModel& model) {
   p.effector_joints = at::zeros({0}, at::kLong);
   p.effector_targets = at::zeros({0, 3});
   p.effector_weights = at::zeros({0});
+  r.problem = to_runtime_problem(p, J);
   r.start = {Eigen::VectorXf::Zero(8), Eigen::VectorXf::Zero(4)};
   return r;
 }
@@ -105,8 +111,8 @@ Motion gentle_motion(const Skeleton& s, int frames, uint32_t seed) {
 
 TEST(LatentSolver, LbfgsAndAdamBothReduceAKeyframeEnergy) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
-  Reachable r = reachable_problem(model);
+  const runtime::NemfRuntime model = tiny_runtime();
+  Reachable r = reachable_problem(tiny_model());
   for (LatentOptimizer method : {LatentOptimizer::Lbfgs, LatentOptimizer::Adam}) {
     LatentSolution s = solve_latents(model, r.problem, r.start, quick(method), {});
     EXPECT_GT(s.summary.iterations, 0);
@@ -125,8 +131,8 @@ TEST(LatentSolver, LbfgsAndAdamBothReduceAKeyframeEnergy) {
 
 TEST(LatentSolver, LbfgsStopsEarlyOnConvergence) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
-  Reachable r = reachable_problem(model);
+  const runtime::NemfRuntime model = tiny_runtime();
+  Reachable r = reachable_problem(tiny_model());
   LatentSolverOptions o = default_solver_options();
   o.max_iterations = 200;
   o.function_tolerance = 1e-2;
@@ -137,8 +143,8 @@ TEST(LatentSolver, LbfgsStopsEarlyOnConvergence) {
 
 TEST(LatentSolver, ProgressObservesAndCancels) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
-  Reachable r = reachable_problem(model);
+  const runtime::NemfRuntime model = tiny_runtime();
+  Reachable r = reachable_problem(tiny_model());
   for (LatentOptimizer method : {LatentOptimizer::Lbfgs, LatentOptimizer::Adam}) {
     std::vector<int> seen;
     TaskContext ctx;
@@ -163,7 +169,7 @@ TEST(LatentSolver, ProgressObservesAndCancels) {
 
 TEST(LatentSolver, KnownFramesComeOutExactlyAndUnknownFramesAreNeverRead) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  const runtime::NemfRuntime model = tiny_runtime();
   Motion m = test::random_motion(model.rig().skeleton, 26, 30.0, 7);
   const std::vector<int> keys = {0, 6, 13, 25};
   CompletionReport report;
@@ -192,7 +198,7 @@ TEST(LatentSolver, KnownFramesComeOutExactlyAndUnknownFramesAreNeverRead) {
 
 TEST(LatentSolver, DiagnosticsCarryEachWindowsEnergyTerms) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  const runtime::NemfRuntime model = tiny_runtime();
   Motion m = test::random_motion(model.rig().skeleton, 26, 30.0, 7);
   std::vector<std::pair<std::string, double>> diagnostics;
   TaskContext ctx;
@@ -214,7 +220,7 @@ TEST(LatentSolver, DiagnosticsCarryEachWindowsEnergyTerms) {
 
 TEST(LatentSolver, DeterministicForTheSameInput) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  const runtime::NemfRuntime model = tiny_runtime();
   Motion m = test::random_motion(model.rig().skeleton, 30, 30.0, 8);
   for (LatentOptimizer method : {LatentOptimizer::Lbfgs, LatentOptimizer::Adam}) {
     TaskContext ctx;
@@ -227,7 +233,7 @@ TEST(LatentSolver, DeterministicForTheSameInput) {
 
 TEST(LatentSolver, PartialConstraintsIgnoreUnconstrainedJoints) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  const runtime::NemfRuntime model = tiny_runtime();
   Motion m = test::random_motion(model.rig().skeleton, 24, 30.0, 9);
   MotionConstraints c = MotionConstraints::full_pose({0, 23});
   PoseKey legs;  // frame 12: only the left leg (UpperLeg_L, Foot_L)
@@ -253,7 +259,7 @@ TEST(LatentSolver, PartialConstraintsIgnoreUnconstrainedJoints) {
 
 TEST(LatentSolver, EndEffectorPullsTheJointTowardItsTarget) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  const runtime::NemfRuntime model = tiny_runtime();
   const int foot = model.rig().foot_joints[0];
   Motion m = gentle_motion(model.rig().skeleton, 24, 10);
   LatentSolverOptions o = quick(LatentOptimizer::Lbfgs);
@@ -276,7 +282,7 @@ TEST(LatentSolver, EndEffectorPullsTheJointTowardItsTarget) {
 
 TEST(LatentSolver, LongInputsUseOverlappingWindowsWithoutSeams) {
   at::set_num_threads(1);
-  NemfModel model = tiny_model();
+  const runtime::NemfRuntime model = tiny_runtime();
   const int N = 100;
   Motion m = gentle_motion(model.rig().skeleton, N, 12);
   std::vector<int> keys;
@@ -323,7 +329,7 @@ TEST(LatentSolver, LongInputsUseOverlappingWindowsWithoutSeams) {
 // reports foot contact everywhere (`contact_logit`).
 struct LeggedModel {
   Skeleton skeleton;
-  std::unique_ptr<NemfModel> model;
+  std::shared_ptr<const runtime::NemfRuntime> model;
 };
 // With `arm`, a left arm hangs from the spine: Shoulder_L (8), UpperArm_L (9),
 // LowerArm_L (10), Hand_L (11); the upper and lower arm reach 0.53 m.
@@ -343,7 +349,7 @@ LeggedModel legged_model(float contact_logit, bool arm = false) {
   RigInfo rig = measure_rig(s, {&m});
   rig.root_forward = Eigen::Vector3d::UnitZ();
   rig.foot_thresholds = {10.0, 10.0};  // every height counts as low
-  out.model = std::make_unique<NemfModel>(standing_prior(rig, contact_logit));
+  out.model = test::shared_runtime_of(standing_prior(rig, contact_logit));
   return out;
 }
 
@@ -351,7 +357,7 @@ TEST(LatentSolver, FeetInContactAreLockedAndKnownFramesStay) {
   at::set_num_threads(1);
   LeggedModel legged = legged_model(10.0f);
   const Skeleton& s = legged.skeleton;
-  const NemfModel& model = *legged.model;
+  const runtime::NemfRuntime& model = *legged.model;
   ASSERT_EQ(model.rig().num_feet(), 2);
   Motion m = gentle_motion(s, 24, 14);
   LatentSolverOptions o = quick(LatentOptimizer::Lbfgs);
@@ -386,7 +392,7 @@ TEST(LatentSolver, FeetInContactAreLockedAndKnownFramesStay) {
 TEST(LatentSolver, EndEffectorIkReachesTheTarget) {
   at::set_num_threads(1);
   LeggedModel legged = legged_model(-10.0f);  // no contacts: no foot locking
-  const NemfModel& model = *legged.model;
+  const runtime::NemfRuntime& model = *legged.model;
   Motion m = gentle_motion(legged.skeleton, 24, 15);
   MotionConstraints c = MotionConstraints::full_pose({0, 23});
   const Eigen::Vector3d target = forward_kinematics(m).position(12, 4) + Eigen::Vector3d(0.05, 0.03, -0.02);
@@ -410,7 +416,7 @@ TEST(LatentSolver, EndEffectorIkReachesTheTarget) {
 TEST(LatentSolver, EndEffectorBeyondTheLegsReachMovesTheRoot) {
   at::set_num_threads(1);
   LeggedModel legged = legged_model(-10.0f);  // no contacts: no foot locking
-  const NemfModel& model = *legged.model;
+  const runtime::NemfRuntime& model = *legged.model;
   Motion m = gentle_motion(legged.skeleton, 24, 15);
   MotionConstraints c = MotionConstraints::full_pose({0, 23});
   // 5 cm farther from the hip than the straight leg (0.84 m) reaches.
@@ -435,7 +441,7 @@ TEST(LatentSolver, EndEffectorBeyondTheLegsReachMovesTheRoot) {
 TEST(LatentSolver, HandTargetBeyondTheArmsReachSwingsTheShoulderThenMovesTheRoot) {
   at::set_num_threads(1);
   LeggedModel armed = legged_model(-10.0f, true);
-  const NemfModel& model = *armed.model;
+  const runtime::NemfRuntime& model = *armed.model;
   const int shoulder = 8, upper = 9, hand = 11, f = 12;
   Motion m = gentle_motion(armed.skeleton, 24, 16);
   const MotionConstraints keys = MotionConstraints::full_pose({0, 23});
@@ -480,7 +486,7 @@ TEST(LatentSolver, HandTargetBeyondTheArmsReachSwingsTheShoulderThenMovesTheRoot
 }
 
 TEST(LatentSolver, BadInputIsAnInputError) {
-  NemfModel model = tiny_model();
+  const runtime::NemfRuntime model = tiny_runtime();
   Motion m = test::random_motion(model.rig().skeleton, 20, 30.0, 1);
   LatentSolverOptions o = quick(LatentOptimizer::Lbfgs);
   Skeleton other = model.rig().skeleton;
@@ -512,7 +518,7 @@ TEST(SolverMethods, NemfMethodsAreRegisteredAndRunThroughTheJobs) {
   EXPECT_TRUE(nemf);
   EXPECT_TRUE(adam);
   TaskContext ctx;
-  ctx.model = std::make_shared<const NemfModel>(tiny_model());
+  ctx.model = test::shared_runtime_of(tiny_model());
   Motion m = test::random_motion(ctx.model->rig().skeleton, 20, 30.0, 4);
   EXPECT_THROW(run_fill(m, 5, 10, "nemf"), InputError);  // no model in the context
   int calls = 0;

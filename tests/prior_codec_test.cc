@@ -212,7 +212,7 @@ TEST(PriorCodec, InputRootPathIsInterpolated) {
 
 TEST(PriorCodec, ResampleKeepsInputFramesExactly) {
   auto model = std::make_shared<const NemfModel>(test::tiny_prior());
-  TaskContext ctx = test::context_of(model);
+  TaskContext ctx = test::context_of(*model);
   const Skeleton& s = model->rig().skeleton;
   struct Case {
     int frames;
@@ -243,7 +243,7 @@ TEST(PriorCodec, ResidualMakesTheReconstructionExactAtInputFrames) {
   // Without the copy of coinciding frames, the residual alone reproduces the
   // input: check through times that sit 1e-4 frames off the input frames.
   auto model = std::make_shared<const NemfModel>(test::tiny_prior());
-  TaskContext ctx = test::context_of(model);
+  TaskContext ctx = test::context_of(*model);
   Motion m = test::random_motion(model->rig().skeleton, 30, 30.0, 4);
   PriorResampleOptions no_residual;
   no_residual.residual = false;
@@ -266,7 +266,7 @@ TEST(PriorCodec, ResidualMakesTheReconstructionExactAtInputFrames) {
 TEST(PriorCodec, PriorResamplingTakesTheQuinticOrTheCodecByTheRatio) {
   auto model = std::make_shared<const NemfModel>(test::tiny_prior());
   ASSERT_DOUBLE_EQ(model->config().fps, 30.0);
-  TaskContext ctx = test::context_of(model);
+  TaskContext ctx = test::context_of(*model);
   const std::pair<double, double> dense[] = {{24.0, 30.0}, {30.0, 60.0}, {30.0, 24.0}, {25.0, 120.0}};
   for (const auto& [in_fps, out_fps] : dense) {
     const Motion m = test::random_motion(model->rig().skeleton, 25, in_fps, 3);
@@ -301,7 +301,7 @@ TEST(PriorCodec, PriorResamplingTakesTheQuinticOrTheCodecByTheRatio) {
 // fallback the solve's blend is returned.
 TEST(PriorCodec, PriorResamplingKeepsTheQuinticWhereTheSolveMissesTheInput) {
   auto model = std::make_shared<const NemfModel>(test::tiny_prior());
-  TaskContext ctx = test::context_of(model);
+  TaskContext ctx = test::context_of(*model);
   const Motion m = test::random_motion(model->rig().skeleton, 9, 7.5, 5);
   std::vector<std::string> warnings;
   const Motion kept = run_resample(m, 30.0, "prior", &warnings, ctx);
@@ -330,9 +330,9 @@ TEST(PriorCodec, RejectsBadInput) {
   TaskContext none;
   Motion m = test::random_motion(model->rig().skeleton, 10, 30.0, 2);
   EXPECT_THROW(resample_with_prior(m, 60.0, 19, none), InputError);
-  TaskContext ctx = test::context_of(model);
+  TaskContext ctx = test::context_of(*model);
   EXPECT_THROW(resample_with_prior(m, -1.0, 19, ctx), InputError);
-  const runtime::NemfRuntime& rt = *ctx.runtime;
+  const runtime::NemfRuntime& rt = *ctx.model;
   EXPECT_THROW(encode_motion(rt, m.slice(0, 1)), InputError);
   Motion other = m;
   other.skeleton.names[1] = "Other";
@@ -340,10 +340,7 @@ TEST(PriorCodec, RejectsBadInput) {
   EncodedMotion code = encode_motion(rt, m);
   code.windows[0].z_l = Eigen::VectorXf::Zero(3);
   EXPECT_THROW(decode_motion(rt, code, 30.0, 10), InputError);
-  // A context with the libtorch prior but no runtime cannot resample with the codec.
-  TaskContext torch_only;
-  torch_only.model = model;
-  EXPECT_THROW(resample_with_prior(m, 60.0, 19, torch_only), ModelMissingError);
+  EXPECT_THROW(resample_with_prior(m, 60.0, 19, none), ModelMissingError);
   // Through the task entry point: "prior" needs a model.
   EXPECT_THROW(run_resample(m, 60.0, "prior", nullptr, none), InputError);
   EXPECT_EQ(run_resample(m, 60.0, "prior", nullptr, ctx).num_frames(), 19);

@@ -15,6 +15,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/motion_bvh.h"
 #include "prior/rig/mirror.h"
+#include "tests/runtime_test_util.h"
 #include "tests/test_util.h"
 
 namespace mf::bench {
@@ -217,7 +218,7 @@ TEST(ProtocolTest, TheContextReachesMethodsThatNeedTheModel) {
   // Without a model in the context the prior's method refuses to run.
   EXPECT_THROW(run_resampling(val, stats, "prior"), InputError);
   TaskContext ctx;
-  ctx.model = std::make_shared<const NemfModel>(test::tiny_prior());
+  ctx.model = test::shared_runtime_of(test::tiny_prior());
   const TaskResult r = run_task(Task::Resample, val, stats, "prior", ProtocolOptions{}, ctx);
   ASSERT_EQ(r.rows.size(), 1u);
   EXPECT_EQ(r.rows[0].metrics.windows, 2);  // 65-frame windows at 0 and 40
@@ -284,7 +285,7 @@ TEST(ProtocolTest, WindowLogKeepsTheSolversEnergyTerms) {
   const EvalStats stats = small_stats();
   std::vector<Clip> val = {make_clip("v", test::random_motion(test::small_skeleton(), 40, 30.0, 50))};
   TaskContext ctx;
-  ctx.model = std::make_shared<const NemfModel>(test::tiny_prior());
+  ctx.model = test::shared_runtime_of(test::tiny_prior());
   ctx.max_iterations = 2;
   WindowLog log("bandai");
   ProtocolOptions options;

@@ -22,6 +22,7 @@
 #include "tasks/constraints/interpolation_fill.h"
 #include "tasks/context/ground_level.h"
 #include "tasks/context/model_rig.h"
+#include "tests/runtime_test_util.h"
 #include "tests/test_util.h"
 
 namespace mf {
@@ -516,7 +517,7 @@ TEST(Retarget, MotionOntoTheModelKeepsTheModelsHinges) {
 // adapter needs its skeleton, frame rate and the rig anatomy, not its weights.
 TaskContext sample_rig_context() {
   TaskContext ctx;
-  ctx.model = std::make_shared<const NemfModel>(test::tiny_nemf_config(), measure_rig(sample().skeleton, {&sample()}));
+  ctx.model = test::shared_runtime_of(NemfModel(test::tiny_nemf_config(), measure_rig(sample().skeleton, {&sample()})));
   ctx.model_anatomy = std::make_shared<const RigAnatomy>(sample_anatomy());
   return ctx;
 }
@@ -651,7 +652,7 @@ TEST(ModelRig, EveryFileOfTheForeignCaptureMapsOntoTheModel) {
   if (!std::filesystem::exists(archive)) GTEST_SKIP() << archive << " is not there";
   const std::string model_path = std::string(MF_SOURCE_DIR) + "/models/motionfield-prior.mfm";
   TaskContext ctx;
-  auto model = std::make_shared<const NemfModel>(load_nemf(model_path));
+  auto model = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::load(model_path));
   ctx.model = model;
   ctx.model_anatomy = load_rig_anatomy_next_to(model_path, model->rig().skeleton);
   ASSERT_TRUE(ctx.model_anatomy);
@@ -679,7 +680,7 @@ TEST(ModelRig, RealElbowsRetargetWithinTheTrainingDatasAxes) {
   if (!std::filesystem::exists(archive)) GTEST_SKIP() << archive << " is not there";
   const std::string model_path = std::string(MF_SOURCE_DIR) + "/models/motionfield-prior.mfm";
   TaskContext ctx;
-  auto model = std::make_shared<const NemfModel>(load_nemf(model_path));
+  auto model = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::load(model_path));
   ctx.model = model;
   ctx.model_anatomy = load_rig_anatomy_next_to(model_path, model->rig().skeleton);
   const bench::ForeignData data = bench::load_foreign_data(archive, default_cache_dir(), 30.0, false);

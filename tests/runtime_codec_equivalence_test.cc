@@ -155,7 +155,7 @@ TEST(RuntimeCodecEquivalence, CodesAndDecodesOfIndependentRandomRotations) {
 TEST(RuntimeCodecEquivalence, ResamplingWithThePrior) {
   ScopedComputeThreads one_thread(1);
   TaskContext ctx;
-  ctx.runtime = std::shared_ptr<const runtime::NemfRuntime>(std::shared_ptr<const void>(), &runtime_model());
+  ctx.model = std::shared_ptr<const runtime::NemfRuntime>(std::shared_ptr<const void>(), &runtime_model());
   const Motion& walk = test::walk_on_model_rig();
   for (RootSource root : {RootSource::kPrior, RootSource::kInput}) {
     PriorResampleOptions options;

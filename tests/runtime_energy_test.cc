@@ -2,7 +2,7 @@
 // forward kinematics (prior/runtime/rotations.h, kinematics.h) and the latent
 // energy with its gradient (tasks/latent/runtime_energy.h) against
 // rotations_torch.h, kinematics_torch.h and evaluate_energy() with autograd
-// (tasks/latent/energies.h), with the shipped model on windows of the sample
+// (tasks/reference/energies.h), with the shipped model on windows of the sample
 // walk, at its encoded codes and at random ones. Every term is compared on its
 // own (weights with only that term on) and in mixes (the default; every term,
 // with the keys' residuals blended into the output motion and without), under
@@ -31,7 +31,7 @@
 #include "prior/runtime/rotations.h"
 #include "prior/util/threads.h"
 #include "tasks/latent/runtime_energy.h"
-#include "tasks/latent/runtime_problem.h"
+#include "tasks/latent/runtime_latent_energy.h"
 #include "tests/runtime_test_util.h"
 
 // In mf::test, where the helpers of runtime_test_util.h are.

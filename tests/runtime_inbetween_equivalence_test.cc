@@ -295,36 +295,5 @@ TEST(RuntimeInbetweenEquivalence, WindowsOfTheWrongShapeAreRefused) {
   EXPECT_THROW(rt->forward(short_known, &out), InputError);
 }
 
-// The transformer fill (tasks/transformer/inbetweener_fill.h) with its forward
-// pass on the runtime gives the libtorch fill's motion: the shipped models of
-// every kind, each stage, the sample walk keyed every 20 frames and with a
-// 30-frame gap, feet locked where the kind predicts contacts.
-TEST(RuntimeInbetweenEquivalence, FillsOnTheRuntimeMatchLibtorch) {
-  const Motion& walk = test::walk_on_model_rig();
-  const std::vector<MotionConstraints> cases = {MotionConstraints::full_pose({0, 20, 40, 60}),
-                                                MotionConstraints::full_pose({0, 1, 2, 3, 4, 5, 36, 60})};
-  for (const char* kind : {kTwoStageKind, kCitlKind, kKeyframeKind}) {
-    const LoadedInbetweener m =
-        load_inbetweener_file(inbetweener_path_next_to(test::shipped_model_path(), kind), kind);
-    ASSERT_TRUE(m.runtime);
-    double worst_angle = 0.0, worst_root = 0.0;
-    for (int stage = 0; stage < static_cast<int>(m.model->stage_names().size()); ++stage) {
-      for (const MotionConstraints& c : cases) {
-        const Motion a = inbetweener_fill(*m.model, nullptr, stage, walk, c, LongGapPolicy::Throw, true);
-        const Motion b = inbetweener_fill(*m.model, m.runtime.get(), stage, walk, c, LongGapPolicy::Throw, true);
-        ASSERT_EQ(a.num_frames(), b.num_frames());
-        for (int f = 0; f < a.num_frames(); ++f) {
-          for (int j = 0; j < a.num_joints(); ++j)
-            worst_angle = std::max(worst_angle, a.rotation(f, j).angularDistance(b.rotation(f, j)));
-          worst_root = std::max(worst_root, (a.root_positions[f] - b.root_positions[f]).norm());
-        }
-      }
-    }
-    std::printf("%s fill, runtime against libtorch: %.2e rad, %.2e m\n", kind, worst_angle, worst_root);
-    EXPECT_LT(worst_angle, 1e-4) << kind;
-    EXPECT_LT(worst_root, 1e-5) << kind;
-  }
-}
-
 }  // namespace
 }  // namespace mf

@@ -1,13 +1,12 @@
 // Re-navigation's energy on the Eigen runtime (RenavRuntimeEnergy,
 // tasks/renav/renav_runtime_energy.h) against the libtorch energy with
-// autograd (evaluate_renav_energy(), tasks/renav/renav.h), with the shipped
+// autograd (evaluate_renav_energy(), tasks/reference/renav_energy.h), with the shipped
 // model on windows of the sample walk re-navigated along a curved path (a
 // first window, and a later one that shares frames with a previous
 // solution), at the encoder's codes and at random ones: every term on its
 // own and together, values within 1e-5 and gradients within 1e-4, relative
 // (issue 56's bounds). Gradients are also checked against central
-// differences of the float64 prior. Then renavigate() with the model's
-// runtime (L-BFGS on the Eigen energy) against renavigate() without it.
+// differences of the float64 prior.
 #include <ATen/ATen.h>
 #include <gtest/gtest.h>
 
@@ -22,6 +21,7 @@
 #include "prior/model/canonical_window.h"
 #include "prior/motion/errors.h"
 #include "prior/util/threads.h"
+#include "tasks/reference/renav_energy.h"
 #include "tasks/renav/renav.h"
 #include "tasks/renav/renav_runtime_energy.h"
 #include "tests/runtime_test_util.h"
@@ -52,7 +52,7 @@ struct NamedWindow {
 // 15 frames with a previous solution (the walk itself).
 const std::vector<NamedWindow>& windows() {
   static const std::vector<NamedWindow> w = [] {
-    const NemfModel& model = shipped_models().frozen;
+    const runtime::NemfRuntime& model = shipped_models().runtime;
     const Motion& walk = walk_on_model_rig();
     const std::vector<Eigen::Vector2d> path = curved_path(walk, 90, model.config().fps);
     return std::vector<NamedWindow>{{"first window", make_renav_window(model, walk, 0, 61, path, 0, 61)},
@@ -201,61 +201,6 @@ TEST(RenavRuntimeEnergy, RefusesAWindowThatDoesNotFit) {
   EXPECT_THROW(Energy e(rt, bad, RenavWeights{}), InputError);
 }
 
-struct Renavigated {
-  Motion motion;
-  RenavReport report;
-};
-
-Renavigated renavigate_walk(int frames, int iterations, bool with_runtime) {
-  const Motion& walk = walk_on_model_rig();
-  const double fps = shipped_models().runtime.config().fps;
-  RenavOptions o = default_renav_options(LatentOptimizer::Lbfgs);
-  o.max_iterations = iterations;
-  Renavigated r;
-  r.motion = renavigate(shipped_models().frozen, walk, curved_path(walk, frames, fps), fps, o,
-                        shipped_context(with_runtime), &r.report);
-  return r;
-}
-
-// renavigate() of the walk along the curve with L-BFGS on the Eigen energy
-// and on the libtorch one. The same starts (the runtime's encoder gives the
-// same codes to float rounding), hence the same initial energies, and over
-// the first 5 iterations the same path; after that L-BFGS's paths part (the
-// energies' float differences of 1e-6 grow as in the latent solver's,
-// tests/runtime_solve_test.cc), and later windows start from the first
-// one's solution: there the test prints what both reach.
-TEST(RenavRuntime, RenavigateOnTheRuntimeFollowsLibtorch) {
-  ScopedComputeThreads one_thread(1);
-  for (const auto& [frames, iterations] : {std::pair<int, int>{100, 5}, {100, 0}, {150, 30}}) {
-    const Renavigated a = renavigate_walk(frames, iterations, true), b = renavigate_walk(frames, iterations, false);
-    ASSERT_EQ(a.report.windows.size(), b.report.windows.size());
-    for (size_t k = 0; k < a.report.windows.size(); ++k) {
-      const RenavWindowSummary& e = a.report.windows[k];
-      const RenavWindowSummary& t = b.report.windows[k];
-      EXPECT_TRUE(e.runtime_energy);
-      EXPECT_FALSE(t.runtime_energy);
-      std::printf("%d frames, cap %d, window %zu: init %s / %s, iterations %d / %d, energy %.6g -> %.6g / %.6g -> "
-                  "%.6g\n",
-                  frames, iterations, k, e.init.c_str(), t.init.c_str(), e.iterations, t.iterations, e.initial_energy,
-                  e.final_energy, t.initial_energy, t.final_energy);
-      EXPECT_LT(e.final_energy, e.initial_energy);
-      if (k > 0) continue;
-      EXPECT_EQ(e.init, t.init);
-      EXPECT_NEAR(e.initial_energy, t.initial_energy, 1e-5 * t.initial_energy);
-      if (iterations == 5) EXPECT_NEAR(e.final_energy, t.final_energy, 1e-3 * t.final_energy);
-    }
-    double angle = 0, root = 0;
-    for (size_t i = 0; i < a.motion.rotations.size(); ++i)
-      angle = std::max(angle, a.motion.rotations[i].angularDistance(b.motion.rotations[i]));
-    for (int f = 0; f < frames; ++f) root = std::max(root, (a.motion.root_positions[f] - b.motion.root_positions[f]).norm());
-    std::printf("%d frames, cap %d: path error (cm) runtime mean %.3f max %.3f, libtorch mean %.3f max %.3f; largest "
-                "angle %.2e rad, largest root distance %.2e m\n",
-                frames, iterations, a.report.path_error_mean_cm, a.report.path_error_max_cm,
-                b.report.path_error_mean_cm, b.report.path_error_max_cm, angle, root);
-    if (iterations == 5) EXPECT_LT(angle, 1e-2);
-    EXPECT_EQ(a.motion.num_frames(), frames);
-  }
-}
 
 }  // namespace
 }  // namespace mf::test

@@ -1,10 +1,9 @@
 // The latent solver on the Eigen runtime's energy (complete_motion(),
-// tasks/latent/latent_solver.h, with ModelSet::runtime): with the shipped
-// model on windows of the sample walk, L-BFGS on the Eigen energy ends where
-// L-BFGS on the libtorch energy does (the energies agree to about 1e-6, so
-// the paths differ only in the last digits), with keys alone and with every
-// kind of output constraint; Adam and contexts without the model's runtime
-// keep the libtorch energy.
+// tasks/latent/latent_solver.h): with the shipped model on windows of the
+// sample walk, L-BFGS on the Eigen energy ends where L-BFGS on the libtorch
+// reference energy (TaskContext::reference, tasks/reference/libtorch_energies.h)
+// does (the energies agree to about 1e-6, so the paths differ only in the last
+// digits), with keys alone and with every kind of output constraint.
 #include <ATen/ATen.h>
 #include <gtest/gtest.h>
 
@@ -17,7 +16,8 @@
 #include "prior/motion/errors.h"
 #include "prior/util/threads.h"
 #include "tasks/latent/latent_solver.h"
-#include "tasks/latent/runtime_problem.h"
+#include "tasks/latent/runtime_latent_energy.h"
+#include "tasks/reference/energies.h"
 #include "tests/runtime_test_util.h"
 
 // In mf::test, where the helpers of runtime_test_util.h are.
@@ -71,8 +71,8 @@ TEST(LatentSolverRuntime, EigenEnergyEndsWhereTheLibtorchEnergyDoes) {
   for (const auto& c : cases) {
     LatentSolverOptions o = default_solver_options(LatentOptimizer::Lbfgs);
     if (c.iterations > 0) o.max_iterations = c.iterations;
-    const Solved eigen = solve(c.input, c.constraints, o, shipped_context(true));
-    const Solved torch = solve(c.input, c.constraints, o, shipped_context(false));
+    const Solved eigen = solve(c.input, c.constraints, o, shipped_context());
+    const Solved torch = solve(c.input, c.constraints, o, shipped_context(/*libtorch=*/true));
     ASSERT_EQ(eigen.report.windows.size(), 1u) << c.name;
     ASSERT_EQ(torch.report.windows.size(), 1u) << c.name;
     const SolveSummary& e = eigen.report.windows[0];
@@ -95,8 +95,9 @@ TEST(LatentSolverRuntime, EigenEnergyEndsWhereTheLibtorchEnergyDoes) {
   }
 }
 
-// L-BFGS and Adam with the model's runtime minimise the Eigen energy whatever
-// terms are active; a context without the model's runtime keeps libtorch's.
+// L-BFGS and Adam minimise the Eigen energy whatever terms are active; a
+// context with the libtorch reference energies (TaskContext::reference)
+// minimises those.
 TEST(LatentSolverRuntime, UsesTheEigenEnergyWithTheModelsRuntime) {
   ScopedComputeThreads one_thread(1);
   const Motion input = walk_on_model_rig().slice(0, 41);
@@ -112,23 +113,21 @@ TEST(LatentSolverRuntime, UsesTheEigenEnergyWithTheModelsRuntime) {
   adam.max_iterations = 3;
   LatentSolverOptions skating = lbfgs;
   skating.weights.foot_skating = 1.0;
-  TaskContext other_model = shipped_context(true);
-  other_model.model = nullptr;
   const struct {
     const char* name;
     MotionConstraints constraints;
     LatentSolverOptions options;
     TaskContext ctx;
     bool runtime;
-  } cases[] = {{"gap", gap, lbfgs, shipped_context(true), true},
-               {"effector target", effector, lbfgs, shipped_context(true), true},
-               {"foot skating weight", gap, skating, shipped_context(true), true},
-               {"Adam", gap, adam, shipped_context(true), true},
-               {"Adam without the runtime", gap, adam, shipped_context(false), false},
-               {"runtime of another model", gap, lbfgs, other_model, false}};
+  } cases[] = {{"gap", gap, lbfgs, shipped_context(), true},
+               {"effector target", effector, lbfgs, shipped_context(), true},
+               {"foot skating weight", gap, skating, shipped_context(), true},
+               {"Adam", gap, adam, shipped_context(), true},
+               {"L-BFGS on the libtorch reference", gap, lbfgs, shipped_context(true), false},
+               {"Adam on the libtorch reference", gap, adam, shipped_context(true), false}};
   for (const auto& c : cases) {
     CompletionReport report;
-    complete_motion(shipped_models().frozen, input, c.constraints, c.options, c.ctx, &report);
+    complete_motion(shipped_models().runtime, input, c.constraints, c.options, c.ctx, &report);
     ASSERT_EQ(report.windows.size(), 1u) << c.name;
     EXPECT_EQ(report.windows[0].runtime_energy, c.runtime) << c.name;
     EXPECT_GT(report.windows[0].iterations, 0) << c.name;

@@ -99,11 +99,11 @@ void expect_total_and_gradient(const RuntimeEnergyTerms& runtime, const EnergyTe
   EXPECT_LT(a->gradient, kGradientTolerance) << what;
 }
 
-TaskContext shipped_context(bool with_runtime) {
+TaskContext shipped_context(bool libtorch) {
   const BothModels& m = shipped_models();
   TaskContext ctx;
-  ctx.model = std::shared_ptr<const NemfModel>(std::shared_ptr<const NemfModel>(), &m.frozen);
-  if (with_runtime) ctx.runtime = std::shared_ptr<const runtime::NemfRuntime>(std::shared_ptr<const void>(), &m.runtime);
+  ctx.model = std::shared_ptr<const runtime::NemfRuntime>(std::shared_ptr<const void>(), &m.runtime);
+  if (libtorch) ctx.reference = libtorch_energies(std::shared_ptr<const NemfModel>(std::shared_ptr<const void>(), &m.frozen));
   return ctx;
 }
 
@@ -111,9 +111,8 @@ const Motion& walk_on_model_rig() {
   static const Motion m = [] {
     const Motion walk = read_motion(std::string(MF_SOURCE_DIR) + "/samples/walk_keyframes.bvh");
     TaskContext ctx;
-    auto model = std::make_shared<const NemfModel>(load_nemf(shipped_model_path()));
-    ctx.model = model;
-    ctx.model_anatomy = load_rig_anatomy_next_to(shipped_model_path(), model->rig().skeleton);
+    ctx.model = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::load(shipped_model_path()));
+    ctx.model_anatomy = load_rig_anatomy_next_to(shipped_model_path(), ctx.model->rig().skeleton);
     return model_retargeter(walk, {}, ctx).to_model(walk);
   }();
   return m;
@@ -124,11 +123,19 @@ runtime::NemfRuntime runtime_of(const NemfModel& model) {
   return runtime::NemfRuntime::from_bytes(bytes.data(), bytes.size(), "test prior");
 }
 
-TaskContext context_of(std::shared_ptr<const NemfModel> model) {
+TaskContext context_of(const NemfModel& model) {
   TaskContext ctx;
-  ctx.runtime = std::make_shared<const runtime::NemfRuntime>(runtime_of(*model));
-  ctx.model = std::move(model);
+  ctx.model = std::make_shared<const runtime::NemfRuntime>(runtime_of(model));
   return ctx;
+}
+
+std::shared_ptr<const runtime::NemfRuntime> shared_runtime_of(const NemfModel& model) {
+  return std::make_shared<const runtime::NemfRuntime>(runtime_of(model));
+}
+
+std::shared_ptr<const runtime::InbetweenerRuntime> runtime_of(const InbetweenModel& model) {
+  const std::vector<uint8_t> bytes = serialize_inbetweener(model);
+  return runtime::inbetweener_runtime_from_bytes(bytes.data(), bytes.size(), "test " + model.kind());
 }
 
 }  // namespace mf::test

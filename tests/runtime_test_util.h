@@ -20,9 +20,12 @@
 
 #include "prior/model/model_file.h"
 #include "prior/motion/motion.h"
+#include "prior/inbetween/inbetweener.h"
+#include "prior/runtime/inbetween_runtime.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "tasks/context/task_context.h"
-#include "tasks/latent/latent_energy.h"
+#include "tasks/reference/latent_energy.h"
+#include "tasks/reference/libtorch_energies.h"
 #include "tasks/latent/runtime_energy.h"
 
 namespace mf::test {
@@ -89,8 +92,9 @@ void expect_total_and_gradient(const RuntimeEnergyTerms& runtime, const EnergyTe
 double code_gradient_difference(const Eigen::VectorXf& g_zl, const Eigen::VectorXf& g_zg, const at::Tensor& t_zl,
                                 const at::Tensor& t_zg);
 
-/// The shipped models as a context (not owning them): with the runtime or without.
-TaskContext shipped_context(bool with_runtime);
+/// The shipped prior as a context (not owning it); `libtorch`: with the
+/// libtorch reference energies (TaskContext::reference) for the latent solver.
+TaskContext shipped_context(bool libtorch = false);
 
 /// Standard normal entries.
 MatrixRXf normal_matrix(Eigen::Index rows, Eigen::Index cols, std::mt19937& rng);
@@ -125,7 +129,10 @@ const Motion& walk_on_model_rig();
 
 /// `model` (a test's tiny prior) on the Eigen runtime, through its model file's bytes.
 runtime::NemfRuntime runtime_of(const NemfModel& model);
-/// A context with `model` and its twin on the Eigen runtime (runtime_of()).
-TaskContext context_of(std::shared_ptr<const NemfModel> model);
+std::shared_ptr<const runtime::NemfRuntime> shared_runtime_of(const NemfModel& model);
+/// A context with `model` on the Eigen runtime (runtime_of()).
+TaskContext context_of(const NemfModel& model);
+/// An in-betweener (a test's tiny one) on the Eigen runtime, through its model file's bytes.
+std::shared_ptr<const runtime::InbetweenerRuntime> runtime_of(const InbetweenModel& model);
 
 }  // namespace mf::test

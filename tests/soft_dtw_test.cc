@@ -1,4 +1,4 @@
-#include "tasks/renav/soft_dtw.h"
+#include "tasks/reference/soft_dtw.h"
 
 #include <ATen/ATen.h>
 #include <ATen/Parallel.h>

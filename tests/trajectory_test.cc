@@ -1,7 +1,7 @@
 // The trajectory as a task input: the CSV reader (tasks/constraints/trajectory_csv.h), the
 // constraints file's "trajectory" member (tasks/constraints/constraint_spec.h), the rows
 // the solvers follow (MotionConstraints::followed_trajectory), the window
-// problem's rows and the trajectory energy terms (tasks/latent/energies.h), the
+// problem's rows and the trajectory energy terms (tasks/reference/energies.h), the
 // report (tasks/constraints/constraint_report.h) and the refusal of methods that cannot
 // follow a trajectory (tasks/methods/jobs.h run_constrained).
 #include <ATen/ATen.h>
@@ -18,7 +18,7 @@
 #include "tasks/constraints/constraint_report.h"
 #include "tasks/constraints/constraint_spec.h"
 #include "tasks/constraints/trajectory_csv.h"
-#include "tasks/latent/energies.h"
+#include "tasks/reference/energies.h"
 #include "tasks/methods/jobs.h"
 #include "tests/test_util.h"
 

@@ -309,8 +309,8 @@ TEST_P(TransformerKind, BadHyperparametersThrow) {
 
 TEST_P(TransformerKind, ParameterCountMatchesTheBuiltNetwork) {
   const Kind& kind = GetParam();
-  const InbetweenerKind& product_kind = inbetweener_kind(kind.name);
-  ASSERT_TRUE(product_kind.count_parameters);
+  const InbetweenNetwork* product_kind = find_inbetween_network(kind.name);
+  ASSERT_TRUE(product_kind && product_kind->count_parameters);
   const RigInfo rig = test::tiny_rig();
   std::vector<std::map<std::string, double>> sizes = {kind.tiny, {}};
   for (const auto& [key, value] : std::vector<std::pair<std::string, double>>{
@@ -320,10 +320,10 @@ TEST_P(TransformerKind, ParameterCountMatchesTheBuiltNetwork) {
     sizes.push_back(h);
   }
   for (const auto& h : sizes) {
-    EXPECT_EQ(product_kind.count_parameters(h, rig), kind.make(h, rig)->num_parameters())
+    EXPECT_EQ(product_kind->count_parameters(h, rig), kind.make(h, rig)->num_parameters())
         << ::testing::PrintToString(h);
   }
-  EXPECT_THROW(product_kind.count_parameters({{"heads", 3}}, rig), InputError);
+  EXPECT_THROW(product_kind->count_parameters({{"heads", 3}}, rig), InputError);
 }
 
 // A file whose hyperparameters are within their bounds but describe a network

@@ -1,6 +1,6 @@
 // The transformer methods ("context", "detail", "citl"), their fill
 // (inbetweener_fill) and the transformer initialisers, with a stand-in model:
-// a test-only InbetweenModel that interpolates the known pose features
+// a test-only InbetweenerRuntime that interpolates the known pose features
 // linearly per channel (stage 1 = stage 0 moved 1 cm along canonical x and
 // joint 1 turned a little at unknown values; optionally every output 5 cm
 // off), and
@@ -14,8 +14,9 @@
 #include <limits>
 #include <memory>
 
-#include "prior/inbetween/inbetweener.h"
+#include "prior/inbetween/inbetweener_kinds.h"
 #include "prior/model/nemf.h"
+#include "prior/runtime/inbetween_runtime.h"
 #include "prior/motion/errors.h"
 #include "tasks/constraints/interpolation_fill.h"
 #include "tasks/constraints/seams.h"
@@ -24,106 +25,98 @@
 #include "tasks/methods/jobs.h"
 #include "tasks/methods/transformer_methods.h"
 #include "tasks/transformer/inbetweener_files.h"
+#include "tests/runtime_test_util.h"
 #include "tests/test_util.h"
 
 namespace mf {
 namespace {
 
-class LinearInbetweener : public InbetweenModel {
+class LinearInbetweener : public runtime::InbetweenerRuntime {
  public:
   LinearInbetweener(const RigInfo& rig, std::string kind, int window)
-      : InbetweenModel(rig), kind_(std::move(kind)), window_(window) {}
+      : InbetweenerRuntime(rig, identity_normalisation(rig)), kind_(std::move(kind)), window_(window) {}
 
   std::string kind() const override { return kind_; }
   std::vector<std::string> stage_names() const override {
     return kind_ == kTwoStageKind ? std::vector<std::string>{"context", "detail"} : std::vector<std::string>{"citl"};
   }
-  std::map<std::string, double> hyperparameters() const override { return {{"window", window_}, {"fps", 30.0}}; }
-  std::string describe() const override { return "linear stand-in"; }
-  std::vector<std::pair<std::string, at::Tensor>> named_parameters() const override { return {}; }
-  void train(bool) override {}
+  int window() const override { return window_; }
+  double fps() const override { return 30.0; }
 
-  InbetweenOutput forward(const InbetweenBatch& batch) const override {
+  void forward(const runtime::InbetweenWindow& in, runtime::InbetweenResult* result) const override {
     const int J = rig().num_joints(), D = pose_size();
-    const int64_t B = batch.pose.size(0), T = batch.pose.size(1);
-    EXPECT_EQ(batch.pose.size(2), D);
-    EXPECT_EQ(batch.known.sizes(), (std::vector<int64_t>{B, T, J + 1}));
-    EXPECT_EQ(batch.valid.sizes(), (std::vector<int64_t>{B, T}));
+    const int T = static_cast<int>(in.pose.rows());
+    EXPECT_EQ(in.pose.cols(), D);
+    EXPECT_EQ(in.known.rows(), T);
+    EXPECT_EQ(in.known.cols(), J + 1);
+    EXPECT_EQ(in.valid.size(), T);
     ++calls;
-    max_frames = std::max<int64_t>(max_frames, T);
-    last_known = batch.known.clone();
-    const at::Tensor mask = at::cat({batch.known.narrow(2, 0, J).repeat_interleave(6, 2),
-                                     batch.known.narrow(2, J, 1).expand({B, T, 3})},
-                                    2);
-    unknown_abs_sum += (batch.pose * (1 - mask)).abs().sum().item<double>();
-    const at::Tensor pose = batch.pose.contiguous(), m = mask.contiguous(), valid = batch.valid.contiguous();
-    at::Tensor out = at::zeros_like(pose);
-    auto p = pose.accessor<float, 3>();
-    auto k = m.accessor<float, 3>();
-    auto v = valid.accessor<float, 2>();
-    auto o = out.accessor<float, 3>();
-    for (int64_t b = 0; b < B; ++b) {
-      int64_t frames = 0;
-      while (frames < T && v[b][frames] > 0.5f) ++frames;
-      // The contract: windows are canonical at a known first frame and end at one.
-      for (int j = 0; j <= J; ++j) {
-        EXPECT_EQ(batch.known[b][0][j].item<float>(), 1.0f) << "window " << b << " does not start at a full key";
-      }
-      EXPECT_EQ(batch.known[b][frames - 1][J].item<float>(), 1.0f) << "window " << b << " does not end at a key";
-      for (int64_t d = 0; d < D; ++d) {
-        std::vector<int64_t> at_known;
-        for (int64_t t = 0; t < frames; ++t) {
-          if (k[b][t][d] > 0.5f) at_known.push_back(t);
-        }
-        for (int64_t t = 0; t < frames; ++t) {
-          auto it = std::lower_bound(at_known.begin(), at_known.end(), t);
-          if (it == at_known.end()) {
-            o[b][t][d] = p[b][at_known.back()][d];
-          } else if (*it == t || it == at_known.begin()) {
-            o[b][t][d] = p[b][*it][d];
-          } else {
-            const int64_t a = *(it - 1), c = *it;
-            const float w = static_cast<float>(t - a) / static_cast<float>(c - a);
-            o[b][t][d] = p[b][a][d] * (1 - w) + p[b][c][d] * w;
-          }
+    max_frames = std::max(max_frames, T);
+    known.push_back(in.known);
+    runtime::MatrixRXf mask(T, D);
+    for (int j = 0; j < J; ++j) mask.middleCols(6 * j, 6) = in.known.col(j).replicate(1, 6);
+    mask.rightCols(3) = in.known.col(J).replicate(1, 3);
+    unknown_abs_sum += (in.pose.array() * (1 - mask.array())).abs().sum();
+    int frames = 0;
+    while (frames < T && in.valid[frames] > 0.5f) ++frames;
+    // The contract: windows are canonical at a known first frame and end at one.
+    for (int j = 0; j <= J; ++j) EXPECT_EQ(in.known(0, j), 1.0f) << "a window does not start at a full key";
+    EXPECT_EQ(in.known(frames - 1, J), 1.0f) << "a window does not end at a key";
+    runtime::MatrixRXf out = runtime::MatrixRXf::Zero(T, D);
+    for (int d = 0; d < D; ++d) {
+      std::vector<int> at_known;
+      for (int t = 0; t < frames; ++t)
+        if (mask(t, d) > 0.5f) at_known.push_back(t);
+      for (int t = 0; t < frames; ++t) {
+        auto it = std::lower_bound(at_known.begin(), at_known.end(), t);
+        if (it == at_known.end()) {
+          out(t, d) = in.pose(at_known.back(), d);
+        } else if (*it == t || it == at_known.begin()) {
+          out(t, d) = in.pose(*it, d);
+        } else {
+          const int a = *(it - 1), c = *it;
+          const float w = static_cast<float>(t - a) / static_cast<float>(c - a);
+          out(t, d) = in.pose(a, d) * (1 - w) + in.pose(c, d) * w;
         }
       }
     }
-    if (miss_keys) out.select(2, D - 3).add_(0.05);  // misses even the keys by 5 cm
-    InbetweenOutput result;
-    result.stages.push_back(out);
+    if (miss_keys) out.col(D - 3).array() += 0.05f;  // misses even the keys by 5 cm
+    *result = runtime::InbetweenResult();
+    result->stages.push_back(out);
     if (kind_ == kTwoStageKind) {
-      at::Tensor moved = out.clone();
-      moved.select(2, D - 3).add_(0.01 * (1 - batch.known.select(2, J)));
-      moved.select(2, 6).add_(0.05 * (1 - batch.known.select(2, 1)));  // joint 1's 6D
-      if (jump_off_keys != 0.0) moved.select(2, D - 3).add_(jump_off_keys * (1 - batch.known.select(2, J)));
-      result.stages.push_back(moved);
+      runtime::MatrixRXf moved = out;
+      const Eigen::ArrayXf root_unknown = 1 - in.known.col(J).array();
+      moved.col(D - 3).array() += 0.01f * root_unknown;
+      moved.col(6).array() += 0.05f * (1 - in.known.col(1).array());  // joint 1's 6D
+      if (jump_off_keys != 0.0) moved.col(D - 3).array() += static_cast<float>(jump_off_keys) * root_unknown;
+      result->stages.push_back(moved);
     }
-    return result;
   }
 
   mutable int calls = 0;
-  mutable int64_t max_frames = 0;
+  mutable int max_frames = 0;
   mutable double unknown_abs_sum = 0.0;
-  mutable at::Tensor last_known;
+  mutable std::vector<runtime::MatrixRXf> known;  // each window's known mask, in call order
   bool miss_keys = false;
   double jump_off_keys = 0.0;  // the two-stage's last stage: the root moved by this much (m) at unknown frames
 
  private:
+  static runtime::InbetweenNormalisation identity_normalisation(const RigInfo& rig) {
+    const int D = rig.num_joints() * 6 + 3;
+    return {runtime::RowVectorXf::Zero(D), runtime::RowVectorXf::Ones(D)};
+  }
   std::string kind_;
-  double window_;
+  int window_;
 };
 
 struct Fixture {
-  std::shared_ptr<NemfModel> prior;
+  std::shared_ptr<const runtime::NemfRuntime> prior;
   std::shared_ptr<LinearInbetweener> twostage, citl;
   TaskContext ctx;
 
   explicit Fixture(int window = 32) {
-    at::set_num_threads(1);
     const RigInfo rig = test::tiny_rig();
-    prior = std::make_shared<NemfModel>(test::tiny_nemf_config(), rig);
-    prior->set_requires_grad(false);
+    prior = test::shared_runtime_of(NemfModel(test::tiny_nemf_config(), rig));
     twostage = std::make_shared<LinearInbetweener>(rig, kTwoStageKind, window);
     citl = std::make_shared<LinearInbetweener>(rig, kCitlKind, window);
     ctx.model = prior;
@@ -312,9 +305,9 @@ TEST(TransformerMethods, LongInputsInWindowsThatStartAndEndAtKeys) {
   for (int f = 0; f < 200; f += 7) keys.push_back(f);
   keys.push_back(199);
   const Motion out = run_inbetween(in, keys, "citl", fx.ctx);
-  EXPECT_EQ(fx.citl->calls, 1);  // every window in one batch
+  EXPECT_GE(fx.citl->calls, 200 / 24);  // one pass per window
+  EXPECT_EQ(fx.citl->known.size(), static_cast<size_t>(fx.citl->calls));
   EXPECT_LE(fx.citl->max_frames, 24);
-  EXPECT_GE(fx.citl->last_known.size(0), 200 / 24);
   expect_known_exact(in, out, keys);
   expect_finite(out);
   const Motion interp = interpolate_motion(in, keys);
@@ -379,17 +372,17 @@ TEST(TransformerMethods, GapsWhoseOutputJumpsAtTheKeysAreInterpolated) {
   const std::vector<int> keys = {0, 9, 21, 29};
   const Motion interp = interpolate_motion(in, keys);
   std::vector<std::string> warnings;
-  const Motion smooth = inbetweener_fill(*fx.twostage, nullptr, 1, in, MotionConstraints::full_pose(keys),
+  const Motion smooth = inbetweener_fill(*fx.twostage, 1, in, MotionConstraints::full_pose(keys),
                                          LongGapPolicy::Throw, false, {true, &warnings});
   EXPECT_TRUE(warnings.empty());  // the stand-in's 1 cm step is within a body's reach
   EXPECT_GT((smooth.root_positions[15] - interp.root_positions[15]).norm(), 0.005);
 
   fx.twostage->jump_off_keys = 0.3;
-  const Motion kept = inbetweener_fill(*fx.twostage, nullptr, 1, in, MotionConstraints::full_pose(keys), LongGapPolicy::Throw,
+  const Motion kept = inbetweener_fill(*fx.twostage, 1, in, MotionConstraints::full_pose(keys), LongGapPolicy::Throw,
                                        false, {false, &warnings});
   EXPECT_TRUE(warnings.empty());
   EXPECT_GT((kept.root_positions[15] - interp.root_positions[15]).norm(), 0.25);
-  const Motion out = inbetweener_fill(*fx.twostage, nullptr, 1, in, MotionConstraints::full_pose(keys), LongGapPolicy::Throw,
+  const Motion out = inbetweener_fill(*fx.twostage, 1, in, MotionConstraints::full_pose(keys), LongGapPolicy::Throw,
                                       false, {true, &warnings});
   expect_known_exact(in, out, keys);
   for (int f = 0; f < in.num_frames(); ++f) {
@@ -427,22 +420,21 @@ TEST(TransformerMethods, PartialKeysGiveTheirKnownMask) {
   c.keys.push_back({10, {0}, true});       // root only: fixes the root
   c.keys.push_back({20, {3, 4}, false});   // two joints, no root position
   c.keys.push_back({31, {}, true});
-  const Motion out = inbetweener_fill(*fx.citl, nullptr, -1, in, c, LongGapPolicy::Throw);
-  ASSERT_TRUE(fx.citl->last_known.defined());
+  const Motion out = inbetweener_fill(*fx.citl, -1, in, c, LongGapPolicy::Throw);
   // One window [0, 31], canonical at 0.
-  ASSERT_EQ(fx.citl->last_known.size(0), 1);
-  const at::Tensor k = fx.citl->last_known[0];
+  ASSERT_EQ(fx.citl->known.size(), 1u);
+  const runtime::MatrixRXf& k = fx.citl->known[0];
   for (int j = 0; j <= J; ++j) {
-    EXPECT_EQ(k[10][j].item<float>(), (j == 0 || j == J) ? 1.0f : 0.0f) << j;
-    EXPECT_EQ(k[20][j].item<float>(), (j == 3 || j == 4) ? 1.0f : 0.0f) << j;
-    EXPECT_EQ(k[15][j].item<float>(), 0.0f) << j;
+    EXPECT_EQ(k(10, j), (j == 0 || j == J) ? 1.0f : 0.0f) << j;
+    EXPECT_EQ(k(20, j), (j == 3 || j == 4) ? 1.0f : 0.0f) << j;
+    EXPECT_EQ(k(15, j), 0.0f) << j;
   }
   EXPECT_EQ(out.rotation(10, 0).coeffs(), in.rotation(10, 0).coeffs());
   EXPECT_EQ(out.root_positions[10], in.root_positions[10]);
   EXPECT_EQ(out.rotation(20, 3).coeffs(), in.rotation(20, 3).coeffs());
   EXPECT_EQ(out.rotation(20, 4).coeffs(), in.rotation(20, 4).coeffs());
   expect_finite(out);
-  EXPECT_THROW(inbetweener_fill(*fx.twostage, nullptr, 2, in, c, LongGapPolicy::Throw), InputError);  // no stage 2
+  EXPECT_THROW(inbetweener_fill(*fx.twostage, 2, in, c, LongGapPolicy::Throw), InputError);  // no stage 2
 }
 
 TEST(TransformerInitializers, FiniteCodesOfThePriorsShapeFromEachTransformer) {

@@ -16,6 +16,7 @@
 #include "prior/motion/errors.h"
 #include "prior/motion/interpolation.h"
 #include "prior/motion/motion_bvh.h"
+#include "tests/runtime_test_util.h"
 #include "tests/test_util.h"
 
 namespace mf {
@@ -305,7 +306,7 @@ TEST(Transition, DefaultMethodWithThePrior) {
   const Motion source = test::random_motion(s, 50, 30.0, 11);
   const Motion a = source.slice(0, 20), b = source.slice(25, 50);
   TaskContext ctx;
-  ctx.model = std::make_shared<const NemfModel>(test::tiny_prior());
+  ctx.model = test::shared_runtime_of(test::tiny_prior());
   const TransitionResult t = run_transition(a, b, request(8), "", 0, ctx);
   EXPECT_EQ(t.method, default_method(ctx));
   const Motion& out = t.motions[0];

@@ -54,8 +54,9 @@
  * library does not know are zero, and rejected with MF_ERROR_UNSUPPORTED
  * otherwise.
  *
- * Threads. The library's numeric work runs on an intra-op thread pool whose
- * size mf_set_num_threads() sets for the whole process. Tasks may be run from
+ * Threads. A task's numeric work runs on the thread that called it (its
+ * matrix products on the BLAS's pool, whose size mf_set_num_threads() sets
+ * for the whole process). Tasks may be run from
  * several threads at once on one shared model; each gives the same result as
  * when run alone with the same thread count. Progress callbacks run on the
  * thread that called the task.
@@ -166,19 +167,15 @@ MF_API int mf_printable_text(const char *text, size_t length, char *out, size_t 
 
 /* ================================================================ threads */
 
-/** Sets the number of intra-op threads of the numeric work in this process
- *  (1..1024; libtorch's setting, so other libtorch work in the process gets it
- *  too). Until it is called, each task runs on one intra-op thread, its
- *  calling thread, and libtorch's own setting is left alone. More than one
- *  pays only on an otherwise idle machine: libtorch's OpenMP threads spin
- *  while they wait for each other, and with another process busy on one of two
- *  cores a 128-frame solve on two threads took 25-40x as long as on one
- *  (docs/BENCHMARKS.md, "Threads"). Either way the BLAS library's own
- *  thread pool is kept at one thread, since libtorch calls it from inside its
- *  own threads. Results may differ in the last bits between thread counts. */
+/** Sets the number of threads of the matrix products in this process
+ *  (1..1024): the size of the BLAS library's own thread pool (OpenBLAS's,
+ *  process-wide). Every task runs its numeric work on its calling thread
+ *  and, until this is called, multiplies matrices there too (the pool held at
+ *  one thread). More threads pay only for long windows on an otherwise idle
+ *  machine; to run several tasks at once, call them from several threads.
+ *  Results may differ in the last bits between thread counts. */
 MF_API int mf_set_num_threads(int32_t num_threads);
-/** The number of intra-op threads a task started now on the calling thread
- *  runs with: the count set by mf_set_num_threads(), else 1. */
+/** The count set by mf_set_num_threads(), else 1. */
 MF_API int mf_get_num_threads(int32_t *out);
 
 /* ================================================================ cancel, progress */
@@ -968,8 +965,8 @@ typedef struct mf_job_runner_options {
   uint32_t struct_size;
   /** MF_JOB_* flags. */
   uint32_t flags;
-  /** Intra-op threads named in the --verbose line (mf_set_num_threads sets
-   *  them); 0: 1. */
+  /** The thread count named in the --verbose line (mf_set_num_threads sets
+   *  it); 0: 1. */
   int32_t threads;
   /** The model file; NULL or "": the default model, loaded on first need. */
   const char *model;

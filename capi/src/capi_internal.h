@@ -15,7 +15,6 @@
 #include "motionfield.h"
 #include "prior/motion/bvh.h"
 #include "prior/motion/motion.h"
-#include "prior/util/threads.h"
 #include "tasks/constraints/constraint_report.h"
 #include "tasks/constraints/constraint_spec.h"
 #include "tasks/context/task_context.h"
@@ -223,18 +222,12 @@ std::unique_ptr<mf_solution> new_solution(ConstrainedResult&& result, const mf_m
 /// callback, cancel token and rig map (read from rig_map_path if given).
 TaskContext task_context(const mf_model* model, const mf_task_options& options);
 
-/// The intra-op threads of one task call, for its lifetime: the count of
-/// mf_set_num_threads() (process-wide, as libtorch's), else one thread for the
-/// calling thread only (the process's libtorch setting untouched). More than
-/// one is a choice the caller makes: libtorch's OpenMP threads spin while they
-/// wait, and on a machine where another process holds a core a solve on two
-/// threads took 25-40x as long as on one (docs/BENCHMARKS.md, "Threads").
+/// Made at the start of every task call: holds the BLAS's thread pool at one
+/// thread until mf_set_num_threads() chooses a count (the process-wide size
+/// of that pool, prior/util/blas.h).
 class TaskThreads {
  public:
   TaskThreads();
-
- private:
-  ScopedComputeThreads scope_;
 };
 
 }  // namespace mf::capi

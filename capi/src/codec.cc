@@ -93,8 +93,8 @@ int mf_encode(const mf_model* model, const mf_motion* input, const mf_codec_opti
     require(input, "input");
     require(out, "out");
     const mf_codec_options o = mf::capi::codec_options(options);
-    if (!model->runtime) throw mf::ModelMissingError("encoding needs the prior, and none is loaded");
-    const int model_joints = model->runtime->rig().num_joints();
+    if (!model->model) throw mf::ModelMissingError("encoding needs the prior, and none is loaded");
+    const int model_joints = model->model->rig().num_joints();
     if (input->motion.num_joints() != model_joints)
       throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the motion has " + std::to_string(input->motion.num_joints()) +
                                                     " joints but the model's skeleton has " +
@@ -103,8 +103,8 @@ int mf_encode(const mf_model* model, const mf_motion* input, const mf_codec_opti
     co.hop = o.hop;
     const mf::capi::TaskThreads threads;
     auto handle = std::make_unique<mf_encoding>();
-    handle->model = model->runtime;
-    handle->code = mf::encode_motion(*model->runtime, input->motion, co);
+    handle->model = model->model;
+    handle->code = mf::encode_motion(*model->model, input->motion, co);
     handle->shell.layout = input->layout;
     handle->shell.layout_fps = input->layout_fps;
     handle->shell.length_scale = input->length_scale;

@@ -12,11 +12,11 @@
 #include <iterator>
 
 #include "capi/src/capi_internal.h"
-#include "prior/inbetween/inbetweener.h"
-#include "prior/model/model_file.h"
-#include "prior/model/nemf.h"
+#include "prior/inbetween/inbetweener_kinds.h"
+#include "prior/model/model_container.h"
 #include "prior/motion/errors.h"
 #include "prior/rig/retarget.h"
+#include "prior/runtime/inbetween_runtime.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/util/binary_io.h"
 #include "tasks/context/model_rig.h"
@@ -54,18 +54,11 @@ std::string default_path() {
   return mf::default_model_path();
 }
 
-std::unique_ptr<mf_model> make_model(NemfModel model) {  // frozen by deserialize_nemf()
-  auto handle = std::make_unique<mf_model>();
-  handle->model = std::make_shared<const NemfModel>(std::move(model));
-  return handle;
-}
-
-// The prior of a model file's bytes, for libtorch and for the Eigen runtime
-// (whose energy the latent solvers minimise: ModelSet::runtime).
+// The prior of a model file's bytes.
 std::unique_ptr<mf_model> load_bytes(const uint8_t* data, size_t size, const std::string& source) {
   try {
-    std::unique_ptr<mf_model> handle = make_model(deserialize_nemf(data, size, source));
-    handle->runtime = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::from_bytes(data, size, source));
+    auto handle = std::make_unique<mf_model>();
+    handle->model = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::from_bytes(data, size, source));
     return handle;
   } catch (const InputError& e) {
     throw ApiError(MF_ERROR_MODEL, e.what());
@@ -78,7 +71,8 @@ FileBytes read_file(const std::string& file) { return read_file_bytes(file); }  
 // The in-betweener file `file` for the prior of `model`: MF_ERROR_IO when
 // unreadable, MF_ERROR_MODEL when it is not an in-betweener or not on the
 // prior's skeleton.
-LoadedInbetweener load_user_inbetweener(const std::string& file, const mf_model& model) {
+std::shared_ptr<const runtime::InbetweenerRuntime> load_user_inbetweener(const std::string& file,
+                                                                         const mf_model& model) {
   const FileBytes bytes = read_file(file);
   try {
     return inbetweener_from_bytes(bytes.data(), bytes.size(), file, "", model.model.get());
@@ -97,7 +91,7 @@ void load_anatomy(mf_model* handle, const std::string& prior_file) {
   }
 }
 
-const NemfModel& get(const mf_model* model) {
+const runtime::NemfRuntime& get(const mf_model* model) {
   require(model, "model");
   return *model->model;
 }
@@ -121,8 +115,7 @@ std::unique_ptr<mf_model> load_model_set(const char* path, const char* const* in
   for (size_t i = 0; i < count; ++i) {
     require(inbetweeners[i], "an in-betweener path");
     if (!*inbetweeners[i]) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the transformer model path is empty");
-    LoadedInbetweener loaded = load_user_inbetweener(inbetweeners[i], *handle);
-    handle->add_inbetweener(std::move(loaded.model), std::move(loaded.runtime));
+    handle->add_inbetweener(load_user_inbetweener(inbetweeners[i], *handle));
   }
   return handle;
 }
@@ -186,8 +179,7 @@ int mf_model_with_inbetweener(const mf_model* model, const char* path, mf_model*
     require(out, "out");
     if (!*path) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "the transformer model path is empty");
     auto handle = std::make_unique<mf_model>(*model);
-    mf::LoadedInbetweener loaded = mf::capi::load_user_inbetweener(path, *model);
-    handle->add_inbetweener(std::move(loaded.model), std::move(loaded.runtime));
+    handle->add_inbetweener(mf::capi::load_user_inbetweener(path, *model));
     *out = handle.release();
   });
 }
@@ -203,7 +195,7 @@ int mf_model_has_inbetweener(const mf_model* model, const char* kind, int32_t* o
 
 int mf_model_describe(const mf_model* model, char* out, size_t capacity, size_t* needed) {
   return guard([&] {
-    const mf::NemfModel& m = mf::capi::get(model);
+    const mf::runtime::NemfRuntime& m = mf::capi::get(model);
     nlohmann::ordered_json j;
     j["format_version"] = mf::kModelFormatVersion;
     j["joints"] = m.rig().num_joints();
@@ -225,7 +217,7 @@ int mf_model_describe(const mf_model* model, char* out, size_t capacity, size_t*
 
 int mf_model_get_joint_count(const mf_model* model, int32_t* out) {
   return guard([&] {
-    const mf::NemfModel& m = mf::capi::get(model);
+    const mf::runtime::NemfRuntime& m = mf::capi::get(model);
     require(out, "out");
     *out = m.rig().num_joints();
   });
@@ -245,7 +237,7 @@ int mf_model_get_offsets(const mf_model* model, float* out, size_t capacity, siz
 
 int mf_model_get_fps(const mf_model* model, double* out) {
   return guard([&] {
-    const mf::NemfModel& m = mf::capi::get(model);
+    const mf::runtime::NemfRuntime& m = mf::capi::get(model);
     require(out, "out");
     *out = m.config().fps;
   });
@@ -253,7 +245,7 @@ int mf_model_get_fps(const mf_model* model, double* out) {
 
 int mf_model_get_window(const mf_model* model, int32_t* out) {
   return guard([&] {
-    const mf::NemfModel& m = mf::capi::get(model);
+    const mf::runtime::NemfRuntime& m = mf::capi::get(model);
     require(out, "out");
     *out = m.config().window;
   });
@@ -261,7 +253,7 @@ int mf_model_get_window(const mf_model* model, int32_t* out) {
 
 int mf_model_get_latent_sizes(const mf_model* model, int32_t* local_size, int32_t* global_size) {
   return guard([&] {
-    const mf::NemfModel& m = mf::capi::get(model);
+    const mf::runtime::NemfRuntime& m = mf::capi::get(model);
     if (!local_size && !global_size) throw ApiError(MF_ERROR_INVALID_ARGUMENT, "local_size and global_size are both NULL");
     if (local_size) *local_size = m.config().zl;
     if (global_size) *global_size = m.config().zg;

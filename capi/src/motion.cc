@@ -9,7 +9,7 @@
 #include <limits>
 
 #include "capi/src/capi_internal.h"
-#include "prior/model/nemf.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/motion_bvh.h"
 #include "prior/motion/fbx_reader.h"

@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include "capi/src/capi_internal.h"
-#include "prior/model/nemf.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/motion/errors.h"
 #include "tasks/renav/renav.h"
 

@@ -2,7 +2,7 @@
 #include <nlohmann/json.hpp>
 
 #include "capi/src/capi_internal.h"
-#include "prior/model/nemf.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/motion/errors.h"
 #include "prior/rig/retarget.h"
 #include "prior/rig/rig_map.h"

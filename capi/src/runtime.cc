@@ -1,6 +1,4 @@
 // Version, status codes and messages, threads, cancel tokens, methods.
-#include <ATen/Parallel.h>
-
 #include <cstdio>
 #include <mutex>
 #include <new>
@@ -8,7 +6,7 @@
 #include "capi/src/capi_internal.h"
 #include "prior/motion/errors.h"
 #include "prior/util/binary_io.h"
-#include "prior/util/threads.h"
+#include "prior/util/blas.h"
 #include "tasks/methods/jobs.h"
 
 namespace mf::capi {
@@ -177,26 +175,15 @@ void skeleton_offsets(const Skeleton& s, float* out, size_t capacity, size_t* ne
   write_buffer(offsets.data(), offsets.size(), out, capacity, needed);
 }
 
-namespace {
-
-// The count TaskThreads scopes the calling thread to: 0 (nothing to scope)
-// when the caller chose one, which is applied process-wide here, else 1.
-int task_scope_threads() {
-  const int n = g_num_threads.load();
-  if (n > 0) {
-    if (at::get_num_threads() != n) mf::set_compute_threads(n);
-    return 0;
-  }
-  // OpenBLAS's pool must not run under libtorch's threads either: left at one
-  // thread per core it made a caller who never chose a thread count 10x slower.
+// Until the caller chooses a count, OpenBLAS's pool is held at one thread:
+// left at one thread per core it made a caller who never chose one 10x slower
+// on a busy machine.
+TaskThreads::TaskThreads() {
   static std::once_flag blas_once;
-  std::call_once(blas_once, mf::keep_blas_single_threaded);
-  return 1;
+  std::call_once(blas_once, [] {
+    if (g_num_threads.load() == 0) mf::keep_blas_single_threaded();
+  });
 }
-
-}  // namespace
-
-TaskThreads::TaskThreads() : scope_(task_scope_threads()) {}
 
 }  // namespace mf::capi
 
@@ -241,15 +228,15 @@ int mf_set_num_threads(int32_t num_threads) {
       throw ApiError(MF_ERROR_INVALID_ARGUMENT,
                      "the thread count must be between 1 and 1024, not " + std::to_string(num_threads));
     mf::capi::g_num_threads.store(num_threads);
-    mf::set_compute_threads(num_threads);
+    mf::set_blas_threads(num_threads);
   });
 }
 
 int mf_get_num_threads(int32_t* out) {
   return guard([&] {
     require(out, "out");
-    const mf::capi::TaskThreads threads;
-    *out = static_cast<int32_t>(at::get_num_threads());
+    const int n = mf::capi::g_num_threads.load();
+    *out = n > 0 ? n : 1;
   });
 }
 

@@ -251,9 +251,6 @@ int64_t citl_parameter_count(const std::map<std::string, double>& hyperparameter
          linear(c.time_dim, W) + feed_forward + (3 * W * W + W) + (3 * W * pose_size + pose_size);
 }
 
-InbetweenerKind citl_kind() {
-  return {kCitlKind, "CITL transformer", "motionfield-citl.mfm", {{"citl", "CITL transformer"}},
-          make_citl, citl_parameter_count};
-}
+InbetweenNetwork citl_network() { return {make_citl, citl_parameter_count}; }
 
 }  // namespace mf

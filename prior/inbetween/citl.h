@@ -47,8 +47,7 @@ std::unique_ptr<InbetweenModel> make_citl(const std::map<std::string, double>& h
 /// The parameters make_citl would allocate, counted without building it.
 int64_t citl_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig);
 
-/// The kind's entry in the registry (inbetweener_kinds()): name, title, model
-/// file, stages, and make_citl as its factory.
-InbetweenerKind citl_kind();
+/// The kind's network (find_inbetween_network()): make_citl and its parameter count.
+InbetweenNetwork citl_network();
 
 }  // namespace mf

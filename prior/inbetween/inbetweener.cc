@@ -148,34 +148,11 @@ void InbetweenModel::set_requires_grad(bool on) {
   for (auto& [name, p] : named_parameters()) p.set_requires_grad(on);
 }
 
-const std::vector<InbetweenerKind>& inbetweener_kinds() {
-  static const std::vector<InbetweenerKind> kinds = {two_stage_kind(), citl_kind(), keyframe_net_kind()};
-  return kinds;
-}
-
-const InbetweenerKind* find_inbetweener_kind(const std::string& name) {
-  for (const InbetweenerKind& k : inbetweener_kinds()) {
-    if (k.name == name) return &k;
-  }
-  return nullptr;
-}
-
-const InbetweenerKind* find_inbetweener_stage(const std::string& stage, int* index) {
-  for (const InbetweenerKind& k : inbetweener_kinds()) {
-    for (size_t i = 0; i < k.stages.size(); ++i) {
-      if (k.stages[i].name != stage) continue;
-      if (index) *index = static_cast<int>(i);
-      return &k;
-    }
-  }
-  return nullptr;
-}
-
-const InbetweenerKind& inbetweener_kind(const std::string& name) {
-  if (const InbetweenerKind* k = find_inbetweener_kind(name)) return *k;
-  std::string list;
-  for (const InbetweenerKind& k : inbetweener_kinds()) list += (list.empty() ? "" : ", ") + k.name;
-  throw InputError("unknown in-betweener kind '" + name + "' (available: " + list + ")");
+const InbetweenNetwork* find_inbetween_network(const std::string& kind) {
+  static const std::map<std::string, InbetweenNetwork> networks = {
+      {kTwoStageKind, two_stage_network()}, {kCitlKind, citl_network()}, {kKeyframeKind, keyframe_net_network()}};
+  auto it = networks.find(kind);
+  return it == networks.end() ? nullptr : &it->second;
 }
 
 void register_inbetweener_kind(const std::string& kind, InbetweenFactory factory) {
@@ -191,7 +168,7 @@ std::unique_ptr<InbetweenModel> make_inbetweener(const std::string& kind,
                                                  const RigInfo& rig) {
   if (rig.num_joints() < 1) throw InputError("in-betweener: the rig has no joints");
   InbetweenFactory factory;
-  if (const InbetweenerKind* k = find_inbetweener_kind(kind)) {
+  if (const InbetweenNetwork* k = find_inbetween_network(kind)) {
     factory = k->make;
   } else {
     std::lock_guard<std::mutex> lock(registry_mutex());
@@ -222,10 +199,11 @@ std::unique_ptr<InbetweenModel> deserialize_inbetweener(const uint8_t* data, siz
   // billions of parameters; building it would take minutes and gigabytes
   // before the first tensor's shape is found wrong, so the count comes first.
   const InbetweenerKind* kind = find_inbetweener_kind(c.kind);
-  if (kind && kind->count_parameters) {
+  const InbetweenNetwork* network = find_inbetween_network(c.kind);
+  if (kind && network && network->count_parameters) {
     int64_t wanted = 0, held = 0;
     try {
-      wanted = kind->count_parameters(c.hyperparameters, c.rig);
+      wanted = network->count_parameters(c.hyperparameters, c.rig);
     } catch (const InputError& e) {
       throw InputError(source + ": invalid hyperparameters: " + e.what());
     }

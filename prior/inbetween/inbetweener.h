@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "prior/inbetween/inbetween_config.h"
+#include "prior/inbetween/inbetweener_kinds.h"
 #include "prior/model/representation.h"
 
 namespace mf {
@@ -152,47 +153,16 @@ using InbetweenFactory =
 using InbetweenParameterCount =
     std::function<int64_t(const std::map<std::string, double>&, const RigInfo&)>;
 
-/// One output stage of a kind, as the product offers it: the stage alone is
-/// the method `name` (one pass), its output encoded by the prior is the
-/// initialiser "<name>-encoder", and the latent solver started there is the
-/// method "nemf-<name>".
-struct InbetweenerStage {
-  std::string name;         ///< "context"; also the model's stage_names() entry
-  std::string description;  ///< "Context Transformer only", in method lists
-};
-
-/// A kind of in-betweener: everything the rest of the product derives from it
-/// (methods, initialisers, the file next to the prior, the trainer's
-/// subcommand, the benchmarks' flags).
-struct InbetweenerKind {
-  std::string name;                      ///< "twostage": the model file's kind
-  std::string title;                     ///< "two-stage transformer", in messages
-  std::string file_name;                 ///< "motionfield-twostage.mfm", next to the prior's file
-  std::vector<InbetweenerStage> stages;  ///< in the model's stage_names() order
+/// A product kind's libtorch network (inbetweener_kinds.h has the kinds):
+/// how to make one, and its parameter count.
+struct InbetweenNetwork {
   InbetweenFactory make;
   /// make's parameter count: a model file whose hyperparameters ask for more
   /// parameters than it holds values is refused before the network is built.
   InbetweenParameterCount count_parameters;
-  /// The network is conditioned on InbetweenBatch::trajectory, so its
-  /// methods follow a trajectory the caller gives.
-  bool reads_trajectory = false;
-  /// Its methods hold planted feet with the model's contact head (foot
-  /// locking in inbetweener_fill() of tasks/transformer/inbetweener_fill.h): set where it
-  /// measured better (docs/BENCHMARKS.md, "Long transitions").
-  bool locks_feet = false;
 };
-
-/// The product's kinds, in a fixed order (two-stage, CITL, keyframe). Adding a kind is
-/// its network's file (which defines its InbetweenerKind) and one line in the
-/// list in inbetweener.cc.
-const std::vector<InbetweenerKind>& inbetweener_kinds();
-/// The product's kind called `name`, or null.
-const InbetweenerKind* find_inbetweener_kind(const std::string& name);
-/// The same; mf::InputError listing the product's kinds when there is none.
-const InbetweenerKind& inbetweener_kind(const std::string& name);
-/// The product kind that has a stage called `stage`, or null; *index (if
-/// non-null) receives the stage's index.
-const InbetweenerKind* find_inbetweener_stage(const std::string& stage, int* index = nullptr);
+/// The network of the product kind `kind`, or null.
+const InbetweenNetwork* find_inbetween_network(const std::string& kind);
 
 /// Registers another kind for make_inbetweener / load_inbetweener only (tests
 /// use it for tiny stand-in models); it gets no methods and no file name.

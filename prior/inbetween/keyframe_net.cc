@@ -258,16 +258,6 @@ int64_t keyframe_net_parameter_count(const std::map<std::string, double>& hyperp
          blocks::stage_parameter_count(c.trunk(), inputs + 1, pose_size + rig.num_feet(), false);
 }
 
-InbetweenerKind keyframe_net_kind() {
-  return {kKeyframeKind,
-          "keyframe transformer (KeyframeNet + RefineNet)",
-          "motionfield-keyframe.mfm",
-          {{"keyframe", "KeyframeNet's keyframes, interpolated"},
-           {"refine", "KeyframeNet + RefineNet (trajectory-conditioned)"}},
-          make_keyframe_net,
-          keyframe_net_parameter_count,
-          /*reads_trajectory=*/true,
-          /*locks_feet=*/true};
-}
+InbetweenNetwork keyframe_net_network() { return {make_keyframe_net, keyframe_net_parameter_count}; }
 
 }  // namespace mf

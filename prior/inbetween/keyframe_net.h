@@ -80,8 +80,8 @@ std::unique_ptr<InbetweenModel> make_keyframe_net(const std::map<std::string, do
 /// The parameters make_keyframe_net would allocate, counted without building it.
 int64_t keyframe_net_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig);
 
-/// The kind's entry in the registry (inbetweener_kinds()).
-InbetweenerKind keyframe_net_kind();
+/// The kind's network (find_inbetween_network()): make_keyframe_net and its parameter count.
+InbetweenNetwork keyframe_net_network();
 
 /// Adaptive keyframe selection (see the top of this file): logits [B, T] (the
 /// score logits), anchors [B, T] (bool: frames interpolation must go through),

@@ -121,15 +121,6 @@ int64_t two_stage_parameter_count(const std::map<std::string, double>& hyperpara
          blocks::stage_parameter_count(c.trunk(), inputs, pose_size + rig.num_feet(), false) + c.interp_input;
 }
 
-InbetweenerKind two_stage_kind() {
-  return {kTwoStageKind,
-          "two-stage transformer",
-          "motionfield-twostage.mfm",
-          {{"context", "Context Transformer only"}, {"detail", "Context + Detail Transformer"}},
-          make_two_stage,
-          two_stage_parameter_count,
-          /*reads_trajectory=*/false,
-          /*locks_feet=*/true};
-}
+InbetweenNetwork two_stage_network() { return {make_two_stage, two_stage_parameter_count}; }
 
 }  // namespace mf

@@ -65,8 +65,7 @@ std::unique_ptr<InbetweenModel> make_two_stage(const std::map<std::string, doubl
 /// The parameters make_two_stage would allocate, counted without building it.
 int64_t two_stage_parameter_count(const std::map<std::string, double>& hyperparameters, const RigInfo& rig);
 
-/// The kind's entry in the registry (inbetweener_kinds()): name, title, model
-/// file, stages, and make_two_stage as its factory.
-InbetweenerKind two_stage_kind();
+/// The kind's network (find_inbetween_network()): make_two_stage and its parameter count.
+InbetweenNetwork two_stage_network();
 
 }  // namespace mf

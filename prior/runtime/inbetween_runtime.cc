@@ -1,5 +1,6 @@
 #include "prior/runtime/inbetween_runtime.h"
 
+#include <sstream>
 #include <utility>
 
 #include "prior/inbetween/inbetween_config.h"
@@ -15,6 +16,12 @@ namespace mf::runtime {
 
 InbetweenerRuntime::InbetweenerRuntime(const RigInfo& rig, InbetweenNormalisation normalisation)
     : rig_(rig), normalisation_(std::move(normalisation)) {}
+
+std::string InbetweenerRuntime::describe() const {
+  std::ostringstream s;
+  s << kind() << ", window " << window() << " at " << fps() << " fps";
+  return s.str();
+}
 
 int InbetweenerRuntime::checked_frames(const InbetweenWindow& in, int window, const std::string& name) const {
   const Eigen::Index J = rig_.num_joints(), D = pose_size(), T = in.pose.rows();

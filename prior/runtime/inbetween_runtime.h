@@ -79,6 +79,9 @@ class InbetweenerRuntime {
   /// other shapes, naming the kind); `out` is overwritten.
   virtual void forward(const InbetweenWindow& in, InbetweenResult* out) const = 0;
 
+  /// "twostage, window 41 at 30 fps": for logs and benchmark headers.
+  std::string describe() const;
+
   const RigInfo& rig() const { return rig_; }
   const InbetweenNormalisation& normalisation() const { return normalisation_; }
   int pose_size() const { return rig_.num_joints() * 6 + 3; }

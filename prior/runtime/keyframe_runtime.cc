@@ -24,15 +24,35 @@ Matrix3Rf root_rotation(const MatrixRXf& pose, Eigen::Index t) {
   return r;
 }
 
-// The root's forward direction on the ground, (forward_x, forward_z), of a
-// root rotation (trajectory_features in prior/model/representation.h).
-void ground_facing(const Matrix3Rf& root, const RigInfo& rig, float* facing) {
-  const float w[3] = {static_cast<float>(rig.root_forward.x()), static_cast<float>(rig.root_forward.y()),
-                      static_cast<float>(rig.root_forward.z())};
-  float h[9];
-  kernels::heading_rotation(root.data(), w, h);
-  facing[0] = h[2];
-  facing[1] = h[8];
+// Poses [T, D] (raw) moved onto the trajectory: the root's ground x, z set to
+// the trajectory's, the root rotation turned about +Y to its facing.
+MatrixRXf follow_trajectory(const MatrixRXf& pose, const MatrixRXf& trajectory, const RigInfo& rig) {
+  MatrixRXf out = pose;
+  const Eigen::Index D = pose.cols();
+  for (Eigen::Index t = 0; t < pose.rows(); ++t) {
+    const Matrix3Rf root = root_rotation(pose, t);
+    float facing[2];
+    ground_facing(root.data(), rig, facing);
+    const float delta = std::atan2(trajectory(t, 2), trajectory(t, 3)) - std::atan2(facing[0], facing[1]);
+    const float c = std::cos(delta), s = std::sin(delta);
+    Matrix3Rf turn;
+    turn << c, 0, s, 0, 1, 0, -s, 0, c;
+    const Matrix3Rf turned = turn * root;
+    out.row(t).head(6) << turned.col(0).transpose(), turned.col(1).transpose();
+    out(t, D - 3) = trajectory(t, 0);
+    out(t, D - 1) = trajectory(t, 1);
+  }
+  return out;
+}
+
+// The picked keyframes of a window (select_keyframes in keyframe_net.h).
+std::vector<bool> picked_keyframes(const Eigen::VectorXf& logits, const std::vector<bool>& anchors,
+                                   const std::vector<bool>& valid, const KeyframeConfig& c) {
+  const int T = static_cast<int>(logits.size());
+  std::unique_ptr<bool[]> a(new bool[T]), v(new bool[T]), picked(new bool[T]);
+  for (int t = 0; t < T; ++t) a[t] = anchors[t], v[t] = valid[t], picked[t] = false;
+  select_window_keyframes(logits.data(), a.get(), v.get(), T, c.min_spacing, c.max_spacing, picked.get());
+  return std::vector<bool>(picked.get(), picked.get() + T);
 }
 
 // Facing directions [T, 2] interpolated between the known rows and
@@ -62,50 +82,33 @@ MatrixRXf interpolated_facing(const MatrixRXf& facing, const std::vector<bool>& 
   return out;
 }
 
-// Poses [T, D] (raw) moved onto the trajectory: the root's ground x, z set to
-// the trajectory's, the root rotation turned about +Y to its facing.
-MatrixRXf follow_trajectory(const MatrixRXf& pose, const MatrixRXf& trajectory, const RigInfo& rig) {
-  MatrixRXf out = pose;
-  const Eigen::Index D = pose.cols();
-  for (Eigen::Index t = 0; t < pose.rows(); ++t) {
-    const Matrix3Rf root = root_rotation(pose, t);
-    float facing[2];
-    ground_facing(root, rig, facing);
-    const float delta = std::atan2(trajectory(t, 2), trajectory(t, 3)) - std::atan2(facing[0], facing[1]);
-    const float c = std::cos(delta), s = std::sin(delta);
-    Matrix3Rf turn;
-    turn << c, 0, s, 0, 1, 0, -s, 0, c;
-    const Matrix3Rf turned = turn * root;
-    out.row(t).head(6) << turned.col(0).transpose(), turned.col(1).transpose();
-    out(t, D - 3) = trajectory(t, 0);
-    out(t, D - 1) = trajectory(t, 1);
-  }
+}  // namespace
+
+void ground_facing(const float* root, const RigInfo& rig, float* facing) {
+  const float w[3] = {static_cast<float>(rig.root_forward.x()), static_cast<float>(rig.root_forward.y()),
+                      static_cast<float>(rig.root_forward.z())};
+  float h[9];
+  kernels::heading_rotation(root, w, h);
+  facing[0] = h[2];
+  facing[1] = h[8];
+}
+
+MatrixRXf interpolate_trajectory_rows(const MatrixRXf& rows, const std::vector<bool>& xz_known,
+                                      const std::vector<bool>& facing_known) {
+  MatrixRXf out(rows.rows(), kTrajectorySize);
+  out << interpolate_known(rows.leftCols(2), xz_known), interpolated_facing(rows.rightCols(2), facing_known);
   return out;
 }
-
-// The picked keyframes of a window (select_keyframes in keyframe_net.h).
-std::vector<bool> picked_keyframes(const Eigen::VectorXf& logits, const std::vector<bool>& anchors,
-                                   const std::vector<bool>& valid, const KeyframeConfig& c) {
-  const int T = static_cast<int>(logits.size());
-  std::unique_ptr<bool[]> a(new bool[T]), v(new bool[T]), picked(new bool[T]);
-  for (int t = 0; t < T; ++t) a[t] = anchors[t], v[t] = valid[t], picked[t] = false;
-  select_window_keyframes(logits.data(), a.get(), v.get(), T, c.min_spacing, c.max_spacing, picked.get());
-  return std::vector<bool>(picked.get(), picked.get() + T);
-}
-
-}  // namespace
 
 MatrixRXf interpolated_trajectory(const MatrixRXf& pose, const MatrixRXf& known, const RigInfo& rig) {
   const Eigen::Index T = pose.rows(), J = rig.num_joints(), D = pose.cols();
-  MatrixRXf xz(T, 2), facing(T, 2);
+  MatrixRXf rows(T, kTrajectorySize);
   for (Eigen::Index t = 0; t < T; ++t) {
-    xz(t, 0) = pose(t, D - 3);
-    xz(t, 1) = pose(t, D - 1);
-    ground_facing(root_rotation(pose, t), rig, facing.row(t).data());
+    rows(t, 0) = pose(t, D - 3);
+    rows(t, 1) = pose(t, D - 1);
+    ground_facing(root_rotation(pose, t).data(), rig, &rows(t, 2));
   }
-  MatrixRXf out(T, kTrajectorySize);
-  out << interpolate_known(xz, flags_of(known.col(J))), interpolated_facing(facing, flags_of(known.col(0)));
-  return out;
+  return interpolate_trajectory_rows(rows, flags_of(known.col(J)), flags_of(known.col(0)));
 }
 
 MatrixRXf interpolate_keyframe_poses(const MatrixRXf& poses, const std::vector<bool>& keys, int joints) {

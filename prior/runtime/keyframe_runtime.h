@@ -43,6 +43,18 @@ class KeyframeRuntime final : public InbetweenerRuntime {
 /// outside them.
 MatrixRXf interpolate_keyframe_poses(const MatrixRXf& poses, const std::vector<bool>& keys, int joints);
 
+/// The root's forward direction on the ground (forward_x, forward_z) of a
+/// root rotation (row-major 3x3), as trajectory_features() of
+/// prior/model/representation.h.
+void ground_facing(const float* root, const RigInfo& rig, float* facing);
+
+/// Trajectory rows [T, 4] (x, z, forward_x, forward_z) completed between the
+/// known ones (interpolate_trajectory_rows in keyframe_net.h): x, z linearly
+/// between the rows where `xz_known` holds, the facing between those where
+/// `facing_known` holds, normalised; both held outside them.
+MatrixRXf interpolate_trajectory_rows(const MatrixRXf& rows, const std::vector<bool>& xz_known,
+                                      const std::vector<bool>& facing_known);
+
 /// The trajectory [T, 4] the model makes without one (interpolated_trajectory
 /// in keyframe_net.h) from raw poses [T, D] and known [T, J + 1] (already
 /// multiplied by valid).

@@ -1,18 +1,16 @@
-// The process's compute threads and the BLAS behind libtorch's matrix
-// products. libtorch's at::set_num_threads sizes its own intra-op pool only;
-// OpenBLAS (the libblas.so.3 that scripts/install-deps.sh selects) keeps a pool
-// of its own, one thread per core unless told otherwise, so a "1 thread" run
-// would still multiply matrices on every core, and a 2-thread run nests two
-// pools that thrash. set_compute_threads sizes libtorch's pool and keeps
-// OpenBLAS's at 1.
+// libtorch's compute threads (training, the benchmarks and tests that run the
+// libtorch networks) and the BLAS under them (prior/util/blas.h).
+// libtorch's at::set_num_threads sizes its own intra-op pool only; OpenBLAS
+// keeps a pool of its own, so a "1 thread" run would still multiply matrices
+// on every core, and a 2-thread run nests two pools that thrash.
+// set_compute_threads sizes libtorch's pool and keeps OpenBLAS's at 1.
 #pragma once
 
-#include <string>
+#include "prior/util/blas.h"
 
 namespace mf {
 
-/// at::set_num_threads(n) and, when OpenBLAS is loaded, openblas_set_num_threads(1).
-/// n >= 1.
+/// at::set_num_threads(n) and keep_blas_single_threaded(). n >= 1.
 void set_compute_threads(int n);
 
 /// Limits the calling thread's intra-op parallelism (libtorch's and our own
@@ -29,23 +27,5 @@ class ScopedComputeThreads {
  private:
   int saved_ = 0;  // 0: nothing to restore
 };
-
-/// Only the second half: OpenBLAS's pool at 1 thread, libtorch's untouched. For
-/// a library whose caller never chose a thread count.
-void keep_blas_single_threaded();
-
-/// The file (links resolved) of the library whose sgemm_ serves libtorch's
-/// float matrix products in this process, e.g.
-/// "/usr/lib/x86_64-linux-gnu/openblas-pthread/libblas.so.3", or "unknown".
-/// For benchmark headers and the BLAS test.
-std::string blas_library();
-
-/// OpenBLAS's name of the kernels it runs in this process
-/// (openblas_get_corename(): "SkylakeX", "Haswell", "Zen", ...; chosen when it
-/// was loaded; docs/BLAS.md), or "" when the BLAS is not OpenBLAS.
-std::string openblas_core();
-
-/// blas_library() and, for OpenBLAS, its kernels: the BLAS line of benchmark headers.
-std::string describe_blas();
 
 }  // namespace mf

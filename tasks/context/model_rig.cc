@@ -7,7 +7,7 @@
 #include <sstream>
 #include <optional>
 
-#include "prior/model/nemf.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "prior/util/binary_io.h"
@@ -175,7 +175,7 @@ bool has_full_rotation_key(const MotionConstraints& c) {
 
 // The ground under `motion` (on the model's rig) seen from the frames
 // `known`; a key in the air within a second of one on the ground does not lift it.
-std::vector<double> model_ground(const Motion& motion, const std::vector<int>& known, const NemfModel& prior) {
+std::vector<double> model_ground(const Motion& motion, const std::vector<int>& known, const runtime::NemfRuntime& prior) {
   return ground_heights(motion, known, prior.rig(), static_cast<int>(std::lround(prior.config().fps)));
 }
 
@@ -248,7 +248,7 @@ Motion match_known_frames(const Motion& out_in, const Motion& input, const std::
 Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known, const TaskContext& ctx,
                              const CompleteFn& complete, const std::optional<RigMap>& map) {
   if (!needs_model_rig(input, ctx)) return complete(input, known);
-  const NemfModel& prior = require_prior(ctx, "this method");
+  const runtime::NemfRuntime& prior = require_prior(ctx, "this method");
   const double model_fps = prior.config().fps;
   const bool native = input.skeleton.same_as(prior.rig().skeleton);
   // The reference: interpolation between the known frames on the user's rig
@@ -281,7 +281,7 @@ Motion complete_on_model_rig(const Motion& input, const std::vector<int>& known,
 Motion complete_constrained_on_model_rig(const Motion& input, const MotionConstraints& constraints,
                                          const TaskContext& ctx, const ConstrainedFn& complete,
                                          std::vector<std::string>* warnings, const std::optional<RigMap>& map) {
-  const NemfModel& prior = require_prior(ctx, "this method");
+  const runtime::NemfRuntime& prior = require_prior(ctx, "this method");
   const Skeleton& model = prior.rig().skeleton;
   const double model_fps = prior.config().fps;
   // The model's joints and hierarchy: the solvers work on the input's own bone lengths.

@@ -19,13 +19,9 @@
 namespace mf {
 namespace runtime {
 class NemfRuntime;
-}
-
-class NemfModel;
-class InbetweenModel;
-namespace runtime {
 class InbetweenerRuntime;
-}
+}  // namespace runtime
+class ReferenceEnergies;
 struct RigAnatomy;
 
 /// Progress of a long-running method (a solver's iterations).
@@ -47,23 +43,18 @@ class CancelledError : public std::runtime_error {
 };
 
 /// The models a request may use, loaded together (the C API's mf_model holds
-/// one). Immutable once loaded, shared between threads; cheap to copy.
+/// one): the networks on the Eigen runtime (prior/runtime/), without libtorch.
+/// Immutable once loaded, shared between threads; cheap to copy.
 struct ModelSet {
-  /// The prior; required by methods with needs_model, unused by the baselines.
-  std::shared_ptr<const NemfModel> model;
-  /// The same prior on the Eigen runtime (prior/runtime/nemf_runtime.h), read
-  /// from the same model file. With it, the latent solvers' L-BFGS minimises
-  /// the Eigen energy (tasks/latent/runtime_energy.h) of every window
-  /// (complete_motion(), tasks/latent/latent_solver.h).
-  /// Null (a model built without a file, or a caller that wants the libtorch
-  /// energy throughout): they minimise the libtorch energy
-  /// (tasks/latent/energies.h).
-  std::shared_ptr<const runtime::NemfRuntime> runtime;
-  /// The in-betweeners by kind (prior/inbetween/inbetweener.h: the product's
-  /// kinds are inbetweener_kinds()), on the prior's skeleton and frozen
-  /// (set_requires_grad(false)). The C API loads each kind's file_name next
-  /// to the prior's file (tasks/transformer/inbetweener_files.h).
-  std::map<std::string, std::shared_ptr<const InbetweenModel>> inbetweeners;
+  /// The prior (prior/runtime/nemf_runtime.h); required by methods with
+  /// needs_model, unused by the baselines.
+  std::shared_ptr<const runtime::NemfRuntime> model;
+  /// The in-betweeners by kind (prior/runtime/inbetween_runtime.h: the
+  /// product's kinds are inbetweener_kinds() of
+  /// prior/inbetween/inbetweener_kinds.h), on the prior's skeleton. The C API
+  /// loads each kind's file_name next to the prior's file
+  /// (tasks/transformer/inbetweener_files.h).
+  std::map<std::string, std::shared_ptr<const runtime::InbetweenerRuntime>> inbetweeners;
   /// Why a kind's file next to the prior did not load (absent kinds have no
   /// entry): the missing-model error of a method that needs it quotes it.
   std::map<std::string, std::string> inbetweener_errors;
@@ -74,27 +65,14 @@ struct ModelSet {
   /// Why that file did not load ("" when it did or is absent).
   std::string model_anatomy_error;
 
-  /// The same models on the Eigen runtime (prior/runtime/inbetween_runtime.h),
-  /// by kind, read from the same files: the transformer fills run their
-  /// forward passes there (tasks/transformer/inbetweener_fill.h). A kind
-  /// without one runs on libtorch.
-  std::map<std::string, std::shared_ptr<const runtime::InbetweenerRuntime>> inbetweener_runtimes;
-
   /// The in-betweener of `kind`; null when not loaded.
-  const InbetweenModel* inbetweener(const std::string& kind) const {
+  const runtime::InbetweenerRuntime* inbetweener(const std::string& kind) const {
     auto it = inbetweeners.find(kind);
     return it == inbetweeners.end() ? nullptr : it->second.get();
   }
-  /// Its twin on the Eigen runtime; null when there is none.
-  const runtime::InbetweenerRuntime* inbetweener_runtime(const std::string& kind) const {
-    auto it = inbetweener_runtimes.find(kind);
-    return it == inbetweener_runtimes.end() ? nullptr : it->second.get();
-  }
-  /// Adds (or replaces) the in-betweener of `model`'s kind, with its twin on
-  /// the Eigen runtime when given (read from the same file; null: none), and
-  /// forgets that kind's load error.
-  void add_inbetweener(std::shared_ptr<const InbetweenModel> model,
-                       std::shared_ptr<const runtime::InbetweenerRuntime> twin = nullptr);
+  /// Adds (or replaces) the in-betweener of `model`'s kind and forgets that
+  /// kind's load error.
+  void add_inbetweener(std::shared_ptr<const runtime::InbetweenerRuntime> model);
 };
 
 /// What a method may use besides its input: the models, the caller's rig map,
@@ -128,6 +106,11 @@ struct TaskContext : ModelSet {
   /// where the prior cannot reach the keys (tasks/latent/fallback.h); false
   /// keeps their own result everywhere.
   bool interpolation_fallback = true;
+  /// Energies other than the runtime's for the latent solvers to minimise
+  /// (tasks/latent/window_energies.h): the libtorch reference of
+  /// tasks/reference/, for equivalence tests and benchmarks. Null in the
+  /// product: the runtime's.
+  std::shared_ptr<const ReferenceEnergies> reference;
 
   /// Calls `progress` (with this context's window) and checks `cancel`;
   /// throws CancelledError when asked to stop.
@@ -140,6 +123,6 @@ struct TaskContext : ModelSet {
 
 /// The prior of `ctx`; throws mf::ModelMissingError "<what> needs a model
 /// (the prior), and none is loaded" when there is none.
-const NemfModel& require_prior(const TaskContext& ctx, const std::string& what);
+const runtime::NemfRuntime& require_prior(const TaskContext& ctx, const std::string& what);
 
 }  // namespace mf

@@ -1,4 +1,4 @@
-// The weights of the latent solvers' energy terms (tasks/latent/energies.h
+// The weights of the latent solvers' energy terms (tasks/reference/energies.h
 // defines the terms) and which terms a window problem makes active: torch-free,
 // shared by the libtorch energy (energies.h) and the Eigen one
 // (runtime_energy.h), so both switch the same terms on.
@@ -6,10 +6,10 @@
 
 namespace mf {
 
-/// How residuals are penalised (see the top of tasks/latent/energies.h).
+/// How residuals are penalised (see the top of tasks/reference/energies.h).
 enum class Penalty { Squared, Absolute };
 
-/// Weights of the energy terms (see the top of tasks/latent/energies.h for each
+/// Weights of the energy terms (see the top of tasks/reference/energies.h for each
 /// term's definition and unit). Defaults were chosen by measurement
 /// (docs/experiments/2026-12-07-solver-defaults.md, "Energy weights").
 struct EnergyWeights {

@@ -1,15 +1,11 @@
 #include "tasks/latent/initializers.h"
 
-#include <ATen/ATen.h>
-
-#include "prior/inbetween/inbetweener.h"
-#include "prior/model/nemf.h"
+#include "prior/inbetween/inbetweener_kinds.h"
 #include "prior/motion/errors.h"
 #include "prior/model/canonical_window.h"
 #include "prior/motion/rotations.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "tasks/constraints/interpolation_fill.h"
-#include "tasks/latent/latent_energy.h"
 #include "tasks/transformer/inbetweener_files.h"
 #include "tasks/transformer/inbetweener_fill.h"
 
@@ -24,18 +20,7 @@ InitialGuess encode_window(const runtime::NemfRuntime& model, const Motion& wind
   return {z.mu_l, z.mu_g};
 }
 
-InitialGuess encode_window(const NemfModel& model, const Motion& window, int anchor) {
-  at::NoGradGuard no_grad;
-  const int T = window.num_frames();
-  if (T < 2 || T > model.config().window)
-    throw InputError("encode_window: the window must have 2 to " + std::to_string(model.config().window) + " frames");
-  WindowTensors w = window_tensors(window, 0, T, model.rig(), anchor);
-  NemfLatent z = model.encode(w.local_rotations, at::ones({1, T}, at::kFloat));
-  return {codes_vector(z.mu_l), codes_vector(z.mu_g)};
-}
-
 InitialGuess encode_window(const InitRequest& r, const Motion& window) {
-  if (r.runtime) return encode_window(*r.runtime, window, r.anchor);
   if (!r.model) throw std::invalid_argument("InitRequest is incomplete");
   return encode_window(*r.model, window, r.anchor);
 }
@@ -55,41 +40,31 @@ std::optional<Motion> InterpolationEncoderInitializer::fill_input(const Motion& 
 }
 
 InitialGuess ZeroInitializer::initialize(const InitRequest& r) const {
-  if (!r.model && !r.runtime) throw std::invalid_argument("InitRequest is incomplete");
-  const NemfConfig& config = r.runtime ? r.runtime->config() : r.model->config();
+  if (!r.model) throw std::invalid_argument("InitRequest is incomplete");
+  const NemfConfig& config = r.model->config();
   return {Eigen::VectorXf::Zero(config.zl), Eigen::VectorXf::Zero(config.zg)};
 }
 
 TransformerEncoderInitializer::TransformerEncoderInitializer(
-    std::string name, std::string kind, int stage, std::shared_ptr<const InbetweenModel> bound,
-    std::shared_ptr<const runtime::InbetweenerRuntime> bound_runtime)
-    : name_(std::move(name)),
-      kind_(std::move(kind)),
-      stage_(stage),
-      bound_(std::move(bound)),
-      bound_runtime_(std::move(bound_runtime)) {}
+    std::string name, std::string kind, int stage, std::shared_ptr<const runtime::InbetweenerRuntime> bound)
+    : name_(std::move(name)), kind_(std::move(kind)), stage_(stage), bound_(std::move(bound)) {}
 
-const InbetweenModel& TransformerEncoderInitializer::transformer(const TaskContext* context) const {
+const runtime::InbetweenerRuntime& TransformerEncoderInitializer::transformer(const TaskContext* context) const {
   const std::string what = "initialiser '" + name_ + "'";
   if (!bound_ && !context) throw ModelMissingError(missing_inbetweener_message(what, kind_));
   return bound_ ? *bound_ : require_inbetweener(*context, kind_, what);
 }
 
-const runtime::InbetweenerRuntime* TransformerEncoderInitializer::network(const TaskContext* context) const {
-  if (bound_) return bound_runtime_.get();
-  return context ? context->inbetweener_runtime(kind_) : nullptr;
-}
-
 InitialGuess TransformerEncoderInitializer::initialize(const InitRequest& r) const {
   if (!r.window || !r.constraints) throw std::invalid_argument("InitRequest is incomplete");
-  const Motion filled = inbetweener_fill(transformer(r.context), network(r.context), stage_, *r.window,
-                                         *r.constraints, LongGapPolicy::Interpolate);
+  const Motion filled =
+      inbetweener_fill(transformer(r.context), stage_, *r.window, *r.constraints, LongGapPolicy::Interpolate);
   return encode_window(r, filled);
 }
 
 std::optional<Motion> TransformerEncoderInitializer::fill_input(const Motion& input, const MotionConstraints& c,
                                                                 const TaskContext& context) const {
-  return inbetweener_fill(transformer(&context), network(&context), stage_, input, c, LongGapPolicy::Interpolate);
+  return inbetweener_fill(transformer(&context), stage_, input, c, LongGapPolicy::Interpolate);
 }
 
 std::vector<std::string> initializer_names() {
@@ -108,16 +83,13 @@ std::shared_ptr<const LatentInitializer> make_named(const std::string& name, con
   for (const InbetweenerKind& kind : inbetweener_kinds()) {
     for (size_t stage = 0; stage < kind.stages.size(); ++stage) {
       if (name != kind.stages[stage].name + "-encoder") continue;
-      std::shared_ptr<const InbetweenModel> bound;
-      std::shared_ptr<const runtime::InbetweenerRuntime> bound_runtime;
+      std::shared_ptr<const runtime::InbetweenerRuntime> bound;
       if (context) {
         require_inbetweener(*context, kind.name, "initialiser '" + name + "'");
         bound = context->inbetweeners.at(kind.name);
-        const auto twin = context->inbetweener_runtimes.find(kind.name);
-        if (twin != context->inbetweener_runtimes.end()) bound_runtime = twin->second;
       }
       return std::make_shared<TransformerEncoderInitializer>(name, kind.name, static_cast<int>(stage),
-                                                             std::move(bound), std::move(bound_runtime));
+                                                             std::move(bound));
     }
   }
   std::string list;

@@ -20,8 +20,6 @@
 
 namespace mf {
 
-class NemfModel;
-class InbetweenModel;
 
 /// Starting codes of one window.
 struct InitialGuess {
@@ -35,10 +33,7 @@ struct InitialGuess {
 /// window-relative and `anchor` is the window frame the solver canonicalises at
 /// (a key that fixes the root).
 struct InitRequest {
-  const NemfModel* model = nullptr;
-  /// The model's Eigen runtime: when set, windows are encoded on it, not on
-  /// `model` (which may then be null).
-  const runtime::NemfRuntime* runtime = nullptr;
+  const runtime::NemfRuntime* model = nullptr;  ///< the prior
   const Motion* window = nullptr;
   const MotionConstraints* constraints = nullptr;
   int anchor = 0;
@@ -92,20 +87,17 @@ class ZeroInitializer : public LatentInitializer {
 /// the root are held) -> the filled window canonicalised at the anchor and
 /// encoded (encode_window); the codes are the posterior means.
 /// One per stage of every in-betweener kind, "<stage>-encoder"
-/// (prior/inbetween/inbetweener.h InbetweenerKind::stages):
+/// (prior/inbetween/inbetweener_kinds.h InbetweenerKind::stages):
 ///   "context-encoder"  stage 0 of the two-stage model
 ///   "detail-encoder"   stage 1 of the two-stage model
 ///   "citl-encoder"     the CITL model
-/// The transformer is the one bound at construction (with its twin on the
-/// Eigen runtime, which then runs the pass, when given), else the request
-/// context's (and its twin: ModelSet::inbetweener_runtime()); initialize()
-/// throws mf::InputError when there is none.
+/// The transformer is the one bound at construction, else the request
+/// context's; initialize() throws mf::ModelMissingError when there is none.
 class TransformerEncoderInitializer : public LatentInitializer {
  public:
   /// `kind` an in-betweener kind; `stage` 0-based, -1 = the last.
   TransformerEncoderInitializer(std::string name, std::string kind, int stage,
-                                std::shared_ptr<const InbetweenModel> bound = nullptr,
-                                std::shared_ptr<const runtime::InbetweenerRuntime> bound_runtime = nullptr);
+                                std::shared_ptr<const runtime::InbetweenerRuntime> bound = nullptr);
   std::string name() const override { return name_; }
   InitialGuess initialize(const InitRequest& request) const override;
   /// One pass of the transformer over the whole input (its own windows,
@@ -115,12 +107,10 @@ class TransformerEncoderInitializer : public LatentInitializer {
   const std::string& kind() const { return kind_; }
 
  private:
-  const InbetweenModel& transformer(const TaskContext* context) const;
-  const runtime::InbetweenerRuntime* network(const TaskContext* context) const;
+  const runtime::InbetweenerRuntime& transformer(const TaskContext* context) const;
   std::string name_, kind_;
   int stage_;
-  std::shared_ptr<const InbetweenModel> bound_;
-  std::shared_ptr<const runtime::InbetweenerRuntime> bound_runtime_;
+  std::shared_ptr<const runtime::InbetweenerRuntime> bound_;
 };
 
 /// Names accepted by make_initializer(), the default first: "interp-encoder",
@@ -137,10 +127,8 @@ std::shared_ptr<const LatentInitializer> make_initializer(const std::string& nam
 
 /// The window `window` (all frames meaningful) canonicalised at `anchor` and
 /// encoded: the posterior means. For initialisers that produce a full motion.
-/// On the Eigen runtime, or on libtorch for a model without one.
 InitialGuess encode_window(const runtime::NemfRuntime& model, const Motion& window, int anchor);
-InitialGuess encode_window(const NemfModel& model, const Motion& window, int anchor);
-/// encode_window() on the request's runtime when it has one, else on its model.
+/// encode_window() with the request's prior and anchor.
 InitialGuess encode_window(const InitRequest& request, const Motion& window);
 
 }  // namespace mf

@@ -2,7 +2,7 @@
 // tasks/renav/renav.h): minimises an energy of a flat latent vector
 // x = [z_l, z_g] that evaluates itself and its gradient (DirectLatentEnergy:
 // the Eigen runtime's energies, or a libtorch energy through
-// TensorLatentEnergy of tasks/latent/latent_energy.h) with L-BFGS (Ceres
+// TensorLatentEnergy of tasks/reference/latent_energy.h) with L-BFGS (Ceres
 // GradientProblemSolver) or with Adam (NeMF's reference), reporting progress
 // through the task context once per iteration so that callers can observe
 // and cancel. No libtorch here.
@@ -67,7 +67,7 @@ struct LatentOptimizerStats {
 };
 
 /// An energy of x ([size()] values) that evaluates itself and its gradient:
-/// the Eigen runtime's (RuntimeLatentEnergy, tasks/latent/runtime_problem.h)
+/// the Eigen runtime's (RuntimeLatentEnergy, tasks/latent/runtime_latent_energy.h)
 /// or a libtorch energy's adapter (TensorLatentEnergy). It keeps buffers
 /// between evaluations, so evaluating is not const; one per thread.
 class DirectLatentEnergy {
@@ -77,7 +77,7 @@ class DirectLatentEnergy {
   /// The total at x and, when `gradient` is not null, its gradient there.
   virtual double evaluate(const double* x, double* gradient) = 0;
   /// Each active term's weighted value (named and ordered as EnergyTerms,
-  /// tasks/latent/latent_energy.h) and, in *total, their sum at x.
+  /// tasks/reference/latent_energy.h) and, in *total, their sum at x.
   virtual std::vector<std::pair<std::string, double>> terms(const double* x, double* total) = 0;
 };
 

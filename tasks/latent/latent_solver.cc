@@ -1,7 +1,5 @@
 #include "tasks/latent/latent_solver.h"
 
-#include <ATen/ATen.h>
-
 #include <algorithm>
 #include <cassert>
 #include <chrono>
@@ -13,17 +11,16 @@
 #include <random>
 #include <sstream>
 
-#include "prior/model/nemf.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
 #include "prior/runtime/nemf_runtime.h"
-#include "prior/util/threads.h"
 #include "tasks/constraints/interpolation_fill.h"
 #include "tasks/constraints/residuals.h"
 #include "tasks/fixups/effector_ik.h"
 #include "tasks/fixups/foot_locking.h"
 #include "tasks/latent/latent_optimizer.h"
-#include "tasks/latent/runtime_problem.h"
+#include "tasks/latent/runtime_latent_energy.h"
+#include "tasks/latent/window_energies.h"
 #include "tasks/latent/windows.h"
 
 namespace mf {
@@ -49,20 +46,7 @@ std::vector<int> key_frames_of(const MotionConstraints& c) {
   return frames;
 }
 
-std::vector<int> key_frames_of(const WindowProblem& p) {
-  std::vector<int> frames;
-  if (p.num_keys() == 0) return frames;
-  const at::Tensor f = p.key_frames.contiguous();
-  for (int64_t k = 0; k < f.numel(); ++k) frames.push_back(static_cast<int>(f.data_ptr<int64_t>()[k]));
-  return frames;
-}
-
-// The energy of a window's problem as a function of the codes.
-CodeEnergy window_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& weights) {
-  return [&model, &problem, weights](const at::Tensor& z_l, const at::Tensor& z_g) {
-    return evaluate_energy(model, problem, weights, z_l, z_g);
-  };
-}
+std::vector<int> key_frames_of(const RuntimeWindowProblem& p) { return p.key_frames; }
 
 // Makes the constrained values of `out` exactly the input's, spreading the
 // residuals with smoothstep ramps (see the header). Records the raw error first.
@@ -93,7 +77,7 @@ void check_solver_options(const LatentSolverOptions& options) {
 
 // Throws InputError unless the call can run: valid options, the model's
 // skeleton, a well-formed motion and constraints, finite known values.
-void check_completion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
+void check_completion(const runtime::NemfRuntime& model, const Motion& input, const MotionConstraints& constraints,
                       const LatentSolverOptions& options) {
   check_solver_options(options);
   const int N = input.num_frames(), J = input.num_joints();
@@ -217,59 +201,34 @@ InitialGuess perturbed(InitialGuess g, const LatentSolverOptions& o, int window)
   return g;
 }
 
-// A window's full and keys-only energies (solve_window_latents()): on the
-// Eigen runtime when the context carries the runtime of `model`, else on
-// libtorch.
-struct WindowEnergies {
-  virtual ~WindowEnergies() = default;
-  virtual DirectLatentEnergy& full() = 0;
-  virtual DirectLatentEnergy& keyed() = 0;
-  virtual DecodedWindow decode(const Eigen::VectorXf& z_l, const Eigen::VectorXf& z_g) = 0;
-  bool runtime = false;
-};
-
-struct RuntimeWindowEnergies final : WindowEnergies {
-  RuntimeWindowEnergies(const runtime::NemfRuntime& model, const WindowProblem& p, const EnergyWeights& full_weights,
-                        const EnergyWeights& keyed_weights)
-      : evaluator(model),
-        problem(to_runtime_problem(p, model.rig().num_joints())),
-        full_energy(evaluator, problem, full_weights, model.config().zl, model.config().zg),
-        keyed_energy(evaluator, problem, keyed_weights, model.config().zl, model.config().zg) {
-    runtime = true;
-  }
-  DirectLatentEnergy& full() override { return full_energy; }
-  DirectLatentEnergy& keyed() override { return keyed_energy; }
+// A window's energies on the Eigen runtime: the product's.
+class RuntimeWindowEnergies final : public WindowEnergies {
+ public:
+  RuntimeWindowEnergies(const runtime::NemfRuntime& model, const RuntimeWindowProblem& p,
+                        const EnergyWeights& full_weights, const EnergyWeights& keyed_weights)
+      : evaluator_(model),
+        problem_(p),
+        full_(evaluator_, problem_, full_weights, model.config().zl, model.config().zg),
+        keyed_(evaluator_, problem_, keyed_weights, model.config().zl, model.config().zg) {}
+  DirectLatentEnergy& full() override { return full_; }
+  DirectLatentEnergy& keyed() override { return keyed_; }
   DecodedWindow decode(const Eigen::VectorXf& z_l, const Eigen::VectorXf& z_g) override {
-    return evaluator.decode_window(problem, z_l, z_g);
+    return evaluator_.decode_window(problem_, z_l, z_g);
   }
-  RuntimeEnergy evaluator;
-  RuntimeWindowProblem problem;
-  RuntimeLatentEnergy full_energy, keyed_energy;
+  bool on_runtime() const override { return true; }
+
+ private:
+  RuntimeEnergy evaluator_;
+  const RuntimeWindowProblem& problem_;
+  RuntimeLatentEnergy full_, keyed_;
 };
 
-struct TensorWindowEnergies final : WindowEnergies {
-  TensorWindowEnergies(const NemfModel& m, const WindowProblem& p, const EnergyWeights& full_weights,
-                       const EnergyWeights& keyed_weights)
-      : model(m),
-        problem(p),
-        full_energy(window_energy(m, p, full_weights), m.config().zl, m.config().zg),
-        keyed_energy(window_energy(m, p, keyed_weights), m.config().zl, m.config().zg) {}
-  DirectLatentEnergy& full() override { return full_energy; }
-  DirectLatentEnergy& keyed() override { return keyed_energy; }
-  DecodedWindow decode(const Eigen::VectorXf& z_l, const Eigen::VectorXf& z_g) override {
-    return decode_window(model, problem, codes_tensor(z_l), codes_tensor(z_g));
-  }
-  const NemfModel& model;
-  const WindowProblem& problem;
-  FlatLatentEnergy full_energy, keyed_energy;
-};
-
-std::unique_ptr<WindowEnergies> window_energies(const NemfModel& model, const TaskContext& ctx,
-                                                const WindowProblem& p, const EnergyWeights& full,
+// The context's reference energies when it has them, else the runtime's.
+std::unique_ptr<WindowEnergies> window_energies(const runtime::NemfRuntime& model, const TaskContext& ctx,
+                                                const RuntimeWindowProblem& p, const EnergyWeights& full,
                                                 const EnergyWeights& keyed) {
-  if (ctx.runtime && ctx.model.get() == &model)
-    return std::make_unique<RuntimeWindowEnergies>(*ctx.runtime, p, full, keyed);
-  return std::make_unique<TensorWindowEnergies>(model, p, full, keyed);
+  if (ctx.reference) return ctx.reference->latent_window(p, full, keyed);
+  return std::make_unique<RuntimeWindowEnergies>(model, p, full, keyed);
 }
 
 // The keys-only weights of a window's first stage.
@@ -282,7 +241,8 @@ EnergyWeights keyed_weights(const EnergyWeights& full) {
 
 // solve_latents() on options the caller validated: complete_motion() checks
 // them once per call, not once per window.
-LatentSolution solve_window_latents(WindowEnergies& energies, const NemfConfig& config, const WindowProblem& problem,
+LatentSolution solve_window_latents(WindowEnergies& energies, const NemfConfig& config,
+                                    const RuntimeWindowProblem& problem,
                                     const InitialGuess& start, const LatentSolverOptions& options,
                                     const TaskContext& ctx, int iteration_offset, int iteration_total) {
   assert(options.validate().empty());
@@ -302,7 +262,7 @@ LatentSolution solve_window_latents(WindowEnergies& energies, const NemfConfig& 
                                             first);
   out.z_l = head_codes(x, zl);
   out.z_g = tail_codes(x, zg);
-  out.summary.runtime_energy = energies.runtime;
+  out.summary.runtime_energy = energies.on_runtime();
   out.summary.wall_ms = ms_since(t0);
   return out;
 }
@@ -310,18 +270,14 @@ LatentSolution solve_window_latents(WindowEnergies& energies, const NemfConfig& 
 // Solves window `w` of `input` from its initial codes (`whole`: the
 // initialiser's fill of the whole input, when there is one) given the
 // solution so far, and records its summary.
-SolvedWindow solve_window(const NemfModel& model, const Motion& input, const WindowPlan& w, const Motion& so_far,
+SolvedWindow solve_window(const runtime::NemfRuntime& model, const Motion& input, const WindowPlan& w, const Motion& so_far,
                           const LatentInitializer& init, const std::optional<Motion>& whole,
                           const LatentSolverOptions& options, const TaskContext& ctx, const TaskContext& window_ctx,
                           int iteration_offset, int iteration_total, CompletionReport* rep) {
-  // A short window's tensors are too small for a second thread to pay; its
-  // operators' parallel regions would only cost (docs/BENCHMARKS.md, "Threads").
-  const ScopedComputeThreads threads(w.length < kNemfParallelFrames ? 1 : 0);
   const Motion src = window_source(input, so_far, w);
-  const WindowProblem problem = make_window_problem(model.rig(), src, 0, w.length, w.constraints, w.anchor);
+  const RuntimeWindowProblem problem = make_runtime_problem(model.rig(), src, 0, w.length, w.constraints, w.anchor);
   InitRequest request;
   request.model = &model;
-  if (ctx.runtime && ctx.model.get() == &model) request.runtime = ctx.runtime.get();
   request.window = &src;
   request.constraints = &w.constraints;
   request.anchor = w.anchor;
@@ -349,7 +305,7 @@ SolvedWindow solve_window(const NemfModel& model, const Motion& input, const Win
 // their caps) and joins their solutions (WindowSolver). With several windows,
 // each starts from its slice of the initialiser's fill of the whole input
 // when it has one (LatentInitializer::fill_input).
-WindowedSolution solve_windows(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
+WindowedSolution solve_windows(const runtime::NemfRuntime& model, const Motion& input, const MotionConstraints& constraints,
                                const std::vector<WindowPlan>& plan, const LatentSolverOptions& options,
                                const TaskContext& ctx, CompletionReport* rep) {
   std::shared_ptr<const LatentInitializer> init = options.initializer;
@@ -447,7 +403,7 @@ LatentSolverOptions default_solver_options(LatentOptimizer optimizer) {
   return o;
 }
 
-LatentSolution solve_latents(const NemfModel& model, const WindowProblem& problem, const InitialGuess& start,
+LatentSolution solve_latents(const runtime::NemfRuntime& model, const RuntimeWindowProblem& problem, const InitialGuess& start,
                              const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset,
                              int iteration_total) {
   check_solver_options(options);
@@ -457,7 +413,7 @@ LatentSolution solve_latents(const NemfModel& model, const WindowProblem& proble
                               iteration_total);
 }
 
-Motion complete_motion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
+Motion complete_motion(const runtime::NemfRuntime& model, const Motion& input, const MotionConstraints& constraints,
                        const LatentSolverOptions& options, const TaskContext& ctx, CompletionReport* report) {
   const auto t0 = Clock::now();
   check_completion(model, input, constraints, options);

@@ -1,23 +1,22 @@
 // The latent solvers: in-betweening, gap filling, partial and end-effector
 // constraints by optimising the prior's latent codes (z_l, z_g) of each window
-// with the network frozen (tasks/latent/energies.h defines the energy).
+// with the network frozen (tasks/reference/energies.h defines the energy).
 //
 // Two optimisers, selectable:
 //   Lbfgs (default)  Ceres' GradientProblemSolver with L-BFGS and a Wolfe line
 //                    search; cost and gradient from the Eigen runtime's energy
-//                    (tasks/latent/runtime_energy.h, no tensors per
-//                    evaluation) when the context carries the prior's runtime
-//                    (ModelSet::runtime), else by torch autograd (the double
-//                    parameters of Ceres converted to float and back either way;
-//                    the two energies agree to about 1e-6, relative).
+//                    (tasks/latent/runtime_energy.h; the double parameters of
+//                    Ceres converted to float and back), or from the
+//                    context's reference energies (TaskContext::reference,
+//                    tasks/latent/window_energies.h) when it has them.
 //   Adam             NeMF's reference: lr 0.1, 600 iterations, x0.7 every 200;
 //                    returns the lowest-energy iterate.
 // L-BFGS may run a cheap keys-only stage first (keyed_iterations). Both stop
 // early on convergence, report iterations and the final energy per
 // term and wall time, and call TaskContext::report() once per iteration, so a
 // progress callback or the cancel flag can stop them (CancelledError).
-// Deterministic for a given input, options, seed and torch thread count (no
-// step is random: the seed is handed to initialisers that sample).
+// Deterministic for a given input, options and seed (no step is random: the
+// seed is handed to initialisers that sample).
 //
 // Defaults (docs/BENCHMARKS.md, "Latent solvers", has the measurements):
 // L-BFGS: 30 keys-only iterations then at most 20 full ones (a single stage of
@@ -75,15 +74,18 @@
 #include "tasks/context/task_context.h"
 #include "tasks/fixups/effector_ik.h"
 #include "tasks/fixups/foot_locking.h"
-#include "tasks/latent/energies.h"
+#include "tasks/latent/energy_weights.h"
 #include "tasks/latent/initializers.h"
 #include "tasks/latent/fallback.h"
 #include "tasks/latent/latent_optimizer.h"
+#include "tasks/latent/window_problem.h"
 #include "tasks/latent/window_solver.h"
 
 namespace mf {
 
-class NemfModel;
+namespace runtime {
+class NemfRuntime;
+}
 
 /// The options of complete_motion() and solve_latents(). The optimiser and its
 /// settings are embedded (LatentOptimizerSettings, with its defaults: L-BFGS,
@@ -177,7 +179,7 @@ struct LatentSolution {
 /// complete_motion() checks its options once per request and solves its
 /// windows without checking them again), CancelledError when the context asks
 /// to stop.
-LatentSolution solve_latents(const NemfModel& model, const WindowProblem& problem, const InitialGuess& start,
+LatentSolution solve_latents(const runtime::NemfRuntime& model, const RuntimeWindowProblem& problem, const InitialGuess& start,
                              const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset = 0,
                              int iteration_total = 0);
 
@@ -199,7 +201,7 @@ struct CompletionReport {
 /// after its minimisation are appended to it ("initial.<term>",
 /// "final.<term>"; one entry per window and term). Throws mf::InputError on bad constraints, a skeleton that does not
 /// match the model or bad options; CancelledError when cancelled.
-Motion complete_motion(const NemfModel& model, const Motion& input, const MotionConstraints& constraints,
+Motion complete_motion(const runtime::NemfRuntime& model, const Motion& input, const MotionConstraints& constraints,
                        const LatentSolverOptions& options, const TaskContext& ctx = {},
                        CompletionReport* report = nullptr);
 

@@ -410,8 +410,8 @@ Motion resample_with_prior(const CodecPrior& prior, const Motion& motion, double
 
 Motion resample_with_prior(const Motion& motion, double fps, int frames, const TaskContext& ctx,
                            const PriorResampleOptions& options) {
-  if (!ctx.runtime) throw ModelMissingError("resampling with the prior needs a model, and none is loaded");
-  return resample_with_prior(RuntimeCodecPrior(*ctx.runtime), motion, fps, frames, options);
+  if (!ctx.model) throw ModelMissingError("resampling with the prior needs a model, and none is loaded");
+  return resample_with_prior(RuntimeCodecPrior(*ctx.model), motion, fps, frames, options);
 }
 
 }  // namespace mf

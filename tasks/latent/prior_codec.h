@@ -186,7 +186,7 @@ struct PriorResampleOptions {
 /// frame position i * motion.fps / fps lies within 1e-5 (relative, as
 /// resample_interpolate()) of an integer copy that input frame exactly, so known
 /// frames come out as given. Throws mf::ModelMissingError (an InputError)
-/// when ctx has no runtime (plus the codec's errors). Uses ctx.runtime only.
+/// when ctx has no prior (plus the codec's errors).
 Motion resample_with_prior(const Motion& motion, double fps, int frames, const TaskContext& ctx,
                            const PriorResampleOptions& options = {});
 /// The same with the networks of `prior`.

@@ -1,6 +1,6 @@
 // The latent solvers' energy on the Eigen runtime (prior/runtime/), without
 // libtorch, with its gradient with respect to the latent codes written out:
-// every term of evaluate_energy() (tasks/latent/energies.h), in its order,
+// every term of evaluate_energy() (tasks/reference/energies.h), in its order,
 // under either penalty and with the same rule of which terms are active
 // (active_terms(), energy_weights.h). The decode, the GMP on the dense
 // decode and its root path (integrated and aligned at the anchor) are
@@ -18,7 +18,7 @@
 // gives to 2e-5 only, within 1e-5 of the float64 prior's).
 //
 // This header and its implementation include no libtorch;
-// tasks/latent/runtime_problem.h converts the tensor WindowProblem.
+// tasks/latent/runtime_latent_energy.h converts the tensor WindowProblem.
 #pragma once
 
 #include <Eigen/Core>

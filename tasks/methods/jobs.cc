@@ -5,8 +5,8 @@
 #include <optional>
 #include <sstream>
 
-#include "prior/inbetween/inbetweener.h"
-#include "prior/model/nemf.h"
+#include "prior/inbetween/inbetween_config.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/motion/errors.h"
 #include "tasks/constraints/interpolation_fill.h"
 #include "tasks/constraints/motion_constraints.h"

@@ -2,7 +2,7 @@
 #include <cmath>
 #include <vector>
 
-#include "prior/model/nemf.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/motion/errors.h"
 #include "tasks/constraints/interpolation_fill.h"
 #include "tasks/context/model_rig.h"

@@ -2,8 +2,7 @@
 // "nemf-adam" (NeMF's Adam-600 reference), and L-BFGS started from a
 // transformer in-betweener (tasks/latent/initializers.h TransformerEncoderInitializer):
 // "nemf-context", "nemf-detail" (two-stage model) and "nemf-citl".
-#include "prior/inbetween/inbetweener.h"
-#include "prior/model/nemf.h"
+#include "prior/inbetween/inbetweener_kinds.h"
 #include "tasks/latent/latent_solver.h"
 #include "tasks/methods/method.h"
 #include "tasks/transformer/inbetweener_files.h"
@@ -26,12 +25,12 @@ Method solver_method(const std::string& name, const std::string& description, La
   m.description = description;
   m.needs_model = true;
   m.needs_inbetweener = inbetweener;
-  m.follows_trajectory = true;  // the trajectory energy (tasks/latent/energies.h)
+  m.follows_trajectory = true;  // the trajectory energy (tasks/latent/runtime_energy.h)
   LatentSolverOptions options = default_solver_options(optimizer);
   if (!initializer.empty()) options.initializer = make_initializer(initializer);
   m.complete = [options, method_name = name, inbetweener](const Motion& input, const std::vector<int>& known,
                                                    const TaskContext& ctx, CompletionNotes* notes) {
-    const NemfModel& model = require_prior(ctx, "method '" + method_name + "'");
+    const runtime::NemfRuntime& model = require_prior(ctx, "method '" + method_name + "'");
     if (!inbetweener.empty()) require_inbetweener(ctx, inbetweener, "method '" + method_name + "'");
     LatentSolverOptions o = options;
     if (ctx.max_iterations > 0) o.max_iterations = ctx.max_iterations;
@@ -49,7 +48,7 @@ Method solver_method(const std::string& name, const std::string& description, La
   m.complete_constrained = [options, method_name = name, inbetweener](const Motion& input, const MotionConstraints& c,
                                                                int variant, const TaskContext& ctx,
                                                                std::vector<std::string>* warnings) {
-    const NemfModel& model = require_prior(ctx, "method '" + method_name + "'");
+    const runtime::NemfRuntime& model = require_prior(ctx, "method '" + method_name + "'");
     if (!inbetweener.empty()) require_inbetweener(ctx, inbetweener, "method '" + method_name + "'");
     LatentSolverOptions o = options;
     if (ctx.max_iterations > 0) o.max_iterations = ctx.max_iterations;

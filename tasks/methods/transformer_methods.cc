@@ -1,6 +1,6 @@
 #include "tasks/methods/transformer_methods.h"
 
-#include "prior/inbetween/inbetweener.h"
+#include "prior/inbetween/inbetweener_kinds.h"
 #include "prior/motion/errors.h"
 
 namespace mf {
@@ -16,9 +16,8 @@ Method transformer_method(const std::string& name, const std::string& descriptio
   m.needs_inbetweener = kind;
   m.complete = [name, kind, stage, locks_feet](const Motion& input, const std::vector<int>& known,
                                                const TaskContext& ctx, CompletionNotes* notes) {
-    const InbetweenModel& model = require_inbetweener(ctx, kind, "method '" + name + "'");
-    return inbetweener_fill(model, ctx.inbetweener_runtime(kind), stage, input, MotionConstraints::full_pose(known),
-                            LongGapPolicy::Throw, locks_feet,
+    const runtime::InbetweenerRuntime& model = require_inbetweener(ctx, kind, "method '" + name + "'");
+    return inbetweener_fill(model, stage, input, MotionConstraints::full_pose(known), LongGapPolicy::Throw, locks_feet,
                             {ctx.interpolation_fallback, notes ? &notes->warnings : nullptr});
   };
   // Keys (full or partial) and a trajectory, one answer: inbetweener_fill reads both.
@@ -29,8 +28,8 @@ Method transformer_method(const std::string& name, const std::string& descriptio
       throw InputError("method '" + name +
                        "' takes keys and a trajectory only: end-effector targets, contacts and alternatives need a "
                        "latent solver (nemf, nemf-" + name + ", ...)");
-    const InbetweenModel& model = require_inbetweener(ctx, kind, "method '" + name + "'");
-    return inbetweener_fill(model, ctx.inbetweener_runtime(kind), stage, input, c, LongGapPolicy::Throw, locks_feet,
+    const runtime::InbetweenerRuntime& model = require_inbetweener(ctx, kind, "method '" + name + "'");
+    return inbetweener_fill(model, stage, input, c, LongGapPolicy::Throw, locks_feet,
                             {ctx.interpolation_fallback, warnings});
   };
   return m;

@@ -1,4 +1,4 @@
-// The transformer in-betweeners (prior/inbetween/inbetweener.h) as task
+// The transformer in-betweeners (prior/runtime/inbetween_runtime.h) as task
 // methods (tasks/methods/method.h, transformer_methods(), registered by tasks/methods/jobs.cc):
 //   "context"  stage 0 of the two-stage model (Context Transformer)
 //   "detail"   stage 1 of the two-stage model (Detail Transformer)

@@ -1,7 +1,5 @@
 #include "tasks/renav/renav.h"
 
-#include <ATen/ATen.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,19 +9,16 @@
 #include <random>
 #include <sstream>
 
-#include "prior/model/nemf.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/interpolation.h"
-#include "prior/motion/kinematics_torch.h"
 #include "prior/motion/rotations.h"
-#include "prior/motion/rotations_torch.h"
 #include "prior/runtime/local_features.h"
 #include "tasks/constraints/interpolation_fill.h"
 #include "tasks/context/model_rig.h"
 #include "tasks/latent/initializers.h"
-#include "tasks/latent/latent_energy.h"
 #include "tasks/latent/latent_optimizer.h"
-#include "tasks/latent/runtime_problem.h"
+#include "tasks/latent/runtime_latent_energy.h"
 #include "tasks/latent/windows.h"
 #include "tasks/renav/renav_runtime_energy.h"
 
@@ -58,7 +53,7 @@ int default_iterations(LatentOptimizer s) { return s == LatentOptimizer::Adam ? 
 
 namespace {
 
-void check_window_arguments(const NemfModel& model, const Motion& reference, int ref_begin, int ref_length, int N,
+void check_window_arguments(const runtime::NemfRuntime& model, const Motion& reference, int ref_begin, int ref_length, int N,
                             int begin, int length, const Motion* previous, int shared) {
   const int W = model.config().window;
   check_model_skeleton(model.rig(), reference.skeleton, "reference");
@@ -177,7 +172,7 @@ void set_shared_frames(const RigInfo& rig, const Motion& previous, int begin, in
 
 }  // namespace
 
-RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, int ref_begin, int ref_length,
+RenavWindow make_renav_window(const runtime::NemfRuntime& model, const Motion& reference, int ref_begin, int ref_length,
                               const std::vector<Eigen::Vector2d>& path, int begin, int length, const Motion* previous,
                               int shared) {
   check_window_arguments(model, reference, ref_begin, ref_length, static_cast<int>(path.size()), begin, length,
@@ -211,101 +206,9 @@ RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, i
   return w;
 }
 
-// ---------------------------------------------------------------- the energy
-
-namespace {
-
-// A window's matrix as a tensor of `shape` (no copy: valid while the window is).
-at::Tensor view(const runtime::MatrixRXf& m, at::IntArrayRef shape) {
-  return at::from_blob(const_cast<float*>(m.data()), shape, at::kFloat);
-}
-
-}  // namespace
-
-RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindow& window, const RenavWeights& w,
-                                const at::Tensor& rot, const at::Tensor& root, const at::Tensor& contacts) {
-  const int T = window.length;
-  if (rot.dim() != 5 || rot.size(0) != 1 || rot.size(1) != T || root.dim() != 3 || root.size(1) != T)
-    throw InputError("renav_motion_energy: expected rotations [1, T, J, 3, 3] and root positions [1, T, 3] with T = " +
-                     std::to_string(T));
-  const at::TensorOptions opt = rot.options();
-  const int J = rig.num_joints(), R = static_cast<int>(window.reference_joints.rows());
-  RenavEnergy out;
-  auto add = [&](const char* name, double weight, const at::Tensor& value) {
-    out.terms.emplace_back(name, value * weight);
-  };
-  if (w.path > 0) {
-    at::Tensor d = ground_xz(root).squeeze(0) - view(window.target_xz, {T, 2}).to(opt);
-    add("path", w.path, at::sqrt(d.square() + 1e-6).mean());
-  }
-  const bool use_cont = w.continuity > 0 && window.num_shared() > 0;
-  at::Tensor hp;
-  if (w.joints > 0 || use_cont) hp = heading_relative_positions(rot, rig);  // [1, T, J, 3]
-  if (w.joints > 0) {
-    add("joints", w.joints,
-        soft_dtw_divergence(hp.flatten(-2), view(window.reference_joints, {1, R, J * 3}).to(opt), w.gamma).squeeze(0));
-  }
-  if (w.heading > 0) {
-    at::Tensor h = heading_rotation(rot.select(-3, 0), rig.root_forward);  // [1, T, 3, 3]
-    at::Tensor s = h.select(-2, 0).select(-1, 2), c = h.select(-2, 2).select(-1, 2);  // heading = (s, 0, c)
-    at::Tensor tangent = view(window.target_tangent, {T, 2}).to(opt);
-    at::Tensor signal = (s * tangent.select(-1, 0) + c * tangent.select(-1, 1)).unsqueeze(-1);  // [1, T, 1]
-    const at::Tensor reference = view(window.reference_heading, {1, R, 1}).to(opt);
-    add("heading", w.heading, soft_dtw_divergence(signal, reference, w.gamma).squeeze(0));
-  }
-  if (w.foot_skating > 0 && rig.num_feet() > 0 && T >= 2) {
-    if (!contacts.defined()) throw InputError("renav_motion_energy: foot skating needs the contact probabilities");
-    const at::Tensor offsets = offsets_tensor(rig.skeleton).to(opt);
-    at::Tensor pos = forward_kinematics(rig.skeleton.parents, offsets, rot, root).positions;  // [1, T, J, 3]
-    at::Tensor feet = at::tensor(std::vector<int64_t>(rig.foot_joints.begin(), rig.foot_joints.end()), at::kLong);
-    at::Tensor fp = pos.index_select(2, feet);
-    at::Tensor v = (fp.narrow(1, 1, T - 1) - fp.narrow(1, 0, T - 1)) * fps;
-    at::Tensor speed2 = v.select(-1, 0).square() + v.select(-1, 2).square();
-    add("foot_skating", w.foot_skating, (contacts.narrow(1, 1, T - 1).detach().to(opt) * speed2).mean());
-  }
-  if (use_cont) {
-    const int S = window.num_shared();
-    at::Tensor r = rot.squeeze(0).narrow(0, 0, S);
-    at::Tensor angle = torch_rot::geodesic_angle(r, view(window.shared_rotations, {S, J, 3, 3}).to(opt));
-    at::Tensor p = hp.squeeze(0).narrow(0, 0, S);
-    at::Tensor d2 = (p - view(window.shared_joints, {S, J, 3}).to(opt)).square().sum(-1);
-    add("continuity", w.continuity, angle.square().mean() + 10.0 * d2.mean());
-  }
-  out.total = at::zeros({}, opt);
-  for (const auto& t : out.terms) out.total = out.total + t.second;
-  return out;
-}
-
-RenavEnergy evaluate_renav_energy(const NemfModel& model, const RenavWindow& window, const RenavWeights& weights,
-                                  const at::Tensor& z_l, const at::Tensor& z_g) {
-  at::Tensor rot = model.decode(at::arange(window.length, at::kFloat), z_l, z_g);
-  GmpOutput gmp = model.predict_global(rot, GmpUse::Steering);
-  at::Tensor root = model.root_positions(rot, gmp, at::Tensor());
-  at::Tensor contacts;
-  if (weights.foot_skating > 0) contacts = at::sigmoid(gmp.contact_logits);
-  return renav_motion_energy(model.rig(), model.config().fps, window, weights, rot, root, contacts);
-}
-
-DecodedWindow decode_renav_window(const NemfModel& model, const RenavWindow& window, const at::Tensor& z_l,
-                                  const at::Tensor& z_g) {
-  at::NoGradGuard no_grad;
-  const int64_t T = window.length, J = model.rig().num_joints(), F = model.rig().num_feet();
-  const at::Tensor rotations = model.decode(at::arange(T, at::kFloat), z_l, z_g);
-  GmpOutput gmp = model.predict_global(rotations, GmpUse::Steering);
-  return {rows_of(rotations, T, J * 9), rows_of(model.root_positions(rotations, gmp, at::Tensor()), T, 3),
-          rows_of(at::sigmoid(gmp.contact_logits), T, F)};
-}
-
 // ---------------------------------------------------------------- solvers
 
 namespace {
-
-// The energy of a window as a function of the codes.
-CodeEnergy window_energy(const NemfModel& model, const RenavWindow& window, const RenavWeights& weights) {
-  return [&model, &window, weights](const at::Tensor& z_l, const at::Tensor& z_g) {
-    return evaluate_renav_energy(model, window, weights, z_l, z_g);
-  };
-}
 
 const std::vector<std::string>& init_names() {
   static const std::vector<std::string> names{"turned", "reference", "random"};
@@ -343,7 +246,7 @@ RenavOptions default_renav_options(LatentOptimizer optimizer) {
 
 namespace {
 
-void check_renav_input(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
+void check_renav_input(const runtime::NemfRuntime& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
                        double path_fps, const RenavOptions& options) {
   const std::string bad = options.validate();
   if (!bad.empty()) throw InputError("invalid re-navigation options: " + bad);
@@ -432,49 +335,35 @@ std::vector<RenavSpan> renav_spans(int M, int R, int W, int overlap) {
   return spans;
 }
 
-// The energies of one window: the Eigen runtime's when the context carries
-// the runtime of the model (which the solve then minimises, starts from and
-// decodes with), else libtorch's.
+// The energy of one window on the Eigen runtime (which the solve minimises
+// and decodes with).
 struct RenavWindowEnergies {
-  RenavWindowEnergies(const NemfModel& model, const RenavWindow& window, const RenavOptions& options,
-                      const TaskContext& ctx)
-      : torch(window_energy(model, window, options.weights), model.config().zl, model.config().zg) {
-    if (!ctx.runtime || ctx.model.get() != &model) return;
-    runtime = ctx.runtime.get();
-    evaluator = std::make_unique<RenavRuntimeEnergy>(*runtime, window, options.weights);
-    direct = std::make_unique<RuntimeLatentEnergy>(
-        [e = evaluator.get()](const Eigen::Ref<const Eigen::VectorXf>& z_l,
-                              const Eigen::Ref<const Eigen::VectorXf>& z_g, Eigen::VectorXf* g_zl,
-                              Eigen::VectorXf* g_zg) { return e->evaluate(z_l, z_g, g_zl, g_zg); },
-        model.config().zl, model.config().zg);
-  }
+  RenavWindowEnergies(const runtime::NemfRuntime& model, const RenavWindow& window, const RenavOptions& options)
+      : evaluator(model, window, options.weights),
+        direct(
+            [e = &evaluator](const Eigen::Ref<const Eigen::VectorXf>& z_l, const Eigen::Ref<const Eigen::VectorXf>& z_g,
+                             Eigen::VectorXf* g_zl,
+                             Eigen::VectorXf* g_zg) { return e->evaluate(z_l, z_g, g_zl, g_zg); },
+            model.config().zl, model.config().zg) {}
 
-  DirectLatentEnergy& energy() { return direct ? static_cast<DirectLatentEnergy&>(*direct) : torch; }
+  DirectLatentEnergy& energy() { return direct; }
 
-  FlatLatentEnergy torch;
-  const runtime::NemfRuntime* runtime = nullptr;
-  std::unique_ptr<RenavRuntimeEnergy> evaluator;
-  std::unique_ptr<RuntimeLatentEnergy> direct;
+  RenavRuntimeEnergy evaluator;
+  RuntimeLatentEnergy direct;
 };
-
-// The encoder's mean codes of a segment canonical at its first frame: on the
-// runtime when there is one, else on libtorch.
-InitialGuess encode_segment(const NemfModel& model, const runtime::NemfRuntime* rt, const Motion& seg) {
-  return rt ? encode_window(*rt, seg, 0) : encode_window(model, seg, 0);
-}
 
 // The initial codes of window `k`: z_l from the reference segment, z_g from
 // each candidate of `inits`; the lowest energy is kept (recorded in *sum).
-Eigen::VectorXd initial_codes(const NemfModel& model, const RenavWindow& window, RenavWindowEnergies& energy,
+Eigen::VectorXd initial_codes(const runtime::NemfRuntime& model, const RenavWindow& window, RenavWindowEnergies& energy,
                               const std::vector<std::string>& inits, uint64_t seed, int k, RenavWindowSummary* sum) {
   const int zg = model.config().zg;
-  const InitialGuess ref_code = encode_segment(model, energy.runtime, window.reference_segment);
+  const InitialGuess ref_code = encode_window(model, window.reference_segment, 0);
   Eigen::VectorXd x0;
   double best = std::numeric_limits<double>::infinity();
   for (const std::string& name : inits) {
     Eigen::VectorXf z_g(zg);
     if (name == "turned") {
-      z_g = encode_segment(model, energy.runtime, window.turned_segment).z_g;
+      z_g = encode_window(model, window.turned_segment, 0).z_g;
     } else if (name == "reference") {
       z_g = ref_code.z_g;
     } else {
@@ -494,13 +383,12 @@ Eigen::VectorXd initial_codes(const NemfModel& model, const RenavWindow& window,
   return x0;
 }
 
-// The window decoded at the solution x, on the runtime when the energy is its.
-DecodedWindow decode_solution(const NemfModel& model, const RenavWindow& window, const RenavWindowEnergies& energy,
+// The window decoded at the solution x.
+DecodedWindow decode_solution(const runtime::NemfRuntime& model, RenavWindowEnergies& energy,
                               const Eigen::VectorXd& x) {
   const Eigen::VectorXf z_l = head_codes(x, model.config().zl), z_g = tail_codes(x, model.config().zg);
-  if (!energy.evaluator) return decode_renav_window(model, window, codes_tensor(z_l), codes_tensor(z_g));
   DecodedWindow d;
-  energy.evaluator->decode_window(z_l, z_g, &d.local_rotations, &d.root_positions, &d.contacts);
+  energy.evaluator.decode_window(z_l, z_g, &d.local_rotations, &d.root_positions, &d.contacts);
   return d;
 }
 
@@ -527,7 +415,7 @@ struct RenavPlan {
   int cap = 0;
 };
 
-RenavPlan plan_renav(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
+RenavPlan plan_renav(const runtime::NemfRuntime& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
                      double path_fps, const RenavOptions& options) {
   const double fm = model.config().fps;
   const int W = model.config().window;
@@ -548,7 +436,7 @@ RenavPlan plan_renav(const NemfModel& model, const Motion& reference, const std:
 
 // Solves window `k` of `plan` given the solution so far (model rate) from the
 // best of `inits`, and records its summary.
-SolvedWindow solve_renav_window(const NemfModel& model, const RenavPlan& plan, int k, const Motion& so_far,
+SolvedWindow solve_renav_window(const runtime::NemfRuntime& model, const RenavPlan& plan, int k, const Motion& so_far,
                                 const RenavOptions& options, const std::vector<std::string>& inits, uint64_t seed,
                                 const TaskContext& window_ctx, int iteration_offset, RenavReport* rep) {
   const auto t0 = Clock::now();
@@ -563,12 +451,12 @@ SolvedWindow solve_renav_window(const NemfModel& model, const RenavPlan& plan, i
   sum.length = span.length;
   sum.reference_from = span.ref_begin * plan.pace / fm;
   sum.reference_to = (span.ref_begin + span.ref_length - 1) * plan.pace / fm;
-  RenavWindowEnergies energy(model, window, options, window_ctx);
+  RenavWindowEnergies energy(model, window, options);
   const Eigen::VectorXd x0 = initial_codes(model, window, energy, inits, seed, k, &sum);
   const Eigen::VectorXd x =
       minimize_window(energy.energy(), x0, options.capped(plan.cap), window_ctx, iteration_offset, total, &sum);
-  sum.runtime_energy = energy.direct != nullptr;
-  SolvedWindow solved{decode_solution(model, window, energy, x), window.transform, sum.iterations};
+  sum.runtime_energy = true;
+  SolvedWindow solved{decode_solution(model, energy, x), window.transform, sum.iterations};
   sum.wall_ms = ms_since(t0);
   rep->windows.push_back(std::move(sum));
   return solved;
@@ -576,7 +464,7 @@ SolvedWindow solve_renav_window(const NemfModel& model, const RenavPlan& plan, i
 
 }  // namespace
 
-Motion renavigate(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
+Motion renavigate(const runtime::NemfRuntime& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
                   double path_fps, const RenavOptions& options, const TaskContext& ctx, RenavReport* report) {
   const auto t0 = Clock::now();
   check_renav_input(model, reference, path, path_fps, options);
@@ -655,7 +543,7 @@ Motion run_renav(const Motion& reference, const std::vector<Eigen::Vector2d>& pa
     for (const std::string& n : renav_methods()) list += (list.empty() ? "" : ", ") + n;
     throw InputError("unknown re-navigation method '" + method + "' (available: " + list + ")");
   }
-  const NemfModel& model = require_prior(ctx, "re-navigation");
+  const runtime::NemfRuntime& model = require_prior(ctx, "re-navigation");
   std::optional<RigMap> rig_map = check_model_rig(reference.skeleton, ctx);
   if (reference.num_frames() < 2) throw InputError("the reference needs at least two frames");
   if (!(std::isfinite(reference.fps) && reference.fps > 0))

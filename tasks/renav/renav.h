@@ -1,7 +1,7 @@
 // Re-navigation: a reference clip plus a new ground path -> a motion that
 // follows the path in the reference's style, by optimising the prior's latent
 // codes (z_l, z_g) with the network frozen. NeMF's formulation (REFERENCE.md
-// section 1) with the soft-DTW divergence of tasks/renav/soft_dtw.h.
+// section 1) with the soft-DTW divergence of tasks/renav/soft_dtw_kernels.h.
 //
 // Paths. A ground path is a list of (x, z) points in metres, world frame (Y up,
 // prior/motion/skeleton.h; tasks/constraints/ground_path.h). It comes either
@@ -85,37 +85,35 @@
 //
 // Solvers: L-BFGS (Ceres GradientProblemSolver, the default, method "nemf")
 // or NeMF's Adam (lr 0.1, decay x0.7 every 200, up to 600 iterations, method
-// "nemf-adam"). When the context carries the model's Eigen runtime
-// (TaskContext::runtime), either optimiser minimises the energy on it
-// (tasks/renav/renav_runtime_energy.h), the initial codes come from its
-// encoders (NemfRuntime::encode_rotations) and the solution is decoded on it;
-// otherwise everything runs on libtorch. Both stop early,
+// "nemf-adam"). Either minimises the energy on the Eigen runtime
+// (tasks/renav/renav_runtime_energy.h; tasks/reference/renav_energy.h is the
+// libtorch reference it is tested against), the initial codes come from its
+// encoders (NemfRuntime::encode_rotations) and the solution is decoded on it.
+// Both stop early,
 // report progress once per iteration (TaskContext::report: the callback and
 // the cancel flag can stop them: CancelledError) and fill a per-window summary. Deterministic for a given input,
 // options, seed and thread count.
 #pragma once
 
-#include <ATen/core/Tensor.h>
 #include <Eigen/Core>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "prior/model/representation.h"
 #include "prior/motion/motion.h"
 #include "tasks/constraints/ground_path.h"
 #include "tasks/constraints/path_csv.h"  // parse_path_csv(), read_path_csv() for the callers
 #include "tasks/context/task_context.h"
 #include "tasks/fixups/foot_locking.h"
-#include "tasks/latent/latent_energy.h"
 #include "tasks/latent/latent_optimizer.h"
 #include "tasks/latent/window_solver.h"
 #include "tasks/renav/renav_window.h"
-#include "tasks/renav/soft_dtw.h"
 
 namespace mf {
 
-class NemfModel;
+namespace runtime {
+class NemfRuntime;
+}
 
 // ---------------------------------------------------------------- the energy
 
@@ -127,36 +125,9 @@ class NemfModel;
 /// with shared = 0 the window starts at path[begin] heading along the target
 /// with the reference's facing offset. Throws mf::InputError on bad ranges or a
 /// skeleton that does not match the model.
-RenavWindow make_renav_window(const NemfModel& model, const Motion& reference, int ref_begin, int ref_length,
+RenavWindow make_renav_window(const runtime::NemfRuntime& model, const Motion& reference, int ref_begin, int ref_length,
                               const std::vector<Eigen::Vector2d>& path, int begin, int length,
                               const Motion* previous = nullptr, int shared = 0);
-
-/// The energy and its weighted terms (names "path", "joints", "heading",
-/// "foot_skating", "continuity"; only the active ones, in that order).
-using RenavEnergy = EnergyTerms;
-
-/// The energy of a given canonical window motion: local rotations
-/// [1, T, J, 3, 3] (root in the canonical frame), root positions [1, T, 3]
-/// (canonical) and foot contact probabilities [1, T, F] (may be undefined when
-/// foot_skating is 0). Differentiable in the rotations and positions.
-RenavEnergy renav_motion_energy(const RigInfo& rig, double fps, const RenavWindow& window, const RenavWeights& weights,
-                                const at::Tensor& local_rotations, const at::Tensor& root_positions,
-                                const at::Tensor& contacts);
-
-/// The energy of latent codes z_l [1, zl], z_g [1, zg] on libtorch: the window
-/// decoded at frames 0..T-1, root path from the GMP starting at the origin,
-/// then renav_motion_energy(). Differentiable with respect to the codes (the
-/// caller freezes the network). Adam and contexts without the model's Eigen
-/// runtime minimise it; L-BFGS with the runtime minimises RenavRuntimeEnergy
-/// (tasks/renav/renav_runtime_energy.h), the same energy.
-RenavEnergy evaluate_renav_energy(const NemfModel& model, const RenavWindow& window, const RenavWeights& weights,
-                                  const at::Tensor& z_l, const at::Tensor& z_g);
-
-/// The decoded window (no grad, DecodedWindow of tasks/latent/window_solver.h):
-/// local rotations [1, T, J, 3, 3], root positions [1, T, 3] and contact
-/// probabilities [1, T, F], canonical.
-DecodedWindow decode_renav_window(const NemfModel& model, const RenavWindow& window, const at::Tensor& z_l,
-                                 const at::Tensor& z_g);
 
 // ---------------------------------------------------------------- the solve
 
@@ -235,7 +206,7 @@ struct RenavReport {
 /// `path_fps`, validated with validate_path()). The output has the
 /// reference's skeleton, path.size() frames, fps = path_fps. Throws
 /// mf::InputError on bad input or options, CancelledError when cancelled.
-Motion renavigate(const NemfModel& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
+Motion renavigate(const runtime::NemfRuntime& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
                   double path_fps, const RenavOptions& options, const TaskContext& ctx = {},
                   RenavReport* report = nullptr);
 

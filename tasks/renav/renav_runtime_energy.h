@@ -11,7 +11,7 @@
 // origin), equal to heading_relative_positions() up to float rounding.
 // tests/runtime_renav_equivalence_test.cc holds it to the libtorch energy
 // (values within 1e-5, gradients within 1e-4, relative); renavigate()
-// minimises it as a RuntimeLatentEnergy (tasks/latent/runtime_problem.h).
+// minimises it as a RuntimeLatentEnergy (tasks/latent/runtime_latent_energy.h).
 #pragma once
 
 #include <Eigen/Core>

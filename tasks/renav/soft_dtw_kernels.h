@@ -1,4 +1,4 @@
-// The soft-DTW kernels of tasks/renav/soft_dtw.h without libtorch: the
+// The soft-DTW kernels of tasks/reference/soft_dtw.h without libtorch: the
 // recursion of one cost matrix, its backward, and the squared Euclidean cost
 // of a sequence pair with its gradient, in double, on raw row-major buffers.
 // soft_dtw.h wraps them in torch autograd functions (with their checks and

@@ -2,10 +2,10 @@
 
 #include <filesystem>
 
-#include "prior/inbetween/inbetweener.h"
-#include "prior/model/nemf.h"
+#include "prior/inbetween/inbetweener_kinds.h"
 #include "prior/motion/errors.h"
 #include "prior/runtime/inbetween_runtime.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "prior/util/binary_io.h"
 
 namespace mf {
@@ -21,29 +21,28 @@ std::string inbetweener_path_next_to(const std::string& prior_path, const std::s
   return (std::filesystem::path(prior_path).parent_path() / inbetweener_file_name(kind)).string();
 }
 
-std::shared_ptr<const InbetweenModel> frozen_inbetweener(std::unique_ptr<InbetweenModel> model,
-                                                         const std::string& source, const std::string& kind,
-                                                         const NemfModel* prior) {
+std::shared_ptr<const runtime::InbetweenerRuntime> checked_inbetweener(
+    std::unique_ptr<const runtime::InbetweenerRuntime> model, const std::string& source, const std::string& kind,
+    const runtime::NemfRuntime* prior) {
   if (!kind.empty() && model->kind() != kind)
     throw InputError(source + " holds a '" + model->kind() + "' model, not the expected '" + kind + "'");
   if (prior && !model->rig().skeleton.same_as(prior->rig().skeleton))
     throw InputError(source + ": the " + inbetweener_title(model->kind()) + "'s skeleton (" +
                      std::to_string(model->rig().num_joints()) + " joints) is not the prior's (" +
                      std::to_string(prior->rig().num_joints()) + " joints): train it on the prior's data");
-  model->set_requires_grad(false);
-  model->train(false);
-  return std::shared_ptr<const InbetweenModel>(std::move(model));
+  return std::shared_ptr<const runtime::InbetweenerRuntime>(std::move(model));
 }
 
-LoadedInbetweener inbetweener_from_bytes(const uint8_t* data, size_t size, const std::string& source,
-                                         const std::string& kind, const NemfModel* prior) {
-  LoadedInbetweener out;
-  out.model = frozen_inbetweener(deserialize_inbetweener(data, size, source), source, kind, prior);
-  out.runtime = runtime::inbetweener_runtime_from_bytes(data, size, source);
-  return out;
+std::shared_ptr<const runtime::InbetweenerRuntime> inbetweener_from_bytes(const uint8_t* data, size_t size,
+                                                                          const std::string& source,
+                                                                          const std::string& kind,
+                                                                          const runtime::NemfRuntime* prior) {
+  return checked_inbetweener(runtime::inbetweener_runtime_from_bytes(data, size, source), source, kind, prior);
 }
 
-LoadedInbetweener load_inbetweener_file(const std::string& path, const std::string& kind, const NemfModel* prior) {
+std::shared_ptr<const runtime::InbetweenerRuntime> load_inbetweener_file(const std::string& path,
+                                                                         const std::string& kind,
+                                                                         const runtime::NemfRuntime* prior) {
   const FileBytes bytes = read_file_bytes(path);
   return inbetweener_from_bytes(bytes.data(), bytes.size(), path, kind, prior);
 }
@@ -58,8 +57,7 @@ void load_inbetweeners(const std::string& prior_path, const std::map<std::string
     if (!is_named && !std::filesystem::exists(file, ec)) continue;
     if (log) log(kind.title, file);
     try {
-      LoadedInbetweener loaded = load_inbetweener_file(file, kind.name, models->model.get());
-      models->add_inbetweener(std::move(loaded.model), std::move(loaded.runtime));
+      models->add_inbetweener(load_inbetweener_file(file, kind.name, models->model.get()));
     } catch (const std::exception& e) {
       if (is_named || strict) throw;
       models->inbetweener_errors[kind.name] = e.what();
@@ -78,8 +76,9 @@ std::string missing_inbetweener_message(const std::string& what, const std::stri
          "), and it is not loaded: put it next to the prior's model file";
 }
 
-const InbetweenModel& require_inbetweener(const ModelSet& models, const std::string& kind, const std::string& what) {
-  if (const InbetweenModel* model = models.inbetweener(kind)) return *model;
+const runtime::InbetweenerRuntime& require_inbetweener(const ModelSet& models, const std::string& kind,
+                                                      const std::string& what) {
+  if (const runtime::InbetweenerRuntime* model = models.inbetweener(kind)) return *model;
   std::string message = missing_inbetweener_message(what, kind);
   auto why = models.inbetweener_errors.find(kind);
   if (why != models.inbetweener_errors.end())

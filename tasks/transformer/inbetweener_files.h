@@ -1,7 +1,7 @@
-// The in-betweeners' model files (prior/inbetween/inbetweener.h): where each
-// kind's file is looked for (next to the prior's model file), loading one
-// ready to be shared between threads, and the error of a method whose
-// in-betweener is not loaded.
+// The in-betweeners' model files (prior/inbetween/inbetweener_kinds.h): where
+// each kind's file is looked for (next to the prior's model file), loading one
+// on the Eigen runtime (prior/runtime/inbetween_runtime.h) ready to be shared
+// between threads, and the error of a method whose in-betweener is not loaded.
 #pragma once
 
 #include <cstddef>
@@ -15,9 +15,9 @@
 
 namespace mf {
 
-class InbetweenModel;
 namespace runtime {
 class InbetweenerRuntime;
+class NemfRuntime;
 }
 
 /// The file name of the product kind `kind` (InbetweenerKind::file_name);
@@ -32,28 +32,22 @@ std::string inbetweener_title(const std::string& kind);
 /// `prior_path`: the same directory, inbetweener_file_name(kind).
 std::string inbetweener_path_next_to(const std::string& prior_path, const std::string& kind);
 
-/// Makes a loaded model ready to be shared between threads: checks that it is
-/// of `kind` (unless empty) and on the skeleton of `prior` (unless null), then
-/// freezes it (evaluation mode, no gradients). InputError naming `source`
-/// otherwise.
-std::shared_ptr<const InbetweenModel> frozen_inbetweener(std::unique_ptr<InbetweenModel> model,
-                                                         const std::string& source, const std::string& kind,
-                                                         const NemfModel* prior = nullptr);
+/// Checks a loaded in-betweener: of `kind` (unless empty) and on the skeleton
+/// of `prior` (unless null). InputError naming `source` otherwise.
+std::shared_ptr<const runtime::InbetweenerRuntime> checked_inbetweener(
+    std::unique_ptr<const runtime::InbetweenerRuntime> model, const std::string& source, const std::string& kind,
+    const runtime::NemfRuntime* prior = nullptr);
 
-/// A model file's in-betweener, frozen (frozen_inbetweener()), and its twin
-/// on the Eigen runtime (ModelSet::inbetweener_runtimes) read from the same
-/// bytes.
-struct LoadedInbetweener {
-  std::shared_ptr<const InbetweenModel> model;
-  std::shared_ptr<const runtime::InbetweenerRuntime> runtime;
-};
 /// The in-betweener of a model file's bytes (`source` names it in errors:
-/// InputError as frozen_inbetweener()'s and the runtime's loader's).
-LoadedInbetweener inbetweener_from_bytes(const uint8_t* data, size_t size, const std::string& source,
-                                         const std::string& kind, const NemfModel* prior = nullptr);
+/// InputError as the runtime's loader's and checked_inbetweener()'s).
+std::shared_ptr<const runtime::InbetweenerRuntime> inbetweener_from_bytes(const uint8_t* data, size_t size,
+                                                                          const std::string& source,
+                                                                          const std::string& kind,
+                                                                          const runtime::NemfRuntime* prior = nullptr);
 /// The same from the file at `path` (FileError when it cannot be read).
-LoadedInbetweener load_inbetweener_file(const std::string& path, const std::string& kind,
-                                        const NemfModel* prior = nullptr);
+std::shared_ptr<const runtime::InbetweenerRuntime> load_inbetweener_file(const std::string& path,
+                                                                         const std::string& kind,
+                                                                         const runtime::NemfRuntime* prior = nullptr);
 
 /// Told the title and the path of each in-betweener file before it loads.
 using InbetweenerLog = std::function<void(const std::string& title, const std::string& path)>;
@@ -79,6 +73,6 @@ std::string missing_inbetweener_message(const std::string& what, const std::stri
 /// The in-betweener of `kind` in `models`; throws mf::ModelMissingError with
 /// missing_inbetweener_message(what, kind), and why its file did not load
 /// when it did not, when it is not loaded.
-const InbetweenModel& require_inbetweener(const ModelSet& models, const std::string& kind, const std::string& what);
+const runtime::InbetweenerRuntime& require_inbetweener(const ModelSet& models, const std::string& kind, const std::string& what);
 
 }  // namespace mf

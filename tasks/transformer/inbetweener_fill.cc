@@ -1,17 +1,13 @@
 #include "tasks/transformer/inbetweener_fill.h"
 
-#include <ATen/ATen.h>
-
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-#include "prior/inbetween/inbetweener.h"
-#include "prior/inbetween/keyframe_net.h"
-#include "prior/model/representation.h"
 #include "prior/runtime/inbetween_runtime.h"
+#include "prior/runtime/keyframe_runtime.h"
 #include "prior/runtime/rotations.h"
 #include "prior/motion/errors.h"
 #include "prior/motion/rotations.h"
@@ -52,7 +48,7 @@ KeyIndex index_keys(const MotionConstraints& c, int frames) {
 }
 
 // Validates the call; returns the stage whose output is used.
-int checked_stage(const InbetweenModel& model, int stage, const Motion& input, const MotionConstraints& c) {
+int checked_stage(const runtime::InbetweenerRuntime& model, int stage, const Motion& input, const MotionConstraints& c) {
   const int J = input.num_joints();
   const RigInfo& rig = model.rig();
   if (J != rig.num_joints())
@@ -111,7 +107,7 @@ struct FillInput {
 
 std::vector<FillInput> make_inputs(const RigInfo& rig, const Motion& filled, const std::vector<FillWindow>& windows,
                                    const KeyIndex& keys, const MotionConstraints& c,
-                                   const at::Tensor& world_trajectory) {
+                                   const runtime::MatrixRXf& world_trajectory) {
   const int J = filled.num_joints();
   std::vector<FillInput> out;
   for (const FillWindow& w : windows) {
@@ -134,10 +130,8 @@ std::vector<FillInput> make_inputs(const RigInfo& rig, const Motion& filled, con
       }
       for (int i = 0; i < 3; ++i) x.pose(t, J * 6 + i) = m.root_positions(t, i) * x.known(t, J);
     }
-    if (world_trajectory.defined()) {
-      const at::Tensor r = canonical_trajectory(world_trajectory.narrow(0, w.start, T), in.transform).contiguous();
-      x.trajectory = Eigen::Map<const runtime::MatrixRXf>(r.data_ptr<float>(), T, 4);
-    }
+    if (world_trajectory.rows() > 0)
+      x.trajectory = canonical_trajectory(world_trajectory.middleRows(w.start, T), in.transform);
     out.push_back(std::move(in));
   }
   return out;
@@ -149,48 +143,6 @@ struct FillOutput {
   runtime::MatrixRXf pose;
   runtime::MatrixRXf contact_logits;
 };
-
-// One pass of the libtorch model over all windows as one batch, padded to the
-// longest window (padding frames invalid; a trajectory held over them).
-std::vector<FillOutput> forward_libtorch(const InbetweenModel& model, int stage, const std::vector<FillInput>& inputs) {
-  at::NoGradGuard no_grad;
-  const int B = static_cast<int>(inputs.size()), D = model.pose_size();
-  const int J1 = model.rig().num_joints() + 1;
-  int L = 0;
-  for (const FillInput& in : inputs) L = std::max(L, static_cast<int>(in.window.pose.rows()));
-  InbetweenBatch batch{at::zeros({B, L, D}, at::kFloat), at::zeros({B, L, J1}, at::kFloat),
-                       at::zeros({B, L}, at::kFloat), at::Tensor()};
-  const bool trajectory = inputs.front().window.trajectory.rows() > 0;
-  if (trajectory) batch.trajectory = at::zeros({B, L, 4}, at::kFloat);
-  auto rows = [](const runtime::MatrixRXf& m) {
-    return at::from_blob(const_cast<float*>(m.data()), {m.rows(), m.cols()}, at::kFloat);
-  };
-  for (int b = 0; b < B; ++b) {
-    const runtime::InbetweenWindow& x = inputs[static_cast<size_t>(b)].window;
-    const int64_t T = x.pose.rows();
-    batch.pose[b].narrow(0, 0, T).copy_(rows(x.pose));
-    batch.known[b].narrow(0, 0, T).copy_(rows(x.known));
-    batch.valid[b].narrow(0, 0, T).fill_(1.0f);
-    if (!trajectory) continue;
-    batch.trajectory[b].narrow(0, 0, T).copy_(rows(x.trajectory));
-    batch.trajectory[b].narrow(0, T, L - T).copy_(rows(x.trajectory)[T - 1].expand({L - T, 4}));
-  }
-  const InbetweenOutput result = model.forward(batch);
-  if (stage >= static_cast<int>(result.stages.size()))
-    throw std::logic_error("the in-betweener returned fewer stages than stage_names() lists");
-  const at::Tensor pose = result.stages[static_cast<size_t>(stage)].detach().to(at::kFloat).contiguous();
-  const at::Tensor contacts =
-      result.contact_logits.defined() ? result.contact_logits.detach().to(at::kFloat).contiguous() : at::Tensor();
-  std::vector<FillOutput> out(inputs.size());
-  for (int b = 0; b < B; ++b) {
-    const int64_t T = inputs[static_cast<size_t>(b)].window.pose.rows();
-    out[b].pose = Eigen::Map<const runtime::MatrixRXf>(pose[b].data_ptr<float>(), L, D).topRows(T);
-    if (contacts.defined())
-      out[b].contact_logits =
-          Eigen::Map<const runtime::MatrixRXf>(contacts[b].data_ptr<float>(), L, contacts.size(2)).topRows(T);
-  }
-  return out;
-}
 
 // One pass of the Eigen runtime's model per window.
 std::vector<FillOutput> forward_runtime(const runtime::InbetweenerRuntime& net, int stage,
@@ -309,48 +261,49 @@ void copy_constrained(const Motion& input, const MotionConstraints& c, Motion* o
 
 }  // namespace
 
-at::Tensor constrained_trajectory(const Motion& input, const MotionConstraints& c, const RigInfo& rig) {
-  if (c.trajectory.empty()) return at::Tensor();
+runtime::MatrixRXf constrained_trajectory(const Motion& input, const MotionConstraints& c, const RigInfo& rig) {
+  if (c.trajectory.empty()) return runtime::MatrixRXf(0, 4);
   const int n = input.num_frames();
-  at::Tensor rows = at::zeros({1, n, 4}, at::kFloat);
-  at::Tensor xz_known = at::zeros({1, n}, at::kBool), facing_known = at::zeros({1, n}, at::kBool);
+  runtime::MatrixRXf rows = runtime::MatrixRXf::Zero(n, 4);
+  std::vector<bool> xz_known(n, false), facing_known(n, false);
   for (const TrajectoryPoint& p : c.trajectory) {
-    rows[0][p.frame] = at::tensor({p.x, p.z, p.forward_x, p.forward_z}, at::kDouble).to(at::kFloat);
-    xz_known[0][p.frame] = true;
-    facing_known[0][p.frame] = true;
+    rows.row(p.frame) << static_cast<float>(p.x), static_cast<float>(p.z), static_cast<float>(p.forward_x),
+        static_cast<float>(p.forward_z);
+    xz_known[p.frame] = facing_known[p.frame] = true;
   }
   for (size_t k = 0; k < c.keys.size(); ++k) {
     const int f = c.keys[k].frame;
-    at::Tensor r = at::empty({3, 3}, at::kFloat), pos = at::empty({3}, at::kFloat);
-    const Eigen::Matrix3d m = input.rotation(f, 0).normalized().toRotationMatrix();
-    for (int a = 0; a < 3; ++a) {
-      pos[a] = input.root_positions[f][a];
-      for (int b = 0; b < 3; ++b) r[a][b] = m(a, b);
-    }
-    at::Tensor own = trajectory_features(r, pos, rig.root_forward);  // [4]
     if (c.keys[k].root_position) {
-      rows[0][f].narrow(0, 0, 2).copy_(own.narrow(0, 0, 2));
-      xz_known[0][f] = true;
+      rows(f, 0) = static_cast<float>(input.root_positions[f].x());
+      rows(f, 1) = static_cast<float>(input.root_positions[f].z());
+      xz_known[f] = true;
     }
     if (c.key_has_joint(k, 0)) {
-      rows[0][f].narrow(0, 2, 2).copy_(own.narrow(0, 2, 2));
-      facing_known[0][f] = true;
+      const Eigen::Matrix<float, 3, 3, Eigen::RowMajor> root =
+          input.rotation(f, 0).normalized().toRotationMatrix().cast<float>();
+      runtime::ground_facing(root.data(), rig, &rows(f, 2));
+      facing_known[f] = true;
     }
   }
-  return interpolate_trajectory_rows(rows, xz_known, facing_known)[0];
+  return runtime::interpolate_trajectory_rows(rows, xz_known, facing_known);
 }
 
-at::Tensor canonical_trajectory(const at::Tensor& world, const GroundTransform& transform) {
-  if (world.dim() < 1 || world.size(-1) != 4) throw InputError("canonical_trajectory: rows must be [..., 4]");
+runtime::MatrixRXf canonical_trajectory(const Eigen::Ref<const runtime::MatrixRXf>& world,
+                                        const GroundTransform& transform) {
+  if (world.cols() != 4) throw InputError("canonical_trajectory: rows must be [n, 4]");
   const double c = std::cos(transform.yaw), s = std::sin(transform.yaw);
-  at::Tensor x = world.select(-1, 0) - transform.x, z = world.select(-1, 1) - transform.z;
-  at::Tensor fx = world.select(-1, 2), fz = world.select(-1, 3);
-  return at::stack({c * x - s * z, s * x + c * z, c * fx - s * fz, s * fx + c * fz}, -1);
+  runtime::MatrixRXf out(world.rows(), 4);
+  for (Eigen::Index t = 0; t < world.rows(); ++t) {
+    const double x = world(t, 0) - transform.x, z = world(t, 1) - transform.z, fx = world(t, 2), fz = world(t, 3);
+    out.row(t) << static_cast<float>(c * x - s * z), static_cast<float>(s * x + c * z),
+        static_cast<float>(c * fx - s * fz), static_cast<float>(s * fx + c * fz);
+  }
+  return out;
 }
 
-Motion inbetweener_fill(const InbetweenModel& model, const runtime::InbetweenerRuntime* network, int stage,
-                        const Motion& input, const MotionConstraints& constraints, LongGapPolicy policy,
-                        bool foot_lock, const FillFallback& fallback) {
+Motion inbetweener_fill(const runtime::InbetweenerRuntime& model, int stage, const Motion& input,
+                        const MotionConstraints& constraints, LongGapPolicy policy, bool foot_lock,
+                        const FillFallback& fallback) {
   const int used_stage = checked_stage(model, stage, input, constraints);
   // Reads only the constrained values; every frame holds something sensible.
   Motion out = fill_by_interpolation(input, constraints);
@@ -364,8 +317,7 @@ Motion inbetweener_fill(const InbetweenModel& model, const runtime::InbetweenerR
   if (!windows.empty()) {
     const std::vector<FillInput> inputs =
         make_inputs(model.rig(), out, windows, keys, constraints, constrained_trajectory(input, constraints, model.rig()));
-    const std::vector<FillOutput> outputs =
-        network ? forward_runtime(*network, used_stage, inputs) : forward_libtorch(model, used_stage, inputs);
+    const std::vector<FillOutput> outputs = forward_runtime(model, used_stage, inputs);
     // The contact head reads the last stage: its contacts hold for that stage's pose only.
     const int feet = model.rig().num_feet();
     const bool lock = foot_lock && outputs.front().contact_logits.cols() == feet && feet > 0 &&

@@ -1,4 +1,4 @@
-// How a transformer in-betweener (prior/inbetween/inbetweener.h) fills a
+// How a transformer in-betweener (prior/runtime/inbetween_runtime.h) fills a
 // motion in one pass: inbetweener_fill(), behind the transformer methods
 // (tasks/methods/transformer_methods.h) and the transformer initialisers of the latent
 // solvers (tasks/latent/initializers.h).
@@ -13,9 +13,7 @@
 //    gap they fill as context (or, when the keys are sparse, the previous key
 //    if it is at most 40 frames back): the known patterns of training. A
 //    window extends over as many following gaps as fit. Each gap is produced
-//    by exactly one window, so the pieces meet only at known frames; all
-//    windows of a call run as one batch
-//    (on libtorch; the Eigen runtime runs them one by one).
+//    by exactly one window, so the pieces meet only at known frames.
 //  * A gap longer than the window (two keys more than window() - 1 frames
 //    apart) cannot be filled by one pass: LongGapPolicy::Throw says so with
 //    mf::InputError (the methods), LongGapPolicy::Interpolate leaves that gap
@@ -33,11 +31,11 @@
 //    (the two residual rotations composed; unlike tasks/constraints/residuals.h, which
 //    interpolates between them).
 //  * A ground trajectory (constraints.trajectory, world x, z and facing) goes
-//    to the model as InbetweenBatch::trajectory, in each window's canonical
+//    to the model as InbetweenWindow::trajectory, in each window's canonical
 //    frame (canonical_trajectory()), for the kinds that read it (the others
 //    ignore it): constrained_trajectory() completes it over every frame (the
 //    keys' own root wins over a row at the same frame; frames without a row
-//    are interpolated). Without trajectory rows the batch has none and a
+//    are interpolated). Without trajectory rows the window has none and a
 //    trajectory-conditioned kind interpolates between the known roots itself.
 //    Callers (CLI, C ABI, batch) only fill MotionConstraints::trajectory.
 //  * Jumps at the keys (`fallback.interpolate_jumps`): a gap whose output
@@ -51,21 +49,19 @@
 //    contacts, as after a latent solve (the frames of keys that constrain a
 //    leg untouched). Measured in docs/BENCHMARKS.md ("Long transitions").
 //  * The input's frames are taken as frames of the model (no resampling to
-//    the model's fps). Deterministic for a given input and thread count.
+//    the model's fps). Deterministic.
 #pragma once
-
-#include <ATen/core/Tensor.h>
 
 #include <string>
 #include <vector>
 
-#include "prior/model/representation.h"
+#include "prior/model/canonical_window.h"
+#include "prior/runtime/tensor_ops.h"
 #include "prior/motion/motion.h"
 #include "tasks/constraints/motion_constraints.h"
 
 namespace mf {
 
-class InbetweenModel;
 namespace runtime {
 class InbetweenerRuntime;
 }
@@ -85,30 +81,28 @@ struct FillFallback {
 
 /// Completes `input` under `constraints` (full or partial keys; end-effector
 /// targets are ignored) with one pass of `model`, using the output of stage
-/// `stage` (0-based; -1 = the last stage). See the top of this file.
-/// `network`, when given, is the same model file on the Eigen runtime
-/// (prior/runtime/inbetween_runtime.h; ModelSet::inbetweener_runtime()): the
-/// forward pass then runs there, window by window, without libtorch; the
-/// libtorch model still answers for its kind, stages and rig. Throws
+/// `stage` (0-based; -1 = the last stage). See the top of this file. Throws
 /// mf::InputError for constraints that do not validate, a skeleton whose
 /// joint count differs from the model's, a stage the model does not have, or
 /// (LongGapPolicy::Throw) a gap longer than the window.
-Motion inbetweener_fill(const InbetweenModel& model, const runtime::InbetweenerRuntime* network, int stage,
-                        const Motion& input, const MotionConstraints& constraints, LongGapPolicy policy,
+Motion inbetweener_fill(const runtime::InbetweenerRuntime& model, int stage, const Motion& input,
+                        const MotionConstraints& constraints, LongGapPolicy policy,
                         bool foot_lock = false, const FillFallback& fallback = {});
 
-/// The ground trajectory of every frame of `input`, [frames, 4] float (world:
+/// The ground trajectory of every frame of `input`, [frames, 4] (world:
 /// x, z, forward_x, forward_z as trajectory_features() of
 /// prior/model/representation.h), that `constraints` ask for: the rows of
 /// constraints.trajectory, except at keys that give the root position (x, z)
 /// or the root rotation (facing), whose own values win; the other frames
 /// interpolated between those (interpolate_trajectory_rows() of
-/// prior/inbetween/keyframe_net.h: linear, facing normalised, held at the
-/// ends). Undefined when constraints.trajectory is empty.
-at::Tensor constrained_trajectory(const Motion& input, const MotionConstraints& constraints, const RigInfo& rig);
+/// prior/runtime/keyframe_runtime.h: linear, facing normalised, held at the
+/// ends). No rows (0 x 4) when constraints.trajectory is empty.
+runtime::MatrixRXf constrained_trajectory(const Motion& input, const MotionConstraints& constraints,
+                                          const RigInfo& rig);
 
-/// World trajectory rows [..., 4] in the canonical frame of `transform`
+/// World trajectory rows [n, 4] in the canonical frame of `transform`
 /// (canonical = R_y(-yaw) (world - (x, 0, z)); the facing only rotated).
-at::Tensor canonical_trajectory(const at::Tensor& world, const GroundTransform& transform);
+runtime::MatrixRXf canonical_trajectory(const Eigen::Ref<const runtime::MatrixRXf>& world,
+                                        const GroundTransform& transform);
 
 }  // namespace mf

@@ -1,9 +1,6 @@
-// The bridge between the tensor side of the latent solvers and the Eigen
-// runtime's energy (tasks/latent/runtime_energy.h): the one conversion from
-// the tensor WindowProblem (tasks/latent/energies.h) to the runtime's
-// RuntimeWindowProblem, so that a solver can evaluate the same window either
-// way, and the runtime's energy as the optimiser's DirectLatentEnergy
-// (tasks/latent/latent_optimizer.h).
+// The Eigen runtime's energy of a window (tasks/latent/runtime_energy.h) as
+// the optimiser's DirectLatentEnergy (tasks/latent/latent_optimizer.h): a
+// function of x = [z_l, z_g].
 #pragma once
 
 #include <Eigen/Core>
@@ -12,15 +9,10 @@
 #include <utility>
 #include <vector>
 
-#include "tasks/latent/energies.h"
 #include "tasks/latent/latent_optimizer.h"
 #include "tasks/latent/runtime_energy.h"
 
 namespace mf {
-
-/// The problem's constraints copied to float matrices (one row per key,
-/// effector or trajectory row) and index vectors, for a rig of `joints` joints.
-RuntimeWindowProblem to_runtime_problem(const WindowProblem& problem, int joints);
 
 /// An energy of the codes (z_l [zl], z_g [zg]) on the Eigen runtime: its
 /// terms and, when g_zl and g_zg are not null, its gradient.
@@ -31,7 +23,7 @@ using RuntimeCodeEnergy =
 
 /// A runtime energy of the codes as a function of x = [z_l, z_g] (zl + zg
 /// values, rounded to float as the tensor energy's x is), as
-/// FlatLatentEnergy (tasks/latent/latent_energy.h) is the tensor energy's.
+/// FlatLatentEnergy (tasks/reference/latent_energy.h) is libtorch's.
 class RuntimeLatentEnergy final : public DirectLatentEnergy {
  public:
   RuntimeLatentEnergy(RuntimeCodeEnergy energy, int zl, int zg);

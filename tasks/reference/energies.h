@@ -65,7 +65,7 @@
 #include "prior/motion/motion.h"
 #include "tasks/constraints/motion_constraints.h"
 #include "tasks/latent/energy_weights.h"
-#include "tasks/latent/latent_energy.h"
+#include "tasks/reference/latent_energy.h"
 #include "tasks/latent/window_problem.h"
 #include "tasks/latent/window_solver.h"
 
@@ -123,9 +123,11 @@ WindowProblem make_window_problem(const RigInfo& rig, const Motion& motion, int 
 /// as tensors, for a rig of `joints` joints: what make_window_problem()
 /// returns for the same window.
 WindowProblem to_tensor_problem(const RuntimeWindowProblem& runtime, int joints);
+/// The inverse: the problem's tensors copied to float matrices and index vectors.
+RuntimeWindowProblem to_runtime_problem(const WindowProblem& problem, int joints);
 
 /// Evaluates the energy of (z_l [1, zl], z_g [1, zg]) on `problem`: the
-/// active terms, weighted, in the order above (EnergyTerms, tasks/latent/latent_energy.h).
+/// active terms, weighted, in the order above (EnergyTerms, tasks/reference/latent_energy.h).
 /// Differentiable with respect to the latents (the caller freezes the network).
 EnergyTerms evaluate_energy(const NemfModel& model, const WindowProblem& problem, const EnergyWeights& weights,
                             const at::Tensor& z_l, const at::Tensor& z_g);

@@ -3,9 +3,9 @@
 // of named, weighted terms (EnergyTerms); FlatLatentEnergy turns it into a
 // DirectLatentEnergy of one flat vector x = [z_l, z_g], the variable of
 // tasks/latent/latent_optimizer.h, with its gradient from autograd. The Eigen
-// runtime's energies (tasks/latent/runtime_problem.h) are DirectLatentEnergy
+// runtime's energies (tasks/latent/runtime_latent_energy.h) are DirectLatentEnergy
 // themselves; this adapter serves the libtorch energies the runtime is
-// checked against and models that have no runtime.
+// checked against (tasks/reference/).
 #pragma once
 
 #include <ATen/core/Tensor.h>

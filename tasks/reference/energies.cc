@@ -1,4 +1,4 @@
-#include "tasks/latent/energies.h"
+#include "tasks/reference/energies.h"
 
 #include <ATen/ATen.h>
 
@@ -84,6 +84,43 @@ WindowProblem to_tensor_problem(const RuntimeWindowProblem& r, int J) {
   p.trajectory_frames = long_tensor(r.trajectory_frames);
   p.trajectory_ground = float_tensor(r.trajectory_ground, {R, 2});
   p.trajectory_forward = float_tensor(r.trajectory_forward, {R, 2});
+  return p;
+}
+
+namespace {
+
+// The values of an int64 tensor of n entries.
+std::vector<int> ints_of(const at::Tensor& t, int n) {
+  if (n == 0) return {};
+  const at::Tensor c = t.to(at::kLong).contiguous();
+  return std::vector<int>(c.data_ptr<int64_t>(), c.data_ptr<int64_t>() + n);
+}
+
+}  // namespace
+
+RuntimeWindowProblem to_runtime_problem(const WindowProblem& problem, int joints) {
+  RuntimeWindowProblem p;
+  const int K = problem.num_keys(), J = joints;
+  p.length = problem.length;
+  p.anchor = problem.anchor;
+  p.transform = problem.transform;
+  p.key_frames = ints_of(problem.key_frames, K);
+  p.key_rotations = rows_of(problem.key_rotations, K, J * 9);
+  p.key_rotation_mask = rows_of(problem.key_rotation_mask, K, J);
+  p.key_positions = rows_of(problem.key_positions, K, J * 3);
+  p.key_position_mask = rows_of(problem.key_position_mask, K, J);
+  p.key_root = rows_of(problem.key_root, K, 3);
+  p.key_root_mask = rows_of(problem.key_root_mask, K, 1).col(0);
+  const int E = problem.num_effectors(), P = problem.num_pin_steps(), R = problem.num_trajectory();
+  p.effector_frames = ints_of(problem.effector_frames, E);
+  p.effector_joints = ints_of(problem.effector_joints, E);
+  p.effector_targets = rows_of(problem.effector_targets, E, 3);
+  p.effector_weights = rows_of(problem.effector_weights, E, 1).col(0);
+  p.pin_from = ints_of(problem.pin_from, P);
+  p.pin_to = ints_of(problem.pin_to, P);
+  p.trajectory_frames = ints_of(problem.trajectory_frames, R);
+  p.trajectory_ground = rows_of(problem.trajectory_ground, R, 2);
+  p.trajectory_forward = rows_of(problem.trajectory_forward, R, 2);
   return p;
 }
 

@@ -1,4 +1,4 @@
-#include "tasks/latent/latent_energy.h"
+#include "tasks/reference/latent_energy.h"
 
 #include <torch/csrc/autograd/autograd.h>
 
