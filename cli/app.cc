@@ -115,7 +115,7 @@ void add_constraints(CLI::App* cmd, JobOptions& job) {
 void define_global_options(CLI::App& app, Settings& s, bool& version_flag) {
   app.option_defaults()->group("global options");
   app.set_help_flag("-h,--help", "this help; `motionfield <command> --help` for a command");
-  app.add_option("--threads", s.threads, "intra-op threads of each job's solver (default 1; more\npay only on an idle machine: with another process busy,\na solve on 2 threads of 2 cores took 25-40x as long)")
+  app.add_option("--threads", s.threads, "intra-op threads of each job: the BLAS's pool for its\nmatrix products (default 1; batch jobs side by side use\nthe cores better)")
       ->type_name("N")
       ->check(quiet(CLI::Range(1, 1024)));
   app.add_option("--model", s.model,

@@ -49,7 +49,7 @@ void print_outcome(const Outcome& o, const Settings& settings) {
 // the cores better than threads inside one job (docs/BENCHMARKS.md, "Threads":
 // a 128-frame solve is only 3-20 % faster on two threads of an idle machine,
 // and far slower when the cores are busy).
-// At most 8 by default: every job holds its own solver's tensors.
+// At most 8 by default: every job holds its own solver's buffers.
 int batch_workers(const Settings& settings) {
   if (settings.jobs > 0) return settings.jobs;
   const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

@@ -13,7 +13,7 @@ namespace motionfield::cli {
 
 /// The global options (motionfield --help).
 struct Settings {
-  int threads = 1;                    ///< --threads: intra-op threads of each job (TaskThreads in capi/src/capi_internal.h: why 1)
+  int threads = 1;                    ///< --threads: intra-op threads of each job (mf_set_num_threads: the BLAS's pool)
   bool verbose = false;
   bool quiet = false;                 ///< --quiet: no progress bar, no warnings
   bool json = false;                  ///< --json: a JSON summary of each job on stdout

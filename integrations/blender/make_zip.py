@@ -9,8 +9,9 @@ python/setup.py): with the built library and the bundled models inside it
 (``--library``, by default the checkout's build/capi/libmotionfield.so.0),
 or pure Python with ``--no-bundle`` (the library is then found through the
 add-on's "Library" preference, $MOTIONFIELD_LIBRARY or the system's library
-path). The library links Debian's libtorch: the zip works on machines with
-the same packages (scripts/install-deps.sh).
+path). The library links no libtorch; it needs Debian's Ceres, OpenBLAS,
+assimp and tinygltf: the zip works on machines with the same packages
+(scripts/install-deps.sh).
 """
 
 import argparse

@@ -63,16 +63,15 @@ def library_path() -> str:
 
 
 def set_num_threads(n: int) -> None:
-    """Sets the intra-op threads of the numeric work, for the whole process.
+    """Sets the threads of the matrix products, for the whole process.
 
     Parameters
     ----------
     n : int
-        Number of threads, 1..1024. Until it is called, each task runs on one
-        thread (its calling thread), as the CLI's default. More than one pays only
-        on an otherwise idle machine: libtorch's OpenMP threads spin while they
-        wait, and with another process busy a solve on two threads of two cores
-        took 25-40x as long as on one.
+        Number of threads, 1..1024: the size of the BLAS library's own pool.
+        Every task runs its numeric work on its calling thread and, until this
+        is called, multiplies matrices there too, as the CLI's default. To run
+        several tasks at once, call them from several threads.
 
     Returns
     -------
@@ -87,13 +86,12 @@ def set_num_threads(n: int) -> None:
 
 
 def get_num_threads() -> int:
-    """The intra-op threads of the numeric work.
+    """The threads of the matrix products.
 
     Returns
     -------
     int
-        The threads a task started now on the calling thread runs with: the
-        count set by set_num_threads(), else 1.
+        The count set by set_num_threads(), else 1.
 
     Raises
     ------

@@ -3,7 +3,7 @@ default model, the same default method, the same result.
 
 The CLI is $MF_CLI (CTest sets it), else the source tree's build/cli/motionfield.
 Named after test_motionfield.py on purpose: unittest discovers files in order,
-and test_motionfield.py checks that importing motionfield brings libtorch.
+and test_motionfield.py checks that importing motionfield brings no libtorch.
 """
 
 import os
