@@ -35,7 +35,7 @@
 #include "bench/options.h"
 #include "bench/protocol.h"
 #include "bench/text.h"
-#include "prior/model/nemf.h"
+#include "prior/runtime/nemf_runtime.h"
 #include "tasks/transition/transition.h"
 
 namespace {
