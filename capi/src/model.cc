@@ -108,8 +108,12 @@ std::unique_ptr<mf_model> load_model_set(const char* path, const char* const* in
     if (file.empty())
       throw ApiError(MF_ERROR_IO, "no default model: set MF_MODEL or install models/motionfield-prior.mfm (see README)");
   }
-  const FileBytes bytes = read_file(file);
-  std::unique_ptr<mf_model> handle = load_bytes(bytes.data(), bytes.size(), file);
+  std::unique_ptr<mf_model> handle;
+  {
+    // The prior's bytes go before the in-betweeners load (the peak memory of a load).
+    const FileBytes bytes = read_file(file);
+    handle = load_bytes(bytes.data(), bytes.size(), file);
+  }
   load_inbetweeners_next_to(file, handle.get());
   load_anatomy(handle.get(), file);
   for (size_t i = 0; i < count; ++i) {
