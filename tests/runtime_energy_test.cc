@@ -32,6 +32,7 @@
 #include "prior/util/threads.h"
 #include "tasks/latent/runtime_energy.h"
 #include "tasks/latent/runtime_latent_energy.h"
+#include "tasks/reference/energies.h"
 #include "tests/runtime_test_util.h"
 
 // In mf::test, where the helpers of runtime_test_util.h are.
