@@ -1,5 +1,5 @@
 // mf_encoding: the prior as a codec (tasks/latent/prior_codec.h) at the C
-// boundary, on the model set's Eigen runtime (ModelSet::runtime).
+// boundary, on the model set's prior (ModelSet::model, the Eigen runtime).
 #include <cmath>
 #include <cstring>
 

@@ -1,7 +1,7 @@
 // The weights of the latent solvers' energy terms (tasks/reference/energies.h
 // defines the terms) and which terms a window problem makes active: torch-free,
-// shared by the libtorch energy (energies.h) and the Eigen one
-// (runtime_energy.h), so both switch the same terms on.
+// shared by the Eigen energy (runtime_energy.h) and the libtorch reference
+// (tasks/reference/energies.h), so both switch the same terms on.
 #pragma once
 
 namespace mf {

@@ -68,7 +68,7 @@ struct LatentOptimizerStats {
 
 /// An energy of x ([size()] values) that evaluates itself and its gradient:
 /// the Eigen runtime's (RuntimeLatentEnergy, tasks/latent/runtime_latent_energy.h)
-/// or a libtorch energy's adapter (TensorLatentEnergy). It keeps buffers
+/// or a libtorch energy's adapter (FlatLatentEnergy, tasks/reference/). It keeps buffers
 /// between evaluations, so evaluating is not const; one per thread.
 class DirectLatentEnergy {
  public:

@@ -42,7 +42,8 @@ struct SolveSummary {
   double wall_ms = 0.0;
   std::string message;       ///< the optimiser's stop reason
   /// The stages minimised the Eigen runtime's energy
-  /// (tasks/latent/runtime_energy.h), not a libtorch one (set by the task).
+  /// (tasks/latent/runtime_energy.h), not a reference one
+  /// (TaskContext::reference; set by the task).
   bool runtime_energy = false;
 };
 

@@ -1,6 +1,6 @@
 // One window of a re-navigation problem (tasks/renav/renav.h) and the weights
 // of its energy, as plain Eigen data: what both evaluations of the energy
-// read, the libtorch one (evaluate_renav_energy(), renav.h) and the Eigen
+// read, the libtorch one (evaluate_renav_energy(), tasks/reference/renav_energy.h) and the Eigen
 // runtime's (RenavRuntimeEnergy, tasks/renav/renav_runtime_energy.h). No
 // libtorch.
 #pragma once
