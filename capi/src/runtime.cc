@@ -235,6 +235,7 @@ int mf_set_num_threads(int32_t num_threads) {
 int mf_get_num_threads(int32_t* out) {
   return guard([&] {
     require(out, "out");
+    const mf::capi::TaskThreads threads;
     const int n = mf::capi::g_num_threads.load();
     *out = n > 0 ? n : 1;
   });
