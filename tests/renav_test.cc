@@ -31,6 +31,9 @@ std::shared_ptr<NemfModel> tiny_model() {
   return model;
 }
 
+// A test prior on the Eigen runtime, as the tasks take it.
+runtime::NemfRuntime on_runtime(const NemfModel& model) { return test::runtime_of(model); }
+
 // The message of the InputError `fn` throws ("" if none).
 template <class Fn>
 std::string input_error(Fn&& fn) {
@@ -166,7 +169,7 @@ TEST(RenavEnergyTest, LowerForAMotionThatFollowsThePath) {
   // The target is the reference's own root path: the reference itself follows
   // it in its own style (joints and heading divergences 0).
   const std::vector<Eigen::Vector2d> path = root_path(ref);
-  const RenavWindow w = make_renav_window(test::runtime_of(*model), ref, 0, 32, path, 0, 32);
+  const RenavWindow w = make_renav_window(on_runtime(*model), ref, 0, 32, path, 0, 32);
   const RenavWeights weights;
   // The energy of a world motion, given in the window's canonical frame.
   auto energy = [&](const Motion& m) {
@@ -205,7 +208,7 @@ TEST(RenavEnergyTest, GradientsReachTheCodesOnly) {
   auto model = tiny_model();
   const RigInfo& rig = model->rig();
   const Motion ref = test::random_motion(rig.skeleton, 40, 30.0, 9);
-  const RenavWindow w = make_renav_window(test::runtime_of(*model), ref, 0, 32, line_path(40, 0.04), 4, 32);
+  const RenavWindow w = make_renav_window(on_runtime(*model), ref, 0, 32, line_path(40, 0.04), 4, 32);
   RenavWeights weights;
   weights.foot_skating = 1.0;
   at::manual_seed(3);
@@ -236,7 +239,7 @@ TEST(RenavEnergyTest, UsesTheSteeringGmp) {
   NemfModel model(c, test::tiny_rig());
   model.set_requires_grad(false);
   const Motion ref = test::random_motion(model.rig().skeleton, 40, 30.0, 9);
-  const RenavWindow w = make_renav_window(test::runtime_of(model), ref, 0, 32, line_path(40, 0.04), 4, 32);
+  const RenavWindow w = make_renav_window(on_runtime(model), ref, 0, 32, line_path(40, 0.04), 4, 32);
   RenavWeights weights;
   weights.foot_skating = 1.0;
   at::manual_seed(3);
@@ -263,7 +266,7 @@ TEST(RenavEnergyTest, WindowStartsOnThePathWithTheReferencesFacing) {
   const RigInfo& rig = model->rig();
   const Motion ref = test::random_motion(rig.skeleton, 32, 30.0, 10);
   const auto path = line_path(32, 0.05);
-  const RenavWindow w = make_renav_window(test::runtime_of(*model), ref, 0, 32, path, 0, 32);
+  const RenavWindow w = make_renav_window(on_runtime(*model), ref, 0, 32, path, 0, 32);
   EXPECT_DOUBLE_EQ(w.transform.x, path[0].x());
   EXPECT_DOUBLE_EQ(w.transform.z, path[0].y());
   EXPECT_NEAR(w.target_xz(0, 0), 0.0, 1e-6);
@@ -293,7 +296,7 @@ TEST(Renavigate, DecreasesTheEnergyAndHasThePathsLength) {
   const Motion ref = test::random_motion(model->rig().skeleton, 40, 30.0, 11);
   const auto path = line_path(50, 0.04);  // 50 frames: two windows of 32
   RenavReport report;
-  const Motion out = renavigate(test::runtime_of(*model), ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 25), {}, &report);
+  const Motion out = renavigate(on_runtime(*model), ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 25), {}, &report);
   EXPECT_EQ(out.num_frames(), 50);
   EXPECT_EQ(out.fps, 30.0);
   EXPECT_TRUE(out.skeleton.same_as(ref.skeleton));
@@ -322,9 +325,9 @@ TEST(Renavigate, PlaysTheReferenceAtThePathsPace) {
   const auto path = line_path(20, 0.04);  // 1.2 m/s
   RenavOptions o = quick(LatentOptimizer::Lbfgs, 5);
   RenavReport paced, as_is;
-  const Motion a = renavigate(test::runtime_of(*model), ref, path, 30.0, o, {}, &paced);
+  const Motion a = renavigate(on_runtime(*model), ref, path, 30.0, o, {}, &paced);
   o.match_pace = false;
-  const Motion b = renavigate(test::runtime_of(*model), ref, path, 30.0, o, {}, &as_is);
+  const Motion b = renavigate(on_runtime(*model), ref, path, 30.0, o, {}, &as_is);
   EXPECT_NEAR(paced.pace, 2.0, 1e-9);
   EXPECT_EQ(as_is.pace, 1.0);
   EXPECT_EQ(a.num_frames(), 20);
@@ -338,7 +341,7 @@ TEST(Renavigate, PlaysTheReferenceAtThePathsPace) {
   // Two frames cannot be played twice as fast: such a reference keeps its pace.
   RenavReport two;
   o.match_pace = true;
-  const Motion c = renavigate(test::runtime_of(*model), ref.slice(0, 2), path, 30.0, o, {}, &two);
+  const Motion c = renavigate(on_runtime(*model), ref.slice(0, 2), path, 30.0, o, {}, &two);
   EXPECT_EQ(c.num_frames(), 20);
   EXPECT_EQ(two.pace, 1.0);
 }
@@ -348,7 +351,7 @@ TEST(Renavigate, AdamAndOtherFrameRates) {
   const Motion ref = test::random_motion(model->rig().skeleton, 30, 30.0, 12);
   // 45 points at 60 fps: 22 model frames (one window), resampled back to 45 frames at 60 fps.
   RenavReport report;
-  const Motion out = renavigate(test::runtime_of(*model), ref, line_path(45, 0.02), 60.0, quick(LatentOptimizer::Adam, 30), {}, &report);
+  const Motion out = renavigate(on_runtime(*model), ref, line_path(45, 0.02), 60.0, quick(LatentOptimizer::Adam, 30), {}, &report);
   EXPECT_EQ(out.num_frames(), 45);
   EXPECT_EQ(out.fps, 60.0);
   ASSERT_EQ(report.windows.size(), 1u);
@@ -356,7 +359,7 @@ TEST(Renavigate, AdamAndOtherFrameRates) {
   EXPECT_LE(report.windows[0].final_energy, report.windows[0].initial_energy);
   // A reference at another frame rate is resampled to the model's.
   Motion ref60 = test::random_motion(model->rig().skeleton, 40, 60.0, 13);
-  const Motion out2 = renavigate(test::runtime_of(*model), ref60, line_path(20, 0.04), 30.0, quick(LatentOptimizer::Lbfgs, 5));
+  const Motion out2 = renavigate(on_runtime(*model), ref60, line_path(20, 0.04), 30.0, quick(LatentOptimizer::Lbfgs, 5));
   EXPECT_EQ(out2.num_frames(), 20);
 }
 
@@ -367,17 +370,17 @@ TEST(Renavigate, RespectsCancelAndProgress) {
   std::atomic<int> cancel{1};
   TaskContext ctx;
   ctx.cancel = &cancel;
-  EXPECT_THROW(renavigate(test::runtime_of(*model), ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 50), ctx), CancelledError);
+  EXPECT_THROW(renavigate(on_runtime(*model), ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 50), ctx), CancelledError);
   int calls = 0;
   TaskContext ctx2;
   ctx2.progress = [&](const TaskProgress& p) {
     EXPECT_EQ(p.max_iterations, 50);
     return ++calls < 4;
   };
-  EXPECT_THROW(renavigate(test::runtime_of(*model), ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 50), ctx2), CancelledError);
+  EXPECT_THROW(renavigate(on_runtime(*model), ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 50), ctx2), CancelledError);
   EXPECT_EQ(calls, 4);
   calls = 0;
-  EXPECT_THROW(renavigate(test::runtime_of(*model), ref, path, 30.0, quick(LatentOptimizer::Adam, 50), ctx2), CancelledError);
+  EXPECT_THROW(renavigate(on_runtime(*model), ref, path, 30.0, quick(LatentOptimizer::Adam, 50), ctx2), CancelledError);
   EXPECT_EQ(calls, 4);
 }
 
@@ -387,8 +390,8 @@ TEST(Renavigate, Deterministic) {
   const auto path = line_path(40, 0.03);
   TaskContext ctx;
   ctx.seed = 7;
-  const Motion a = renavigate(test::runtime_of(*model), ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 10), ctx);
-  const Motion b = renavigate(test::runtime_of(*model), ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 10), ctx);
+  const Motion a = renavigate(on_runtime(*model), ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 10), ctx);
+  const Motion b = renavigate(on_runtime(*model), ref, path, 30.0, quick(LatentOptimizer::Lbfgs, 10), ctx);
   for (int f = 0; f < a.num_frames(); ++f) {
     ASSERT_EQ(a.root_positions[f], b.root_positions[f]) << f;
     for (int j = 0; j < a.num_joints(); ++j) ASSERT_EQ(a.rotation(f, j).coeffs(), b.rotation(f, j).coeffs());
@@ -417,7 +420,8 @@ TEST(Renavigate, FeetInContactAreLocked) {
   const auto path = line_path(40, 0.01);
   RenavOptions locked = quick(LatentOptimizer::Lbfgs, 10), free = locked;
   free.foot_lock_ramp = -1;
-  const Motion a = renavigate(test::runtime_of(model), ref, path, 30.0, locked), b = renavigate(test::runtime_of(model), ref, path, 30.0, free);
+  const Motion a = renavigate(on_runtime(model), ref, path, 30.0, locked);
+  const Motion b = renavigate(on_runtime(model), ref, path, 30.0, free);
   const auto travel = [](const Motion& m, int foot) {
     const GlobalPose pose = forward_kinematics(m);
     double sum = 0.0;
@@ -466,7 +470,7 @@ TEST(RunRenav, EntryPointAndErrors) {
   RenavOptions bad;
   bad.inits = {"psychic"};
   EXPECT_NE(bad.validate().find("psychic"), std::string::npos);
-  EXPECT_THROW(renavigate(test::runtime_of(*model), ref, path, 30.0, bad), InputError);
+  EXPECT_THROW(renavigate(on_runtime(*model), ref, path, 30.0, bad), InputError);
 }
 
 }  // namespace

@@ -175,7 +175,8 @@ bool has_full_rotation_key(const MotionConstraints& c) {
 
 // The ground under `motion` (on the model's rig) seen from the frames
 // `known`; a key in the air within a second of one on the ground does not lift it.
-std::vector<double> model_ground(const Motion& motion, const std::vector<int>& known, const runtime::NemfRuntime& prior) {
+std::vector<double> model_ground(const Motion& motion, const std::vector<int>& known,
+                                 const runtime::NemfRuntime& prior) {
   return ground_heights(motion, known, prior.rig(), static_cast<int>(std::lround(prior.config().fps)));
 }
 

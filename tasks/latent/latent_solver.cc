@@ -270,8 +270,8 @@ LatentSolution solve_window_latents(WindowEnergies& energies, const NemfConfig& 
 // Solves window `w` of `input` from its initial codes (`whole`: the
 // initialiser's fill of the whole input, when there is one) given the
 // solution so far, and records its summary.
-SolvedWindow solve_window(const runtime::NemfRuntime& model, const Motion& input, const WindowPlan& w, const Motion& so_far,
-                          const LatentInitializer& init, const std::optional<Motion>& whole,
+SolvedWindow solve_window(const runtime::NemfRuntime& model, const Motion& input, const WindowPlan& w,
+                          const Motion& so_far, const LatentInitializer& init, const std::optional<Motion>& whole,
                           const LatentSolverOptions& options, const TaskContext& ctx, const TaskContext& window_ctx,
                           int iteration_offset, int iteration_total, CompletionReport* rep) {
   const Motion src = window_source(input, so_far, w);
@@ -305,9 +305,9 @@ SolvedWindow solve_window(const runtime::NemfRuntime& model, const Motion& input
 // their caps) and joins their solutions (WindowSolver). With several windows,
 // each starts from its slice of the initialiser's fill of the whole input
 // when it has one (LatentInitializer::fill_input).
-WindowedSolution solve_windows(const runtime::NemfRuntime& model, const Motion& input, const MotionConstraints& constraints,
-                               const std::vector<WindowPlan>& plan, const LatentSolverOptions& options,
-                               const TaskContext& ctx, CompletionReport* rep) {
+WindowedSolution solve_windows(const runtime::NemfRuntime& model, const Motion& input,
+                               const MotionConstraints& constraints, const std::vector<WindowPlan>& plan,
+                               const LatentSolverOptions& options, const TaskContext& ctx, CompletionReport* rep) {
   std::shared_ptr<const LatentInitializer> init = options.initializer;
   if (!init) init = std::make_shared<InterpolationEncoderInitializer>();
   int total = 0;
@@ -403,9 +403,9 @@ LatentSolverOptions default_solver_options(LatentOptimizer optimizer) {
   return o;
 }
 
-LatentSolution solve_latents(const runtime::NemfRuntime& model, const RuntimeWindowProblem& problem, const InitialGuess& start,
-                             const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset,
-                             int iteration_total) {
+LatentSolution solve_latents(const runtime::NemfRuntime& model, const RuntimeWindowProblem& problem,
+                             const InitialGuess& start, const LatentSolverOptions& options, const TaskContext& ctx,
+                             int iteration_offset, int iteration_total) {
   check_solver_options(options);
   const std::unique_ptr<WindowEnergies> energies =
       window_energies(model, ctx, problem, options.weights, keyed_weights(options.weights));

@@ -179,9 +179,9 @@ struct LatentSolution {
 /// complete_motion() checks its options once per request and solves its
 /// windows without checking them again), CancelledError when the context asks
 /// to stop.
-LatentSolution solve_latents(const runtime::NemfRuntime& model, const RuntimeWindowProblem& problem, const InitialGuess& start,
-                             const LatentSolverOptions& options, const TaskContext& ctx, int iteration_offset = 0,
-                             int iteration_total = 0);
+LatentSolution solve_latents(const runtime::NemfRuntime& model, const RuntimeWindowProblem& problem,
+                             const InitialGuess& start, const LatentSolverOptions& options, const TaskContext& ctx,
+                             int iteration_offset = 0, int iteration_total = 0);
 
 struct CompletionReport {
   std::vector<SolveSummary> windows;   ///< in solve order

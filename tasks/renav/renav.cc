@@ -53,8 +53,8 @@ int default_iterations(LatentOptimizer s) { return s == LatentOptimizer::Adam ? 
 
 namespace {
 
-void check_window_arguments(const runtime::NemfRuntime& model, const Motion& reference, int ref_begin, int ref_length, int N,
-                            int begin, int length, const Motion* previous, int shared) {
+void check_window_arguments(const runtime::NemfRuntime& model, const Motion& reference, int ref_begin, int ref_length,
+                            int N, int begin, int length, const Motion* previous, int shared) {
   const int W = model.config().window;
   check_model_skeleton(model.rig(), reference.skeleton, "reference");
   if (ref_begin < 0 || ref_length < 2 || ref_begin + ref_length > reference.num_frames())
@@ -246,8 +246,8 @@ RenavOptions default_renav_options(LatentOptimizer optimizer) {
 
 namespace {
 
-void check_renav_input(const runtime::NemfRuntime& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
-                       double path_fps, const RenavOptions& options) {
+void check_renav_input(const runtime::NemfRuntime& model, const Motion& reference,
+                       const std::vector<Eigen::Vector2d>& path, double path_fps, const RenavOptions& options) {
   const std::string bad = options.validate();
   if (!bad.empty()) throw InputError("invalid re-navigation options: " + bad);
   check_model_skeleton(model.rig(), reference.skeleton, "reference");
@@ -415,8 +415,8 @@ struct RenavPlan {
   int cap = 0;
 };
 
-RenavPlan plan_renav(const runtime::NemfRuntime& model, const Motion& reference, const std::vector<Eigen::Vector2d>& path,
-                     double path_fps, const RenavOptions& options) {
+RenavPlan plan_renav(const runtime::NemfRuntime& model, const Motion& reference,
+                     const std::vector<Eigen::Vector2d>& path, double path_fps, const RenavOptions& options) {
   const double fm = model.config().fps;
   const int W = model.config().window;
   RenavPlan plan;

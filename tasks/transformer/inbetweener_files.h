@@ -73,6 +73,7 @@ std::string missing_inbetweener_message(const std::string& what, const std::stri
 /// The in-betweener of `kind` in `models`; throws mf::ModelMissingError with
 /// missing_inbetweener_message(what, kind), and why its file did not load
 /// when it did not, when it is not loaded.
-const runtime::InbetweenerRuntime& require_inbetweener(const ModelSet& models, const std::string& kind, const std::string& what);
+const runtime::InbetweenerRuntime& require_inbetweener(const ModelSet& models, const std::string& kind,
+                                                      const std::string& what);
 
 }  // namespace mf

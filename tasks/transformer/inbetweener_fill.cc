@@ -48,7 +48,8 @@ KeyIndex index_keys(const MotionConstraints& c, int frames) {
 }
 
 // Validates the call; returns the stage whose output is used.
-int checked_stage(const runtime::InbetweenerRuntime& model, int stage, const Motion& input, const MotionConstraints& c) {
+int checked_stage(const runtime::InbetweenerRuntime& model, int stage, const Motion& input,
+                  const MotionConstraints& c) {
   const int J = input.num_joints();
   const RigInfo& rig = model.rig();
   if (J != rig.num_joints())
