@@ -55,10 +55,13 @@ std::string default_path() {
 }
 
 // The prior of a model file's bytes.
-std::unique_ptr<mf_model> load_bytes(const uint8_t* data, size_t size, const std::string& source) {
+// With the `file` the bytes are, its pages are given back as the weights are copied.
+std::unique_ptr<mf_model> load_bytes(const uint8_t* data, size_t size, const std::string& source,
+                                     const FileBytes* file = nullptr) {
   try {
     auto handle = std::make_unique<mf_model>();
-    handle->model = std::make_shared<const runtime::NemfRuntime>(runtime::NemfRuntime::from_bytes(data, size, source));
+    handle->model = std::make_shared<const runtime::NemfRuntime>(
+        file ? runtime::NemfRuntime::from_file(*file, source) : runtime::NemfRuntime::from_bytes(data, size, source));
     return handle;
   } catch (const InputError& e) {
     throw ApiError(MF_ERROR_MODEL, e.what());
@@ -112,7 +115,7 @@ std::unique_ptr<mf_model> load_model_set(const char* path, const char* const* in
   {
     // The prior's bytes go before the in-betweeners load (the peak memory of a load).
     const FileBytes bytes = read_file(file);
-    handle = load_bytes(bytes.data(), bytes.size(), file);
+    handle = load_bytes(bytes.data(), bytes.size(), file, &bytes);
   }
   load_inbetweeners_next_to(file, handle.get());
   load_anatomy(handle.get(), file);

@@ -28,12 +28,20 @@ NemfRuntimeStats read_stats(WeightReader& w, int joints) {
 }  // namespace
 
 NemfRuntime NemfRuntime::from_bytes(const uint8_t* data, size_t size, const std::string& source) {
+  return read(data, size, source, nullptr);
+}
+
+NemfRuntime NemfRuntime::from_file(const FileBytes& file, const std::string& source) {
+  return read(file.data(), file.size(), source, &file);
+}
+
+NemfRuntime NemfRuntime::read(const uint8_t* data, size_t size, const std::string& source, const FileBytes* file) {
   ModelFileContents c = parse_model_file(data, size, source, {kNemfKind});
   NemfRuntime r;
   r.config_ = checked_nemf_config(c.hyperparameters, source);
   r.rig_ = c.rig;
   const int J = r.rig_.num_joints(), F = r.rig_.num_feet();
-  WeightReader w(&c.tensors, source);
+  WeightReader w(&c.tensors, source, file);
   r.stats_ = read_stats(w, J);
   r.encoders_ = std::make_shared<const NemfEncoders>(r.config_, r.rig_.skeleton.parents, w);
   r.decoder_ = std::make_shared<const NemfDecoder>(r.config_, J, w);
@@ -45,8 +53,7 @@ NemfRuntime NemfRuntime::from_bytes(const uint8_t* data, size_t size, const std:
 }
 
 NemfRuntime NemfRuntime::load(const std::string& path) {
-  const FileBytes bytes = read_file_bytes(path);
-  return from_bytes(bytes.data(), bytes.size(), path);
+  return from_file(read_file_bytes(path), path);
 }
 
 void NemfRuntime::decode(const Eigen::Ref<const Eigen::VectorXd>& frames, const Eigen::Ref<const Eigen::VectorXf>& z_l,

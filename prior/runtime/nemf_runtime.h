@@ -25,6 +25,7 @@
 #include "prior/runtime/gmp.h"
 #include "prior/runtime/kinematics.h"
 #include "prior/runtime/tensor_ops.h"
+#include "prior/util/binary_io.h"
 
 namespace mf::runtime {
 
@@ -47,6 +48,10 @@ class NemfRuntime {
   /// The prior of a model file's bytes (format checks and errors as
   /// deserialize_nemf: InputError naming `source`).
   static NemfRuntime from_bytes(const uint8_t* data, size_t size, const std::string& source);
+  /// The same from a whole file's bytes, each weight's pages given back to the
+  /// system once copied (FileBytes::release): the load's peak memory is about
+  /// the runtime's weights, not twice them.
+  static NemfRuntime from_file(const FileBytes& file, const std::string& source);
   /// The prior of the model file at `path`.
   static NemfRuntime load(const std::string& path);
 
@@ -86,6 +91,7 @@ class NemfRuntime {
 
  private:
   NemfRuntime() = default;
+  static NemfRuntime read(const uint8_t* data, size_t size, const std::string& source, const FileBytes* file);
   const NemfGmpNetwork& gmp(GmpUse use) const;
   NemfConfig config_;
   RigInfo rig_;

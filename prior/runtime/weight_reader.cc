@@ -7,8 +7,8 @@
 
 namespace mf::runtime {
 
-WeightReader::WeightReader(std::map<std::string, StoredTensor>* tensors, std::string source)
-    : tensors_(tensors), source_(std::move(source)) {}
+WeightReader::WeightReader(std::map<std::string, StoredTensor>* tensors, std::string source, const FileBytes* file)
+    : tensors_(tensors), source_(std::move(source)), file_(file) {}
 
 std::vector<float> WeightReader::take(const std::string& name, const std::vector<int64_t>& shape) {
   auto it = tensors_->find(name);
@@ -19,6 +19,7 @@ std::vector<float> WeightReader::take(const std::string& name, const std::vector
   }
   std::vector<float> values(static_cast<size_t>(it->second.numel()));
   if (!values.empty()) std::memcpy(values.data(), it->second.data, values.size() * sizeof(float));
+  if (file_) file_->release(it->second.data, values.size() * sizeof(float));
   tensors_->erase(it);
   return values;
 }

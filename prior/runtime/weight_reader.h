@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "prior/model/model_container.h"
+#include "prior/util/binary_io.h"
 #include "prior/runtime/tensor_ops.h"
 
 namespace mf::runtime {
@@ -18,10 +19,12 @@ namespace mf::runtime {
 /// missing or misshapen tensor throws InputError naming it and `source`.
 /// finish() throws when a tensor is left over (another architecture), so a
 /// reader that took every weight the architecture has proves the file has
-/// no others.
+/// no others. With the `file` the tensors view, each tensor's pages are
+/// released once copied (FileBytes::release), so that a load does not hold the
+/// weights twice.
 class WeightReader {
  public:
-  WeightReader(std::map<std::string, StoredTensor>* tensors, std::string source);
+  WeightReader(std::map<std::string, StoredTensor>* tensors, std::string source, const FileBytes* file = nullptr);
 
   /// A [rows, cols] tensor as it is stored (libtorch's Linear: [out, in]).
   MatrixRXf matrix(const std::string& name, int64_t rows, int64_t cols);
@@ -40,6 +43,7 @@ class WeightReader {
   std::vector<float> take(const std::string& name, const std::vector<int64_t>& shape);
   std::map<std::string, StoredTensor>* tensors_;
   std::string source_;
+  const FileBytes* file_;
 };
 
 }  // namespace mf::runtime

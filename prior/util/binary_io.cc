@@ -90,6 +90,16 @@ const uint8_t* FileBytes::data() const {
 
 size_t FileBytes::size() const { return map_ ? map_size_ : text_.size(); }
 
+void FileBytes::release(const uint8_t* begin, size_t n) const {
+  if (!map_ || n == 0) return;
+  const uintptr_t base = reinterpret_cast<uintptr_t>(map_);  // page-aligned
+  const uintptr_t page = static_cast<uintptr_t>(::sysconf(_SC_PAGESIZE));
+  const uintptr_t lo = reinterpret_cast<uintptr_t>(begin);
+  if (lo < base || n > map_size_ || lo - base > map_size_ - n) return;
+  const uintptr_t first = (lo + page - 1) / page * page, end = (lo + n) / page * page;
+  if (end > first) ::madvise(reinterpret_cast<void*>(first), end - first, MADV_DONTNEED);
+}
+
 FileBytes read_file_bytes(const std::string& path) {
   const std::string what = "model file";
   FileBytes out;

@@ -152,6 +152,12 @@ class FileBytes {
 
   const uint8_t* data() const;
   size_t size() const;
+  /// Gives back the memory of the whole pages within [begin, begin + n),
+  /// bytes of this file the caller has copied and will not read again: a
+  /// mapped file's pages leave the process (touched again, they are read back
+  /// from the file), so a loader that copies a large file piece by piece does
+  /// not hold it twice. No effect on bytes read into memory or outside the file.
+  void release(const uint8_t* begin, size_t n) const;
 
  private:
   friend FileBytes read_file_bytes(const std::string& path);

@@ -7,14 +7,18 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
+#include <fstream>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "prior/motion/errors.h"
 #include "prior/runtime/inbetween_runtime.h"
 #include "prior/runtime/kinematics.h"
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/runtime/rotations.h"
+#include "prior/util/binary_io.h"
 #include "tasks/latent/runtime_energy.h"
 
 namespace mf::runtime {
@@ -168,6 +172,56 @@ TEST(RuntimeStandalone, RejectsWrongShapes) {
   EXPECT_THROW(m.encode_features(MatrixRXf::Zero(m.config().window + 1, J * 15), MatrixRXf::Zero(m.config().window + 1, 6),
                                  Eigen::VectorXf::Ones(m.config().window + 1)),
                InputError);
+}
+
+// The resident memory of this process in KiB (VmRSS), or -1.
+long resident_kib() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  }
+  return -1;
+}
+
+// Loading from a mapped file gives its pages back as the weights are copied:
+// the process does not hold the weights twice, the file's bytes still read
+// back unchanged, and the runtime is the one from_bytes() makes.
+TEST(RuntimeStandalone, LoadingAFileDoesNotHoldItsWeightsTwice) {
+  const std::string path = std::string(MF_SOURCE_DIR) + "/models/motionfield-prior.mfm";
+  const std::vector<uint8_t> copy = [&] {
+    const FileBytes f = read_file_bytes(path);
+    return std::vector<uint8_t>(f.data(), f.data() + f.size());
+  }();
+  const FileBytes file = read_file_bytes(path);
+  const long mapped = resident_kib();
+  const NemfRuntime loaded = NemfRuntime::from_file(file, path);
+  const long after = resident_kib();
+  ASSERT_GT(mapped, 0);
+  EXPECT_LT(after - mapped, static_cast<long>(file.size() / 1024 / 4)) << "KiB resident: " << mapped << " -> " << after;
+  ASSERT_EQ(file.size(), copy.size());
+  EXPECT_EQ(std::memcmp(file.data(), copy.data(), copy.size()), 0);
+
+  const NemfRuntime reference = NemfRuntime::from_bytes(copy.data(), copy.size(), path);
+  std::mt19937 rng(5);
+  const Eigen::VectorXf z_l = normal_vector(loaded.config().zl, rng), z_g = normal_vector(loaded.config().zg, rng);
+  const Eigen::VectorXd frames = Eigen::VectorXd::LinSpaced(30, 0.0, 29.0);
+  DecoderWorkspace ws;
+  MatrixRXf a, b;
+  loaded.decode(frames, z_l, z_g, &ws, &a);
+  reference.decode(frames, z_l, z_g, &ws, &b);
+  EXPECT_EQ(a, b);
+}
+
+// Releasing bytes outside a mapped file, or of a file read into memory, does nothing.
+TEST(RuntimeStandalone, ReleasingForeignBytesDoesNothing) {
+  const FileBytes file = read_file_bytes(std::string(MF_SOURCE_DIR) + "/models/motionfield-rig.json");
+  const std::vector<uint8_t> copy(file.data(), file.data() + file.size());
+  std::vector<uint8_t> other(1 << 16, 7);
+  file.release(other.data(), other.size());
+  file.release(file.data() + 1, file.size());  // runs past the end
+  EXPECT_EQ(std::vector<uint8_t>(file.data(), file.data() + file.size()), copy);
+  EXPECT_TRUE(std::all_of(other.begin(), other.end(), [](uint8_t v) { return v == 7; }));
 }
 
 TEST(RuntimeStandalone, RefusesAFileWithoutItsWeights) {
