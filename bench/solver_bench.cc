@@ -28,7 +28,7 @@
 // each solved by every solver method; wall time, iterations, evaluations, the
 // time in the optimiser (the rest is the initialiser, the decode and the
 // overwrite) and the floor (one decoder forward + backward over 128 frames,
-// times the iterations) per solve. --op-profile adds, after each gap or sparse table and
+// times the iterations; the Eigen runtime's, libtorch's with --libtorch-energy) per solve. --op-profile adds, after each gap or sparse table and
 // after the speed table, the operators run per energy evaluation and the time in
 // them (bench/op_profile.h; with --threads 1). L-BFGS minimises the Eigen
 // runtime's energy where it ports the window's terms, as the product does
@@ -511,6 +511,27 @@ std::string long_table(const std::string& method, const Runner& runner, const st
 }
 
 // Median wall time of one decoder forward + backward to the latents over 128 frames.
+// The median time of the decoder's forward pass and gradient over the
+// model's window: the libtorch model's (autograd), or the Eigen runtime's
+// (forward + VJP into the codes) that the solve runs unless --libtorch-energy.
+double decoder_step_ms(const mf::runtime::NemfRuntime& model) {
+  const mf::NemfConfig& c = model.config();
+  const Eigen::VectorXd frames = Eigen::VectorXd::LinSpaced(c.window, 0.0, c.window - 1.0);
+  const Eigen::VectorXf zl = Eigen::VectorXf::Zero(c.zl), zg = Eigen::VectorXf::Zero(c.zg);
+  mf::runtime::DecoderWorkspace ws;
+  mf::runtime::MatrixRXf out;
+  Eigen::VectorXf g_zl, g_zg;
+  std::vector<double> t;
+  for (int i = 0; i < 21; ++i) {
+    const auto t0 = Clock::now();
+    model.decode(frames, zl, zg, &ws, &out);
+    model.decode_vjp(&ws, mf::runtime::MatrixRXf::Ones(out.rows(), out.cols()), &g_zl, &g_zg);
+    if (i > 0) t.push_back(ms_since(t0));
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
 double decoder_step_ms(const mf::NemfModel& model) {
   const mf::NemfConfig& c = model.config();
   at::Tensor frames = at::arange(c.window, at::kFloat);
@@ -677,13 +698,14 @@ int run(Args& args, const std::string& command) {
   }
 
   if (args.speed > 0) {
-    const double step = decoder_step_ms(*loaded);
+    const double step = args.libtorch_energy ? decoder_step_ms(*loaded) : decoder_step_ms(model);
     const auto windows = mf::bench::cap_windows(mf::bench::protocol_windows(clips, 128, 40), args.speed);
     const std::vector<int> keys = mf::bench::sparse_keyframes(128, 15);
     std::ostringstream s;
     s << "#### Speed: sparse keyframes every 15 frames, 128-frame windows, " << windows.size() << " windows, "
       << at::get_num_threads() << " torch thread(s)\n\n"
-      << "Decoder forward + backward over 128 frames: " << fixed(step, 2) << " ms (median of 20).\n\n"
+      << "Decoder forward + backward over 128 frames (" << (args.libtorch_energy ? "libtorch" : "the Eigen runtime")
+      << "): " << fixed(step, 2) << " ms (median of 20).\n\n"
       << "| method | ms / solve (mean) | ms / solve (median) | process CPU ms / solve (mean) | iterations | "
          "evaluations | of which in the optimiser (ms, mean) | floor: decoder f+b x iterations (ms) | L2P |\n"
          "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
