@@ -28,7 +28,8 @@
 // each solved by every solver method; wall time, iterations, evaluations, the
 // time in the optimiser (the rest is the initialiser, the decode and the
 // overwrite) and the floor (one decoder forward + backward over 128 frames,
-// times the iterations; the Eigen runtime's, libtorch's with --libtorch-energy) per solve. --op-profile adds, after each gap or sparse table and
+// times the iterations; the Eigen runtime's, libtorch's with --libtorch-energy)
+// per solve. --op-profile adds, after each gap or sparse table and
 // after the speed table, the operators run per energy evaluation and the time in
 // them (bench/op_profile.h; with --threads 1). L-BFGS minimises the Eigen
 // runtime's energy where it ports the window's terms, as the product does
@@ -510,10 +511,9 @@ std::string long_table(const std::string& method, const Runner& runner, const st
   return s.str();
 }
 
-// Median wall time of one decoder forward + backward to the latents over 128 frames.
-// The median time of the decoder's forward pass and gradient over the
-// model's window: the libtorch model's (autograd), or the Eigen runtime's
-// (forward + VJP into the codes) that the solve runs unless --libtorch-energy.
+// Median wall time of one decoder forward + backward to the latents over the
+// model's window (128 frames): the Eigen runtime's (forward + VJP), which the
+// solve runs, and libtorch's (autograd), which --libtorch-energy runs.
 double decoder_step_ms(const mf::runtime::NemfRuntime& model) {
   const mf::NemfConfig& c = model.config();
   const Eigen::VectorXd frames = Eigen::VectorXd::LinSpaced(c.window, 0.0, c.window - 1.0);
