@@ -88,8 +88,12 @@ TEST(CApiLeak, ResidentMemoryDoesNotGrowOverAThousandJobs) {
               after / 1024, growth / 1024);
   // One leaked output motion of the sample (61 frames x 21 joints) is about
   // 21 KiB, so a leak of any result per job would be 20 MiB here; 4 MiB leaves
-  // room for the allocator's fragmentation.
+  // room for the allocator's fragmentation. Under ASan its quarantine keeps
+  // freed memory resident (the test passes with quarantine_size_mb=0), and
+  // LeakSanitizer checks these jobs for leaks at exit instead.
+#ifndef __SANITIZE_ADDRESS__
   EXPECT_LT(growth, 4LL << 20) << "the resident set grew by " << growth / 1024 << " KiB over 1000 jobs";
+#endif
 }
 
 }  // namespace
