@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "prior/model/model_container.h"
-#include "prior/util/binary_io.h"
 #include "prior/runtime/tensor_ops.h"
+#include "prior/util/binary_io.h"
 
 namespace mf::runtime {
 

@@ -5,25 +5,18 @@
 // libtorch's lazy initialisation) and again after 1,000 more jobs.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "tests/capi/capi_test_util.h"
+#include "tests/resident_memory.h"
 
 namespace mf::capi_test {
 namespace {
 
-// Resident set size of this process in bytes (/proc/self/statm, field 2).
-long long resident_bytes() {
-  std::ifstream statm("/proc/self/statm");
-  long long size = 0, resident = 0;
-  statm >> size >> resident;
-  return resident * ::sysconf(_SC_PAGESIZE);
-}
+using test::resident_bytes;
 
 std::string sample_text() {
   std::ifstream in(sample_bvh(), std::ios::binary);

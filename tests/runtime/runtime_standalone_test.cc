@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <fstream>
 #include <random>
 #include <string>
 #include <vector>
@@ -19,6 +18,7 @@
 #include "prior/runtime/nemf_runtime.h"
 #include "prior/runtime/rotations.h"
 #include "prior/util/binary_io.h"
+#include "tests/resident_memory.h"
 #include "tasks/latent/runtime_energy.h"
 
 namespace mf::runtime {
@@ -174,16 +174,6 @@ TEST(RuntimeStandalone, RejectsWrongShapes) {
                InputError);
 }
 
-// The resident memory of this process in KiB (VmRSS), or -1.
-long resident_kib() {
-  std::ifstream status("/proc/self/status");
-  std::string line;
-  while (std::getline(status, line)) {
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  }
-  return -1;
-}
-
 // Loading from a mapped file gives its pages back as the weights are copied:
 // the process does not hold the weights twice, the file's bytes still read
 // back unchanged, and the runtime is the one from_bytes() makes.
@@ -194,12 +184,13 @@ TEST(RuntimeStandalone, LoadingAFileDoesNotHoldItsWeightsTwice) {
     return std::vector<uint8_t>(f.data(), f.data() + f.size());
   }();
   const FileBytes file = read_file_bytes(path);
-  const long mapped = resident_kib();
+  const long long mapped = test::resident_bytes();
   const NemfRuntime loaded = NemfRuntime::from_file(file, path);
-  const long after = resident_kib();
+  const long long after = test::resident_bytes();
   ASSERT_GT(mapped, 0);
 #ifndef __SANITIZE_ADDRESS__  // ASan's quarantine keeps the loader's freed buffers resident
-  EXPECT_LT(after - mapped, static_cast<long>(file.size() / 1024 / 4)) << "KiB resident: " << mapped << " -> " << after;
+  EXPECT_LT(after - mapped, static_cast<long long>(file.size() / 4))
+      << "KiB resident: " << mapped / 1024 << " -> " << after / 1024;
 #endif
   ASSERT_EQ(file.size(), copy.size());
   EXPECT_EQ(std::memcmp(file.data(), copy.data(), copy.size()), 0);
