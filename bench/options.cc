@@ -9,6 +9,7 @@
 #include "prior/motion/errors.h"
 #include "prior/rig/mirror.h"
 #include "prior/runtime/nemf_runtime.h"
+#include "prior/runtime/tensor_ops.h"
 #include "prior/util/command_line.h"
 #include "prior/util/threads.h"
 #include "tasks/context/model_rig.h"
@@ -72,6 +73,16 @@ void add_split_options(CLI::App& app, SplitChoice& choice) {
 
 void add_threads_option(CLI::App& app, int& threads) {
   app.add_option("--threads", threads, "torch intra-op threads")->check(mf::cli::at_least(1));
+  app.add_option_function<std::string>(
+         "--gemm",
+         [](const std::string& name) {
+           runtime::set_gemm_backend(name == "blas"    ? runtime::GemmBackend::Blas
+                                     : name == "eigen" ? runtime::GemmBackend::Eigen
+                                                       : runtime::GemmBackend::Kernels);
+         },
+         "who multiplies the runtime's matrices: kernels (the runtime's own; the default where the CPU has AVX2 + "
+         "FMA or AVX-512), blas, eigen (prior/runtime/tensor_ops.h)")
+      ->check(CLI::IsMember({"kernels", "blas", "eigen"}));
 }
 
 void add_model_bench_options(CLI::App& app, ModelBenchOptions& options) {

@@ -60,6 +60,8 @@ struct SplitChoice {
 void add_split_options(CLI::App& app, SplitChoice& choice);
 
 /// --threads N (N >= 1): torch's intra-op threads; `threads` holds the default.
+/// With it --gemm kernels|blas|eigen: who multiplies the runtime's matrices
+/// (set_gemm_backend, prior/runtime/tensor_ops.h), for comparisons.
 void add_threads_option(CLI::App& app, int& threads);
 
 /// What every benchmark on the protocol's clips with the learned models takes:

@@ -316,6 +316,7 @@ Agreement compare_energies(const WindowProblem& problem, const EnergyWeights& w,
 
 TEST(RuntimeEnergy, EveryTermMatchesLibtorchOnWindowsOfTheWalk) {
   ScopedComputeThreads one_thread(1);
+  ScopedGemmBackend blas(runtime::GemmBackend::Blas);
   std::mt19937 rng(3);
   for (const NamedProblem& p : problems()) {
     const auto codes = codes_for(p.problem, rng);
@@ -340,6 +341,7 @@ TEST(RuntimeEnergy, EveryTermMatchesLibtorchOnWindowsOfTheWalk) {
 // every kind of constraint, alone and together, against libtorch.
 TEST(RuntimeEnergy, OutputTermsMatchLibtorch) {
   ScopedComputeThreads one_thread(1);
+  ScopedGemmBackend blas(runtime::GemmBackend::Blas);
   std::mt19937 rng(6);
   const WindowProblem& problem = output_problem();
   const auto codes = codes_for(problem, rng);
@@ -355,6 +357,38 @@ TEST(RuntimeEnergy, OutputTermsMatchLibtorch) {
       }
       std::printf("energy %-22s %-8s: values %.2e, gradient %.2e\n", w.name,
                   penalty == Penalty::Squared ? "squared" : "absolute", worst.value, worst.gradient);
+    }
+  }
+}
+
+// The runtime's kernels against the BLAS (both runtime), at random codes on
+// the walk's windows and the window with every kind of constraint: values
+// within 1e-5, gradients within 1e-4 relative (ScopedGemmBackend says why not
+// at the encoded codes).
+TEST(RuntimeEnergy, KernelsMatchTheBlasAtRandomCodes) {
+  if (runtime::cpu_kernel_isa() == runtime::KernelIsa::None) GTEST_SKIP() << "no kernels on this CPU";
+  ScopedComputeThreads one_thread(1);
+  const BothModels& m = shipped_models();
+  std::mt19937 rng(8);
+  const NemfConfig& c = m.runtime.config();
+  const NamedProblem output{"output terms", output_problem()};
+  for (const NamedProblem* p : {&problems()[0], &problems()[1], &problems()[2], &output}) {
+    const RuntimeWindowProblem rp = to_runtime_problem(p->problem, m.runtime.rig().num_joints());
+    const EnergyWeights w = p == &output ? output_weight_sets(Penalty::Squared)[6].weights : EnergyWeights{};
+    for (int draw = 0; draw < 2; ++draw) {
+      const Eigen::VectorXf z_l = normal_matrix(c.zl, 1, rng).col(0), z_g = normal_matrix(c.zg, 1, rng).col(0);
+      Eigen::VectorXf g[2][2];
+      double value[2];
+      for (int b = 0; b < 2; ++b) {
+        ScopedGemmBackend backend(b == 0 ? runtime::GemmBackend::Kernels : runtime::GemmBackend::Blas);
+        RuntimeEnergy energy(m.runtime);
+        value[b] = energy.evaluate(rp, w, z_l, z_g, &g[b][0], &g[b][1]).total;
+      }
+      Eigen::VectorXf kernels(c.zl + c.zg), blas(c.zl + c.zg);
+      kernels << g[0][0], g[0][1];
+      blas << g[1][0], g[1][1];
+      EXPECT_LT(std::abs(value[0] - value[1]) / std::abs(value[1]), kOutputTolerance) << p->name << " " << draw;
+      EXPECT_LT(relative_vector_difference(kernels, blas), kGradientTolerance) << p->name << " " << draw;
     }
   }
 }

@@ -59,6 +59,7 @@ MotionConstraints output_constraints(const Motion& walk) {
 
 TEST(LatentSolverRuntime, EigenEnergyEndsWhereTheLibtorchEnergyDoes) {
   ScopedComputeThreads one_thread(1);
+  ScopedGemmBackend blas(runtime::GemmBackend::Blas);  // why: ScopedGemmBackend
   const Motion& walk = walk_on_model_rig();
   const struct {
     const char* name;

@@ -23,6 +23,7 @@
 #include "prior/inbetween/inbetweener.h"
 #include "prior/runtime/inbetween_runtime.h"
 #include "prior/runtime/nemf_runtime.h"
+#include "prior/runtime/tensor_ops.h"
 #include "tasks/context/task_context.h"
 #include "tasks/reference/latent_energy.h"
 #include "tasks/reference/libtorch_energies.h"
@@ -40,6 +41,28 @@ constexpr double kGradientTolerance = 1e-4;
 /// almost none of the ReLU kinks, which made float32 differences disagree by
 /// 1e-3 to 1e-1 (steps 1e-3 to 1e-1).
 constexpr double kDifferenceStep = 1e-5;
+
+/// Who multiplies the runtime's matrices while it lives (set_gemm_backend).
+/// The comparisons with libtorch hold the runtime to the BLAS: libtorch's
+/// products are OpenBLAS's, so on the same products the runtime agrees with
+/// it to rounding everywhere. The encoded codes of the walk's windows lie
+/// within rounding of a leaky ReLU's kink: a change of 1e-5 in z_l moves the
+/// float64 prior's gradient by 3.4e-4 relative, and the runtime's kernels,
+/// which sum in another order, land across it (3e-4 to 4e-3 from float64
+/// there, 1e-6 at random codes). RuntimeEnergy.KernelsMatchTheBlasAtRandomCodes
+/// checks the kernels.
+class ScopedGemmBackend {
+ public:
+  explicit ScopedGemmBackend(runtime::GemmBackend backend) : before_(runtime::gemm_backend()) {
+    runtime::set_gemm_backend(backend);
+  }
+  ~ScopedGemmBackend() { runtime::set_gemm_backend(before_); }
+  ScopedGemmBackend(const ScopedGemmBackend&) = delete;
+  ScopedGemmBackend& operator=(const ScopedGemmBackend&) = delete;
+
+ private:
+  runtime::GemmBackend before_;
+};
 
 /// models/motionfield-prior.mfm of the source tree.
 const std::string& shipped_model_path();

@@ -32,16 +32,16 @@ NemfDecoder::NemfDecoder(const NemfConfig& config, int joints, WeightReader& wei
   for (int l = 0; l < L; ++l) {
     const std::string p = "decoder.", s = std::to_string(l);
     Layer layer;
-    layer.pe = weights.matrix(p + "pe" + s + ".weight", W, 2 * config.pe_frequencies);
+    layer.pe = WeightMatrix(weights.matrix(p + "pe" + s + ".weight", W, 2 * config.pe_frequencies));
     layer.pe_bias = weights.vector(p + "pe" + s + ".bias", W);
     layer.zl = weights.matrix(p + "zl" + s + ".weight", W, config.zl);
-    if (l > 0) layer.hidden = weights.matrix(p + "h" + s + ".weight", W, W);
+    if (l > 0) layer.hidden = WeightMatrix(weights.matrix(p + "h" + s + ".weight", W, W));
     if (l >= L - config.zg_layers) layer.zg = weights.matrix(p + "zg" + s + ".weight", W, config.zg);
     layer.norm_weight = weights.vector(p + "norm" + s + ".weight", W);
     layer.norm_bias = weights.vector(p + "norm" + s + ".bias", W);
     layers_.push_back(std::move(layer));
   }
-  head_ = weights.matrix("decoder.head.weight", joints * 6, W);
+  head_ = WeightMatrix(weights.matrix("decoder.head.weight", joints * 6, W));
   head_bias_ = weights.vector("decoder.head.bias", joints * 6);
   // The head's output is centred on the identity rotation's 6D (1, 0, 0, 0, 1, 0).
   RowVectorXf identity = RowVectorXf::Zero(joints * 6);

@@ -64,10 +64,10 @@ class NemfDecoder {
 
  private:
   struct Layer {
-    MatrixRXf pe;        // [W, 2F]
+    WeightMatrix pe;     // [W, 2F]
     RowVectorXf pe_bias; // [W]
     MatrixRXf zl;        // [W, zl]
-    MatrixRXf hidden;    // [W, W]; empty in layer 0
+    WeightMatrix hidden; // [W, W]; empty in layer 0
     MatrixRXf zg;        // [W, zg]; empty before the last zg_layers
     RowVectorXf norm_weight, norm_bias;
   };
@@ -76,7 +76,7 @@ class NemfDecoder {
   NemfConfig config_;
   int joints_;
   std::vector<Layer> layers_;
-  MatrixRXf head_;            // [J * 6, W]
+  WeightMatrix head_;         // [J * 6, W]
   RowVectorXf head_bias_;     // [J * 6], the identity rotation's 6D added
 };
 

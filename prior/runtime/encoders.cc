@@ -24,7 +24,7 @@ void mask_skeleton_conv(const std::vector<int>& parents, Conv1dWeights* conv) {
   for (int j = 0; j < J; ++j)
     for (int i = 0; i < J; ++i) {
       if (i == j || parents[j] == i || parents[i] == j) continue;
-      for (MatrixRXf& tap : conv->taps) tap.block(i * cin, j * cout, cin, cout).setZero();
+      for (WeightMatrix& tap : conv->taps) tap.mutable_values().block(i * cin, j * cout, cin, cout).setZero();
     }
 }
 

@@ -17,7 +17,7 @@ namespace mf::runtime {
 
 namespace {
 
-std::atomic<GemmBackend> g_backend{GemmBackend::Blas};
+std::atomic<GemmBackend> g_backend{cpu_kernel_isa() == KernelIsa::None ? GemmBackend::Blas : GemmBackend::Kernels};
 
 using StridedMap = Eigen::Map<MatrixRXf, 0, Eigen::OuterStride<>>;
 using ConstStridedMap = Eigen::Map<const MatrixRXf, 0, Eigen::OuterStride<>>;
@@ -47,6 +47,31 @@ void eigen_gemm(const A& a, const B& b, MatrixRef c, float beta) {
 void set_gemm_backend(GemmBackend backend) { g_backend.store(backend); }
 GemmBackend gemm_backend() { return g_backend.load(); }
 
+MatrixRXf& WeightMatrix::mutable_values() {
+  packs_ = std::make_shared<Packs>();
+  return values_;
+}
+
+const PackedOperand& WeightMatrix::packed(bool transpose) const {
+  const int i = transpose ? 1 : 0;
+  std::call_once(packs_->once[i], [&] {
+    packs_->op[i] = std::make_unique<PackedOperand>(values_.data(), values_.rows(), values_.cols(),
+                                                    values_.outerStride(), transpose, cpu_kernel_isa());
+  });
+  return *packs_->op[i];
+}
+
+void gemm(ConstMatrixRef a, bool transpose_a, const WeightMatrix& b, bool transpose_b, MatrixRef c, float beta) {
+  const Eigen::Index m = transpose_a ? a.cols() : a.rows(), k = transpose_a ? a.rows() : a.cols();
+  const Eigen::Index n = transpose_b ? b.rows() : b.cols();
+  const bool kernels = gemm_backend() == GemmBackend::Kernels && cpu_kernel_isa() != KernelIsa::None;
+  if (!kernels || transpose_a || m == 0 || n == 0 || k == 0 || m != c.rows() || n != c.cols() ||
+      k != (transpose_b ? b.cols() : b.rows())) {
+    return gemm(a, transpose_a, b.values(), transpose_b, c, beta);  // checks the shapes
+  }
+  packed_gemm(a.data(), m, a.outerStride(), b.packed(transpose_b), c.data(), c.outerStride(), beta);
+}
+
 void gemm(ConstMatrixRef a, bool transpose_a, ConstMatrixRef b, bool transpose_b, MatrixRef c, float beta) {
   const Eigen::Index m = transpose_a ? a.cols() : a.rows(), k = transpose_a ? a.rows() : a.cols();
   const Eigen::Index kb = transpose_b ? b.cols() : b.rows(), n = transpose_b ? b.rows() : b.cols();
@@ -61,7 +86,7 @@ void gemm(ConstMatrixRef a, bool transpose_a, ConstMatrixRef b, bool transpose_b
     else c *= beta;
     return;
   }
-  if (gemm_backend() == GemmBackend::Blas) return blas_gemm(a, transpose_a, b, transpose_b, c, beta, static_cast<int>(k));
+  if (gemm_backend() != GemmBackend::Eigen) return blas_gemm(a, transpose_a, b, transpose_b, c, beta, static_cast<int>(k));
   if (!transpose_a && !transpose_b) eigen_gemm(a, b, c, beta);
   else if (transpose_a && !transpose_b) eigen_gemm(a.transpose(), b, c, beta);
   else if (!transpose_a) eigen_gemm(a, b.transpose(), c, beta);

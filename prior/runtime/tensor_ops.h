@@ -9,7 +9,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
+#include <mutex>
 #include <vector>
+
+#include "prior/runtime/packed_gemm.h"
 
 namespace mf::runtime {
 
@@ -20,17 +24,49 @@ using RowVectorXf = Eigen::Matrix<float, 1, Eigen::Dynamic>;
 using ConstMatrixRef = Eigen::Ref<const MatrixRXf>;
 using MatrixRef = Eigen::Ref<MatrixRXf>;
 
-/// Who multiplies matrices: the system's libblas.so.3 (OpenBLAS; the BLAS
-/// libtorch calls, with kernels chosen for the CPU when it loads) or Eigen's
-/// own kernels (compiled for the build's instruction set: SSE2 on a generic
-/// x86-64 build). Process-wide; Blas unless set.
-enum class GemmBackend { Blas, Eigen };
+/// Who multiplies matrices. Kernels: products with a network's weight run on
+/// the runtime's own kernels (packed_gemm.h), the others on the BLAS; the
+/// default where the CPU has AVX2 + FMA or AVX-512, and Blas where it has
+/// neither. Blas: the system's libblas.so.3 (OpenBLAS; the BLAS libtorch
+/// calls, with kernels chosen for the CPU when it loads). Eigen: Eigen's own
+/// kernels (compiled for the build's instruction set: SSE2 on a generic x86-64
+/// build). Process-wide.
+enum class GemmBackend { Kernels, Blas, Eigen };
 void set_gemm_backend(GemmBackend backend);
 GemmBackend gemm_backend();
 
 /// c = beta * c + op(a) * op(b), op(x) = x^T when its flag is set. Shapes must
 /// agree (op(a) [m, k], op(b) [k, n], c [m, n]); beta = 0 ignores c's values.
 void gemm(ConstMatrixRef a, bool transpose_a, ConstMatrixRef b, bool transpose_b, MatrixRef c, float beta);
+
+/// A network's constant matrix: its values and, made on first use, op(values)
+/// packed for the runtime's kernels, one copy per orientation used. Copies
+/// share what was packed; packing is thread-safe.
+class WeightMatrix {
+ public:
+  WeightMatrix() = default;
+  explicit WeightMatrix(MatrixRXf values) : values_(std::move(values)) {}
+  const MatrixRXf& values() const { return values_; }
+  /// The values, to change: forgets what was packed from the old ones.
+  MatrixRXf& mutable_values();
+  Eigen::Index rows() const { return values_.rows(); }
+  Eigen::Index cols() const { return values_.cols(); }
+  Eigen::Index size() const { return values_.size(); }
+  /// op(values) for the CPU's kernels (cpu_kernel_isa() must not be None).
+  const PackedOperand& packed(bool transpose) const;
+
+ private:
+  struct Packs {
+    std::once_flag once[2];
+    std::unique_ptr<PackedOperand> op[2];
+  };
+  MatrixRXf values_;
+  std::shared_ptr<Packs> packs_ = std::make_shared<Packs>();
+};
+
+/// gemm with a weight as the right operand: on the Kernels backend, the
+/// runtime's kernels on op(b) packed (a is read in place, not transposed).
+void gemm(ConstMatrixRef a, bool transpose_a, const WeightMatrix& b, bool transpose_b, MatrixRef c, float beta);
 
 /// y = beta * y + op(a) * x for vectors x [op(a)'s columns] and y [its rows]
 /// (the latent codes' products), on the same backend as gemm.
@@ -41,7 +77,7 @@ void gemv(ConstMatrixRef a, bool transpose_a, const Eigen::Ref<const Eigen::Vect
 /// as K matrices taps[k] [in, out] (taps[k](c, o) = weight[o, c, k]) and its
 /// bias [out] (zeros when the convolution has none).
 struct Conv1dWeights {
-  std::vector<MatrixRXf> taps;
+  std::vector<WeightMatrix> taps;
   RowVectorXf bias;
   int in() const { return static_cast<int>(taps.front().rows()); }
   int out() const { return static_cast<int>(taps.front().cols()); }

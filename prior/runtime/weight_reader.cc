@@ -36,18 +36,19 @@ RowVectorXf WeightReader::vector(const std::string& name, int64_t n) {
 
 Conv1dWeights WeightReader::conv(const std::string& prefix, int64_t out, int64_t in, int64_t kernel, bool bias) {
   const std::vector<float> w = take(prefix + ".weight", {out, in, kernel});
-  Conv1dWeights c;
-  c.taps.assign(kernel, MatrixRXf(in, out));
+  std::vector<MatrixRXf> taps(kernel, MatrixRXf(in, out));
   for (int64_t o = 0; o < out; ++o)
     for (int64_t i = 0; i < in; ++i)
-      for (int64_t k = 0; k < kernel; ++k) c.taps[k](i, o) = w[(o * in + i) * kernel + k];
+      for (int64_t k = 0; k < kernel; ++k) taps[k](i, o) = w[(o * in + i) * kernel + k];
+  Conv1dWeights c;
+  for (MatrixRXf& tap : taps) c.taps.emplace_back(std::move(tap));
   c.bias = bias ? vector(prefix + ".bias", out) : RowVectorXf::Zero(out);
   return c;
 }
 
 Conv1dWeights WeightReader::linear(const std::string& prefix, int64_t out, int64_t in) {
   Conv1dWeights c;
-  c.taps.push_back(matrix(prefix + ".weight", out, in).transpose());
+  c.taps.emplace_back(MatrixRXf(matrix(prefix + ".weight", out, in).transpose()));
   c.bias = vector(prefix + ".bias", out);
   return c;
 }

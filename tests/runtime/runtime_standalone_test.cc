@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -16,6 +18,7 @@
 #include "prior/runtime/inbetween_runtime.h"
 #include "prior/runtime/kinematics.h"
 #include "prior/runtime/nemf_runtime.h"
+#include "prior/runtime/packed_gemm.h"
 #include "prior/runtime/rotations.h"
 #include "prior/util/binary_io.h"
 #include "tests/resident_memory.h"
@@ -93,6 +96,69 @@ TEST(RuntimeStandalone, GmpsHaveTheirShapes) {
   EXPECT_TRUE(g_x.allFinite());
 }
 
+// The runtime's own kernels, for each instruction set this CPU runs, against
+// Eigen's product: every row-block and panel tail, a depth over one pass,
+// beta 0 (c's NaNs ignored), 1 and 0.5, b as is and transposed, and rows of a
+// read at a stride shorter than their length (a convolution's overlapping
+// rows).
+TEST(RuntimeStandalone, OwnKernelsMatchEigensProducts) {
+  std::vector<KernelIsa> isas;
+  if (cpu_kernel_isa() == KernelIsa::Avx512) isas = {KernelIsa::Avx512, KernelIsa::Avx2};
+  if (cpu_kernel_isa() == KernelIsa::Avx2) isas = {KernelIsa::Avx2};
+  if (isas.empty()) GTEST_SKIP() << "this CPU has neither AVX2 + FMA nor AVX-512";
+  std::mt19937 rng(5);
+  int checked = 0;
+  for (KernelIsa isa : isas)
+    for (int rows : {1, 5, 6, 7, 12, 13, 30, 37})
+      for (int n : {1, 15, 16, 17, 33, 64})
+        for (int depth : {1, 9, 256, 300})
+          for (bool transpose : {false, true})
+            for (float beta : {0.0f, 1.0f, 0.5f}) {
+              const MatrixRXf a = normal_matrix(rows, depth, rng);
+              const MatrixRXf b = transpose ? normal_matrix(n, depth, rng) : normal_matrix(depth, n, rng);
+              const MatrixRXf c0 = normal_matrix(rows, n, rng);
+              const PackedOperand packed(b.data(), b.rows(), b.cols(), b.cols(), transpose, isa);
+              MatrixRXf c = c0;
+              if (beta == 0.0f) c.setConstant(std::numeric_limits<float>::quiet_NaN());
+              packed_gemm(a.data(), rows, depth, packed, c.data(), n, beta);
+              const MatrixRXf op_b = transpose ? MatrixRXf(b.transpose()) : b;
+              const MatrixRXf expected = (beta == 0.0f ? MatrixRXf::Zero(rows, n) : MatrixRXf(beta * c0)) + a * op_b;
+              ASSERT_LT((c - expected).cwiseAbs().maxCoeff(), 1e-4f * (1.0f + std::sqrt(float(depth))))
+                  << "isa " << int(isa) << " rows " << rows << " n " << n << " depth " << depth << " transpose "
+                  << transpose << " beta " << beta;
+              ++checked;
+            }
+  EXPECT_EQ(checked, int(isas.size()) * 8 * 6 * 4 * 2 * 3);
+  // Overlapping rows: row t of the virtual a is x[t .. t + 2] flattened.
+  const MatrixRXf x = normal_matrix(20, 8, rng), w = normal_matrix(24, 16, rng);
+  const PackedOperand packed(w.data(), 24, 16, 16, false, isas.front());
+  MatrixRXf c(18, 16);
+  packed_gemm(x.data(), 18, 8, packed, c.data(), 16, 0.0f);
+  for (int t = 0; t < 18; ++t) {
+    const Eigen::Map<const Eigen::RowVectorXf> row(x.data() + 8 * t, 24);
+    EXPECT_LT((c.row(t) - row * w).cwiseAbs().maxCoeff(), 1e-4f) << t;
+  }
+}
+
+// A weight's product runs on the kernels by default where the CPU has them,
+// and agrees with the BLAS's; a weight changed after it was packed is packed
+// again.
+TEST(RuntimeStandalone, WeightProductsAgreeAcrossBackends) {
+  std::mt19937 rng(6);
+  const MatrixRXf a = normal_matrix(30, 40, rng);
+  WeightMatrix w(normal_matrix(24, 40, rng));
+  if (cpu_kernel_isa() != KernelIsa::None) EXPECT_EQ(gemm_backend(), GemmBackend::Kernels);
+  MatrixRXf kernels(30, 24), blas(30, 24);
+  gemm(a, false, w, true, kernels, 0.0f);
+  set_gemm_backend(GemmBackend::Blas);
+  gemm(a, false, w, true, blas, 0.0f);
+  set_gemm_backend(GemmBackend::Kernels);
+  EXPECT_LT((kernels - blas).cwiseAbs().maxCoeff(), 1e-4f);
+  w.mutable_values().setZero();
+  gemm(a, false, w, true, kernels, 0.0f);
+  EXPECT_EQ(kernels.cwiseAbs().maxCoeff(), 0.0f);
+}
+
 // Both matrix-product backends (the system BLAS, Eigen's kernels) give the
 // same products, transposed operands and strided blocks included.
 TEST(RuntimeStandalone, GemmBackendsAgree) {
@@ -104,7 +170,7 @@ TEST(RuntimeStandalone, GemmBackendsAgree) {
   gemm(a, false, b, true, blas, 0.5f);
   set_gemm_backend(GemmBackend::Eigen);
   gemm(a, false, b, true, eigen, 0.5f);
-  set_gemm_backend(GemmBackend::Blas);
+  set_gemm_backend(GemmBackend::Kernels);
   const MatrixRXf expected = 0.5f * c0 + a * b.transpose();
   EXPECT_LT((blas - expected).cwiseAbs().maxCoeff(), 1e-4f);
   EXPECT_LT((eigen - expected).cwiseAbs().maxCoeff(), 1e-4f);
