@@ -1,5 +1,6 @@
 #include "prior/runtime/decoder.h"
 
+#include <atomic>
 #include <cmath>
 #include <string>
 
@@ -10,6 +11,11 @@ namespace mf::runtime {
 namespace {
 
 constexpr float kLayerNormEps = 1e-5f;  // torch::nn::LayerNorm's default
+
+uint64_t next_decoder_id() {
+  static std::atomic<uint64_t> id{0};
+  return ++id;
+}
 
 }  // namespace
 
@@ -47,6 +53,7 @@ NemfDecoder::NemfDecoder(const NemfConfig& config, int joints, WeightReader& wei
   RowVectorXf identity = RowVectorXf::Zero(joints * 6);
   for (int j = 0; j < joints; ++j) identity[6 * j] = identity[6 * j + 4] = 1.0f;
   head_bias_ += identity;
+  id_ = next_decoder_id();
 }
 
 void NemfDecoder::add_latent_parts(const Eigen::Ref<const Eigen::VectorXf>& z_l,
@@ -65,11 +72,24 @@ void NemfDecoder::add_latent_parts(const Eigen::Ref<const Eigen::VectorXf>& z_l,
   }
 }
 
+void NemfDecoder::time_parts(const Eigen::Ref<const Eigen::VectorXd>& frames, DecoderWorkspace* ws) const {
+  if (ws->time_decoder == id_ && ws->time_frames.size() == frames.size() && ws->time_frames == frames) return;
+  ws->time_decoder = 0;  // until complete
+  decoder_time_features(frames, config_.window, config_.pe_frequencies, &ws->pe);
+  ws->time_part.resize(layers_.size());
+  for (size_t l = 0; l < layers_.size(); ++l) {
+    ws->time_part[l].resize(frames.size(), config_.decoder_width);
+    gemm(ws->pe, false, layers_[l].pe, true, ws->time_part[l], 0.0f);
+  }
+  ws->time_frames = frames;
+  ws->time_decoder = id_;
+}
+
 void NemfDecoder::decode(const Eigen::Ref<const Eigen::VectorXd>& frames, const Eigen::Ref<const Eigen::VectorXf>& z_l,
                          const Eigen::Ref<const Eigen::VectorXf>& z_g, DecoderWorkspace* ws, MatrixRXf* out) const {
   const size_t L = layers_.size();
-  const Eigen::Index S = frames.size(), W = config_.decoder_width;
-  decoder_time_features(frames, config_.window, config_.pe_frequencies, &ws->pe);
+  const Eigen::Index S = frames.size();
+  time_parts(frames, ws);
   add_latent_parts(z_l, z_g, ws);
   ws->pre.resize(L);
   ws->hidden.resize(L);
@@ -78,9 +98,8 @@ void NemfDecoder::decode(const Eigen::Ref<const Eigen::VectorXd>& frames, const 
   for (size_t l = 0; l < L; ++l) {
     const Layer& layer = layers_[l];
     MatrixRXf& a = ws->pre[l];
-    a.resize(S, W);
-    a.rowwise() = ws->latent_part[l].transpose();
-    gemm(ws->pe, false, layer.pe, true, a, 1.0f);
+    a = ws->time_part[l];
+    a.rowwise() += ws->latent_part[l].transpose();
     if (l > 0) gemm(ws->hidden[l - 1], false, layer.hidden, true, a, 1.0f);
     layer_norm_rows(a, layer.norm_weight, layer.norm_bias, kLayerNormEps, &ws->hidden[l], &ws->mean[l],
                     &ws->rstd[l]);
@@ -114,9 +133,9 @@ void NemfDecoder::decode_vjp(DecoderWorkspace* ws, ConstMatrixRef g_out, Eigen::
 }
 
 int64_t NemfDecoder::forward_flops(int64_t S) const {
-  const int64_t W = config_.decoder_width, L = config_.decoder_layers, F2 = 2 * config_.pe_frequencies;
+  const int64_t W = config_.decoder_width, L = config_.decoder_layers;
   const int64_t latent = 2 * W * (config_.zl * L + config_.zg * config_.zg_layers);
-  return latent + S * (2 * F2 * W * L + 2 * W * W * (L - 1) + 2 * W * head_.rows());
+  return latent + S * (2 * W * W * (L - 1) + 2 * W * head_.rows());
 }
 
 int64_t NemfDecoder::vjp_flops(int64_t S) const {

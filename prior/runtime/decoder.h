@@ -21,6 +21,9 @@ namespace mf::runtime {
 /// frames allocates nothing after the first. One workspace per thread.
 struct DecoderWorkspace {
   MatrixRXf pe;                              ///< [S, 2 * pe_frequencies] time features
+  std::vector<MatrixRXf> time_part;          ///< per layer [S, W]: pe times the layer's time weights
+  Eigen::VectorXd time_frames;               ///< the frames pe and time_part are of
+  uint64_t time_decoder = 0;                 ///< the decoder they are of (NemfDecoder's id; 0: none)
   std::vector<MatrixRXf> pre;                ///< per layer [S, W]: before the layer norm
   std::vector<MatrixRXf> hidden;             ///< per layer [S, W]: after the ReLU
   std::vector<Eigen::VectorXf> mean, rstd;   ///< per layer [S]: the layer norm's statistics
@@ -55,7 +58,8 @@ class NemfDecoder {
   void decode_vjp(DecoderWorkspace* ws, ConstMatrixRef g_out, Eigen::VectorXf* g_zl, Eigen::VectorXf* g_zg) const;
 
   /// Floating-point operations of the matrix products of one evaluation of
-  /// S frames: the forward's (latent part included) or the VJP's.
+  /// S frames: the forward's (latent part included; not the time features'
+  /// products, made once while the frames stay the same) or the VJP's.
   int64_t forward_flops(int64_t S) const;
   int64_t vjp_flops(int64_t S) const;
 
@@ -73,11 +77,15 @@ class NemfDecoder {
   };
   void add_latent_parts(const Eigen::Ref<const Eigen::VectorXf>& z_l, const Eigen::Ref<const Eigen::VectorXf>& z_g,
                         DecoderWorkspace* ws) const;
+  // The time features and their products with each layer's time weights, kept
+  // in the workspace while the frames are the same (a solve's evaluations).
+  void time_parts(const Eigen::Ref<const Eigen::VectorXd>& frames, DecoderWorkspace* ws) const;
   NemfConfig config_;
   int joints_;
   std::vector<Layer> layers_;
   WeightMatrix head_;         // [J * 6, W]
   RowVectorXf head_bias_;     // [J * 6], the identity rotation's 6D added
+  uint64_t id_;               // the workspaces' key for time_parts
 };
 
 }  // namespace mf::runtime

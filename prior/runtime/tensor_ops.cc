@@ -42,6 +42,8 @@ void eigen_gemm(const A& a, const B& b, MatrixRef c, float beta) {
   c.noalias() += a * b;
 }
 
+bool kernels_on() { return g_backend.load() == GemmBackend::Kernels && cpu_kernel_isa() != KernelIsa::None; }
+
 }  // namespace
 
 void set_gemm_backend(GemmBackend backend) { g_backend.store(backend); }
@@ -64,8 +66,7 @@ const PackedOperand& WeightMatrix::packed(bool transpose) const {
 void gemm(ConstMatrixRef a, bool transpose_a, const WeightMatrix& b, bool transpose_b, MatrixRef c, float beta) {
   const Eigen::Index m = transpose_a ? a.cols() : a.rows(), k = transpose_a ? a.rows() : a.cols();
   const Eigen::Index n = transpose_b ? b.rows() : b.cols();
-  const bool kernels = gemm_backend() == GemmBackend::Kernels && cpu_kernel_isa() != KernelIsa::None;
-  if (!kernels || transpose_a || m == 0 || n == 0 || k == 0 || m != c.rows() || n != c.cols() ||
+  if (!kernels_on() || transpose_a || m == 0 || n == 0 || k == 0 || m != c.rows() || n != c.cols() ||
       k != (transpose_b ? b.cols() : b.rows())) {
     return gemm(a, transpose_a, b.values(), transpose_b, c, beta);  // checks the shapes
   }
@@ -117,11 +118,29 @@ void gemv(ConstMatrixRef a, bool transpose_a, const Eigen::Ref<const Eigen::Vect
 
 int conv1d_output_rows(int padded_rows, int kernel, int stride) { return (padded_rows - kernel) / stride + 1; }
 
+const PackedOperand& Conv1dWeights::stacked(bool gradient) const {
+  const int i = gradient ? 1 : 0;
+  std::call_once(stacked_->once[i], [&] {
+    const int K = kernel(), rows = gradient ? out() : in(), cols = gradient ? in() : out();
+    MatrixRXf b(K * rows, cols);
+    for (int k = 0; k < K; ++k) {
+      if (gradient) b.middleRows(k * rows, rows) = taps[K - 1 - k].values().transpose();
+      else b.middleRows(k * rows, rows) = taps[k].values();
+    }
+    stacked_->op[i] = std::make_unique<PackedOperand>(b.data(), b.rows(), b.cols(), b.cols(), false, cpu_kernel_isa());
+  });
+  return *stacked_->op[i];
+}
+
 void conv1d(ConstMatrixRef x_padded, const Conv1dWeights& w, int stride, MatrixRXf* y) {
   const int rows = conv1d_output_rows(static_cast<int>(x_padded.rows()), w.kernel(), stride);
   const Eigen::Index ld = x_padded.outerStride();
   y->resize(rows, w.out());
   y->rowwise() = w.bias;
+  if (stride == 1 && w.kernel() > 1 && ld == x_padded.cols() && rows > 0 && kernels_on()) {
+    packed_gemm(x_padded.data(), rows, ld, w.stacked(false), y->data(), y->cols(), 1.0f);
+    return;
+  }
   for (int k = 0; k < w.kernel(); ++k) {
     const ConstStridedMap xk(x_padded.data() + k * ld, rows, x_padded.cols(), Eigen::OuterStride<>(stride * ld));
     gemm(xk, false, w.taps[k], false, *y, 1.0f);
@@ -130,6 +149,17 @@ void conv1d(ConstMatrixRef x_padded, const Conv1dWeights& w, int stride, MatrixR
 
 void conv1d_input_gradient(ConstMatrixRef g_y, const Conv1dWeights& w, int stride, MatrixRef g_x_padded) {
   const Eigen::Index ld = g_x_padded.outerStride();
+  const int K = w.kernel();
+  if (stride == 1 && K > 1 && ld == g_x_padded.cols() && g_y.rows() > 0 && g_x_padded.rows() == g_y.rows() + K - 1 &&
+      kernels_on()) {
+    thread_local MatrixRXf padded;  // g_y between K - 1 rows of zeros at each end
+    padded.resize(g_y.rows() + 2 * (K - 1), g_y.cols());
+    padded.topRows(K - 1).setZero();
+    padded.bottomRows(K - 1).setZero();
+    padded.middleRows(K - 1, g_y.rows()) = g_y;
+    packed_gemm(padded.data(), g_x_padded.rows(), padded.cols(), w.stacked(true), g_x_padded.data(), ld, 1.0f);
+    return;
+  }
   for (int k = 0; k < w.kernel(); ++k) {
     StridedMap gk(g_x_padded.data() + k * ld, g_y.rows(), g_x_padded.cols(), Eigen::OuterStride<>(stride * ld));
     gemm(g_y, false, w.taps[k], true, gk, 1.0f);

@@ -82,6 +82,18 @@ struct Conv1dWeights {
   int in() const { return static_cast<int>(taps.front().rows()); }
   int out() const { return static_cast<int>(taps.front().cols()); }
   int kernel() const { return static_cast<int>(taps.size()); }
+  /// The taps as the operand of one product, packed for the runtime's kernels
+  /// on first use (the taps must not change after): for the forward [K * in,
+  /// out], tap k's rows at k * in; for the input gradient [K * out, in], tap
+  /// K - 1 - j transposed at j * out.
+  const PackedOperand& stacked(bool gradient) const;
+
+ private:
+  struct Stacked {
+    std::once_flag once[2];
+    std::unique_ptr<PackedOperand> op[2];
+  };
+  std::shared_ptr<Stacked> stacked_ = std::make_shared<Stacked>();
 };
 
 /// Rows of a convolution's output over `padded_rows` input rows (padding
@@ -90,10 +102,14 @@ int conv1d_output_rows(int padded_rows, int kernel, int stride);
 
 /// y [R, out] = bias + sum_k x[stride * t + k] * taps[k] over the already padded
 /// input x [padded_rows, in] (libtorch's conv1d with padding 0); y is resized.
+/// On the Kernels backend, K > 1, stride 1, contiguous rows: one product over
+/// the stacked taps, row t of its left operand being x's rows t .. t + K - 1.
 void conv1d(ConstMatrixRef x_padded, const Conv1dWeights& w, int stride, MatrixRXf* y);
 
 /// The input gradient of conv1d: g_x_padded[stride * t + k] += g_y[t] * taps[k]^T
-/// (accumulates; g_x_padded [padded_rows, in] sized by the caller).
+/// (accumulates; g_x_padded [padded_rows, in] sized by the caller). On the
+/// Kernels backend, K > 1, stride 1, contiguous rows: one product, g_y padded
+/// with K - 1 rows of zeros at each end, against the stacked taps.
 void conv1d_input_gradient(ConstMatrixRef g_y, const Conv1dWeights& w, int stride, MatrixRef g_x_padded);
 
 /// x [T, C] replicated by `pad` rows at each end (the first and last row):
