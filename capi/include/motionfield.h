@@ -54,9 +54,10 @@
  * library does not know are zero, and rejected with MF_ERROR_UNSUPPORTED
  * otherwise.
  *
- * Threads. A task's numeric work runs on the thread that called it (its
- * matrix products on the BLAS's pool, whose size mf_set_num_threads() sets
- * for the whole process). Tasks may be run from
+ * Threads. A task's numeric work runs on the thread that called it: its
+ * products with a network's weight on the library's own kernels (where the
+ * CPU has AVX2 + FMA or AVX-512), its other matrix products on the BLAS's
+ * pool, whose size mf_set_num_threads() sets for the whole process. Tasks may be run from
  * several threads at once on one shared model; each gives the same result as
  * when run alone with the same thread count. Progress callbacks run on the
  * thread that called the task.

@@ -68,7 +68,9 @@ def set_num_threads(n: int) -> None:
     Parameters
     ----------
     n : int
-        Number of threads, 1..1024: the size of the BLAS library's own pool.
+        Number of threads, 1..1024: the size of the BLAS library's own pool
+        (the products with a network's weight run on the library's own
+        kernels on the calling thread).
         Every task runs its numeric work on its calling thread and, until this
         is called, multiplies matrices there too, as the CLI's default. To run
         several tasks at once, call them from several threads.
