@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <system_error>
 #include <utility>
 
 #include "prior/motion/errors.h"
@@ -66,9 +67,11 @@ std::vector<uint8_t> serialize_model_container(const std::string& kind,
 namespace {
 
 // The payload of a model file after checking its magic, format version, kind
-// (one of `expected_kinds`; stored in *kind), size and checksum.
+// (one of `expected_kinds`; stored in *kind), size and checksum (left to
+// `checksum` when given).
 ByteReader checked_payload(const uint8_t* data, size_t size, const std::string& source,
-                           const std::vector<std::string>& expected_kinds, std::string* kind) {
+                           const std::vector<std::string>& expected_kinds, std::string* kind,
+                           ConcurrentChecksum* checksum) {
   ByteReader head(data, size, source);
   char magic[8];
   if (size < sizeof(magic) || std::memcmp(data, kMagic, sizeof(magic)) != 0) {
@@ -97,7 +100,9 @@ ByteReader checked_payload(const uint8_t* data, size_t size, const std::string& 
   const uint8_t* payload = data + head.position();
   uint64_t stored;
   std::memcpy(&stored, payload + payload_size, sizeof(stored));
-  if (stored != fnv1a64_bytes(payload, payload_size)) {
+  if (checksum) {
+    checksum->start(payload, payload_size, stored, source);
+  } else if (stored != fnv1a64_bytes(payload, payload_size)) {
     throw InputError(source + ": corrupted model file (checksum mismatch)");
   }
   return ByteReader(payload, payload_size, source);
@@ -169,10 +174,42 @@ std::map<std::string, StoredTensor> read_tensors(ByteReader& p) {
 
 }  // namespace
 
+ConcurrentChecksum::~ConcurrentChecksum() { join(); }
+
+void ConcurrentChecksum::start(const uint8_t* payload, size_t n, uint64_t stored, const std::string& source) {
+  stored_ = stored;
+  source_ = source;
+  started_ = true;
+  auto hash = [this, payload, n] {
+    constexpr size_t kChunk = size_t{1} << 20;
+    uint64_t h = fnv1a64_bytes(payload, 0);
+    for (size_t at = 0; at < n; at += kChunk) {
+      const size_t len = std::min(kChunk, n - at);
+      h = fnv1a64_bytes(payload + at, len, h);
+      if (file_) file_->release(payload + at, len);
+    }
+    computed_ = h;
+  };
+  try {
+    thread_ = std::thread(hash);
+  } catch (const std::system_error&) {
+    hash();  // no thread to be had: inline
+  }
+}
+
+void ConcurrentChecksum::join() {
+  if (thread_.joinable()) thread_.join();
+}
+
+void ConcurrentChecksum::verify() {
+  join();
+  if (started_ && computed_ != stored_) throw InputError(source_ + ": corrupted model file (checksum mismatch)");
+}
+
 ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::string& source,
-                                   const std::vector<std::string>& expected_kinds) {
+                                   const std::vector<std::string>& expected_kinds, ConcurrentChecksum* checksum) {
   ModelFileContents c;
-  ByteReader p = checked_payload(data, size, source, expected_kinds, &c.kind);
+  ByteReader p = checked_payload(data, size, source, expected_kinds, &c.kind, checksum);
   uint32_t n = p.u32();
   if (n > 1000) p.fail("too many hyperparameters");
   for (uint32_t i = 0; i < n; ++i) {

@@ -25,9 +25,12 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "prior/model/rig_info.h"
+#include "prior/motion/errors.h"
+#include "prior/util/binary_io.h"
 
 namespace mf {
 
@@ -65,11 +68,60 @@ struct ModelFileContents {
 std::vector<uint8_t> serialize_model_container(const std::string& kind,
                                                const std::map<std::string, double>& hyperparameters,
                                                const RigInfo& rig, const std::vector<TensorToWrite>& tensors);
+/// The payload's checksum computed on a thread of its own while the caller
+/// parses and builds (FNV-1a goes a byte at a time: most of the time of a
+/// load), giving back the pages of `file` it has passed (FileBytes::release).
+/// verify() waits for it and throws "corrupted model file (checksum
+/// mismatch)"; the destructor waits. Without a thread it computes inline.
+class ConcurrentChecksum {
+ public:
+  explicit ConcurrentChecksum(const FileBytes* file) : file_(file) {}
+  ~ConcurrentChecksum();
+  ConcurrentChecksum(const ConcurrentChecksum&) = delete;
+  ConcurrentChecksum& operator=(const ConcurrentChecksum&) = delete;
+  /// Starts hashing [payload, payload + n) against `stored` (parse_model_file calls it).
+  void start(const uint8_t* payload, size_t n, uint64_t stored, const std::string& source);
+  /// Nothing to do when start() was never called (the header was refused).
+  void verify();
+
+ private:
+  void join();
+  const FileBytes* file_;
+  std::thread thread_;
+  uint64_t stored_ = 0, computed_ = 0;
+  bool started_ = false;
+  std::string source_;
+};
+
 /// Parses and validates a model file (magic, version, size, checksum, rig,
 /// tensors). `expected_kinds` (non-empty) lists the kinds the caller accepts;
 /// any other throws "wrong kind of model". `source` names the file in errors.
+/// With `checksum`, the checksum is left to it (ConcurrentChecksum): the
+/// caller must verify() it before trusting what it built; read_model_file
+/// does so.
 ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::string& source,
-                                   const std::vector<std::string>& expected_kinds);
+                                   const std::vector<std::string>& expected_kinds,
+                                   ConcurrentChecksum* checksum = nullptr);
+
+/// build(contents) on a model file parsed while its checksum is computed on
+/// another thread (`file`, if any, the file the bytes are mapped from). The
+/// checksum is verified before the result is returned and before an
+/// InputError of the parse or of build propagates, so a corrupted file says
+/// so, as parse_model_file does.
+template <class Build>
+auto read_model_file(const uint8_t* data, size_t size, const std::string& source,
+                     const std::vector<std::string>& expected_kinds, const FileBytes* file, Build&& build) {
+  ConcurrentChecksum checksum(file);
+  try {
+    ModelFileContents contents = parse_model_file(data, size, source, expected_kinds, &checksum);
+    auto built = build(contents);
+    checksum.verify();
+    return built;
+  } catch (const InputError&) {
+    checksum.verify();
+    throw;
+  }
+}
 /// Throws InputError naming the first tensor left in `tensors` (one the
 /// architecture does not have), if any.
 void check_no_extra_tensors(const std::map<std::string, StoredTensor>& tensors, const std::string& source);

@@ -39,31 +39,33 @@ int InbetweenerRuntime::checked_frames(const InbetweenWindow& in, int window, co
 
 std::unique_ptr<const InbetweenerRuntime> inbetweener_runtime_from_bytes(const uint8_t* data, size_t size,
                                                                          const std::string& source) {
-  ModelFileContents c = parse_model_file(data, size, source, {kTwoStageKind, kCitlKind, kKeyframeKind});
-  check_window_and_fps(c.hyperparameters, source);
-  if (c.rig.num_joints() < 1) throw InputError(source + ": the rig has no joints");
-  const int64_t D = c.rig.num_joints() * 6 + 3;
-  WeightReader w(&c.tensors, source);
-  InbetweenNormalisation n;
-  n.mean = w.vector("stats.pose_mean", D);
-  n.scale = w.vector("stats.pose_std", D).cwiseMax(1e-6f);
-  auto config = [&](auto parse) {
-    try {
-      return parse(c.hyperparameters);
-    } catch (const InputError& e) {
-      throw InputError(source + ": invalid hyperparameters: " + e.what());
+  const std::vector<std::string> kinds = {kTwoStageKind, kCitlKind, kKeyframeKind};
+  return read_model_file(data, size, source, kinds, nullptr, [&](ModelFileContents& c) {
+    check_window_and_fps(c.hyperparameters, source);
+    if (c.rig.num_joints() < 1) throw InputError(source + ": the rig has no joints");
+    const int64_t D = c.rig.num_joints() * 6 + 3;
+    WeightReader w(&c.tensors, source);
+    InbetweenNormalisation n;
+    n.mean = w.vector("stats.pose_mean", D);
+    n.scale = w.vector("stats.pose_std", D).cwiseMax(1e-6f);
+    auto config = [&](auto parse) {
+      try {
+        return parse(c.hyperparameters);
+      } catch (const InputError& e) {
+        throw InputError(source + ": invalid hyperparameters: " + e.what());
+      }
+    };
+    std::unique_ptr<const InbetweenerRuntime> model;
+    if (c.kind == kTwoStageKind) {
+      model = std::make_unique<TwoStageRuntime>(config(parse_two_stage_config), c.rig, n, w);
+    } else if (c.kind == kCitlKind) {
+      model = std::make_unique<CitlRuntime>(config(parse_citl_config), c.rig, n, w);
+    } else {
+      model = std::make_unique<KeyframeRuntime>(config(parse_keyframe_config), c.rig, n, w);
     }
-  };
-  std::unique_ptr<const InbetweenerRuntime> model;
-  if (c.kind == kTwoStageKind) {
-    model = std::make_unique<TwoStageRuntime>(config(parse_two_stage_config), c.rig, n, w);
-  } else if (c.kind == kCitlKind) {
-    model = std::make_unique<CitlRuntime>(config(parse_citl_config), c.rig, n, w);
-  } else {
-    model = std::make_unique<KeyframeRuntime>(config(parse_keyframe_config), c.rig, n, w);
-  }
-  w.finish();
-  return model;
+    w.finish();
+    return model;
+  });
 }
 
 std::unique_ptr<const InbetweenerRuntime> load_inbetweener_runtime(const std::string& path) {

@@ -36,20 +36,23 @@ NemfRuntime NemfRuntime::from_file(const FileBytes& file, const std::string& sou
 }
 
 NemfRuntime NemfRuntime::read(const uint8_t* data, size_t size, const std::string& source, const FileBytes* file) {
-  ModelFileContents c = parse_model_file(data, size, source, {kNemfKind});
-  NemfRuntime r;
-  r.config_ = checked_nemf_config(c.hyperparameters, source);
-  r.rig_ = c.rig;
-  const int J = r.rig_.num_joints(), F = r.rig_.num_feet();
-  WeightReader w(&c.tensors, source, file);
-  r.stats_ = read_stats(w, J);
-  r.encoders_ = std::make_shared<const NemfEncoders>(r.config_, r.rig_.skeleton.parents, w);
-  r.decoder_ = std::make_shared<const NemfDecoder>(r.config_, J, w);
-  r.kinematics_ = std::make_shared<const Kinematics>(r.rig_.skeleton);
-  r.gmp_ = std::make_shared<const NemfGmpNetwork>(r.config_, J, F, "gmp", w);
-  if (r.config_.steering_gmp) r.steering_gmp_ = std::make_shared<const NemfGmpNetwork>(r.config_, J, F, "steering_gmp", w);
-  w.finish();
-  return r;
+  return read_model_file(data, size, source, {kNemfKind}, file, [&](ModelFileContents& c) {
+    NemfRuntime r;
+    r.config_ = checked_nemf_config(c.hyperparameters, source);
+    r.rig_ = c.rig;
+    const int J = r.rig_.num_joints(), F = r.rig_.num_feet();
+    WeightReader w(&c.tensors, source, file);
+    r.stats_ = read_stats(w, J);
+    r.encoders_ = std::make_shared<const NemfEncoders>(r.config_, r.rig_.skeleton.parents, w);
+    r.decoder_ = std::make_shared<const NemfDecoder>(r.config_, J, w);
+    r.kinematics_ = std::make_shared<const Kinematics>(r.rig_.skeleton);
+    r.gmp_ = std::make_shared<const NemfGmpNetwork>(r.config_, J, F, "gmp", w);
+    if (r.config_.steering_gmp) {
+      r.steering_gmp_ = std::make_shared<const NemfGmpNetwork>(r.config_, J, F, "steering_gmp", w);
+    }
+    w.finish();
+    return r;
+  });
 }
 
 NemfRuntime NemfRuntime::load(const std::string& path) {

@@ -1,6 +1,9 @@
 #include "prior/runtime/packed_gemm.h"
 
+#if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
+#define MF_X86_KERNELS 1
+#endif
 
 #include <algorithm>
 #include <array>
@@ -11,6 +14,7 @@ namespace mf::runtime {
 
 namespace {
 
+#ifdef MF_X86_KERNELS
 // Depth of one pass over a panel: 256 rows of a 32-wide panel are 32 KiB,
 // which stays in a 48 KiB L1 data cache while a panel's row blocks read it.
 constexpr int64_t kDepthBlock = 256;
@@ -97,10 +101,14 @@ struct Avx2 {
 constexpr auto kAvx512 = kernels<Avx512>(std::make_integer_sequence<int, 12>());
 constexpr auto kAvx2 = kernels<Avx2>(std::make_integer_sequence<int, 6>());
 
+#endif  // MF_X86_KERNELS
+
 KernelIsa detect() {
+#ifdef MF_X86_KERNELS
   __builtin_cpu_init();
   if (__builtin_cpu_supports("avx512f")) return KernelIsa::Avx512;
   if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return KernelIsa::Avx2;
+#endif
   return KernelIsa::None;
 }
 
@@ -130,6 +138,10 @@ PackedOperand::PackedOperand(const float* b, int64_t rows, int64_t cols, int64_t
 
 void packed_gemm(const float* a, int64_t rows, int64_t lda, const PackedOperand& b, float* c, int64_t ldc,
                  float beta) {
+#ifndef MF_X86_KERNELS
+  (void)a, (void)rows, (void)lda, (void)b, (void)c, (void)ldc, (void)beta;
+  throw std::logic_error("packed_gemm: no kernels on this architecture");
+#else
   const bool wide = b.isa() == KernelIsa::Avx512;
   const Kernel* table = wide ? kAvx512.data() : kAvx2.data();
   const int64_t max_rows = wide ? static_cast<int64_t>(kAvx512.size()) : static_cast<int64_t>(kAvx2.size());
@@ -146,6 +158,7 @@ void packed_gemm(const float* a, int64_t rows, int64_t lda, const PackedOperand&
       }
     }
   }
+#endif
 }
 
 }  // namespace mf::runtime

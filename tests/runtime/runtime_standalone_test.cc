@@ -320,6 +320,38 @@ TEST(RuntimeStandalone, RefusesAFileWithoutItsWeights) {
                InputError);
 }
 
+// The checksum, computed beside the parse, still decides what a corrupted
+// file is called: a flipped byte anywhere in the payload (a weight made
+// NaN, a hyperparameter's name, the rig) says "checksum mismatch", as the
+// in-line check did; the intact bytes load.
+TEST(RuntimeStandalone, ACorruptedFileIsCalledCorrupted) {
+  const FileBytes file = read_file_bytes(std::string(MF_SOURCE_DIR) + "/models/motionfield-prior.mfm");
+  const std::vector<uint8_t> intact(file.data(), file.data() + file.size());
+  EXPECT_NO_THROW(NemfRuntime::from_bytes(intact.data(), intact.size(), "prior.mfm"));
+  const size_t n = intact.size();
+  for (size_t at : {size_t{40}, size_t{400}, n / 3, n / 2, n - 100}) {
+    for (uint8_t flip : {uint8_t{0x5a}, uint8_t{0xff}}) {
+      std::vector<uint8_t> b = intact;
+      b[at] ^= flip;
+      try {
+        NemfRuntime::from_bytes(b.data(), b.size(), "prior.mfm");
+        ADD_FAILURE() << "byte " << at << " flipped loaded";
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("corrupted model file (checksum mismatch)"), std::string::npos)
+            << "byte " << at << ": " << e.what();
+      }
+    }
+  }
+  std::vector<uint8_t> b = intact;
+  b[8] = 99;  // the format version: refused before any checksum
+  try {
+    NemfRuntime::from_bytes(b.data(), b.size(), "prior.mfm");
+    ADD_FAILURE() << "version 99 loaded";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unsupported model format version 99"), std::string::npos) << e.what();
+  }
+}
+
 // Every shipped in-betweener loads and fills a window (5 context frames and
 // the target known): its stages [T, D], finite; CITL exact on the known values.
 TEST(RuntimeStandalone, InbetweenersFillAWindow) {
