@@ -39,17 +39,20 @@ NemfEncoders::NemfEncoders(const NemfConfig& config, const std::vector<int>& par
     const std::string s = std::to_string(i);
     Stage stage{weights.conv("local_encoder.conv" + s, J * cout, J * cin, 4), {}, {}};
     mask_skeleton_conv(parents, &stage.conv);
+    stage.conv.kernels = false;  // the encoders run once per solve: not worth packing
     stage.norm_weight = weights.vector("local_encoder.norm" + s + ".weight", J * cout);
     stage.norm_bias = weights.vector("local_encoder.norm" + s + ".bias", J * cout);
     local_.push_back(std::move(stage));
     cin = cout;
   }
   mix_ = weights.conv("local_encoder.mix", kMixChannels, J * cin, 1);
+  mix_.kernels = false;
   local_head_ = weights.matrix("local_encoder.head.weight", 2 * config.zl, kMixChannels * positions);
   local_head_bias_ = weights.vector("local_encoder.head.bias", 2 * config.zl);
   const int channels[5] = {7, 64, 128, 128, 128};
   for (int i = 0; i < 4; ++i) {
     global_.push_back({weights.conv("global_encoder.conv" + std::to_string(i), channels[i + 1], channels[i], 4), {}, {}});
+    global_.back().conv.kernels = false;
   }
   global_head_ = weights.matrix("global_encoder.head.weight", 2 * config.zg, channels[4] * positions);
   global_head_bias_ = weights.vector("global_encoder.head.bias", 2 * config.zg);

@@ -137,21 +137,22 @@ void conv1d(ConstMatrixRef x_padded, const Conv1dWeights& w, int stride, MatrixR
   const Eigen::Index ld = x_padded.outerStride();
   y->resize(rows, w.out());
   y->rowwise() = w.bias;
-  if (stride == 1 && w.kernel() > 1 && ld == x_padded.cols() && rows > 0 && kernels_on()) {
+  if (w.kernels && stride == 1 && w.kernel() > 1 && ld == x_padded.cols() && rows > 0 && kernels_on()) {
     packed_gemm(x_padded.data(), rows, ld, w.stacked(false), y->data(), y->cols(), 1.0f);
     return;
   }
   for (int k = 0; k < w.kernel(); ++k) {
     const ConstStridedMap xk(x_padded.data() + k * ld, rows, x_padded.cols(), Eigen::OuterStride<>(stride * ld));
-    gemm(xk, false, w.taps[k], false, *y, 1.0f);
+    if (w.kernels) gemm(xk, false, w.taps[k], false, *y, 1.0f);
+    else gemm(xk, false, w.taps[k].values(), false, *y, 1.0f);
   }
 }
 
 void conv1d_input_gradient(ConstMatrixRef g_y, const Conv1dWeights& w, int stride, MatrixRef g_x_padded) {
   const Eigen::Index ld = g_x_padded.outerStride();
   const int K = w.kernel();
-  if (stride == 1 && K > 1 && ld == g_x_padded.cols() && g_y.rows() > 0 && g_x_padded.rows() == g_y.rows() + K - 1 &&
-      kernels_on()) {
+  if (w.kernels && stride == 1 && K > 1 && ld == g_x_padded.cols() && g_y.rows() > 0 &&
+      g_x_padded.rows() == g_y.rows() + K - 1 && kernels_on()) {
     thread_local MatrixRXf padded;  // g_y between K - 1 rows of zeros at each end
     padded.resize(g_y.rows() + 2 * (K - 1), g_y.cols());
     padded.topRows(K - 1).setZero();
@@ -162,7 +163,8 @@ void conv1d_input_gradient(ConstMatrixRef g_y, const Conv1dWeights& w, int strid
   }
   for (int k = 0; k < w.kernel(); ++k) {
     StridedMap gk(g_x_padded.data() + k * ld, g_y.rows(), g_x_padded.cols(), Eigen::OuterStride<>(stride * ld));
-    gemm(g_y, false, w.taps[k], true, gk, 1.0f);
+    if (w.kernels) gemm(g_y, false, w.taps[k], true, gk, 1.0f);
+    else gemm(g_y, false, w.taps[k].values(), true, gk, 1.0f);
   }
 }
 

@@ -79,6 +79,10 @@ void gemv(ConstMatrixRef a, bool transpose_a, const Eigen::Ref<const Eigen::Vect
 struct Conv1dWeights {
   std::vector<WeightMatrix> taps;
   RowVectorXf bias;
+  /// false: the products go to the BLAS and nothing is packed (weights used
+  /// once per solve, such as the encoders', whose packed copies would cost
+  /// more memory and time than they save).
+  bool kernels = true;
   int in() const { return static_cast<int>(taps.front().rows()); }
   int out() const { return static_cast<int>(taps.front().cols()); }
   int kernel() const { return static_cast<int>(taps.size()); }
