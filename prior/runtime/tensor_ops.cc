@@ -137,7 +137,9 @@ void conv1d(ConstMatrixRef x_padded, const Conv1dWeights& w, int stride, MatrixR
   const Eigen::Index ld = x_padded.outerStride();
   y->resize(rows, w.out());
   y->rowwise() = w.bias;
-  if (w.kernels && stride == 1 && w.kernel() > 1 && ld == x_padded.cols() && rows > 0 && kernels_on()) {
+  // The per-tap products below check the shapes; the fused one reads K rows at a time.
+  if (w.kernels && stride == 1 && w.kernel() > 1 && x_padded.cols() == w.in() && ld == x_padded.cols() && rows > 0 &&
+      kernels_on()) {
     packed_gemm(x_padded.data(), rows, ld, w.stacked(false), y->data(), y->cols(), 1.0f);
     return;
   }
@@ -151,8 +153,8 @@ void conv1d(ConstMatrixRef x_padded, const Conv1dWeights& w, int stride, MatrixR
 void conv1d_input_gradient(ConstMatrixRef g_y, const Conv1dWeights& w, int stride, MatrixRef g_x_padded) {
   const Eigen::Index ld = g_x_padded.outerStride();
   const int K = w.kernel();
-  if (w.kernels && stride == 1 && K > 1 && ld == g_x_padded.cols() && g_y.rows() > 0 &&
-      g_x_padded.rows() == g_y.rows() + K - 1 && kernels_on()) {
+  if (w.kernels && stride == 1 && K > 1 && g_y.cols() == w.out() && g_x_padded.cols() == w.in() &&
+      ld == g_x_padded.cols() && g_y.rows() > 0 && g_x_padded.rows() == g_y.rows() + K - 1 && kernels_on()) {
     thread_local MatrixRXf padded;  // g_y between K - 1 rows of zeros at each end
     padded.resize(g_y.rows() + 2 * (K - 1), g_y.cols());
     padded.topRows(K - 1).setZero();

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -188,6 +189,13 @@ TEST(RuntimeStandalone, ConvolutionsOnTheKernelsMatchTheBlas) {
       EXPECT_LT((y[0] - y[1]).cwiseAbs().maxCoeff(), 1e-4f) << K << " " << stride;
       EXPECT_LT((g_x[0] - g_x[1]).cwiseAbs().maxCoeff(), 1e-4f) << K << " " << stride;
     }
+  // Inputs of the wrong width are refused, not read past.
+  Conv1dWeights w;
+  for (int k = 0; k < 7; ++k) w.taps.emplace_back(normal_matrix(19, 23, rng));
+  w.bias = normal_matrix(1, 23, rng);
+  MatrixRXf y, g_x = MatrixRXf::Zero(40, 18);
+  EXPECT_THROW(conv1d(normal_matrix(40, 18, rng), w, 1, &y), std::logic_error);
+  EXPECT_THROW(conv1d_input_gradient(normal_matrix(34, 23, rng), w, 1, g_x), std::logic_error);
 }
 
 // Both matrix-product backends (the system BLAS, Eigen's kernels) give the
