@@ -105,8 +105,8 @@ ModelFileContents parse_model_file(const uint8_t* data, size_t size, const std::
 
 /// build(contents) on a model file parsed while its checksum is computed on
 /// another thread (`file`, if any, the file the bytes are mapped from). The
-/// checksum is verified before the result is returned and before an
-/// InputError of the parse or of build propagates, so a corrupted file says
+/// checksum is verified before the result is returned and before any
+/// exception of the parse or of build propagates, so a corrupted file says
 /// so, as parse_model_file does.
 template <class Build>
 auto read_model_file(const uint8_t* data, size_t size, const std::string& source,
@@ -117,8 +117,8 @@ auto read_model_file(const uint8_t* data, size_t size, const std::string& source
     auto built = build(contents);
     checksum.verify();
     return built;
-  } catch (const InputError&) {
-    checksum.verify();
+  } catch (...) {
+    checksum.verify();  // a corrupted file's error replaces what its bytes made the parse or build throw
     throw;
   }
 }
