@@ -182,7 +182,7 @@ void ConcurrentChecksum::start(const uint8_t* payload, size_t n, uint64_t stored
   started_ = true;
   auto hash = [this, payload, n] {
     constexpr size_t kChunk = size_t{1} << 20;
-    uint64_t h = fnv1a64_bytes(payload, 0);
+    uint64_t h = fnv1a64_bytes(payload, 0);  // FNV-1a's offset basis, continued chunk by chunk
     for (size_t at = 0; at < n; at += kChunk) {
       const size_t len = std::min(kChunk, n - at);
       h = fnv1a64_bytes(payload + at, len, h);

@@ -10,6 +10,8 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 namespace mf::runtime {
@@ -38,6 +40,25 @@ class PackedOperand {
   KernelIsa isa_;
   int panel_;
   std::vector<float> values_;
+};
+
+/// Two packed operands of one weight (say op(b) and op(b)^T), each made on
+/// its first use, once across threads; copies share them.
+class PackedPair {
+ public:
+  /// The operand `i` (0 or 1), made by make() (a unique_ptr<PackedOperand>) the first time.
+  template <class Make>
+  const PackedOperand& get(int i, Make&& make) const {
+    std::call_once(state_->once[i], [&] { state_->op[i] = make(); });
+    return *state_->op[i];
+  }
+
+ private:
+  struct State {
+    std::once_flag once[2];
+    std::unique_ptr<PackedOperand> op[2];
+  };
+  std::shared_ptr<State> state_ = std::make_shared<State>();
 };
 
 /// c [M, N] (row stride ldc) = beta * c + a * op(b) for a [M, K] read at row

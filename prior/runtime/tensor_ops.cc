@@ -50,17 +50,15 @@ void set_gemm_backend(GemmBackend backend) { g_backend.store(backend); }
 GemmBackend gemm_backend() { return g_backend.load(); }
 
 MatrixRXf& WeightMatrix::mutable_values() {
-  packs_ = std::make_shared<Packs>();
+  packs_ = PackedPair();
   return values_;
 }
 
 const PackedOperand& WeightMatrix::packed(bool transpose) const {
-  const int i = transpose ? 1 : 0;
-  std::call_once(packs_->once[i], [&] {
-    packs_->op[i] = std::make_unique<PackedOperand>(values_.data(), values_.rows(), values_.cols(),
-                                                    values_.outerStride(), transpose, cpu_kernel_isa());
+  return packs_.get(transpose ? 1 : 0, [&] {
+    return std::make_unique<PackedOperand>(values_.data(), values_.rows(), values_.cols(), values_.outerStride(),
+                                           transpose, cpu_kernel_isa());
   });
-  return *packs_->op[i];
 }
 
 void gemm(ConstMatrixRef a, bool transpose_a, const WeightMatrix& b, bool transpose_b, MatrixRef c, float beta) {
@@ -119,17 +117,15 @@ void gemv(ConstMatrixRef a, bool transpose_a, const Eigen::Ref<const Eigen::Vect
 int conv1d_output_rows(int padded_rows, int kernel, int stride) { return (padded_rows - kernel) / stride + 1; }
 
 const PackedOperand& Conv1dWeights::stacked(bool gradient) const {
-  const int i = gradient ? 1 : 0;
-  std::call_once(stacked_->once[i], [&] {
+  return stacked_.get(gradient ? 1 : 0, [&] {
     const int K = kernel(), rows = gradient ? out() : in(), cols = gradient ? in() : out();
     MatrixRXf b(K * rows, cols);
     for (int k = 0; k < K; ++k) {
       if (gradient) b.middleRows(k * rows, rows) = taps[K - 1 - k].values().transpose();
       else b.middleRows(k * rows, rows) = taps[k].values();
     }
-    stacked_->op[i] = std::make_unique<PackedOperand>(b.data(), b.rows(), b.cols(), b.cols(), false, cpu_kernel_isa());
+    return std::make_unique<PackedOperand>(b.data(), b.rows(), b.cols(), b.cols(), false, cpu_kernel_isa());
   });
-  return *stacked_->op[i];
 }
 
 void conv1d(ConstMatrixRef x_padded, const Conv1dWeights& w, int stride, MatrixRXf* y) {

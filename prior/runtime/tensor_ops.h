@@ -9,8 +9,6 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <memory>
-#include <mutex>
 #include <vector>
 
 #include "prior/runtime/packed_gemm.h"
@@ -56,12 +54,8 @@ class WeightMatrix {
   const PackedOperand& packed(bool transpose) const;
 
  private:
-  struct Packs {
-    std::once_flag once[2];
-    std::unique_ptr<PackedOperand> op[2];
-  };
   MatrixRXf values_;
-  std::shared_ptr<Packs> packs_ = std::make_shared<Packs>();
+  PackedPair packs_;
 };
 
 /// gemm with a weight as the right operand: on the Kernels backend, the
@@ -93,11 +87,7 @@ struct Conv1dWeights {
   const PackedOperand& stacked(bool gradient) const;
 
  private:
-  struct Stacked {
-    std::once_flag once[2];
-    std::unique_ptr<PackedOperand> op[2];
-  };
-  std::shared_ptr<Stacked> stacked_ = std::make_shared<Stacked>();
+  PackedPair stacked_;
 };
 
 /// Rows of a convolution's output over `padded_rows` input rows (padding
